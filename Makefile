@@ -1,0 +1,51 @@
+# Two commands matter (see README): `make up` and `make test`.
+# Every target installs what it needs, so both work on a fresh clone.
+SHELL := /bin/bash
+PY := .venv/bin/python
+PIP := .venv/bin/pip
+STAMP := .venv/.installed
+FRONT_STAMP := frontend/node_modules/.installed
+HOST ?= 127.0.0.1
+PORT ?= 8000
+
+.PHONY: up test install frontend browser lint pytest vitest bench clean
+
+up: install frontend
+	$(PY) scripts/up.py --host $(HOST) --port $(PORT)
+
+test: install frontend browser lint vitest pytest
+
+install: $(STAMP)
+
+$(STAMP): pyproject.toml
+	test -x $(PY) || python3 -m venv .venv
+	$(PIP) install -q --upgrade pip
+	$(PIP) install -q -e ".[dev,bench]"
+	touch $(STAMP)
+
+$(FRONT_STAMP): frontend/package.json frontend/package-lock.json
+	cd frontend && npm ci --no-audit --no-fund
+	touch $(FRONT_STAMP)
+
+frontend: $(FRONT_STAMP)
+	cd frontend && npm run build
+
+# Browser tests drive Debian's Chromium; nothing downloads a browser of its own.
+browser:
+	@command -v chromium >/dev/null || { apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium; }
+
+lint: install
+	.venv/bin/ruff check .
+
+vitest: $(FRONT_STAMP)
+	cd frontend && npm test
+
+pytest: install
+	$(PY) -m pytest
+
+bench: install
+	$(PY) -m motionlib.bench io
+	$(PY) -m motionlib bench
+
+clean:
+	rm -rf .venv frontend/node_modules frontend/dist var
