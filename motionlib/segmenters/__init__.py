@@ -1,0 +1,35 @@
+"""Registry of segmentation methods: one name -> one Segmenter class.
+
+The service and the command line both list methods and validate parameters here, so
+they always agree on names and parameter schemas.
+"""
+
+from __future__ import annotations
+
+from motionlib.segmenters.base import Param, ParamError, Segmentation, Segmenter
+from motionlib.segmenters.bone_angle import BoneAngle
+
+_REGISTRY: dict[str, type[Segmenter]] = {cls.name: cls for cls in (BoneAngle,)}
+
+__all__ = [
+    "Param",
+    "ParamError",
+    "Segmentation",
+    "Segmenter",
+    "get_segmenter",
+    "list_segmenters",
+]
+
+
+def list_segmenters() -> list[type[Segmenter]]:
+    """Every registered method, the service's default first."""
+    return sorted(_REGISTRY.values(), key=lambda cls: (cls.name != "default", cls.name))
+
+
+def get_segmenter(name: str) -> type[Segmenter]:
+    """The Segmenter class registered under ``name``; ParamError if there is none."""
+    try:
+        return _REGISTRY[name]
+    except (KeyError, TypeError):
+        valid = ", ".join(cls.name for cls in list_segmenters())
+        raise ParamError(f"method: unknown segmenter {name!r} (valid: {valid})") from None
