@@ -1,0 +1,144 @@
+"""Captures: upload, list, detail, feature signals, playback frames, detection runs."""
+
+import base64
+import math
+
+import numpy as np
+from django.conf import settings
+from drf_spectacular.utils import OpenApiParameter, extend_schema
+from rest_framework import mixins, viewsets
+from rest_framework.decorators import action
+from rest_framework.exceptions import NotFound
+from rest_framework.pagination import PageNumberPagination
+from rest_framework.parsers import FormParser, JSONParser, MultiPartParser
+from rest_framework.response import Response
+
+from segmentation import services, storage
+from segmentation.api.projects import project_for
+from segmentation.api.serializers import (
+    CaptureSerializer,
+    RunRequestSerializer,
+    RunSerializer,
+    UploadSerializer,
+)
+from segmentation.errors import NotReady, UploadTooLarge
+from segmentation.models import Capture
+
+
+class CapturePagination(PageNumberPagination):
+    page_size = 50
+    page_size_query_param = "page_size"
+    max_page_size = 200
+
+
+def int_param(request, name, default, low=None, high=None):
+    """An integer query parameter; ValueError (a 400) names it and its value."""
+    raw = request.query_params.get(name)
+    if raw is None or raw == "":
+        return default
+    try:
+        value = int(raw)
+    except ValueError:
+        raise ValueError(f"{name}: must be an integer, got {raw!r}") from None
+    if low is not None and value < low or high is not None and value > high:
+        raise ValueError(f"{name}: must be between {low} and {high}, got {value}")
+    return value
+
+
+class CaptureViewSet(
+    mixins.ListModelMixin,
+    mixins.RetrieveModelMixin,
+    mixins.CreateModelMixin,
+    viewsets.GenericViewSet,
+):
+    serializer_class = CaptureSerializer
+    pagination_class = CapturePagination
+    parser_classes = [MultiPartParser, FormParser, JSONParser]
+
+    def get_queryset(self):
+        captures = Capture.objects.visible_to(self.request.user).prefetch_related("runs")
+        project = int_param(self.request, "project", None)
+        if project is not None:
+            captures = captures.filter(project_id=project)
+        if self.request.query_params.get("status"):
+            captures = captures.filter(status=self.request.query_params["status"])
+        if self.request.query_params.get("search"):
+            captures = captures.filter(name__icontains=self.request.query_params["search"])
+        return captures
+
+    @extend_schema(request={"multipart/form-data": UploadSerializer}, responses=CaptureSerializer)
+    def create(self, request, *args, **kwargs):
+        # Refuse an oversized body before reading it.
+        length = int(request.META.get("CONTENT_LENGTH") or 0)
+        limit = services.captures.max_upload_bytes()
+        if length > limit + 1024 * 1024:
+            raise UploadTooLarge(
+                f"file: the upload is {length / 2**20:.1f} MB; the limit is "
+                f"{settings.CUTROOM_MAX_UPLOAD_MB} MB (CUTROOM_MAX_UPLOAD_MB)"
+            )
+        upload = UploadSerializer(data=request.data)
+        upload.is_valid(raise_exception=True)
+        data = upload.validated_data
+        project = project_for(request.user, data["project"])
+        capture, created = services.do_upload_capture(
+            project, request.user, data["file"], data.get("asf")
+        )
+        body = {**CaptureSerializer(capture).data, "duplicate": not created}
+        return Response(body, status=201 if created else 200)
+
+    @extend_schema(parameters=[OpenApiParameter("max_points", int)], responses=dict)
+    @action(detail=True)
+    def signal(self, request, pk=None):
+        capture = self.get_object()
+        max_points = int_param(request, "max_points", 2000, 2, 1_000_000)
+        run = capture.latest_finished_run()
+        body = {"run": run.pk if run else None, "fps": capture.fps, "n_frames": capture.n_frames}
+        signals = storage.load_npz(run.signals) if run and run.signals else {}
+        body["signals"] = [_sampled(name, values, max_points) for name, values in signals.items()]
+        return Response(body)
+
+    @extend_schema(
+        parameters=[OpenApiParameter(p, int) for p in ("start", "stop", "step")], responses=dict
+    )
+    @action(detail=True)
+    def frames(self, request, pk=None):
+        capture = self.get_object()
+        if capture.status != "ready":
+            raise NotReady(f"capture {capture.pk} is {capture.status}; it has no frames yet")
+        n = capture.n_frames
+        start = int_param(request, "start", 0, 0, n - 1)
+        step = int_param(request, "step", 1, 1, n)
+        stop = int_param(request, "stop", n, start + 1, n)
+        # At most CUTROOM_FRAMES_PER_REQUEST frames; the client continues from "stop".
+        stop = min(stop, start + settings.CUTROOM_FRAMES_PER_REQUEST * step)
+        block = np.ascontiguousarray(storage.load_npy(capture.positions)[start:stop:step], "<f4")
+        return Response({
+            "start": start, "stop": stop, "step": step,
+            "n_frames": int(block.shape[0]), "n_joints": int(block.shape[1]),
+            "dtype": "float32", "data": base64.b64encode(block.tobytes()).decode("ascii"),
+        })
+
+    @extend_schema(request=RunRequestSerializer, responses=RunSerializer(many=True))
+    @action(detail=True, methods=["get", "post"], serializer_class=RunRequestSerializer)
+    def runs(self, request, pk=None):
+        capture = self.get_object()
+        if request.method == "GET":
+            return Response(RunSerializer(capture.runs.all(), many=True).data)
+        body = RunRequestSerializer(data=request.data)
+        body.is_valid(raise_exception=True)
+        run = services.do_start_run(capture, request.user, **body.validated_data)
+        return Response(RunSerializer(run).data, status=202)
+
+
+def _sampled(name, values, max_points):
+    step = max(1, math.ceil(len(values) / max_points))
+    sampled = np.asarray(values[::step], dtype=float)
+    return {"name": name, "start": 0, "step": step, "values": np.round(sampled, 6).tolist()}
+
+
+def capture_for(user, pk):
+    """A capture of one of the user's projects, or 404."""
+    capture = Capture.objects.visible_to(user).filter(pk=pk).first()
+    if capture is None:
+        raise NotFound("No such capture.")
+    return capture

@@ -1,0 +1,58 @@
+"""The one translator from domain errors to HTTP responses.
+
+- ``StaleVersion`` -> 409 with the current review;
+- ``UploadTooLarge`` -> 413;
+- any other ``ValueError`` (motionlib's ``CaptureError``/``ParamError``, the service's
+  own) -> 400 with its message, which names the field, file, line or value at fault;
+- DRF's own errors keep their status, and always carry a readable ``detail``.
+"""
+
+import re
+
+from rest_framework import status
+from rest_framework.response import Response
+from rest_framework.views import exception_handler as drf_exception_handler
+
+from motionlib.segmenters import ParamError
+from segmentation.errors import StaleVersion, UploadTooLarge
+
+FIELD = re.compile(r"^(\w+): (.+)$", re.DOTALL)
+
+
+def exception_handler(exc, context):
+    if isinstance(exc, StaleVersion):
+        from segmentation.api.serializers import ReviewSerializer
+
+        body = {"detail": str(exc), "review": ReviewSerializer(exc.review).data}
+        return Response(body, status=status.HTTP_409_CONFLICT)
+    if isinstance(exc, ValueError):
+        code = 413 if isinstance(exc, UploadTooLarge) else 400
+        return Response(_value_error_body(exc), status=code)
+    response = drf_exception_handler(exc, context)
+    if response is not None and isinstance(response.data, dict) and "detail" not in response.data:
+        response.data = {"detail": _summary(response.data), **response.data}
+    elif response is not None and isinstance(response.data, list):
+        response.data = {"detail": _summary(response.data), "errors": response.data}
+    return response
+
+
+def _value_error_body(exc):
+    message = str(exc)
+    body = {"detail": message}
+    match = FIELD.match(message)
+    if match:
+        field, text = match.groups()
+        if isinstance(exc, ParamError) and field != "method":
+            body["params"] = {field: [text]}
+        else:
+            body[field] = [text]
+    return body
+
+
+def _summary(data):
+    """One line out of DRF's nested field errors: "version: This field is required."."""
+    if isinstance(data, dict):
+        return "; ".join(f"{key}: {_summary(value)}" for key, value in data.items())
+    if isinstance(data, list):
+        return " ".join(_summary(item) for item in data)
+    return str(data)

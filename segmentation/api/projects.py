@@ -1,0 +1,80 @@
+"""Projects, members, labels, the caller, and the method catalogue."""
+
+from django.shortcuts import get_object_or_404
+from drf_spectacular.utils import extend_schema
+from rest_framework import mixins, viewsets
+from rest_framework.decorators import action
+from rest_framework.exceptions import PermissionDenied
+from rest_framework.response import Response
+from rest_framework.views import APIView
+
+from motionlib.segmenters import list_segmenters
+from segmentation import services
+from segmentation.api.serializers import LabelSerializer, MemberSerializer, ProjectSerializer
+from segmentation.models import Project
+
+
+class ProjectViewSet(
+    mixins.ListModelMixin,
+    mixins.RetrieveModelMixin,
+    mixins.CreateModelMixin,
+    viewsets.GenericViewSet,
+):
+    serializer_class = ProjectSerializer
+
+    def get_queryset(self):
+        return Project.objects.for_user(self.request.user).prefetch_related("labels").order_by("id")
+
+    def perform_create(self, serializer):
+        serializer.instance = services.do_create_project(self.request.user, **serializer.validated_data)
+
+    def _admin_project(self):
+        project = self.get_object()
+        if self.request.method != "GET" and not project.can_manage(self.request.user):
+            raise PermissionDenied("Only the project's admins can change its labels and members.")
+        return project
+
+    @extend_schema(request=LabelSerializer, responses=LabelSerializer(many=True))
+    @action(detail=True, methods=["get", "post"], serializer_class=LabelSerializer)
+    def labels(self, request, pk=None):
+        project = self._admin_project()
+        if request.method == "GET":
+            return Response(LabelSerializer(project.labels.all(), many=True).data)
+        serializer = LabelSerializer(data=request.data)
+        serializer.is_valid(raise_exception=True)
+        label = services.do_add_label(project, **serializer.validated_data)
+        return Response(LabelSerializer(label).data, status=201)
+
+    @extend_schema(request=MemberSerializer, responses=MemberSerializer(many=True))
+    @action(detail=True, methods=["get", "post"], serializer_class=MemberSerializer)
+    def members(self, request, pk=None):
+        project = self._admin_project()
+        if request.method == "GET":
+            members = project.memberships.select_related("user").order_by("id")
+            return Response(MemberSerializer(members, many=True).data)
+        serializer = MemberSerializer(data=request.data)
+        serializer.is_valid(raise_exception=True)
+        data = serializer.validated_data
+        member = services.do_set_member(project, data["user"]["username"], data["role"])
+        return Response(MemberSerializer(member).data, status=201)
+
+
+class MeView(APIView):
+    @extend_schema(responses=dict)
+    def get(self, request):
+        projects = [
+            {"id": m.project_id, "name": m.project.name, "role": m.role}
+            for m in request.user.memberships.select_related("project").order_by("project_id")
+        ]
+        return Response({"id": request.user.pk, "username": request.user.username, "projects": projects})
+
+
+class MethodsView(APIView):
+    @extend_schema(responses=dict)
+    def get(self, request):
+        return Response([cls.schema() for cls in list_segmenters()])
+
+
+def project_for(user, pk):
+    """A project the user is a member of, or 404 (never 403, which would leak it)."""
+    return get_object_or_404(Project.objects.for_user(user), pk=pk)

@@ -1,0 +1,149 @@
+"""JSON shapes of docs/api.md. Output serializers mirror the records; input serializers
+check the request's shape, and the services check its meaning."""
+
+from rest_framework import serializers
+
+from segmentation.models import ROLES, Capture, DetectionRun, Label, Review, ReviewEvent
+
+
+class LabelSerializer(serializers.ModelSerializer):
+    hotkey = serializers.CharField(allow_null=True, required=False, default=None)
+    color = serializers.CharField(required=False, default="#888888")
+
+    class Meta:
+        model = Label
+        fields = ["id", "name", "color", "hotkey"]
+        # Uniqueness is checked by the service with a message naming the clash.
+        validators = []
+
+
+class ProjectSerializer(serializers.Serializer):
+    id = serializers.IntegerField(read_only=True)
+    name = serializers.CharField(max_length=200)
+    role = serializers.SerializerMethodField()
+    default_method = serializers.CharField(required=False, allow_blank=True, default="")
+    default_params = serializers.DictField(required=False, default=dict)
+    labels = LabelSerializer(many=True, read_only=True)
+
+    def get_role(self, project) -> str | None:
+        return project.role_of(self.context["request"].user)
+
+
+class MemberSerializer(serializers.Serializer):
+    id = serializers.IntegerField(source="user.id", read_only=True)
+    username = serializers.CharField(source="user.username")
+    role = serializers.ChoiceField(choices=[r for r, _ in ROLES])
+
+
+class RunSerializer(serializers.ModelSerializer):
+    error = serializers.SerializerMethodField()
+
+    class Meta:
+        model = DetectionRun
+        fields = [
+            "id", "method", "params", "status", "error", "created_at", "finished_at",
+            "timings", "candidates",
+        ]
+
+    def get_error(self, run) -> str | None:
+        return run.error or None
+
+
+class RunRequestSerializer(serializers.Serializer):
+    method = serializers.CharField(required=False, allow_blank=True, default="")
+    params = serializers.DictField(required=False, default=dict)
+
+
+class CaptureSerializer(serializers.ModelSerializer):
+    error = serializers.SerializerMethodField()
+    duration = serializers.FloatField(read_only=True)
+    latest_run = serializers.SerializerMethodField()
+    skeleton = serializers.SerializerMethodField()
+
+    class Meta:
+        model = Capture
+        fields = [
+            "id", "project", "name", "format", "status", "error", "fps", "n_frames",
+            "duration", "n_joints", "checksum", "rest_pose_frame", "created_at",
+            "latest_run", "skeleton",
+        ]
+
+    def get_error(self, capture) -> str | None:
+        return capture.error or None
+
+    def get_latest_run(self, capture) -> dict | None:
+        run = capture.latest_run()
+        return RunSerializer(run).data if run else None
+
+    def get_skeleton(self, capture) -> dict | None:
+        return capture.skeleton if capture.status == "ready" else None
+
+
+class UploadSerializer(serializers.Serializer):
+    file = serializers.FileField(allow_empty_file=True)
+    asf = serializers.FileField(required=False, allow_empty_file=True)
+    project = serializers.IntegerField()
+
+
+class CutSerializer(serializers.Serializer):
+    id = serializers.IntegerField()
+    origin = serializers.CharField()
+    fate = serializers.CharField()
+    candidate_frame = serializers.IntegerField(allow_null=True)
+    frame = serializers.IntegerField()
+    confidence = serializers.FloatField(allow_null=True)
+
+
+class ReviewSerializer(serializers.ModelSerializer):
+    annotator = serializers.SerializerMethodField()
+    cuts = serializers.SerializerMethodField()
+    segments = serializers.SerializerMethodField()
+
+    class Meta:
+        model = Review
+        fields = ["id", "capture", "annotator", "run", "status", "version", "cuts", "segments"]
+
+    def get_annotator(self, review) -> dict:
+        return {"id": review.annotator_id, "username": review.annotator.username}
+
+    def get_cuts(self, review) -> list[dict]:
+        return CutSerializer(review.cuts.order_by("frame", "id"), many=True).data
+
+    def get_segments(self, review) -> list[dict]:
+        return [
+            {"index": index, "start": start, "stop": stop, "label": label}
+            for index, start, stop, label in review.segments()
+        ]
+
+
+class VersionSerializer(serializers.Serializer):
+    version = serializers.IntegerField(min_value=1)
+
+
+class InsertCutSerializer(VersionSerializer):
+    frame = serializers.IntegerField()
+
+
+class ChangeCutSerializer(VersionSerializer):
+    fate = serializers.ChoiceField(choices=["accepted", "deleted", "pending"], required=False)
+    frame = serializers.IntegerField(required=False)
+
+    def validate(self, data):
+        if ("fate" in data) == ("frame" in data):
+            raise serializers.ValidationError("send either fate or frame (a move), not both")
+        return data
+
+
+class LabelSegmentSerializer(VersionSerializer):
+    label = serializers.CharField(allow_null=True)
+
+
+class EventSerializer(serializers.ModelSerializer):
+    user = serializers.SerializerMethodField()
+
+    class Meta:
+        model = ReviewEvent
+        fields = ["id", "user", "action", "cut", "before", "after", "created_at"]
+
+    def get_user(self, event) -> str | None:
+        return event.user.username if event.user else None

@@ -1,0 +1,29 @@
+from django.urls import path
+from drf_spectacular.views import SpectacularAPIView, SpectacularSwaggerView
+from rest_framework.authtoken.views import obtain_auth_token
+from rest_framework.routers import SimpleRouter
+
+from segmentation.api import reviews
+from segmentation.api.captures import CaptureViewSet
+from segmentation.api.projects import MethodsView, MeView, ProjectViewSet
+
+router = SimpleRouter()
+router.register("projects", ProjectViewSet, basename="project")
+router.register("captures", CaptureViewSet, basename="capture")
+
+review = "captures/<int:pk>/review/"
+urlpatterns = [
+    path("auth/token/", obtain_auth_token, name="api-token"),
+    path("me/", MeView.as_view(), name="api-me"),
+    path("methods/", MethodsView.as_view(), name="api-methods"),
+    path("schema/", SpectacularAPIView.as_view(), name="api-schema"),
+    path("docs/", SpectacularSwaggerView.as_view(url_name="api-schema"), name="api-docs"),
+    path(review, reviews.ReviewView.as_view(), name="api-review"),
+    path(review + "cuts/", reviews.CutsView.as_view(), name="api-review-cuts"),
+    path(review + "cuts/<int:cut_id>/", reviews.CutView.as_view(), name="api-review-cut"),
+    path(review + "segments/<int:index>/", reviews.SegmentView.as_view(), name="api-review-segment"),
+    path(review + "submit/", reviews.SubmitView.as_view(), name="api-review-submit"),
+    path(review + "events/", reviews.EventsView.as_view(), name="api-review-events"),
+    path("captures/<int:pk>/reviews/", reviews.AllReviewsView.as_view(), name="api-reviews"),
+    *router.urls,
+]

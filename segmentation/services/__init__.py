@@ -1,0 +1,39 @@
+"""Workflows of the service, one module per noun.
+
+``do_*`` functions run under ``transaction.atomic`` and enqueue background work only
+once their transaction commits, so a worker never sees a row that is not there yet.
+"""
+
+from segmentation.services.captures import (
+    default_method,
+    detect_run,
+    do_start_run,
+    do_upload_capture,
+    ingest_capture,
+    sweep_stale_claims,
+)
+from segmentation.services.projects import do_add_label, do_create_project, do_set_member
+from segmentation.services.reviews import (
+    do_change_cut,
+    do_insert_cut,
+    do_label_segment,
+    do_submit_review,
+    get_or_create_review,
+)
+
+__all__ = [
+    "default_method",
+    "detect_run",
+    "do_add_label",
+    "do_change_cut",
+    "do_create_project",
+    "do_insert_cut",
+    "do_label_segment",
+    "do_set_member",
+    "do_start_run",
+    "do_submit_review",
+    "do_upload_capture",
+    "get_or_create_review",
+    "ingest_capture",
+    "sweep_stale_claims",
+]

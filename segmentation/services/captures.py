@@ -1,0 +1,252 @@
+"""Captures and detection runs: upload, ingest, detect, and recovery of abandoned jobs."""
+
+import hashlib
+import logging
+import os
+
+import numpy as np
+from django.conf import settings
+from django.db import IntegrityError, transaction
+from django.utils import timezone
+
+import motionlib
+from motionlib.segmenters import ParamError, get_segmenter, list_segmenters
+from segmentation import storage
+from segmentation.errors import NotReady, UploadError, UploadTooLarge
+from segmentation.models import Capture, DetectionRun
+
+log = logging.getLogger(__name__)
+
+FORMATS = {".bvh": "bvh", ".amc": "amc"}
+
+
+def default_method():
+    """The registry's recommended method: ``default`` once registered, else ``bone_angle``."""
+    names = {cls.name for cls in list_segmenters()}
+    return "default" if "default" in names else "bone_angle"
+
+
+def validate_method(method, params):
+    """(method name, validated params); ParamError names the bad method or parameter."""
+    method = method or default_method()
+    return method, get_segmenter(method).validate_params(params or {})
+
+
+def max_upload_bytes():
+    return settings.CUTROOM_MAX_UPLOAD_MB * 1024 * 1024
+
+
+def check_upload(upload, asf=None):
+    """The capture format of an upload; UploadError says what is wrong with it."""
+    extension = os.path.splitext(upload.name)[1].lower()
+    if extension not in FORMATS:
+        raise UploadError(
+            f"file: {upload.name!r} has extension {extension or '(none)'!r}; "
+            "upload a .bvh file, or an .amc file with its .asf skeleton"
+        )
+    for field, item in (("file", upload), ("asf", asf)):
+        if item is None:
+            continue
+        if item.size == 0:
+            raise UploadError(f"{field}: {item.name!r} is empty (0 bytes)")
+        if item.size > max_upload_bytes():
+            raise UploadTooLarge(
+                f"{field}: {item.name!r} is {item.size / 2**20:.1f} MB; the limit is "
+                f"{settings.CUTROOM_MAX_UPLOAD_MB} MB (CUTROOM_MAX_UPLOAD_MB)"
+            )
+    if FORMATS[extension] == "amc" and asf is None:
+        raise UploadError(f"asf: {upload.name!r} is an AMC file; upload its .asf skeleton with it")
+    if asf is not None and os.path.splitext(asf.name)[1].lower() != ".asf":
+        raise UploadError(f"asf: {asf.name!r} is not an .asf file")
+    return FORMATS[extension]
+
+
+def checksum(upload, asf=None):
+    """SHA-256 over the original (and its ASF): equal takes give equal checksums."""
+    digest = hashlib.sha256()
+    for item in (upload, asf):
+        if item is not None:
+            for chunk in item.chunks():
+                digest.update(chunk)
+    return digest.hexdigest()
+
+
+def do_upload_capture(project, user, upload, asf=None):
+    """Store an upload unchanged and queue its ingest.
+
+    Returns (capture, created); an identical upload to the same project returns the
+    existing capture with ``created=False``.
+    """
+    fmt = check_upload(upload, asf)
+    digest = checksum(upload, asf)
+    existing = Capture.objects.filter(project=project, checksum=digest).first()
+    if existing:
+        return existing, False
+    capture = Capture(project=project, uploaded_by=user, name=upload.name, format=fmt)
+    capture.checksum = digest
+    capture.original.save(os.path.basename(upload.name), upload, save=False)
+    if asf is not None:
+        capture.asf.save(os.path.basename(asf.name), asf, save=False)
+    try:
+        with transaction.atomic():
+            capture.save()
+            _enqueue("ingest", capture.pk)
+    except IntegrityError:
+        # The same file arrived twice at once; the other request stored it.
+        return Capture.objects.get(project=project, checksum=digest), False
+    return capture, True
+
+
+def do_start_run(capture, user, method, params):
+    """Queue a detection run on a ready capture; ParamError names a bad parameter."""
+    if capture.status != "ready":
+        raise NotReady(f"capture {capture.pk} is {capture.status}; detection needs a ready capture")
+    method, params = validate_method(method, params)
+    with transaction.atomic():
+        run = DetectionRun.objects.create(
+            capture=capture, method=method, params=params, created_by=user
+        )
+        _enqueue("detect", run.pk)
+    return run
+
+
+def _enqueue(task_name, pk):
+    from segmentation import tasks
+
+    task = getattr(tasks, task_name)
+    transaction.on_commit(lambda: task.delay(pk))
+
+
+def _read(capture):
+    """The parsed take of a capture's stored original."""
+    with storage.local_path(capture.original) as path:
+        if capture.asf:
+            with storage.local_path(capture.asf) as asf_path:
+                return motionlib.read(path, asf=asf_path)
+        return motionlib.read(path)
+
+
+def _internal_error(what, exc):
+    log.exception("%s failed", what)
+    return (
+        f"{what} failed with an internal error ({type(exc).__name__}: {exc}). "
+        "The original upload is kept; report this to the service's administrators."
+    )
+
+
+def ingest_capture(capture):
+    """Parse a claimed capture, store its metadata and positions, start default detection.
+
+    A bad file marks the capture failed with motionlib's message (file, line, value).
+    """
+    try:
+        take = _read(capture)
+        positions = np.asarray(motionlib.forward_kinematics(take), dtype="<f4")
+        height = float(motionlib.skeleton_height(take))
+    except ValueError as exc:
+        capture.fail(str(exc))
+        return
+    except Exception as exc:
+        capture.fail(_internal_error("Reading the capture", exc))
+        return
+    storage.save_npy(capture.positions, "positions.npy", positions)
+    with transaction.atomic():
+        done = capture.finish(**_metadata(take, height), positions=capture.positions.name)
+        if done:
+            _start_default_run(capture)
+
+
+def _metadata(take, height):
+    return {
+        "format": take.format,
+        "fps": float(take.fps),
+        "n_frames": int(take.n_frames),
+        "n_joints": len(take.skeleton.names),
+        "rest_pose_frame": take.rest_pose_frame,
+        "skeleton": {
+            "joints": list(take.skeleton.names),
+            "parents": [int(p) for p in take.skeleton.parents],
+            "height": height,
+            "up": "y",
+        },
+    }
+
+
+def _start_default_run(capture):
+    project = capture.project
+    try:
+        method, params = validate_method(project.default_method, project.default_params)
+    except ParamError as exc:
+        # Keep the capture usable; the failed run says why the project's defaults are wrong.
+        DetectionRun.objects.create(
+            capture=capture,
+            method=project.default_method or default_method(),
+            params=project.default_params,
+            status="failed",
+            error=f"project default parameters: {exc}",
+        )
+        return
+    run = DetectionRun.objects.create(capture=capture, method=method, params=params)
+    _enqueue("detect", run.pk)
+
+
+def detect_run(run):
+    """Run a claimed detection and store candidates, signals and timings on the row."""
+    try:
+        take = _read(run.capture)
+        segmenter = get_segmenter(run.method)
+        result = segmenter(**segmenter.validate_params(run.params)).fit_predict(take)
+    except ValueError as exc:
+        run.fail(str(exc), finished_at=timezone.now())
+        return
+    except Exception as exc:
+        run.fail(_internal_error("Detection", exc), finished_at=timezone.now())
+        return
+    candidates = [
+        {"frame": int(f), "confidence": round(float(c), 4)}
+        for f, c in zip(result.cuts, result.confidence, strict=True)
+    ]
+    signals = {name: np.asarray(v, dtype="<f4") for name, v in result.signals.items()}
+    storage.save_npz(run.signals, "signals.npz", signals)
+    run.finish(
+        candidates=candidates,
+        timings={k: round(float(v), 4) for k, v in result.timings.items()},
+        signals=run.signals.name,
+        finished_at=timezone.now(),
+    )
+
+
+def exhausted(job):
+    """A job claimed more than CUTROOM_MAX_ATTEMPTS times: its input keeps killing workers."""
+    return job.attempts > settings.CUTROOM_MAX_ATTEMPTS
+
+
+def give_up(job):
+    """Mark a job that never finished as failed, saying why."""
+    extra = {"finished_at": timezone.now()} if isinstance(job, DetectionRun) else {}
+    return job.fail(
+        f"processing started {job.attempts} times and never finished (the worker was killed "
+        "or lost each time); giving up. The original upload is kept.",
+        **extra,
+    )
+
+
+def sweep_stale_claims():
+    """Requeue jobs whose worker vanished mid-way; fail those already retried too often.
+
+    Returns the number of jobs requeued or failed.
+    """
+    count = 0
+    for model, task_name in ((Capture, "ingest"), (DetectionRun, "detect")):
+        for job in model.objects.stale():
+            if job.attempts >= settings.CUTROOM_MAX_ATTEMPTS:
+                count += give_up(job)
+                continue
+            with transaction.atomic():
+                requeued = model.objects.filter(
+                    pk=job.pk, status="processing", claim_token=job.claim_token
+                ).update(status="queued", claim_token="")
+                if requeued:
+                    _enqueue(task_name, job.pk)
+            count += requeued
+    return count

@@ -1,0 +1,53 @@
+"""Projects, their members and their label taxonomy."""
+
+import re
+
+from django.contrib.auth import get_user_model
+from django.db import transaction
+
+from segmentation.models import Label, Membership, Project
+from segmentation.services.captures import validate_method
+
+COLOR = re.compile(r"^#[0-9a-fA-F]{6}$")
+
+
+def do_create_project(user, name, default_method="", default_params=None):
+    """A new project with ``user`` as its admin; ParamError names a bad default."""
+    if default_method or default_params:
+        validate_method(default_method, default_params)
+    with transaction.atomic():
+        project = Project.objects.create(
+            name=name, default_method=default_method or "", default_params=default_params or {}
+        )
+        Membership.objects.create(project=project, user=user, role="admin")
+    return project
+
+
+def do_set_member(project, username, role):
+    """Add a user to the project, or change their role; a project keeps one admin."""
+    user = get_user_model().objects.filter(username=username).first()
+    if user is None:
+        raise ValueError(f"username: no user named {username!r}")
+    demoted = project.role_of(user) == "admin" and role != "admin"
+    if demoted and project.memberships.filter(role="admin").count() == 1:
+        raise ValueError(f"role: {username!r} is the project's only admin; add another admin first")
+    membership, _ = Membership.objects.update_or_create(
+        project=project, user=user, defaults={"role": role}
+    )
+    return membership
+
+
+def do_add_label(project, name, color="#888888", hotkey=None):
+    """Add a label to the taxonomy; names and hotkeys are unique within a project."""
+    name = name.strip()
+    if not name:
+        raise ValueError("name: a label needs a name")
+    if not COLOR.match(color or ""):
+        raise ValueError(f"color: must look like #rrggbb, got {color!r}")
+    if hotkey is not None and (len(hotkey) != 1 or hotkey not in "123456789"):
+        raise ValueError(f"hotkey: must be one of 1..9 or null, got {hotkey!r}")
+    if project.labels.filter(name=name).exists():
+        raise ValueError(f"name: the project already has a label {name!r}")
+    if hotkey and project.labels.filter(hotkey=hotkey).exists():
+        raise ValueError(f"hotkey: {hotkey!r} is already used by another label")
+    return Label.objects.create(project=project, name=name, color=color.lower(), hotkey=hotkey)

@@ -1,0 +1,150 @@
+"""Reviews: one annotator's cuts and labels on one capture, with an audit log.
+
+Every write is ``_write(review, version)``: one conditional UPDATE that bumps the
+version only if the caller saw the current one. Zero rows updated means someone else
+wrote first, and the caller gets ``StaleVersion`` with the current review (a 409), so two
+clients never silently overwrite each other.
+"""
+
+from django.db import IntegrityError, transaction
+from django.db.models import F
+from django.utils import timezone
+
+from segmentation.errors import NotReady, ReviewClosed, StaleVersion
+from segmentation.models import Cut, Review, ReviewEvent, SegmentLabel
+
+FATE_ACTIONS = {"accepted": "accept", "deleted": "delete", "pending": "reset"}
+
+
+def get_or_create_review(capture, user):
+    """The user's review of a capture, created from the latest finished run if new."""
+    review = Review.objects.filter(capture=capture, annotator=user).first()
+    if review:
+        return review
+    if capture.status != "ready":
+        raise NotReady(
+            f"capture {capture.pk} is {capture.status}; it can be reviewed once it is ready"
+        )
+    try:
+        with transaction.atomic():
+            return _create_review(capture, user)
+    except IntegrityError:
+        # Two first requests raced; the other one created it.
+        return Review.objects.get(capture=capture, annotator=user)
+
+
+def _create_review(capture, user):
+    run = capture.latest_finished_run()
+    review = Review.objects.create(capture=capture, annotator=user, run=run)
+    candidates = run.candidates if run else []
+    Cut.objects.bulk_create(
+        Cut(
+            review=review,
+            origin="candidate",
+            candidate_frame=c["frame"],
+            frame=c["frame"],
+            confidence=c["confidence"],
+        )
+        for c in candidates
+    )
+    after = {"run": run.pk if run else None, "candidates": len(candidates)}
+    ReviewEvent.objects.create(review=review, user=user, action="create", after=after)
+    return review
+
+
+def _write(review, version):
+    """Claim the next version of ``review`` or raise StaleVersion / ReviewClosed."""
+    updated = Review.objects.filter(pk=review.pk, version=version, status="in_progress").update(
+        version=F("version") + 1, updated_at=timezone.now()
+    )
+    review.refresh_from_db()
+    if updated:
+        return
+    if review.version != version:
+        raise StaleVersion(review)
+    raise ReviewClosed(f"review {review.pk} was submitted; it takes no more changes")
+
+
+def _check_frame(review, frame, moving=None):
+    """A cut frame must be inside the take and not on another kept cut."""
+    n_frames = review.capture.n_frames
+    if isinstance(frame, bool) or not isinstance(frame, int):
+        raise ValueError(f"frame: must be an integer, got {frame!r}")
+    if not 0 < frame < n_frames:
+        raise ValueError(f"frame: must be between 1 and {n_frames - 1}, got {frame}")
+    taken = review.cuts.exclude(fate="deleted").filter(frame=frame)
+    if moving is not None:
+        taken = taken.exclude(pk=moving.pk)
+    if taken.exists():
+        raise ValueError(f"frame: there is already a cut at frame {frame}")
+
+
+def _log(review, user, action, cut=None, before=None, after=None):
+    ReviewEvent.objects.create(
+        review=review, user=user, action=action, cut=cut, before=before, after=after
+    )
+
+
+def do_insert_cut(review, user, frame, version):
+    """Add a cut the detector missed; it counts as accepted."""
+    with transaction.atomic():
+        _write(review, version)
+        _check_frame(review, frame)
+        cut = Cut.objects.create(review=review, origin="inserted", fate="accepted", frame=frame)
+        _log(review, user, "insert", cut, after=cut.as_json())
+    return review
+
+
+def do_change_cut(review, user, cut, version, fate=None, frame=None):
+    """Accept, delete or reset a cut (``fate``), or move it to ``frame``."""
+    with transaction.atomic():
+        _write(review, version)
+        cut.refresh_from_db()
+        before = cut.as_json()
+        if frame is not None:
+            _check_frame(review, frame, moving=cut)
+            cut.frame = frame
+            cut.fate = "moved" if cut.origin == "candidate" else "accepted"
+            action = "move"
+        else:
+            if fate not in FATE_ACTIONS:
+                raise ValueError(f"fate: must be accepted, deleted or pending, got {fate!r}")
+            if cut.fate == "deleted" and fate != "deleted":
+                _check_frame(review, cut.frame, moving=cut)
+            cut.fate = fate
+            action = FATE_ACTIONS[fate]
+        cut.save(update_fields=["frame", "fate"])
+        _log(review, user, action, cut, before=before, after=cut.as_json())
+    return review
+
+
+def do_label_segment(review, user, index, label_name, version):
+    """Set (or clear, with None) the label of segment ``index``."""
+    with transaction.atomic():
+        _write(review, version)
+        try:
+            start_cut = review.segment_start_cut(index)
+        except IndexError:
+            raise ValueError(f"index: the review has no segment {index}") from None
+        label = None
+        if label_name is not None:
+            label = review.capture.project.labels.filter(name=label_name).first()
+            if label is None:
+                names = ", ".join(review.capture.project.labels.values_list("name", flat=True))
+                raise ValueError(f"label: {label_name!r} is not a label of this project ({names})")
+        row, _ = SegmentLabel.objects.get_or_create(review=review, cut=start_cut)
+        before = {"index": index, "label": row.label.name if row.label else None}
+        row.label = label
+        row.save(update_fields=["label"])
+        _log(review, user, "label", start_cut, before=before, after={"index": index, "label": label_name})
+    return review
+
+
+def do_submit_review(review, user, version):
+    with transaction.atomic():
+        _write(review, version)
+        now = timezone.now()
+        Review.objects.filter(pk=review.pk).update(status="submitted", submitted_at=now)
+        review.status, review.submitted_at = "submitted", now
+        _log(review, user, "submit", before={"status": "in_progress"}, after={"status": "submitted"})
+    return review

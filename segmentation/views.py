@@ -1,0 +1,25 @@
+"""Pages outside the API: the single-page app's index, login and logout."""
+
+from django.conf import settings
+from django.contrib.auth import logout
+from django.contrib.auth.decorators import login_required
+from django.http import HttpResponse
+from django.shortcuts import redirect, render
+from django.views.decorators.http import require_http_methods
+
+
+@login_required
+def app(request, path=""):
+    """The built front end's index.html; every client-side route gets the same page."""
+    index = settings.FRONTEND_DIST / "index.html"
+    if not index.is_file():
+        context = {"dist": settings.FRONTEND_DIST}
+        return render(request, "segmentation/not_built.html", context, status=503)
+    return HttpResponse(index.read_text(encoding="utf-8"))
+
+
+@require_http_methods(["GET", "POST"])
+def logout_view(request):
+    # Logging out by link is what people expect from a small internal tool.
+    logout(request)
+    return redirect(settings.LOGOUT_REDIRECT_URL)
