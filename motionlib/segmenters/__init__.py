@@ -8,8 +8,9 @@ from __future__ import annotations
 
 from motionlib.segmenters.base import Param, ParamError, Segmentation, Segmenter
 from motionlib.segmenters.bone_angle import BoneAngle
+from motionlib.segmenters.default import Default
 
-_REGISTRY: dict[str, type[Segmenter]] = {cls.name: cls for cls in (BoneAngle,)}
+_REGISTRY: dict[str, type[Segmenter]] = {cls.name: cls for cls in (Default, BoneAngle)}
 
 __all__ = [
     "Param",
