@@ -119,7 +119,8 @@ USE_TZ = True
 
 # Static files: the built front end (frontend/dist) and the admin/DRF assets, at /static/.
 STATIC_URL = "/static/"
-STATIC_ROOT = Path(os.environ.get("CUTROOM_STATIC_ROOT") or VAR_DIR / "static")
+# Only needed for `collectstatic`; WhiteNoise serves straight from the finders below.
+STATIC_ROOT = os.environ.get("CUTROOM_STATIC_ROOT") or None
 STATICFILES_DIRS = [FRONTEND_DIST]
 # Serve straight from the finders so a fresh `npm run build` needs no collectstatic.
 WHITENOISE_USE_FINDERS = True
