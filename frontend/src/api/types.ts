@@ -1,0 +1,134 @@
+// Shapes of the HTTP API (docs/api.md). Frame numbers are the capture's own, 0-based.
+
+export interface Label {
+  id: number;
+  name: string;
+  color: string;
+  hotkey: string | null;
+}
+
+export type Role = "annotator" | "reviewer" | "admin";
+
+export interface Project {
+  id: number;
+  name: string;
+  role: Role;
+  default_method: string;
+  default_params: Record<string, unknown>;
+  labels: Label[];
+}
+
+export interface Me {
+  id: number;
+  username: string;
+  projects: { id: number; name: string; role: Role }[];
+}
+
+export interface Skeleton {
+  joints: string[];
+  parents: number[];
+  height: number;
+  up: string;
+}
+
+export type CaptureStatus = "queued" | "processing" | "ready" | "failed";
+
+export interface Run {
+  id: number;
+  method: string;
+  params: Record<string, unknown>;
+  status: string;
+  error: string | null;
+  created_at: string;
+  finished_at: string | null;
+  candidates: { frame: number; confidence: number }[];
+}
+
+export interface Capture {
+  id: number;
+  project: number;
+  name: string;
+  format: "bvh" | "amc";
+  status: CaptureStatus;
+  error: string | null;
+  fps: number;
+  n_frames: number;
+  duration: number;
+  n_joints: number;
+  checksum: string;
+  rest_pose_frame: number | null;
+  created_at: string;
+  latest_run: Run | null;
+  skeleton: Skeleton | null;
+  duplicate?: boolean;
+}
+
+export interface Page<T> {
+  count: number;
+  next: string | null;
+  previous: string | null;
+  results: T[];
+}
+
+export interface Signal {
+  name: string;
+  start: number;
+  step: number;
+  values: number[];
+}
+
+export interface SignalResponse {
+  run: number;
+  fps: number;
+  n_frames: number;
+  signals: Signal[];
+}
+
+export interface FramesResponse {
+  start: number;
+  stop: number;
+  step: number;
+  n_frames: number;
+  n_joints: number;
+  dtype: "float32";
+  data: string;
+}
+
+export type Fate = "pending" | "accepted" | "moved" | "deleted";
+
+export interface Cut {
+  id: number;
+  origin: "candidate" | "inserted";
+  fate: Fate;
+  candidate_frame: number | null;
+  frame: number;
+  confidence: number | null;
+}
+
+export interface Segment {
+  index: number;
+  start: number;
+  stop: number;
+  label: string | null;
+}
+
+export interface Review {
+  id: number;
+  capture: number;
+  annotator: { id: number; username: string };
+  run: number | null;
+  status: "in_progress" | "submitted";
+  version: number;
+  cuts: Cut[];
+  segments: Segment[];
+}
+
+export interface ReviewEvent {
+  id: number;
+  user: string | { id: number; username: string };
+  action: string;
+  cut: number | null;
+  before: unknown;
+  after: unknown;
+  created_at: string;
+}

@@ -1,0 +1,182 @@
+// The capture list: filter by project, status and name; drop files anywhere to upload
+// them (with progress); rows still being processed refresh themselves.
+
+import { get } from "../api/client";
+import type { Capture, Me, Page, Project } from "../api/types";
+import { clear, formatDuration, h, toast } from "../ui/dom";
+import { navigate } from "../router";
+import { pairFiles, upload } from "./upload";
+
+const STATUSES = ["", "queued", "processing", "ready", "failed"];
+
+export interface Filters {
+  project: string;
+  status: string;
+  search: string;
+  page: number;
+}
+
+export function filtersFrom(search: string): Filters {
+  const q = new URLSearchParams(search);
+  return { project: q.get("project") ?? "", status: q.get("status") ?? "", search: q.get("search") ?? "", page: Math.max(Number(q.get("page")) || 1, 1) };
+}
+
+export function queryOf(f: Filters): string {
+  const q = new URLSearchParams();
+  if (f.project) q.set("project", f.project);
+  if (f.status) q.set("status", f.status);
+  if (f.search) q.set("search", f.search);
+  if (f.page > 1) q.set("page", String(f.page));
+  const text = q.toString();
+  return text ? `?${text}` : "";
+}
+
+export async function renderCaptureList(root: HTMLElement): Promise<() => void> {
+  const [me, projectsRaw] = await Promise.all([get<Me>("/api/me/"), get<Project[] | Page<Project>>("/api/projects/")]);
+  const projects = Array.isArray(projectsRaw) ? projectsRaw : projectsRaw.results;
+  let filters = filtersFrom(location.search);
+  let timer = 0;
+  let searchDelay = 0;
+  const rows = h("tbody", { "data-testid": "capture-rows" });
+  const pager = h("div", { class: "pager" });
+  const uploads = h("div", { class: "uploads", "data-testid": "uploads" });
+  const fileInput = h("input", { type: "file", multiple: true, accept: ".bvh,.amc,.asf", hidden: true });
+  const projectName = new Map(projects.map((p) => [p.id, p.name]));
+
+  const select = (name: keyof Filters, options: [string, string][]) => {
+    const el = h("select", { class: "select", "data-testid": `filter-${name}`, "aria-label": name }, ...options.map(([v, t]) => h("option", { value: v, selected: String(filters[name]) === v }, t)));
+    el.addEventListener("change", () => apply({ ...filters, [name]: el.value, page: 1 }));
+    return el;
+  };
+  const search = h("input", { class: "input", type: "search", placeholder: "Search captures…", value: filters.search, "data-testid": "filter-search" });
+  search.addEventListener("input", () => {
+    clearTimeout(searchDelay);
+    searchDelay = window.setTimeout(() => apply({ ...filters, search: search.value.trim(), page: 1 }), 250);
+  });
+
+  const uploadProject = () => Number(filters.project) || projects[0]?.id;
+  const startUploads = (files: File[]) => {
+    const project = uploadProject();
+    if (!project) return toast("Create or join a project before uploading.", "error");
+    const { items, problems } = pairFiles(files);
+    problems.forEach((p) => toast(p, "error"));
+    for (const item of items) {
+      const bar = h("div", { class: "bar" });
+      const state = h("span", { class: "state" }, "0 %");
+      const row = h("div", { class: "upload" }, h("span", { class: "name" }, item.file.name), h("div", { class: "progress" }, bar), state);
+      uploads.append(row);
+      upload(item, project, (share) => {
+        bar.style.width = `${share * 100}%`;
+        state.textContent = `${Math.round(share * 100)} %`;
+      })
+        .then((capture) => {
+          state.textContent = capture.duplicate ? "already uploaded" : "uploaded";
+          row.classList.add("done");
+          setTimeout(() => row.remove(), 4000);
+          void load();
+        })
+        .catch((err: Error) => {
+          state.textContent = err.message;
+          row.classList.add("failed");
+        });
+    }
+  };
+  fileInput.addEventListener("change", () => {
+    startUploads([...(fileInput.files ?? [])]);
+    fileInput.value = "";
+  });
+
+  const dropzone = h("div", { class: "dropzone", "data-testid": "dropzone" }, h("b", {}, "Drop .bvh, or .amc with its .asf, here"), h("span", {}, " or "), h("button", { class: "btn btn-primary", onclick: () => fileInput.click() }, "Choose files"));
+  const page = h(
+    "div",
+    { class: "list-page" },
+    h("header", { class: "topbar" }, h("a", { class: "brand", href: "/" }, "Cutroom"), h("nav", { class: "crumbs" }, h("strong", {}, "Captures")), h("span", { class: "spacer" }), h("span", { class: "user" }, me.username), h("a", { class: "btn btn-ghost", href: "/logout/" }, "Log out")),
+    h(
+      "main",
+      { class: "list-main" },
+      h(
+        "div",
+        { class: "filters" },
+        select("project", [["", "All projects"], ...projects.map((p) => [String(p.id), p.name] as [string, string])]),
+        select("status", STATUSES.map((s) => [s, s ? s : "Any status"] as [string, string])),
+        search,
+      ),
+      dropzone,
+      fileInput,
+      uploads,
+      h(
+        "table",
+        { class: "captures" },
+        h("thead", {}, h("tr", {}, ...["Name", "Project", "Status", "Frames", "Duration", "fps", "Joints", "Cuts", "Uploaded"].map((t) => h("th", {}, t)))),
+        rows,
+      ),
+      pager,
+    ),
+  );
+  clear(root, page);
+
+  const onDrag = (e: DragEvent) => {
+    e.preventDefault();
+    dropzone.classList.toggle("over", e.type === "dragover");
+  };
+  const onDrop = (e: DragEvent) => {
+    e.preventDefault();
+    dropzone.classList.remove("over");
+    startUploads([...(e.dataTransfer?.files ?? [])]);
+  };
+  document.addEventListener("dragover", onDrag);
+  document.addEventListener("dragleave", onDrag);
+  document.addEventListener("drop", onDrop);
+
+  async function load(): Promise<void> {
+    clearTimeout(timer);
+    const q = new URLSearchParams(queryOf(filters).slice(1));
+    const data = await get<Page<Capture>>(`/api/captures/?${q}`).catch((err: Error) => {
+      clear(rows, h("tr", {}, h("td", { colspan: 9, class: "error-text" }, `Could not load captures: ${err.message}`)));
+      return null;
+    });
+    if (!data) return;
+    clear(rows, ...data.results.map((c) => row(c, projectName.get(c.project) ?? String(c.project))));
+    if (!data.results.length) rows.append(h("tr", {}, h("td", { colspan: 9, class: "muted empty" }, "No captures match. Drop a file above to add one.")));
+    clear(
+      pager,
+      h("span", { class: "muted" }, `${data.count} capture${data.count === 1 ? "" : "s"}`),
+      data.previous ? h("button", { class: "btn", onclick: () => apply({ ...filters, page: filters.page - 1 }) }, "← Previous") : null,
+      data.next ? h("button", { class: "btn", onclick: () => apply({ ...filters, page: filters.page + 1 }) }, "Next →") : null,
+    );
+    if (data.results.some((c) => c.status === "queued" || c.status === "processing")) timer = window.setTimeout(() => void load(), 2000);
+  }
+
+  function apply(next: Filters): void {
+    filters = next;
+    history.replaceState(null, "", `/${queryOf(filters)}`);
+    void load();
+  }
+
+  await load();
+  return () => {
+    clearTimeout(timer);
+    document.removeEventListener("dragover", onDrag);
+    document.removeEventListener("dragleave", onDrag);
+    document.removeEventListener("drop", onDrop);
+  };
+}
+
+function row(c: Capture, project: string): HTMLElement {
+  const open = () => navigate(`/captures/${c.id}/`);
+  const status = h("span", { class: `badge badge-${c.status}`, title: c.error ?? "" }, c.status);
+  const cuts = c.latest_run?.candidates?.length;
+  return h(
+    "tr",
+    { class: "capture-row", "data-testid": `capture-${c.id}`, tabindex: 0, onclick: open, onkeydown: (e: Event) => (e as KeyboardEvent).key === "Enter" && open() },
+    h("td", {}, h("a", { href: `/captures/${c.id}/`, onclick: (e: Event) => e.preventDefault() }, c.name), c.status === "failed" && c.error ? h("div", { class: "error-text small" }, c.error) : null),
+    h("td", {}, project),
+    h("td", {}, status),
+    h("td", { class: "num" }, c.n_frames?.toLocaleString() ?? "—"),
+    h("td", { class: "num" }, c.duration ? formatDuration(c.duration) : "—"),
+    h("td", { class: "num" }, c.fps ?? "—"),
+    h("td", { class: "num" }, c.n_joints ?? "—"),
+    h("td", { class: "num" }, cuts ?? "—"),
+    h("td", {}, c.created_at ? new Date(c.created_at).toLocaleString() : ""),
+  );
+}

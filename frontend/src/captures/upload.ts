@@ -1,0 +1,60 @@
+// Uploads with progress. fetch() cannot report upload progress, so this uses XHR.
+
+import { errorText, readCookie } from "../api/client";
+import type { Capture } from "../api/types";
+
+export interface UploadItem {
+  file: File;
+  asf: File | null;
+}
+
+/**
+ * Pair dropped files into uploads: every .bvh alone, every .amc with an .asf (the one
+ * sharing its subject prefix, e.g. 13_29.amc ↔ 13.asf, else the only one dropped).
+ * Returns the uploads and, per file that cannot be uploaded, why.
+ */
+export function pairFiles(files: File[]): { items: UploadItem[]; problems: string[] } {
+  const asfs = files.filter((f) => /\.asf$/i.test(f.name));
+  const items: UploadItem[] = [];
+  const problems: string[] = [];
+  for (const file of files) {
+    if (/\.bvh$/i.test(file.name)) items.push({ file, asf: null });
+    else if (/\.amc$/i.test(file.name)) {
+      const subject = file.name.split(/[_.]/)[0];
+      const asf = asfs.find((a) => a.name.replace(/\.asf$/i, "") === subject) ?? (asfs.length === 1 ? asfs[0] : null);
+      if (asf) items.push({ file, asf });
+      else problems.push(`${file.name}: an .amc needs its skeleton; drop the matching .asf with it.`);
+    } else if (!/\.asf$/i.test(file.name)) {
+      problems.push(`${file.name}: not a .bvh or .amc file.`);
+    }
+  }
+  if (asfs.length && !files.some((f) => /\.amc$/i.test(f.name))) problems.push("An .asf alone is only a skeleton; drop it together with its .amc takes.");
+  return { items, problems };
+}
+
+export function upload(item: UploadItem, project: number, onProgress: (share: number) => void): Promise<Capture> {
+  return new Promise((resolve, reject) => {
+    const form = new FormData();
+    form.append("file", item.file);
+    if (item.asf) form.append("asf", item.asf);
+    form.append("project", String(project));
+    const xhr = new XMLHttpRequest();
+    xhr.open("POST", "/api/captures/");
+    const token = readCookie(document.cookie, "csrftoken");
+    if (token) xhr.setRequestHeader("X-CSRFToken", token);
+    xhr.setRequestHeader("Accept", "application/json");
+    xhr.upload.onprogress = (e) => e.lengthComputable && onProgress(e.loaded / e.total);
+    xhr.onload = () => {
+      let body: unknown = xhr.responseText;
+      try {
+        body = JSON.parse(xhr.responseText);
+      } catch {
+        // keep the text
+      }
+      if (xhr.status >= 200 && xhr.status < 300) resolve(body as Capture);
+      else reject(new Error(errorText(xhr.status, body)));
+    };
+    xhr.onerror = () => reject(new Error("The upload was interrupted (network error)."));
+    xhr.send(form);
+  });
+}

@@ -1,0 +1,166 @@
+// The 3D skeleton: joints as spheres, bones as cylinders (instanced, so one draw call
+// each), a floor grid and an orbit camera that can follow the root. It renders on demand
+// only, which keeps an idle review page from burning a CPU core.
+
+import * as THREE from "three";
+import { OrbitControls } from "three/examples/jsm/controls/OrbitControls.js";
+import type { Skeleton } from "../api/types";
+
+const LEFT = new THREE.Color("#4fc3f7");
+const RIGHT = new THREE.Color("#ffb74d");
+const CENTRE = new THREE.Color("#e0e6ef");
+
+const CMU_LIMBS = "(clavicle|humerus|radius|wrist|hand|fingers|thumb|hipjoint|femur|tibia|foot|toes)";
+
+/** Which side of the body a joint is on: CMU "lfemur", BVH "LeftUpLeg"/"LHipJoint", "mixamorig:RightArm". */
+export function sideOf(name: string): "left" | "right" | "centre" {
+  const bare = name.replace(/^.*:/, "");
+  // Case-sensitive for the single-letter prefix, so "Root" or "LowerBack" stay central.
+  const letter = /^L[A-Z_]/.test(bare) ? "left" : /^R[A-Z_]/.test(bare) ? "right" : null;
+  if (letter) return letter;
+  if (/^left/i.test(bare) || new RegExp(`^l${CMU_LIMBS}`, "i").test(bare) || /[._]l$/i.test(bare)) return "left";
+  if (/^right/i.test(bare) || new RegExp(`^r${CMU_LIMBS}`, "i").test(bare) || /[._]r$/i.test(bare)) return "right";
+  return "centre";
+}
+
+export class SkeletonView {
+  readonly canvas: HTMLCanvasElement;
+  private readonly renderer: THREE.WebGLRenderer;
+  private readonly scene = new THREE.Scene();
+  private readonly camera = new THREE.PerspectiveCamera(40, 1, 0.01, 1000);
+  private readonly controls: OrbitControls;
+  private readonly joints: THREE.InstancedMesh;
+  private readonly bones: THREE.InstancedMesh;
+  private readonly boneList: [number, number][];
+  private readonly radius: number;
+  private lastRoot: THREE.Vector3 | null = null;
+  private pending = false;
+  follow = true;
+
+  constructor(
+    private readonly container: HTMLElement,
+    private readonly skeleton: Skeleton,
+  ) {
+    this.renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
+    this.renderer.setPixelRatio(Math.min(window.devicePixelRatio, 2));
+    this.canvas = this.renderer.domElement;
+    container.appendChild(this.canvas);
+    const height = skeleton.height > 0 ? skeleton.height : 1.8;
+    this.radius = height * 0.018;
+    this.scene.background = new THREE.Color("#161a21");
+    this.scene.fog = new THREE.Fog("#161a21", height * 6, height * 18);
+    this.scene.add(new THREE.HemisphereLight("#ffffff", "#2a3140", 2.2));
+    const sun = new THREE.DirectionalLight("#ffffff", 1.4);
+    sun.position.set(height, height * 3, height * 2);
+    this.scene.add(sun);
+    this.scene.add(floor(height));
+    this.boneList = skeleton.parents.flatMap((p, j) => (p >= 0 ? [[p, j] as [number, number]] : []));
+    this.joints = this.instanced(new THREE.SphereGeometry(1, 14, 10), skeleton.joints.length, (i) => skeleton.joints[i]);
+    this.bones = this.instanced(new THREE.CylinderGeometry(1, 1, 1, 10), this.boneList.length, (i) => skeleton.joints[this.boneList[i][1]]);
+    this.camera.position.set(height * 1.6, height * 1.0, height * 3.2);
+    this.controls = new OrbitControls(this.camera, this.canvas);
+    this.controls.target.set(0, height * 0.5, 0);
+    this.controls.enableDamping = false;
+    this.controls.addEventListener("change", () => this.requestRender());
+    new ResizeObserver(() => this.resize()).observe(container);
+    this.resize();
+  }
+
+  private instanced(geometry: THREE.BufferGeometry, count: number, nameOf: (i: number) => string): THREE.InstancedMesh {
+    const material = new THREE.MeshStandardMaterial({ roughness: 0.55, metalness: 0.05 });
+    const mesh = new THREE.InstancedMesh(geometry, material, Math.max(count, 1));
+    mesh.count = count;
+    for (let i = 0; i < count; i++) {
+      const side = sideOf(nameOf(i));
+      mesh.setColorAt(i, side === "left" ? LEFT : side === "right" ? RIGHT : CENTRE);
+    }
+    mesh.frustumCulled = false;
+    this.scene.add(mesh);
+    return mesh;
+  }
+
+  /** Show one pose: `pose` is (n_joints, 3) flattened, in the capture's units, Y up. */
+  setPose(pose: Float32Array): void {
+    const m = new THREE.Matrix4();
+    const q = new THREE.Quaternion();
+    const a = new THREE.Vector3();
+    const b = new THREE.Vector3();
+    const up = new THREE.Vector3(0, 1, 0);
+    const r = this.radius;
+    for (let j = 0; j < this.skeleton.joints.length; j++) {
+      a.fromArray(pose, j * 3);
+      m.compose(a, q.identity(), b.set(r * 1.25, r * 1.25, r * 1.25));
+      this.joints.setMatrixAt(j, m);
+    }
+    this.boneList.forEach(([p, c], i) => {
+      a.fromArray(pose, p * 3);
+      b.fromArray(pose, c * 3);
+      const length = a.distanceTo(b);
+      const mid = a.clone().add(b).multiplyScalar(0.5);
+      q.setFromUnitVectors(up, length > 1e-9 ? b.sub(a).divideScalar(length) : up);
+      m.compose(mid, q, new THREE.Vector3(length > 1e-9 ? r * 0.8 : 0, length, r * 0.8));
+      this.bones.setMatrixAt(i, m);
+    });
+    this.joints.instanceMatrix.needsUpdate = true;
+    this.bones.instanceMatrix.needsUpdate = true;
+    this.followRoot(new THREE.Vector3().fromArray(pose, 0));
+    this.requestRender();
+  }
+
+  /** Keep the root in frame by sliding camera and target with it over the floor. */
+  private followRoot(root: THREE.Vector3): void {
+    if (this.lastRoot && this.follow) {
+      const delta = root.clone().sub(this.lastRoot).setY(0);
+      this.camera.position.add(delta);
+      this.controls.target.add(delta);
+      this.controls.update();
+    } else if (!this.lastRoot) {
+      const offset = this.camera.position.clone().sub(this.controls.target);
+      this.controls.target.set(root.x, this.controls.target.y, root.z);
+      this.camera.position.copy(this.controls.target).add(offset);
+      this.controls.update();
+    }
+    this.lastRoot = root;
+  }
+
+  requestRender(): void {
+    if (this.pending) return;
+    this.pending = true;
+    requestAnimationFrame(() => {
+      this.pending = false;
+      this.renderer.render(this.scene, this.camera);
+    });
+  }
+
+  private resize(): void {
+    const { clientWidth: w, clientHeight: h } = this.container;
+    if (w === 0 || h === 0) return;
+    this.renderer.setSize(w, h, false);
+    this.canvas.style.width = "100%";
+    this.canvas.style.height = "100%";
+    this.camera.aspect = w / h;
+    this.camera.updateProjectionMatrix();
+    this.requestRender();
+  }
+
+  dispose(): void {
+    this.controls.dispose();
+    this.renderer.dispose();
+    this.canvas.remove();
+  }
+}
+
+function floor(height: number): THREE.Object3D {
+  const group = new THREE.Group();
+  const size = height * 20;
+  const grid = new THREE.GridHelper(size, 40, "#3b4556", "#262d39");
+  group.add(grid);
+  const plane = new THREE.Mesh(
+    new THREE.PlaneGeometry(size, size),
+    new THREE.MeshStandardMaterial({ color: "#1b2029", roughness: 1 }),
+  );
+  plane.rotation.x = -Math.PI / 2;
+  plane.position.y = -0.001 * height;
+  group.add(plane);
+  return group;
+}

@@ -1,0 +1,104 @@
+// Joint positions for playback, fetched in chunks (the API serves at most 5,000 frames
+// per request) into one Float32Array so a 72,000-frame take never builds JS objects
+// per frame. The chunk under the playhead comes first; the rest stream in after it.
+
+import { get } from "../api/client";
+import type { FramesResponse } from "../api/types";
+
+export const CHUNK = 5000;
+
+const LITTLE_ENDIAN = new Uint8Array(new Uint16Array([1]).buffer)[0] === 1;
+
+/** Decode the API's base64 little-endian float32 payload. */
+export function decodeFloat32(base64: string): Float32Array {
+  const binary = atob(base64);
+  const bytes = new Uint8Array(binary.length);
+  for (let i = 0; i < binary.length; i++) bytes[i] = binary.charCodeAt(i);
+  if (bytes.length % 4 !== 0) throw new Error(`Frame data is ${bytes.length} bytes, not a whole number of float32 values.`);
+  if (LITTLE_ENDIAN) return new Float32Array(bytes.buffer);
+  const view = new DataView(bytes.buffer);
+  const out = new Float32Array(bytes.length / 4);
+  for (let i = 0; i < out.length; i++) out[i] = view.getFloat32(i * 4, true);
+  return out;
+}
+
+/** Chunk ranges [start, stop) covering the take, nearest to `firstFrame` first. */
+export function planChunks(nFrames: number, firstFrame = 0, chunk = CHUNK): { start: number; stop: number }[] {
+  const ranges = [];
+  for (let start = 0; start < nFrames; start += chunk) ranges.push({ start, stop: Math.min(start + chunk, nFrames) });
+  const centre = (r: { start: number; stop: number }) =>
+    firstFrame >= r.start && firstFrame < r.stop ? -1 : Math.min(Math.abs(r.start - firstFrame), Math.abs(r.stop - 1 - firstFrame));
+  return ranges.sort((a, b) => centre(a) - centre(b) || a.start - b.start);
+}
+
+export class FrameStore {
+  readonly positions: Float32Array;
+  private readonly loaded: Uint8Array;
+  loadedFrames = 0;
+  error: string | null = null;
+
+  constructor(
+    readonly nFrames: number,
+    readonly nJoints: number,
+  ) {
+    this.positions = new Float32Array(nFrames * nJoints * 3);
+    this.loaded = new Uint8Array(nFrames);
+  }
+
+  has(frame: number): boolean {
+    return this.loaded[frame] === 1;
+  }
+
+  /** Positions of one frame, (n_joints, 3) flattened; a view, not a copy. */
+  pose(frame: number): Float32Array {
+    const size = this.nJoints * 3;
+    return this.positions.subarray(frame * size, (frame + 1) * size);
+  }
+
+  /** The nearest loaded frame at or before `frame` (so playback shows something while loading). */
+  nearestLoaded(frame: number): number | null {
+    for (let f = frame; f >= 0; f--) if (this.loaded[f]) return f;
+    for (let f = frame + 1; f < this.nFrames; f++) if (this.loaded[f]) return f;
+    return null;
+  }
+
+  put(response: FramesResponse): void {
+    const values = decodeFloat32(response.data);
+    const count = response.n_frames;
+    const size = this.nJoints * 3;
+    if (response.n_joints !== this.nJoints || values.length !== count * size) {
+      throw new Error(
+        `Frames ${response.start}–${response.stop}: expected ${count} × ${this.nJoints} joints × 3 values, got ${values.length}.`,
+      );
+    }
+    for (let i = 0; i < count; i++) {
+      const frame = response.start + i * (response.step || 1);
+      if (frame >= this.nFrames) break;
+      this.positions.set(values.subarray(i * size, (i + 1) * size), frame * size);
+      if (!this.loaded[frame]) this.loadedFrames++;
+      this.loaded[frame] = 1;
+    }
+  }
+}
+
+/**
+ * Fill `store` chunk by chunk, two requests in flight (the server is small), calling
+ * `onChunk` after each so the player and progress bar can update.
+ */
+export async function loadFrames(captureId: number, store: FrameStore, firstFrame: number, onChunk: () => void, signal?: AbortSignal): Promise<void> {
+  const queue = planChunks(store.nFrames, firstFrame);
+  const worker = async () => {
+    for (let range = queue.shift(); range && !signal?.aborted; range = queue.shift()) {
+      const response = await get<FramesResponse>(`/api/captures/${captureId}/frames/?start=${range.start}&stop=${range.stop}&step=1`);
+      if (signal?.aborted) return;
+      store.put(response);
+      onChunk();
+    }
+  };
+  try {
+    await Promise.all([worker(), worker()]);
+  } catch (err) {
+    store.error = err instanceof Error ? err.message : String(err);
+    onChunk();
+  }
+}

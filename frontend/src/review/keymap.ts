@@ -1,0 +1,93 @@
+// Keyboard-first editing: one table maps keys to commands, and the "?" overlay is drawn
+// from the same table so the help can never disagree with the behaviour.
+
+export type Command =
+  | { kind: "play" }
+  | { kind: "step"; frames: number }
+  | { kind: "jump"; direction: -1 | 1 }
+  | { kind: "accept" }
+  | { kind: "delete" }
+  | { kind: "insert" }
+  | { kind: "label"; hotkey: string }
+  | { kind: "clearLabel" }
+  | { kind: "undo" }
+  | { kind: "redo" }
+  | { kind: "loop" }
+  | { kind: "speed"; direction: -1 | 1 }
+  | { kind: "zoom"; factor: number }
+  | { kind: "home" }
+  | { kind: "end" }
+  | { kind: "help" }
+  | { kind: "escape" };
+
+export interface KeyInput {
+  key: string;
+  shiftKey: boolean;
+  ctrlKey: boolean;
+  metaKey: boolean;
+  altKey: boolean;
+}
+
+export function commandFor(e: KeyInput): Command | null {
+  const mod = e.ctrlKey || e.metaKey;
+  const key = e.key.length === 1 ? e.key.toLowerCase() : e.key;
+  if (mod && key === "z") return e.shiftKey ? { kind: "redo" } : { kind: "undo" };
+  if (mod && key === "y") return { kind: "redo" };
+  if (mod || e.altKey) return null;
+  if (key === "ArrowLeft") return e.shiftKey ? { kind: "jump", direction: -1 } : { kind: "step", frames: -1 };
+  if (key === "ArrowRight") return e.shiftKey ? { kind: "jump", direction: 1 } : { kind: "step", frames: 1 };
+  if (/^[1-9]$/.test(key)) return { kind: "label", hotkey: key };
+  if (key === "0" || key === "Backspace") return { kind: "clearLabel" };
+  return SIMPLE[e.shiftKey ? `shift+${key}` : key] ?? SIMPLE[key] ?? null;
+}
+
+const SIMPLE: Record<string, Command> = {
+  " ": { kind: "play" },
+  a: { kind: "accept" },
+  d: { kind: "delete" },
+  Delete: { kind: "delete" },
+  i: { kind: "insert" },
+  z: { kind: "undo" },
+  "shift+z": { kind: "redo" },
+  l: { kind: "loop" },
+  "[": { kind: "speed", direction: -1 },
+  "]": { kind: "speed", direction: 1 },
+  "=": { kind: "zoom", factor: 1 / 1.5 },
+  "+": { kind: "zoom", factor: 1 / 1.5 },
+  "-": { kind: "zoom", factor: 1.5 },
+  ",": { kind: "step", frames: -10 },
+  ".": { kind: "step", frames: 10 },
+  Home: { kind: "home" },
+  End: { kind: "end" },
+  "?": { kind: "help" },
+  Escape: { kind: "escape" },
+};
+
+/** Rows of the "?" overlay: keys, then what they do. */
+export const HELP: [string, string][] = [
+  ["Space", "play / pause"],
+  ["← / →", "previous / next frame"],
+  [", / .", "10 frames back / forward"],
+  ["Shift + ← / →", "jump to previous / next cut"],
+  ["Home / End", "first / last frame"],
+  ["A", "accept the selected candidate"],
+  ["D or Delete", "delete the selected cut"],
+  ["I", "insert a cut at the playhead"],
+  ["1 – 9", "label the segment under the playhead"],
+  ["0 or Backspace", "clear that segment's label"],
+  ["Z or Ctrl+Z", "undo"],
+  ["Shift+Z or Ctrl+Shift+Z", "redo"],
+  ["L", "loop the segment under the playhead"],
+  ["[ / ]", "slower / faster"],
+  ["+ / −, wheel", "zoom the timeline (Shift+wheel pans)"],
+  ["Click a dashed cut", "accept it · drag any cut to move it"],
+  ["Double-click", "insert a cut there"],
+  ["?", "show / hide this help"],
+];
+
+/** Keys typed into a form field belong to the field, not to the editor. */
+export function isTypingTarget(target: EventTarget | null): boolean {
+  const el = target as HTMLElement | null;
+  if (!el || !el.tagName) return false;
+  return el.isContentEditable || ["INPUT", "TEXTAREA", "SELECT"].includes(el.tagName);
+}

@@ -1,0 +1,86 @@
+// Sends edits to the server one at a time, each carrying the version of the review the
+// server last returned. Edits are never merged or retried blindly: on a 409 the queue is
+// dropped, the caller is told which edits were not saved, and the server's review wins.
+
+import { api, ApiError, get } from "../api/client";
+import type { Review } from "../api/types";
+import { editRequest, findInsertedId, labelRequest, type Edit } from "./state";
+
+export interface SaverEvents {
+  saved(review: Review, idle: boolean, renamed: Map<number, number>): void;
+  conflict(current: Review, unsaved: string[], message: string): void;
+  failed(current: Review | null, unsaved: string[], message: string): void;
+  busy(pending: number): void;
+}
+
+export class Saver {
+  private queue: { edit: Edit; title: string }[] = [];
+  private running = false;
+  private readonly ids = new Map<number, number>();
+
+  constructor(
+    private readonly captureId: number,
+    public server: Review,
+    private readonly events: SaverEvents,
+  ) {}
+
+  get pending(): number {
+    return this.queue.length;
+  }
+
+  /** Server id of a cut we inserted under a temporary negative id. */
+  readonly resolve = (id: number): number => (id < 0 ? (this.ids.get(id) ?? id) : id);
+
+  push(edits: Edit[], title: string): void {
+    for (const edit of edits) this.queue.push({ edit, title });
+    this.events.busy(this.queue.length);
+    if (!this.running) void this.pump();
+  }
+
+  private async pump(): Promise<void> {
+    this.running = true;
+    while (this.queue.length) {
+      const { edit } = this.queue[0];
+      try {
+        const request =
+          edit.kind === "label"
+            ? labelRequest(this.captureId, this.server, edit, this.server.version)
+            : editRequest(this.captureId, edit, this.server.version, this.resolve);
+        const next = await api<Review>(request.method, request.url, request.body);
+        const renamed = new Map<number, number>();
+        if (edit.kind === "insert") {
+          const id = findInsertedId(this.server, next, edit.frame);
+          if (id !== undefined) {
+            this.ids.set(edit.tempId, id);
+            renamed.set(edit.tempId, id);
+          }
+        }
+        this.server = next;
+        this.queue.shift();
+        this.events.saved(next, this.queue.length === 0, renamed);
+      } catch (err) {
+        await this.abandon(err);
+      }
+    }
+    this.running = false;
+    this.events.busy(0);
+  }
+
+  private async abandon(err: unknown): Promise<void> {
+    const unsaved = [...new Set(this.queue.map((q) => q.title))];
+    this.queue = [];
+    const message = err instanceof Error ? err.message : String(err);
+    const body = err instanceof ApiError ? (err.body as { review?: Review } | null) : null;
+    if (err instanceof ApiError && err.status === 409 && body?.review) {
+      this.server = body.review;
+      this.events.conflict(body.review, unsaved, message);
+      return;
+    }
+    try {
+      this.server = await get<Review>(`/api/captures/${this.captureId}/review/`);
+      this.events.failed(this.server, unsaved, message);
+    } catch {
+      this.events.failed(null, unsaved, message);
+    }
+  }
+}

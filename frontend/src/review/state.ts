@@ -1,0 +1,171 @@
+// The review being edited, as pure functions over the API's `Review` shape.
+// The page applies an edit here at once (so the screen answers immediately) and sends the
+// same edit to the server; the server's answer then replaces the prediction.
+
+import type { Cut, Fate, Review, Segment } from "../api/types";
+
+export type Edit =
+  | { kind: "fate"; cutId: number; fate: "accepted" | "deleted" | "pending" }
+  | { kind: "move"; cutId: number; frame: number }
+  | { kind: "insert"; frame: number; tempId: number }
+  | { kind: "label"; start: number; stop: number; label: string | null };
+
+export class EditError extends Error {}
+
+/**
+ * A cut that is still on the timeline and bounds segments. docs/api.md counts every cut
+ * that is not deleted, so a pending candidate splits segments until it is deleted.
+ */
+export const isKept = (cut: Cut): boolean => cut.fate !== "deleted";
+
+export function clampFrame(frame: number, nFrames: number): number {
+  return Math.min(Math.max(Math.round(frame), 0), Math.max(nFrames - 1, 0));
+}
+
+/** Visible cuts sorted by frame (ties by id so the order is stable). */
+export function sortedCuts(cuts: readonly Cut[]): Cut[] {
+  return cuts.filter(isKept).sort((a, b) => a.frame - b.frame || a.id - b.id);
+}
+
+/**
+ * Segments between kept cuts: the first starts at 0, the last stops at `nFrames`
+ * (exclusive). A new segment takes the label of the old segment that held its middle,
+ * which keeps labels in place when a cut moves or a segment is split.
+ */
+export function deriveSegments(cuts: readonly Cut[], nFrames: number, previous: readonly Segment[] = []): Segment[] {
+  const inner = cuts.filter((c) => isKept(c) && c.frame > 0 && c.frame < nFrames).map((c) => c.frame);
+  const bounds = [0, ...new Set(inner.sort((a, b) => a - b)), nFrames];
+  const segments: Segment[] = [];
+  for (let i = 0; i + 1 < bounds.length; i++) {
+    const start = bounds[i];
+    const stop = bounds[i + 1];
+    const exact = previous.find((s) => s.start === start && s.stop === stop);
+    const middle = (start + stop - 1) / 2;
+    const holder = exact ?? previous.find((s) => s.start <= middle && middle < s.stop);
+    segments.push({ index: i, start, stop, label: holder?.label ?? null });
+  }
+  return segments;
+}
+
+export function segmentAt(segments: readonly Segment[], frame: number): Segment | undefined {
+  return segments.find((s) => s.start <= frame && frame < s.stop) ?? segments[segments.length - 1];
+}
+
+/** The nearest visible cut strictly before (`direction` -1) or after (+1) `frame`. */
+export function neighbourCut(cuts: readonly Cut[], frame: number, direction: -1 | 1): Cut | undefined {
+  const sorted = sortedCuts(cuts);
+  if (direction > 0) return sorted.find((c) => c.frame > frame);
+  return [...sorted].reverse().find((c) => c.frame < frame);
+}
+
+/** Predict the server's answer to `edit`; throws `EditError` for an edit it would refuse. */
+export function applyEdit(review: Review, edit: Edit, nFrames: number): Review {
+  const cuts = review.cuts.map((c) => ({ ...c }));
+  if (edit.kind === "label") {
+    const segments = review.segments.map((s) =>
+      s.start === edit.start && s.stop === edit.stop ? { ...s, label: edit.label } : s,
+    );
+    if (!review.segments.some((s) => s.start === edit.start && s.stop === edit.stop)) {
+      throw new EditError(`No segment ${edit.start}–${edit.stop} to label.`);
+    }
+    return { ...review, segments };
+  }
+  if (edit.kind === "insert") {
+    checkInsert(review.cuts, edit.frame, nFrames);
+    cuts.push({ id: edit.tempId, origin: "inserted", fate: "accepted", candidate_frame: null, frame: edit.frame, confidence: null });
+  } else {
+    const cut = cuts.find((c) => c.id === edit.cutId);
+    if (!cut) throw new EditError(`Cut ${edit.cutId} is not in this review.`);
+    if (edit.kind === "fate") cut.fate = edit.fate;
+    else moveCut(cut, cuts, edit.frame, nFrames);
+  }
+  return { ...review, cuts, segments: deriveSegments(cuts, nFrames, review.segments) };
+}
+
+function checkInsert(cuts: readonly Cut[], frame: number, nFrames: number): void {
+  if (!Number.isInteger(frame) || frame <= 0 || frame >= nFrames) {
+    throw new EditError(`A cut must lie inside the take (1–${nFrames - 1}), not at frame ${frame}.`);
+  }
+  if (cuts.some((c) => isKept(c) && c.frame === frame)) {
+    throw new EditError(`There is already a cut at frame ${frame}.`);
+  }
+}
+
+function moveCut(cut: Cut, cuts: readonly Cut[], frame: number, nFrames: number): void {
+  if (cut.fate === "deleted") throw new EditError(`Cut at frame ${cut.frame} is deleted; restore it before moving it.`);
+  if (!Number.isInteger(frame) || frame <= 0 || frame >= nFrames) {
+    throw new EditError(`A cut must lie inside the take (1–${nFrames - 1}), not at frame ${frame}.`);
+  }
+  if (cuts.some((c) => c.id !== cut.id && isKept(c) && c.frame === frame)) {
+    throw new EditError(`There is already a cut at frame ${frame}.`);
+  }
+  cut.frame = frame;
+  cut.fate = "moved";
+}
+
+export interface Request {
+  method: "POST" | "PATCH";
+  url: string;
+  body: Record<string, unknown>;
+}
+
+/** The API call for `edit` (docs/api.md, "Reviews"); `resolveId` maps local ids to server ids. */
+export function editRequest(captureId: number, edit: Edit, version: number, resolveId: (id: number) => number): Request {
+  const base = `/api/captures/${captureId}/review`;
+  switch (edit.kind) {
+    case "insert":
+      return { method: "POST", url: `${base}/cuts/`, body: { frame: edit.frame, version } };
+    case "fate":
+      return { method: "PATCH", url: `${base}/cuts/${resolveId(edit.cutId)}/`, body: { fate: edit.fate, version } };
+    case "move":
+      return { method: "PATCH", url: `${base}/cuts/${resolveId(edit.cutId)}/`, body: { frame: edit.frame, version } };
+    case "label":
+      throw new EditError("A label edit needs the segment index: use labelRequest.");
+  }
+}
+
+/** Label requests name the segment by its index in the review the server holds now. */
+export function labelRequest(captureId: number, review: Review, edit: Extract<Edit, { kind: "label" }>, version: number): Request {
+  const segment = review.segments.find((s) => s.start === edit.start && s.stop === edit.stop);
+  if (!segment) throw new EditError(`Segment ${edit.start}–${edit.stop} no longer exists.`);
+  return {
+    method: "PATCH",
+    url: `/api/captures/${captureId}/review/segments/${segment.index}/`,
+    body: { label: edit.label, version },
+  };
+}
+
+/** The id the server gave to a cut we inserted: the one new kept cut at that frame. */
+export function findInsertedId(before: Review, after: Review, frame: number): number | undefined {
+  const known = new Set(before.cuts.map((c) => c.id));
+  return after.cuts.find((c) => !known.has(c.id) && c.frame === frame)?.id;
+}
+
+export const FATE_TEXT: Record<Fate, string> = {
+  pending: "candidate",
+  accepted: "accepted",
+  moved: "moved",
+  deleted: "deleted",
+};
+
+/** What differs between the review we showed and the server's current one, in words. */
+export function describeDifferences(mine: Review, theirs: Review): string[] {
+  const lines: string[] = [];
+  const theirCuts = new Map(theirs.cuts.map((c) => [c.id, c]));
+  const myCuts = new Map(mine.cuts.map((c) => [c.id, c]));
+  for (const cut of theirs.cuts) {
+    const old = myCuts.get(cut.id);
+    if (!old) lines.push(`cut at frame ${cut.frame} was added (${FATE_TEXT[cut.fate]})`);
+    else if (old.frame !== cut.frame) lines.push(`cut at frame ${old.frame} is now at frame ${cut.frame}`);
+    else if (old.fate !== cut.fate) lines.push(`cut at frame ${cut.frame} is ${FATE_TEXT[cut.fate]}, not ${FATE_TEXT[old.fate]}`);
+  }
+  for (const cut of mine.cuts) {
+    if (!theirCuts.has(cut.id) && cut.id > 0) lines.push(`cut at frame ${cut.frame} no longer exists`);
+  }
+  for (const s of theirs.segments) {
+    const old = mine.segments.find((o) => o.start === s.start && o.stop === s.stop);
+    if (old && old.label !== s.label) lines.push(`segment ${s.start}–${s.stop} is labelled ${s.label ?? "nothing"}, not ${old.label ?? "nothing"}`);
+  }
+  if (mine.status !== theirs.status) lines.push(`the review is now ${theirs.status.replace("_", " ")}`);
+  return lines;
+}

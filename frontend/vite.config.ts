@@ -1,0 +1,23 @@
+import { defineConfig } from "vitest/config";
+
+// Django serves the built files under /static/ (WhiteNoise) and index.html itself,
+// so every asset URL must start with /static/.
+export default defineConfig({
+  base: "/static/",
+  build: {
+    outDir: "dist",
+    emptyOutDir: true,
+    chunkSizeWarningLimit: 900,
+  },
+  server: {
+    proxy: {
+      "/api": "http://127.0.0.1:8000",
+      "/login": "http://127.0.0.1:8000",
+      "/logout": "http://127.0.0.1:8000",
+    },
+  },
+  test: {
+    include: ["tests/**/*.test.ts"],
+    environment: "node",
+  },
+});
