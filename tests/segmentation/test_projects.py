@@ -1,0 +1,39 @@
+from segmentation.models import Membership
+from tests.segmentation.base import BaseTestCase
+
+
+class ProjectsTestCase(BaseTestCase):
+    def test_it_lists_only_the_callers_projects_with_role_and_labels(self):
+        self.login(self.bob)
+        projects = self.client.get("/api/projects/").json()
+        self.assertEqual([p["name"] for p in projects], ["Studio A"])
+        self.assertEqual(projects[0]["role"], "annotator")
+        self.assertEqual(
+            projects[0]["labels"][0], {"id": self.walk.pk, "name": "walk", "color": "#2563eb", "hotkey": "1"}
+        )
+
+    def test_it_makes_the_creator_admin(self):
+        self.login(self.bob)
+        r = self.client.post("/api/projects/", {"name": "Bob's own"}, format="json")
+        self.assertEqual(r.status_code, 201)
+        self.assertEqual(Membership.objects.get(project_id=r.json()["id"], user=self.bob).role, "admin")
+
+    def test_it_refuses_garbage_default_params(self):
+        self.login(self.bob)
+        r = self.client.post(
+            "/api/projects/", {"name": "x", "default_method": "bone_angle", "default_params": {"param": 7}},
+            format="json",
+        )
+        self.assertEqual(r.status_code, 400)
+        self.assertIn("param", r.json()["params"])
+
+    def test_outsider_gets_404(self):
+        self.login(self.charlie)
+        self.assertEqual(self.client.get(f"/api/projects/{self.project.pk}/").status_code, 404)
+        self.assertEqual(self.client.get(f"/api/projects/{self.project.pk}/labels/").status_code, 404)
+
+    def test_me_lists_memberships(self):
+        self.login(self.rachel)
+        me = self.client.get("/api/me/").json()
+        self.assertEqual(me["username"], "rachel")
+        self.assertEqual(me["projects"], [{"id": self.project.pk, "name": "Studio A", "role": "reviewer"}])
