@@ -154,6 +154,8 @@ CUTROOM_FRAMES_PER_REQUEST = 5000
 CELERY_BROKER_URL = os.environ.get("CELERY_BROKER_URL") or "filesystem://"
 CELERY_BROKER_DIR = Path(os.environ.get("CELERY_BROKER_DIR") or VAR_DIR / "broker")
 CELERY_TASK_IGNORE_RESULT = True
+# Separate deployments (or test sessions) can share one Redis by using their own queue.
+CELERY_TASK_DEFAULT_QUEUE = os.environ.get("CELERY_QUEUE") or "celery"
 # A job is acknowledged only once it finished and is given back if its worker dies, so a
 # killed worker never loses an upload; the claim on the row stops double work.
 CELERY_TASK_ACKS_LATE = True

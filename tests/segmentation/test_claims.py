@@ -1,0 +1,84 @@
+from django.test import override_settings
+from django.utils import timezone
+
+from segmentation import services, tasks
+from segmentation.models import Capture, DetectionRun
+from tests.segmentation.base import BaseTestCase
+
+
+class ClaimsTestCase(BaseTestCase):
+    """Background jobs claim their row; a second delivery of the same job does nothing."""
+
+    def setUp(self):
+        super().setUp()
+        self.capture = self.ready_capture()
+        Capture.objects.filter(pk=self.capture.pk).update(status="queued")
+
+    def test_only_one_claim_wins(self):
+        self.assertTrue(Capture.objects.claim(self.capture.pk, "first"))
+        self.assertFalse(Capture.objects.claim(self.capture.pk, "second"))
+        self.assertEqual(Capture.objects.get(pk=self.capture.pk).claim_token, "first")
+
+    def test_the_same_job_redelivered_after_its_worker_died_reclaims(self):
+        Capture.objects.claim(self.capture.pk, "job-1")
+        self.assertTrue(Capture.objects.claim(self.capture.pk, "job-1"))
+        self.assertEqual(Capture.objects.get(pk=self.capture.pk).attempts, 2)
+
+    @override_settings(CUTROOM_CLAIM_TIMEOUT=60)
+    def test_a_stale_claim_can_be_taken_over(self):
+        Capture.objects.claim(self.capture.pk, "lost")
+        Capture.objects.filter(pk=self.capture.pk).update(
+            claimed_at=timezone.now() - timezone.timedelta(seconds=61)
+        )
+        self.assertTrue(Capture.objects.claim(self.capture.pk, "rescuer"))
+
+    def test_a_finished_job_is_never_claimed_again(self):
+        Capture.objects.filter(pk=self.capture.pk).update(status="ready")
+        self.assertFalse(Capture.objects.claim(self.capture.pk, "late"))
+
+    def test_a_worker_that_lost_its_claim_cannot_store_its_result(self):
+        Capture.objects.claim(self.capture.pk, "slow")
+        slow = Capture.objects.get(pk=self.capture.pk)
+        Capture.objects.filter(pk=self.capture.pk).update(claim_token="fast", status="ready")
+        self.assertFalse(slow.fail("too late"))
+        self.assertEqual(Capture.objects.get(pk=self.capture.pk).error, "")
+
+    @override_settings(CUTROOM_MAX_ATTEMPTS=2)
+    def test_a_job_that_keeps_killing_its_worker_is_marked_failed(self):
+        Capture.objects.filter(pk=self.capture.pk).update(status="processing", attempts=2, claim_token="x")
+        tasks.ingest.apply(args=[self.capture.pk], task_id="x")
+        capture = Capture.objects.get(pk=self.capture.pk)
+        self.assertEqual(capture.status, "failed")
+        self.assertIn("started 3 times and never finished", capture.error)
+        self.assertIn("original upload is kept", capture.error)
+        self.assertTrue(capture.original.storage.exists(capture.original.name))
+
+
+class SweepTestCase(BaseTestCase):
+    def setUp(self):
+        super().setUp()
+        self.capture = self.ready_capture()
+        self.run = self.capture.runs.get()
+        old = timezone.now() - timezone.timedelta(hours=2)
+        DetectionRun.objects.filter(pk=self.run.pk).update(
+            status="processing", claim_token="dead", claimed_at=old, attempts=1
+        )
+
+    def test_it_requeues_a_job_whose_worker_vanished(self):
+        with self.captureOnCommitCallbacks() as callbacks:
+            self.assertEqual(services.sweep_stale_claims(), 1)
+        self.assertEqual(DetectionRun.objects.get(pk=self.run.pk).status, "queued")
+        self.assertEqual(len(callbacks), 1)
+
+    @override_settings(CUTROOM_MAX_ATTEMPTS=1)
+    def test_it_fails_a_stale_job_that_used_up_its_attempts(self):
+        services.sweep_stale_claims()
+        run = DetectionRun.objects.get(pk=self.run.pk)
+        self.assertEqual(run.status, "failed")
+        self.assertIn("never finished", run.error)
+        self.assertIsNotNone(run.finished_at)
+
+    def test_it_leaves_a_fresh_claim_alone(self):
+        DetectionRun.objects.filter(pk=self.run.pk).update(claimed_at=timezone.now())
+        self.assertEqual(services.sweep_stale_claims(), 0)
+        self.assertEqual(DetectionRun.objects.get(pk=self.run.pk).status, "processing")
