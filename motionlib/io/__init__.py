@@ -1,0 +1,47 @@
+"""Reading and writing capture files: BVH and CMU ASF/AMC."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+from motionlib.errors import CaptureError
+from motionlib.io.asf_amc import read_amc, read_asf
+from motionlib.io.bvh import read_bvh, write_bvh
+from motionlib.take import Take
+
+__all__ = ["read", "read_amc", "read_asf", "read_bvh", "write_bvh"]
+
+
+def read(path: str | os.PathLike, *, asf: str | os.PathLike | None = None) -> Take:
+    """Read a capture: BVH by its ``.bvh`` extension, CMU ``.amc`` with its ``asf`` skeleton.
+
+    Parameters
+    ----------
+    path : str or PathLike
+    asf : str or PathLike, optional
+        Required for ``.amc``.
+
+    Returns
+    -------
+    Take
+
+    Raises
+    ------
+    CaptureError
+        Unknown extension, missing file, missing ``asf``, or any problem inside the files
+        (the message names the file and line).
+    """
+    path = os.fspath(path)
+    suffix = Path(path).suffix.lower()
+    if suffix not in (".bvh", ".amc"):
+        raise CaptureError(f"unknown capture format {suffix or '(no extension)'!r}; "
+                           "expected .bvh, or .amc with its .asf", path=path)
+    for p in (path, asf):
+        if p is not None and not Path(p).is_file():
+            raise CaptureError("no such file", path=p)
+    if suffix == ".bvh":
+        return read_bvh(path)
+    if asf is None:
+        raise CaptureError("an .amc motion needs its .asf skeleton (asf=...)", path=path)
+    return read_amc(path, asf)

@@ -1,0 +1,38 @@
+"""Domain errors of motionlib.
+
+Every error a caller can act on is a :class:`CaptureError`, a ``ValueError`` whose message names
+the file, the line and what was wrong, e.g. ``13_29.bvh:190: expected 96 values, found 95``.
+"""
+
+from __future__ import annotations
+
+import os
+
+
+class CaptureError(ValueError):
+    """A capture file (or a take built from one) cannot be used as it is.
+
+    Parameters
+    ----------
+    message : str
+        What was wrong, naming the offending value.
+    path : str or os.PathLike, optional
+        The file at fault; shown by its name.
+    line : int, optional
+        1-based line number in that file.
+    """
+
+    def __init__(self, message: str, *, path: str | os.PathLike | None = None,
+                 line: int | None = None):
+        self.reason = message
+        self.path = None if path is None else os.fspath(path)
+        self.line = line
+        super().__init__(self._format())
+
+    def _format(self) -> str:
+        if self.path is None:
+            return self.reason
+        where = os.path.basename(self.path) or self.path
+        if self.line is not None:
+            where = f"{where}:{self.line}"
+        return f"{where}: {self.reason}"

@@ -1,0 +1,197 @@
+"""Euler angles to rotation matrices and forward kinematics over all frames at once.
+
+Conventions (BVH): column vectors, a joint's rotation channels compose in the order they are
+listed (``Zrotation Yrotation Xrotation`` gives ``R = Rz @ Ry @ Rx``), and a child sits at
+``parent position + parent global rotation @ offset``. Angles are degrees.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+_AXIS = {"X": 0, "Y": 1, "Z": 2}
+# Columns mixed by a right-multiplied rotation about each axis: G @ R_axis(θ).
+_MIXED = {0: (1, 2), 1: (2, 0), 2: (0, 1)}
+
+
+def rotate_columns(G: np.ndarray, axis: int, angle_deg: np.ndarray) -> None:
+    """In place ``G <- G @ R_axis(angle)`` for a stack of matrices.
+
+    Mixing two columns costs a handful of vector operations, far less than a batched 3x3
+    matmul, which is why forward kinematics composes rotations this way.
+
+    Parameters
+    ----------
+    G : ndarray, shape (n, 3, 3)
+    axis : {0, 1, 2}
+        X, Y or Z.
+    angle_deg : ndarray, shape (n,)
+    """
+    theta = np.deg2rad(angle_deg)[:, None]
+    c, s = np.cos(theta), np.sin(theta)
+    i, k = _MIXED[axis]
+    gi = G[:, :, i].copy()
+    gk = G[:, :, k]
+    G[:, :, i] = gi * c + gk * s
+    G[:, :, k] = gk * c - gi * s
+
+
+def euler_to_matrix(angles_deg: np.ndarray, order: str) -> np.ndarray:
+    """Rotation matrices from Euler angles.
+
+    Parameters
+    ----------
+    angles_deg : ndarray, shape (n, len(order))
+        Angles in degrees, column k about axis ``order[k]``.
+    order : str
+        Composition order, e.g. ``"ZYX"`` for ``R = Rz @ Ry @ Rx``.
+
+    Returns
+    -------
+    ndarray, shape (n, 3, 3)
+    """
+    angles_deg = np.asarray(angles_deg, dtype=np.float64).reshape(-1, len(order))
+    R = np.broadcast_to(np.eye(3), (len(angles_deg), 3, 3)).copy()
+    for k, axis in enumerate(order):
+        rotate_columns(R, _AXIS[axis], angles_deg[:, k])
+    return R
+
+
+def matrix_to_euler_zyx(R: np.ndarray) -> np.ndarray:
+    """Euler angles ``(z, y, x)`` in degrees with ``R = Rz @ Ry @ Rx``.
+
+    Parameters
+    ----------
+    R : ndarray, shape (n, 3, 3)
+
+    Returns
+    -------
+    ndarray, shape (n, 3)
+        Columns z, y, x; y in [-90, 90]. At y = ±90 (gimbal lock) x is set to 0 and z carries
+        the whole remaining rotation, so the matrix is still reproduced exactly.
+    """
+    sy = np.clip(-R[:, 2, 0], -1.0, 1.0)
+    y = np.arcsin(sy)
+    locked = np.abs(sy) > 1 - 1e-12
+    z = np.where(locked, np.arctan2(-R[:, 0, 1], R[:, 1, 1]), np.arctan2(R[:, 1, 0], R[:, 0, 0]))
+    x = np.where(locked, 0.0, np.arctan2(R[:, 2, 1], R[:, 2, 2]))
+    return np.rad2deg(np.stack([z, y, x], axis=1))
+
+
+def _joint_columns(skeleton):
+    """Per joint: (translation columns by axis, rotation columns in composition order)."""
+    starts = skeleton.channel_starts
+    layout = []
+    for j, names in enumerate(skeleton.channels):
+        col = {name: starts[j] + k for k, name in enumerate(names)}
+        trans = [col.get(f"{a}position") for a in "XYZ"]
+        rots = [(_AXIS[a], col[f"{a}rotation"]) for a in skeleton.rotation_orders[j]
+                if f"{a}rotation" in col]
+        layout.append((trans, rots))
+    return layout
+
+
+def _local_translation(offset, trans_cols, channels):
+    if all(c is None for c in trans_cols):
+        return offset
+    # Position channels replace the offset component they name (BVH root convention).
+    t = np.repeat(offset[None, :], len(channels), axis=0)
+    for a, c in enumerate(trans_cols):
+        if c is not None:
+            t[:, a] = channels[:, c]
+    return t
+
+
+def _apply(G: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """``G @ v`` for a stack of matrices and one vector (3,) or one vector per frame (n, 3)."""
+    if v.ndim == 1:
+        return G @ v
+    return np.einsum("nij,nj->ni", G, v)
+
+
+def forward_kinematics(take, channels: np.ndarray | None = None) -> np.ndarray:
+    """World positions of every joint in every frame.
+
+    Parameters
+    ----------
+    take : Take
+        Its skeleton gives offsets, channel layout, rotation orders and (ASF) axes.
+    channels : ndarray, shape (n_frames, n_channels), optional
+        Channel values to use instead of ``take.channels`` (rotations in degrees).
+
+    Returns
+    -------
+    positions : ndarray of float64, shape (n_frames, n_joints, 3)
+        In the file's length unit, Y up. Joint j's position is the point it rotates about (for
+        an ASF bone, the start of the bone).
+
+    Notes
+    -----
+    Vectorised over frames; the only Python loop is over joints. A joint's global rotation is
+    kept only until its last child has used it, which bounds memory by the tree's depth.
+    """
+    skeleton = take.skeleton
+    channels = take.channels if channels is None else np.asarray(channels, dtype=np.float64)
+    n, J = channels.shape[0], skeleton.n_joints
+    positions = np.empty((n, J, 3))
+    last_child = {int(p): j for j, p in enumerate(skeleton.parents) if p >= 0}
+    glob: dict[int, np.ndarray] = {}
+    for j, (trans_cols, rots) in enumerate(_joint_columns(skeleton)):
+        p = int(skeleton.parents[j])
+        t = _local_translation(skeleton.offsets[j], trans_cols, channels)
+        if p < 0:
+            positions[:, j] = t
+            G = np.broadcast_to(np.eye(3), (n, 3, 3)).copy()
+        else:
+            positions[:, j] = positions[:, p] + _apply(glob[p], t)
+            G = glob[p].copy()
+        if j in last_child:  # leaves need no rotation of their own
+            glob[j] = _rotate(G, rots, channels, skeleton.axes, j)
+        if p >= 0 and last_child[p] == j:
+            del glob[p]
+    return positions
+
+
+def _rotate(G, rots, channels, axes, j):
+    """``G @ C @ R(channels) @ C.T`` with C the ASF axis frame (identity for BVH)."""
+    if axes is not None:
+        G = G @ axes[j]
+    for axis, col in rots:
+        rotate_columns(G, axis, channels[:, col])
+    if axes is not None:
+        G = G @ axes[j].T
+    return G
+
+
+def rest_positions(take) -> np.ndarray:
+    """Joint and End Site positions with every channel at zero, shape (n_joints + n_ends, 3)."""
+    skeleton = take.skeleton
+    zero = np.zeros((1, skeleton.n_channels))
+    joints = forward_kinematics(take, zero)[0]
+    # At rest every global rotation is the identity (ASF: C @ I @ C.T), so ends are plain sums.
+    ends = [joints[j] + off for j, off in skeleton.end_sites.items()]
+    return np.vstack([joints, *ends]) if ends else joints
+
+
+def skeleton_height(take_or_positions) -> float:
+    """Head-to-toe height, a scale for tolerances.
+
+    Parameters
+    ----------
+    take_or_positions : Take or ndarray of shape (n_frames, n_joints, 3)
+        A take: the vertical (Y) extent of its rest pose, End Sites included. Positions: the
+        median over frames of each frame's vertical extent.
+
+    Returns
+    -------
+    float
+        In the file's length unit.
+    """
+    if hasattr(take_or_positions, "skeleton"):
+        y = rest_positions(take_or_positions)[:, 1]
+        return float(y.max() - y.min())
+    positions = np.asarray(take_or_positions, dtype=np.float64)
+    if positions.ndim != 3 or positions.shape[-1] != 3 or positions.shape[0] == 0:
+        raise ValueError(f"positions must have shape (n_frames, n_joints, 3), got {positions.shape}")
+    y = positions[..., 1]
+    return float(np.median(y.max(axis=1) - y.min(axis=1)))
