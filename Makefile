@@ -40,8 +40,15 @@ lint: install
 vitest: $(FRONT_STAMP)
 	cd frontend && npm test
 
+# Everything but the integration tests on the embedded default (SQLite), then the
+# integration tests against PostgreSQL + Redis + real Celery workers, last so that the
+# final line is that run's summary.
+INTEGRATION_ENV := DATABASE_URL=postgres://postgres@127.0.0.1:5432/test \
+	CELERY_BROKER_URL=redis://127.0.0.1:6379/15
+
 pytest: install
-	$(PY) -m pytest
+	$(PY) -m pytest -m "not integration"
+	$(INTEGRATION_ENV) $(PY) -m pytest -m integration
 
 bench: install
 	$(PY) -m motionlib.bench io
