@@ -9,8 +9,10 @@ from __future__ import annotations
 from motionlib.segmenters.base import Param, ParamError, Segmentation, Segmenter
 from motionlib.segmenters.bone_angle import BoneAngle
 from motionlib.segmenters.default import Default
+from motionlib.segmenters.joint_distance_pca import JointDistancePCA
+from motionlib.segmenters.ppca import PPCA
 
-_REGISTRY: dict[str, type[Segmenter]] = {cls.name: cls for cls in (Default, BoneAngle)}
+_REGISTRY: dict[str, type[Segmenter]] = {cls.name: cls for cls in (Default, BoneAngle, JointDistancePCA, PPCA)}
 
 __all__ = [
     "Param",
