@@ -4,7 +4,7 @@
 // by restoring it, so ids stay stable and no step ever refers to a cut that vanished.
 
 import type { Fate, Review } from "../api/types";
-import { EditError, type Edit } from "./state";
+import { EditError, movedFate, type Edit } from "./state";
 
 export interface CutState {
   fate: Fate;
@@ -45,7 +45,7 @@ export function changeFor(review: Review, edit: Edit): Change {
   if (!cut) throw new EditError(`Cut ${edit.cutId} is not in this review.`);
   const before = { fate: cut.fate, frame: cut.frame };
   if (edit.kind === "move") {
-    return { kind: "cut", title: `move cut ${cut.frame} → ${edit.frame}`, cutId: cut.id, before, after: { fate: "moved", frame: edit.frame } };
+    return { kind: "cut", title: `move cut ${cut.frame} → ${edit.frame}`, cutId: cut.id, before, after: { fate: movedFate(cut), frame: edit.frame } };
   }
   const verb = { accepted: "accept", deleted: "delete", pending: "reset" }[edit.fate];
   return { kind: "cut", title: `${verb} cut at ${cut.frame}`, cutId: cut.id, before, after: { fate: edit.fate, frame: cut.frame } };
@@ -56,7 +56,7 @@ export function changeFor(review: Review, edit: Edit): Change {
  * the cut "moved", so a target fate of pending/accepted is set again after moving back;
  * "moved" itself cannot be asked for, only reached by moving.
  */
-export function transitionEdits(cutId: number, current: CutState, target: CutState): Edit[] {
+export function transitionEdits(cutId: number, current: CutState, target: CutState, origin: "candidate" | "inserted" = "candidate"): Edit[] {
   if (target.fate === "deleted") {
     return current.fate === "deleted" ? [] : [{ kind: "fate", cutId, fate: "deleted" }];
   }
@@ -68,7 +68,7 @@ export function transitionEdits(cutId: number, current: CutState, target: CutSta
   }
   if (current.frame !== target.frame) {
     edits.push({ kind: "move", cutId, frame: target.frame });
-    fate = "moved";
+    fate = movedFate({ origin });
   }
   if (target.fate !== "moved" && fate !== target.fate) {
     edits.push({ kind: "fate", cutId, fate: target.fate });
@@ -87,7 +87,7 @@ export function editsToward(review: Review, change: Change, side: "before" | "af
   const id = resolveId(change.cutId);
   const cut = review.cuts.find((c) => c.id === id);
   if (!cut) throw new EditError(`The cut of "${change.title}" is not in this review any more.`);
-  return transitionEdits(cut.id, { fate: cut.fate, frame: cut.frame }, change[side]);
+  return transitionEdits(cut.id, { fate: cut.fate, frame: cut.frame }, change[side], cut.origin);
 }
 
 export function undo(history: History, review: Review, resolveId: (id: number) => number): { history: History; edits: Edit[]; change: Change } | null {

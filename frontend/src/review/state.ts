@@ -28,23 +28,24 @@ export function sortedCuts(cuts: readonly Cut[]): Cut[] {
 }
 
 /**
- * Segments between kept cuts: the first starts at 0, the last stops at `nFrames`
- * (exclusive). A new segment takes the label of the old segment that held its middle,
- * which keeps labels in place when a cut moves or a segment is split.
+ * Segments between kept cuts, exactly as the server derives them: the first starts at 0,
+ * each kept cut (in frame order) starts the next, the last stops at `nFrames`. The server
+ * stores a label against the cut that starts its segment (null for the first segment),
+ * so `labelOf` is asked by start cut id; labels thus follow a moved cut.
  */
-export function deriveSegments(cuts: readonly Cut[], nFrames: number, previous: readonly Segment[] = []): Segment[] {
-  const inner = cuts.filter((c) => isKept(c) && c.frame > 0 && c.frame < nFrames).map((c) => c.frame);
-  const bounds = [0, ...new Set(inner.sort((a, b) => a - b)), nFrames];
-  const segments: Segment[] = [];
-  for (let i = 0; i + 1 < bounds.length; i++) {
-    const start = bounds[i];
-    const stop = bounds[i + 1];
-    const exact = previous.find((s) => s.start === start && s.stop === stop);
-    const middle = (start + stop - 1) / 2;
-    const holder = exact ?? previous.find((s) => s.start <= middle && middle < s.stop);
-    segments.push({ index: i, start, stop, label: holder?.label ?? null });
-  }
-  return segments;
+export function deriveSegments(cuts: readonly Cut[], nFrames: number, labelOf: (startCutId: number | null) => string | null = () => null): Segment[] {
+  const kept = sortedCuts(cuts);
+  const starts: [number | null, number][] = [[null, 0], ...kept.map((c): [number | null, number] => [c.id, c.frame])];
+  const stops = [...kept.map((c) => c.frame), nFrames];
+  return starts.map(([cutId, start], index) => ({ index, start, stop: stops[index], label: labelOf(cutId) }));
+}
+
+/** The label of each segment keyed by the id of the cut that starts it (null: the first). */
+export function labelsByStartCut(review: Review): Map<number | null, string | null> {
+  const kept = sortedCuts(review.cuts);
+  const map = new Map<number | null, string | null>();
+  for (const s of review.segments) map.set(s.index === 0 ? null : (kept[s.index - 1]?.id ?? NaN), s.label);
+  return map;
 }
 
 export function segmentAt(segments: readonly Segment[], frame: number): Segment | undefined {
@@ -79,7 +80,8 @@ export function applyEdit(review: Review, edit: Edit, nFrames: number): Review {
     if (edit.kind === "fate") cut.fate = edit.fate;
     else moveCut(cut, cuts, edit.frame, nFrames);
   }
-  return { ...review, cuts, segments: deriveSegments(cuts, nFrames, review.segments) };
+  const labels = labelsByStartCut(review);
+  return { ...review, cuts, segments: deriveSegments(cuts, nFrames, (id) => labels.get(id) ?? null) };
 }
 
 function checkInsert(cuts: readonly Cut[], frame: number, nFrames: number): void {
@@ -100,7 +102,12 @@ function moveCut(cut: Cut, cuts: readonly Cut[], frame: number, nFrames: number)
     throw new EditError(`There is already a cut at frame ${frame}.`);
   }
   cut.frame = frame;
-  cut.fate = "moved";
+  // The server calls a moved candidate "moved"; an inserted cut stays "accepted".
+  cut.fate = movedFate(cut);
+}
+
+export function movedFate(cut: Pick<Cut, "origin">): Fate {
+  return cut.origin === "candidate" ? "moved" : "accepted";
 }
 
 export interface Request {
