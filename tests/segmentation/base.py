@@ -22,11 +22,11 @@ SHARED_DATA = Path(__file__).resolve().parents[2] / ".." / "shared" / "data"
 
 def synthetic_bvh(seed=0, **kwargs):
     """Bytes of a seeded synthetic BVH take with known boundaries."""
-    import motionlib
+    from motionlib import synth, write_bvh
 
-    take, _segments = motionlib.synth.generate(seed=seed, fps=120.0, **kwargs)
+    take, _segments = synth.generate(seed=seed, fps=120.0, **kwargs)
     text = io.StringIO()
-    motionlib.write_bvh(take, text)
+    write_bvh(take, text)
     return text.getvalue().encode()
 
 
