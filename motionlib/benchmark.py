@@ -147,3 +147,15 @@ def main(root: Path | None = None, only: list[str] | None = None, out=None) -> i
         print(format_table(f"\n{take} ({truth} true cuts)", rows), file=out)
     print(format_table(f"\nmean over {len(results)} takes", mean_rows(results)), file=out)
     return 0
+
+
+def add_bench(subparsers) -> None:
+    """Register ``python -m motionlib bench`` (see ``motionlib.cli``)."""
+    p = subparsers.add_parser(
+        "bench", help="benchmark the segmenters on the labelled CMU takes",
+        description="Every segmenter (default parameters) and two change-point peers on "
+                    "every labelled take: a table per take and the mean.",
+    )
+    p.add_argument("--data", help="benchmark data folder (default: ../shared/data)")
+    p.add_argument("--method", action="append", help="only this row (repeatable)")
+    p.set_defaults(handler=lambda args: main(args.data, args.method))

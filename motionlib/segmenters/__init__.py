@@ -21,12 +21,24 @@ __all__ = [
     "Segmenter",
     "get_segmenter",
     "list_segmenters",
+    "parse_param_args",
 ]
 
 
 def list_segmenters() -> list[type[Segmenter]]:
     """Every registered method, the service's default first."""
     return sorted(_REGISTRY.values(), key=lambda cls: (cls.name != "default", cls.name))
+
+
+def parse_param_args(pairs: list[str] | None) -> dict[str, str]:
+    """``["k=v", ...]`` from the command line -> ``{"k": "v"}`` (values still strings)."""
+    params: dict[str, str] = {}
+    for pair in pairs or []:
+        key, sep, value = pair.partition("=")
+        if not sep or not key.strip():
+            raise ParamError(f"--param: expected NAME=VALUE, got {pair!r}")
+        params[key.strip()] = value.strip()
+    return params
 
 
 def get_segmenter(name: str) -> type[Segmenter]:

@@ -188,8 +188,8 @@ class Default(Segmenter):
         radius = int(round(p["refine_s"] * fps))
         cuts = np.array([settle_frame(speed, int(c), radius) for c in cuts], dtype=np.int64)
         t3 = time.perf_counter()
-        curve = np.repeat(novelty, step)
-        curve = np.concatenate([curve, np.full(len(x) - len(curve), curve[-1] if len(curve) else 0.0)])
+        centres = np.arange(len(novelty)) * step + step / 2
+        curve = np.interp(np.arange(len(x)), centres, novelty) if len(novelty) else np.zeros(len(x))
         return Segmentation(
             cuts=cuts + first,
             confidence=strength / (strength + p["threshold"] + 1e-12),

@@ -1,0 +1,48 @@
+"""The ``python -m motionlib segment`` command (registered in ``motionlib.cli``)."""
+
+from __future__ import annotations
+
+import json
+
+
+def add_segment(subparsers) -> None:
+    p = subparsers.add_parser(
+        "segment", help="propose cuts for a capture",
+        description="Run a segmentation method on a capture and print its candidate cuts "
+                    "(0-based frames) with their confidence.",
+    )
+    p.add_argument("file", help="a .bvh file, or an .amc file with --asf")
+    p.add_argument("--asf", help="the ASF skeleton of an .amc file")
+    p.add_argument("--method", default="default", help="segmentation method (default: default)")
+    p.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
+                   help="method parameter, repeatable")
+    p.add_argument("--json", action="store_true", help="print JSON instead of a table")
+    p.add_argument("--plot", metavar="OUT.png", help="also draw the signal with the cuts")
+    p.set_defaults(handler=run_segment)
+
+
+def run_segment(args) -> int:
+    from motionlib.io import read
+    from motionlib.segmenters import get_segmenter, parse_param_args
+
+    cls = get_segmenter(args.method)
+    params = cls.validate_params(parse_param_args(args.param))  # before the slow read
+    take = read(args.file, asf=args.asf)
+    result = cls(**params).fit_predict(take)
+    if args.plot:
+        from motionlib.segmenters.plot import plot_segmentation
+
+        plot_segmentation(result, fps=take.fps, path=args.plot,
+                          title=f"{args.file} ({cls.name})")
+    cuts = [{"frame": int(c), "confidence": round(float(p), 4)}
+            for c, p in zip(result.cuts, result.confidence, strict=True)]
+    if args.json:
+        print(json.dumps({"fps": take.fps, "n_frames": take.n_frames, "method": cls.name,
+                          "cuts": cuts}))
+        return 0
+    print(f"{args.file}: {len(cuts)} cuts by {cls.name} "
+          f"({take.n_frames} frames at {take.fps:g} fps)")
+    print(f"{'frame':>8} {'time s':>9} {'confidence':>10}")
+    for cut in cuts:
+        print(f"{cut['frame']:>8} {cut['frame'] / take.fps:>9.3f} {cut['confidence']:>10.3f}")
+    return 0

@@ -1,0 +1,42 @@
+"""Draw a segmentation: the method's signal(s) over time with the cuts as dashed lines."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from motionlib.segmenters.base import Segmentation
+
+
+def plot_segmentation(
+    result: Segmentation, *, fps: float, path: str | Path, title: str = ""
+) -> Path:
+    """Write a PNG of ``result.signals`` (time in seconds) with the cuts marked.
+
+    Each signal is scaled to [0, 1] so several fit one axis; a cut's line is darker the
+    higher its confidence.
+    """
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from matplotlib import pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(12, 3.5), dpi=100)
+    for name, signal in result.signals.items():
+        y = np.asarray(signal, dtype=float)
+        span = np.nanmax(y) - np.nanmin(y) if len(y) else 0.0
+        scaled = (y - np.nanmin(y)) / span if span > 0 else np.zeros_like(y)
+        ax.plot(np.arange(len(y)) / fps, scaled, linewidth=0.8, label=name)
+    for cut, conf in zip(result.cuts, result.confidence, strict=True):
+        ax.axvline(cut / fps, color="k", linestyle="--", linewidth=1, alpha=0.3 + 0.7 * conf)
+    ax.set_xlabel("time (s)")
+    ax.set_yticks([])
+    ax.set_title(title)
+    if result.signals:
+        ax.legend(loc="upper right", fontsize="small")
+    fig.tight_layout()
+    path = Path(path)
+    fig.savefig(path)
+    plt.close(fig)
+    return path
