@@ -1,0 +1,167 @@
+"""Browser tests: Debian's Chromium driven by Playwright against the real Django app
+(pytest-django's ``live_server``) with captures ingested and detected in-process.
+
+The front end must be built (``make test`` runs ``npm run build`` first). Without
+``frontend/dist`` the tests skip loudly, except under CI where that is a failure.
+"""
+
+import io
+import os
+import shutil
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parents[2]
+DIST = REPO / "frontend" / "dist"
+CHROMIUM = shutil.which("chromium") or "/usr/bin/chromium"
+CHROMIUM_ARGS = [
+    "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+    "--disable-background-networking", "--disable-component-update", "--disable-sync",
+    # Software WebGL, so the three.js view renders (and shows in screenshots) headless.
+    "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
+]
+
+# Playwright's sync API runs an event loop in this thread; the ORM calls the tests make
+# between browser steps are still plain synchronous code.
+os.environ.setdefault("DJANGO_ALLOW_ASYNC_UNSAFE", "true")
+
+
+def pytest_collection_modifyitems(items):
+    for item in items:
+        if "tests/e2e/" in str(item.fspath).replace(os.sep, "/"):
+            item.add_marker(pytest.mark.e2e)
+
+
+@pytest.fixture(scope="session")
+def built_frontend():
+    if not (DIST / "index.html").is_file():
+        message = (
+            f"frontend not built: {DIST / 'index.html'} is missing. "
+            "Run `make frontend` (or `cd frontend && npm ci && npm run build`)."
+        )
+        if os.environ.get("CI", "").lower() == "true":
+            pytest.fail(message)
+        pytest.skip(message)
+    return DIST
+
+
+@pytest.fixture(scope="session")
+def browser(built_frontend):
+    if not Path(CHROMIUM).exists():
+        message = f"Chromium not found at {CHROMIUM} (make browser installs Debian's package)"
+        if os.environ.get("CI", "").lower() == "true":
+            pytest.fail(message)
+        pytest.skip(message)
+    from playwright.sync_api import sync_playwright
+
+    with sync_playwright() as p:
+        browser = p.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS, headless=True)
+        yield browser
+        browser.close()
+
+
+@pytest.fixture(autouse=True)
+def _isolated_storage(settings, tmp_path):
+    settings.MEDIA_ROOT = tmp_path / "media"
+
+
+@pytest.fixture(autouse=True, scope="session")
+def _in_memory_broker():
+    """The upload and ingest services queue follow-up jobs on commit; these tests run
+    those jobs in-process themselves, so queued messages go to an in-memory broker
+    instead of the embedded spool folder under var/."""
+    from cutroom.celery import app
+
+    saved = app.conf.broker_url, app.conf.broker_transport_options
+    app.conf.broker_url, app.conf.broker_transport_options = "memory://", {}
+    _forget_connections(app)
+    yield
+    app.conf.broker_url, app.conf.broker_transport_options = saved
+    _forget_connections(app)
+
+
+def _forget_connections(app):
+    # Pools built from the old broker URL are dropped (not closed: kombu shares them),
+    # so the next send builds new ones from the current configuration.
+    app._pool = None
+    app.amqp._producer_pool = None
+
+
+@pytest.fixture
+def studio(transactional_db):
+    """alice administers "Studio A" (labels walk/punch/squat), ann and bob annotate,
+    rachel reviews."""
+    from django.contrib.auth import get_user_model
+
+    from segmentation import services
+
+    users = get_user_model().objects
+    people = {name: users.create_user(name, password=f"{name}-password")
+              for name in ("alice", "ann", "bob", "rachel")}
+    project = services.do_create_project(people["alice"], "Studio A")
+    services.do_set_member(project, "ann", "annotator")
+    services.do_set_member(project, "bob", "annotator")
+    services.do_set_member(project, "rachel", "reviewer")
+    labels = [("walk", "#3b82f6", "1"), ("punch", "#ef4444", "2"), ("squat", "#22c55e", "3"),
+              ("kick", "#f59e0b", "4"), ("jumping_jack", "#a855f7", "5")]
+    for name, colour, key in labels:
+        services.do_add_label(project, name, colour, key)
+    return {"project": project, **people}
+
+
+def synthetic_bvh(seed, duration):
+    import motionlib
+
+    take, _segments = motionlib.synth.generate(seed=seed, fps=120.0, duration=duration)
+    text = io.StringIO()
+    motionlib.write_bvh(take, text)
+    return text.getvalue().encode()
+
+
+@pytest.fixture
+def ingested_capture(studio):
+    """A 40-second synthetic take uploaded, ingested and detected by the service's own
+    task functions, run here in-process as a worker would."""
+    from django.core.files.uploadedfile import SimpleUploadedFile
+
+    from segmentation import services, tasks
+    from segmentation.models import Capture, DetectionRun
+
+    upload = SimpleUploadedFile("warmup_session.bvh", synthetic_bvh(seed=5, duration=40.0))
+    capture, _created = services.do_upload_capture(studio["project"], studio["alice"], upload)
+    tasks.ingest(capture.pk)
+    for run in DetectionRun.objects.filter(capture=capture, status="queued"):
+        tasks.detect(run.pk)
+    capture = Capture.objects.get(pk=capture.pk)
+    assert capture.status == "ready", capture.error
+    run = capture.latest_finished_run()
+    assert run is not None and len(run.candidates) >= 4, "the detector proposed too few cuts"
+    return capture
+
+
+def login(page, base_url, username):
+    page.goto(f"{base_url}/login/?next=/")
+    page.fill("#id_username", username)
+    page.fill("#id_password", f"{username}-password")
+    page.click("button[type=submit]")
+    page.wait_for_url(f"{base_url}/")
+
+
+@pytest.fixture
+def new_page(browser, live_server):
+    """Open a fresh browser context (its own cookies) logged in as someone."""
+    contexts = []
+
+    def open_as(username, width=1440, height=900):
+        context = browser.new_context(viewport={"width": width, "height": height})
+        contexts.append(context)
+        page = context.new_page()
+        page.errors = []
+        page.on("pageerror", lambda exc: page.errors.append(str(exc)))
+        login(page, live_server.url, username)
+        return page
+
+    yield open_as
+    for context in contexts:
+        context.close()

@@ -1,0 +1,232 @@
+"""The review page end to end: an annotator edits a detected capture in the browser and
+every edit lands in the database, survives a reload and shows in the audit log; another
+annotator starts from an untouched review; a reviewer reads it without editing it."""
+
+from pathlib import Path
+
+import pytest
+from playwright.sync_api import expect
+
+SCREENSHOT = Path(__file__).resolve().parents[2] / "docs" / "screenshots" / "review.png"
+
+
+class ReviewScreen:
+    """The review page as the test drives it: canvas geometry and API reads."""
+
+    def __init__(self, page, base_url, capture):
+        self.page, self.base_url, self.capture = page, base_url, capture
+
+    def open(self):
+        self.page.goto(f"{self.base_url}/captures/{self.capture.pk}/")
+        self.wait_ready()
+
+    def wait_ready(self):
+        expect(self.page.get_by_test_id("capture-name")).to_have_text(self.capture.name)
+        # Every chunk of positions arrived (the loader stamps how long it took).
+        self.page.wait_for_selector("[data-testid=frames-loading][data-done]", state="attached")
+
+    def review(self):
+        response = self.page.request.get(f"{self.base_url}/api/captures/{self.capture.pk}/review/")
+        assert response.ok, response.text()
+        return response.json()
+
+    def events(self):
+        return self.page.request.get(f"{self.base_url}/api/captures/{self.capture.pk}/review/events/").json()
+
+    def saved(self):
+        expect(self.page.get_by_test_id("save-state")).to_have_text("Saved")
+
+    def box(self):
+        return self.page.locator("[data-testid=timeline] canvas").bounding_box()
+
+    def x(self, frame):
+        """Page x of a frame while the timeline shows the whole take."""
+        box = self.box()
+        return box["x"] + frame / self.capture.n_frames * box["width"]
+
+    def signal_y(self):
+        return self.box()["y"] + 60
+
+    def ruler_y(self):
+        return self.box()["y"] + 12
+
+    def frame_shown(self):
+        text = self.page.get_by_test_id("hud-frame").inner_text()
+        return int(text.split()[1])
+
+
+def cut_by_id(review, cut_id):
+    return next(c for c in review["cuts"] if c["id"] == cut_id)
+
+
+def test_it_saves_every_edit_and_restores_the_review_exactly_after_reload(live_server, new_page, ingested_capture, studio):
+    page = new_page("ann")
+    # The capture list shows the capture; opening it goes to the review page.
+    row = page.get_by_test_id(f"capture-{ingested_capture.pk}")
+    expect(row).to_contain_text("ready")
+    row.click()
+    screen = ReviewScreen(page, live_server.url, ingested_capture)
+    screen.wait_ready()
+    expect(page.get_by_test_id("hud-time")).to_contain_text("· 120 fps")
+
+    start = screen.review()
+    assert {c["fate"] for c in start["cuts"]} == {"pending"}
+    c0, c1, c2, c3 = sorted(start["cuts"], key=lambda c: c["frame"])[:4]
+    frames_per_px = ingested_capture.n_frames / screen.box()["width"]
+
+    # Accept: click the dashed candidate line.
+    page.mouse.click(screen.x(c0["frame"]), screen.signal_y())
+    screen.saved()
+    assert cut_by_id(screen.review(), c0["id"])["fate"] == "accepted"
+
+    # Move: drag a candidate right, less than halfway to the next one.
+    shift_px = min(20.0, (c2["frame"] - c1["frame"]) / 3 / frames_per_px)
+    page.mouse.move(screen.x(c1["frame"]), screen.signal_y())
+    page.mouse.down()
+    for step in range(1, 6):
+        page.mouse.move(screen.x(c1["frame"]) + shift_px * step / 5, screen.signal_y())
+    page.mouse.up()
+    screen.saved()
+    moved = cut_by_id(screen.review(), c1["id"])
+    assert moved["fate"] == "moved" and moved["candidate_frame"] == c1["frame"]
+    assert abs(moved["frame"] - (c1["frame"] + shift_px * frames_per_px)) <= frames_per_px + 1
+
+    # Delete: from the first frame, Shift+→ three times selects the third cut; D deletes it.
+    page.keyboard.press("Home")
+    for _ in range(3):
+        page.keyboard.press("Shift+ArrowRight")
+    expect(page.get_by_test_id("selected-cut")).to_contain_text(f"Cut at {c2['frame']}")
+    page.keyboard.press("d")
+    screen.saved()
+    assert cut_by_id(screen.review(), c2["id"])["fate"] == "deleted"
+
+    # Insert: scrub the ruler to between the fourth cut and the next one, press I.
+    later = [c["frame"] for c in start["cuts"] if c["frame"] > c3["frame"]]
+    target = (c3["frame"] + (min(later) if later else ingested_capture.n_frames)) // 2
+    page.mouse.click(screen.x(target), screen.ruler_y())
+    inserted_at = screen.frame_shown()
+    assert abs(inserted_at - target) <= frames_per_px + 1
+    page.keyboard.press("i")
+    screen.saved()
+    inserted = [c for c in screen.review()["cuts"] if c["origin"] == "inserted"]
+    assert [(c["frame"], c["fate"]) for c in inserted] == [(inserted_at, "accepted")]
+
+    # Label: hotkey 2 labels the segment under the playhead; a click labels the first one.
+    page.keyboard.press("2")
+    screen.saved()
+    page.keyboard.press("Home")
+    page.get_by_test_id("label-walk").click()
+    screen.saved()
+    segments = {s["start"]: s["label"] for s in screen.review()["segments"]}
+    assert segments[0] == "walk" and segments[inserted_at] == "punch"
+
+    # Undo takes the last label off; redo puts it back; both are saved edits too.
+    page.keyboard.press("z")
+    screen.saved()
+    assert screen.review()["segments"][0]["label"] is None
+    page.keyboard.press("Shift+Z")
+    screen.saved()
+    before_reload = screen.review()
+    assert before_reload["segments"][0]["label"] == "walk"
+
+    page.reload()
+    screen.wait_ready()
+    after_reload = screen.review()
+    assert after_reload == before_reload
+    stats = page.get_by_test_id("stats")
+    expect(stats).to_contain_text("2 of")
+    expect(stats.locator(".stat-deleted b")).to_have_text("1")
+    expect(stats.locator(".stat-inserted b")).to_have_text("1")
+
+    # The database holds exactly what the page showed.
+    from segmentation.models import Review
+
+    stored = Review.objects.get(capture=ingested_capture, annotator=studio["ann"])
+    fates = {c.id: (c.fate, c.frame) for c in stored.cuts.all()}
+    assert fates[c0["id"]] == ("accepted", c0["frame"])
+    assert fates[c1["id"]] == ("moved", moved["frame"])
+    assert fates[c2["id"]][0] == "deleted"
+    assert stored.version == after_reload["version"]
+
+    # The audit log, in the API and on the page, shows each action in order.
+    actions = [e["action"] for e in screen.events()]
+    assert actions == ["create", "accept", "move", "delete", "insert", "label", "label", "label", "label"]
+    shown = page.locator("[data-testid=events] li").evaluate_all("els => els.map(e => e.dataset.action)")
+    assert shown == list(reversed(actions))
+
+    page.get_by_test_id("zoom-in").click()
+    page.get_by_test_id("zoom-in").click()
+    page.keyboard.press("Shift+ArrowLeft")
+    page.wait_for_timeout(300)
+    SCREENSHOT.parent.mkdir(parents=True, exist_ok=True)
+    page.screenshot(path=str(SCREENSHOT))
+    assert page.errors == []
+
+    # Another annotator gets an untouched review of their own.
+    other = new_page("bob")
+    bob = ReviewScreen(other, live_server.url, ingested_capture)
+    bob.open()
+    review = bob.review()
+    assert review["annotator"]["username"] == "bob"
+    assert {c["fate"] for c in review["cuts"]} == {"pending"}
+    assert len(review["cuts"]) == len(start["cuts"])
+    assert all(s["label"] is None for s in review["segments"])
+    expect(other.get_by_test_id("stats").locator(".stat-pending b")).to_have_text(str(len(start["cuts"])))
+    expect(other.get_by_test_id("review-picker")).to_have_count(0)
+    assert other.errors == []
+
+
+def test_it_lets_a_reviewer_read_an_annotators_review_without_editing_it(live_server, new_page, ingested_capture, studio):
+    from segmentation import services
+
+    review = services.get_or_create_review(ingested_capture, studio["ann"])
+    first = review.cuts.order_by("frame").first()
+    services.do_change_cut(review, studio["ann"], first, review.version, fate="deleted")
+
+    page = new_page("rachel")
+    screen = ReviewScreen(page, live_server.url, ingested_capture)
+    screen.open()
+    page.get_by_test_id("review-picker").select_option(label="ann (read-only)")
+    expect(page.get_by_test_id("readonly-banner")).to_contain_text("Viewing ann's review")
+    expect(page.get_by_test_id("stats").locator(".stat-deleted b")).to_have_text("1")
+    page.keyboard.press("i")
+    expect(page.locator(".toast-error")).to_contain_text("read-only")
+    review.refresh_from_db()
+    assert review.version == 2 and review.cuts.count() == len(ingested_capture.latest_finished_run().candidates)
+    assert page.errors == []
+
+
+def test_it_shows_what_changed_when_the_review_was_edited_elsewhere(live_server, new_page, ingested_capture, studio):
+    page = new_page("ann")
+    screen = ReviewScreen(page, live_server.url, ingested_capture)
+    screen.open()
+    start = screen.review()
+    first, second = sorted(start["cuts"], key=lambda c: c["frame"])[:2]
+
+    # The same annotator, in another tab, deletes the first cut.
+    from segmentation import services
+    from segmentation.models import Cut, Review
+
+    review = Review.objects.get(pk=start["id"])
+    services.do_change_cut(review, studio["ann"], Cut.objects.get(pk=first["id"]), start["version"], fate="deleted")
+
+    page.mouse.click(screen.x(second["frame"]), screen.signal_y())
+    dialog = page.get_by_role("dialog")
+    expect(dialog).to_contain_text("This review changed elsewhere")
+    expect(dialog.get_by_test_id("conflict-changes")).to_contain_text(f"cut at frame {first['frame']} is deleted")
+    expect(dialog.get_by_test_id("conflict-unsaved")).to_contain_text(f"accept cut at {second['frame']}")
+    dialog.get_by_test_id("dialog-ok").click()
+    # The page now shows the server's review; nothing was merged behind anyone's back.
+    current = screen.review()
+    assert cut_by_id(current, first["id"])["fate"] == "deleted"
+    assert cut_by_id(current, second["id"])["fate"] == "pending"
+    expect(page.get_by_test_id("stats").locator(".stat-deleted b")).to_have_text("1")
+    assert page.errors == []
+
+
+@pytest.mark.parametrize("path", ["/captures/999999/"])
+def test_it_explains_a_capture_that_does_not_exist(live_server, new_page, studio, path):
+    page = new_page("ann")
+    page.goto(f"{live_server.url}{path}")
+    expect(page.locator(".loading-page")).to_contain_text("Something went wrong")
+    expect(page.locator(".loading-page .error-text")).not_to_be_empty()
