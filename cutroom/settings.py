@@ -196,6 +196,10 @@ SPECTACULAR_SETTINGS = {
     "DESCRIPTION": "Motion-capture takes, candidate cuts, reviews. See docs/api.md.",
     "VERSION": "1",
     "SERVE_INCLUDE_SCHEMA": False,
+    "ENUM_NAME_OVERRIDES": {
+        "JobStatusEnum": "segmentation.models.JOB_STATUSES",
+        "ReviewStatusEnum": "segmentation.models.Review.STATUSES",
+    },
 }
 
 LOGGING = {

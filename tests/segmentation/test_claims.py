@@ -1,3 +1,6 @@
+from io import StringIO
+
+from django.core.management import call_command
 from django.test import override_settings
 from django.utils import timezone
 
@@ -82,3 +85,10 @@ class SweepTestCase(BaseTestCase):
         DetectionRun.objects.filter(pk=self.run.pk).update(claimed_at=timezone.now())
         self.assertEqual(services.sweep_stale_claims(), 0)
         self.assertEqual(DetectionRun.objects.get(pk=self.run.pk).status, "processing")
+
+
+    def test_the_command_sweeps(self):
+        out = StringIO()
+        call_command("sweep_claims", stdout=out)
+        self.assertEqual(out.getvalue().strip(), "1 stale job(s) requeued or failed")
+        self.assertEqual(DetectionRun.objects.get(pk=self.run.pk).status, "queued")
