@@ -92,21 +92,12 @@ def _joint_columns(skeleton):
 
 
 def _local_translation(offset, trans_cols, channels):
+    """Joint translation in its parent's frame: (3, 1), or (3, n_frames) with position channels."""
     if all(c is None for c in trans_cols):
-        return offset
+        return offset[:, None]
     # Position channels replace the offset component they name (BVH root convention).
-    t = np.repeat(offset[None, :], len(channels), axis=0)
-    for a, c in enumerate(trans_cols):
-        if c is not None:
-            t[:, a] = channels[:, c]
-    return t
-
-
-def _apply(G: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """``G @ v`` for a stack of matrices and one vector (3,) or one vector per frame (n, 3)."""
-    if v.ndim == 1:
-        return G @ v
-    return np.einsum("nij,nj->ni", G, v)
+    return np.stack([channels[:, c] if c is not None else np.full(len(channels), offset[a])
+                     for a, c in enumerate(trans_cols)])
 
 
 def forward_kinematics(take, channels: np.ndarray | None = None) -> np.ndarray:
@@ -127,39 +118,64 @@ def forward_kinematics(take, channels: np.ndarray | None = None) -> np.ndarray:
 
     Notes
     -----
-    Vectorised over frames; the only Python loop is over joints. A joint's global rotation is
-    kept only until its last child has used it, which bounds memory by the tree's depth.
+    Vectorised over frames; the only Python loop is over joints. Internally a joint's position
+    is laid out (3, n_frames) and its global rotation (3, 3, n_frames) so that every operation
+    runs over contiguous frames; both are dropped once the joint's last child has used them,
+    which bounds memory by the depth of the tree.
     """
     skeleton = take.skeleton
     channels = take.channels if channels is None else np.asarray(channels, dtype=np.float64)
     n, J = channels.shape[0], skeleton.n_joints
-    positions = np.empty((n, J, 3))
+    out = np.empty((n, J, 3))
     last_child = {int(p): j for j, p in enumerate(skeleton.parents) if p >= 0}
+    pos: dict[int, np.ndarray] = {}
     glob: dict[int, np.ndarray] = {}
     for j, (trans_cols, rots) in enumerate(_joint_columns(skeleton)):
         p = int(skeleton.parents[j])
         t = _local_translation(skeleton.offsets[j], trans_cols, channels)
         if p < 0:
-            positions[:, j] = t
-            G = np.broadcast_to(np.eye(3), (n, 3, 3)).copy()
+            here = np.broadcast_to(t, (3, n)).copy()
+            G = np.broadcast_to(np.eye(3)[:, :, None], (3, 3, n)).copy()
         else:
-            positions[:, j] = positions[:, p] + _apply(glob[p], t)
-            G = glob[p].copy()
-        if j in last_child:  # leaves need no rotation of their own
+            Gp = glob[p]
+            here = pos[p] + Gp[:, 0] * t[0] + Gp[:, 1] * t[1] + Gp[:, 2] * t[2]
+            G = Gp.copy() if j in last_child else None
+        out[:, j] = here.T
+        if G is not None:  # leaves need neither a rotation nor a kept position
             glob[j] = _rotate(G, rots, channels, skeleton.axes, j)
+            pos[j] = here
         if p >= 0 and last_child[p] == j:
-            del glob[p]
-    return positions
+            del glob[p], pos[p]
+    return out
+
+
+def _turn(G: np.ndarray, axis: int, c: np.ndarray, s: np.ndarray) -> None:
+    """In place ``G <- G @ R_axis(angle)`` for matrices laid out (3, 3, n); c, s of the angle."""
+    i, k = _MIXED[axis]
+    gi = G[:, i].copy()
+    gk = G[:, k]
+    G[:, i] *= c
+    G[:, i] += gk * s
+    gk *= c
+    gk -= gi * s
+
+
+def _times_constant(G: np.ndarray, C: np.ndarray) -> np.ndarray:
+    """``G @ C`` for G laid out (3, 3, n) and one matrix C (3, 3)."""
+    return np.einsum("ikn,kj->ijn", G, C)
 
 
 def _rotate(G, rots, channels, axes, j):
     """``G @ C @ R(channels) @ C.T`` with C the ASF axis frame (identity for BVH)."""
     if axes is not None:
-        G = G @ axes[j]
-    for axis, col in rots:
-        rotate_columns(G, axis, channels[:, col])
+        G = _times_constant(G, axes[j])
+    if rots:
+        theta = np.deg2rad(np.ascontiguousarray(channels[:, [col for _, col in rots]].T))
+        cos, sin = np.cos(theta), np.sin(theta)
+        for k, (axis, _) in enumerate(rots):
+            _turn(G, axis, cos[k], sin[k])
     if axes is not None:
-        G = G @ axes[j].T
+        G = _times_constant(G, axes[j].T)
     return G
 
 

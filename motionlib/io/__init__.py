@@ -43,5 +43,5 @@ def read(path: str | os.PathLike, *, asf: str | os.PathLike | None = None) -> Ta
     if suffix == ".bvh":
         return read_bvh(path)
     if asf is None:
-        raise CaptureError("an .amc motion needs its .asf skeleton (asf=...)", path=path)
+        raise CaptureError("an .amc motion needs its .asf skeleton (pass the .asf file too)", path=path)
     return read_amc(path, asf)

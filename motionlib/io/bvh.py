@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from motionlib.errors import CaptureError
-from motionlib.io.numbers import parse_decimals
+from motionlib.io.numbers import parse_decimal_lines
 from motionlib.skeleton import CHANNEL_NAMES, ROTATION_CHANNELS, Skeleton
 from motionlib.take import Take, frame_range
 
@@ -181,13 +181,9 @@ def _motion_header(data: bytes, pos: int, line: int, path) -> tuple[int, float, 
 def _parse_motion(data: bytes, pos: int, line: int, n_frames: int, n_channels: int,
                   path) -> np.ndarray:
     """Frame values as (n_frames, n_channels); ``line`` is the line number of byte ``pos``."""
-    b = np.frombuffer(data, dtype=np.uint8, offset=pos)
-    parsed = parse_decimals(b)
+    parsed = parse_decimal_lines(data, pos)
     if parsed is not None:
-        values, starts = parsed
-        newlines = np.flatnonzero(b == 10)
-        per_line = np.diff(np.searchsorted(starts, newlines), prepend=0,
-                           append=starts.size) if starts.size else np.zeros(0, np.intp)
+        values, per_line = parsed
         per_line = per_line[per_line > 0]
         if per_line.size == n_frames and np.all(per_line == n_channels):
             return values.reshape(n_frames, n_channels)

@@ -1,0 +1,88 @@
+"""Command line: ``python -m motionlib <command> …``.
+
+Each command is one ``add_<command>(subparsers)`` function that declares its arguments and sets
+``handler``; a handler takes the parsed arguments, prints its result and returns an exit code.
+Adding a command is adding one such function to :data:`COMMANDS`. Errors a user can fix
+(bad files, bad arguments) print one line on stderr and exit with status 2.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from motionlib.benchmark import add_bench
+from motionlib.errors import CaptureError
+from motionlib.segmenters.command import add_segment
+
+EXIT_USAGE = 2
+
+
+def add_info(subparsers) -> None:
+    p = subparsers.add_parser("info", help="describe a capture file",
+                              description="Print format, frame rate, frames, duration, joints "
+                                          "and the detected rest-pose frame of a capture.")
+    p.add_argument("file", help="a .bvh file, or an .amc file with --asf")
+    p.add_argument("--asf", help="the ASF skeleton of an .amc file")
+    p.set_defaults(handler=run_info)
+
+
+def run_info(args) -> int:
+    from motionlib.io import read
+
+    take = read(args.file, asf=args.asf)
+    rest = "none" if take.rest_pose_frame is None else str(take.rest_pose_frame)
+    rows = [("file", args.file), ("format", take.format), ("fps", f"{take.fps:g}"),
+            ("frames", str(take.n_frames)), ("duration", f"{take.duration:.3f} s"),
+            ("joints", str(take.skeleton.n_joints)), ("channels", str(take.skeleton.n_channels)),
+            ("rest pose frame", rest)]
+    for key, value in rows:
+        print(f"{key + ':':<17}{value}")
+    return 0
+
+
+def add_convert(subparsers) -> None:
+    p = subparsers.add_parser("convert", help="convert a capture to BVH",
+                              description="Write a capture (CMU .amc with --asf, or .bvh) as "
+                                          "BVH; joint positions are unchanged.")
+    p.add_argument("input", help="an .amc file (with --asf) or a .bvh file")
+    p.add_argument("output", help="the .bvh file to write")
+    p.add_argument("--asf", help="the ASF skeleton of an .amc input")
+    p.add_argument("--start", type=int, help="first frame to keep (0-based)")
+    p.add_argument("--stop", type=int, help="frame to stop before (exclusive)")
+    p.set_defaults(handler=run_convert)
+
+
+def run_convert(args) -> int:
+    from motionlib.io import read, write_bvh
+    from motionlib.take import frame_range
+
+    take = read(args.input, asf=args.asf)
+    start, stop = frame_range(take.n_frames, args.start, args.stop) if take.n_frames else (0, 0)
+    write_bvh(take, args.output, start=start, stop=stop)
+    print(f"wrote {args.output}: frames {start} to {stop - 1} of {args.input} "
+          f"({stop - start} frames at {take.fps:g} fps)")
+    return 0
+
+
+COMMANDS = [add_info, add_convert, add_segment, add_bench]
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="python -m motionlib",
+                                     description="Motion-capture takes: inspect, convert.")
+    subparsers = parser.add_subparsers(dest="command", required=True, metavar="command")
+    for add in COMMANDS:
+        add(subparsers)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the command line; return the exit status."""
+    args = build_parser().parse_args(argv)
+    try:
+        return args.handler(args)
+    except (CaptureError, ValueError, OSError) as exc:
+        message = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        print(f"motionlib {args.command}: error: {message}", file=sys.stderr)
+        return EXIT_USAGE

@@ -1,0 +1,143 @@
+"""Forward kinematics: the vectorised version against a slow, obvious per-frame oracle."""
+
+import numpy as np
+import pytest
+from numpy.testing import assert_allclose
+
+import motionlib
+from motionlib.kinematics import euler_to_matrix, matrix_to_euler_zyx
+from motionlib.skeleton import Skeleton
+from motionlib.take import Take
+
+
+def rot(axis: str, degrees: float) -> np.ndarray:
+    c, s = np.cos(np.radians(degrees)), np.sin(np.radians(degrees))
+    return {"X": np.array([[1, 0, 0], [0, c, -s], [0, s, c]]),
+            "Y": np.array([[c, 0, s], [0, 1, 0], [-s, 0, c]]),
+            "Z": np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]])}[axis]
+
+
+def oracle(take: Take) -> np.ndarray:
+    """One frame at a time, one joint at a time, matrices written out."""
+    sk = take.skeleton
+    out = np.zeros((take.n_frames, sk.n_joints, 3))
+    for f in range(take.n_frames):
+        glob, col = {}, 0
+        for j in range(sk.n_joints):
+            local_t = sk.offsets[j].astype(float).copy()
+            values = {}
+            for name in sk.channels[j]:
+                values[name] = take.channels[f, col]
+                col += 1
+            for a, axis in enumerate("XYZ"):
+                if f"{axis}position" in values:
+                    local_t[a] = values[f"{axis}position"]
+            local_r = np.eye(3)
+            for axis in sk.rotation_orders[j]:
+                local_r = local_r @ rot(axis, values.get(f"{axis}rotation", 0.0))
+            if sk.axes is not None:
+                local_r = sk.axes[j] @ local_r @ np.linalg.inv(sk.axes[j])
+            p = sk.parents[j]
+            if p < 0:
+                out[f, j], glob[j] = local_t, local_r
+            else:
+                out[f, j] = out[f, p] + glob[p] @ local_t
+                glob[j] = glob[p] @ local_r
+    return out
+
+
+def random_take(rng, n_frames=7, n_joints=9, with_axes=False) -> Take:
+    parents = [-1] + [int(rng.integers(0, j)) for j in range(1, n_joints)]
+    channels, orders = [], []
+    for j in range(n_joints):
+        rots = [f"{a}rotation" for a in rng.permutation(list("XYZ"))[:rng.integers(1, 4)]]
+        pos = [f"{a}position" for a in "XYZ" if j == 0 or rng.random() < 0.2]
+        chans = list(rng.permutation(rots + pos))
+        channels.append(tuple(chans))
+        orders.append("".join(c[0] for c in chans if c.endswith("rotation")))
+    axes = None
+    if with_axes:
+        axes = euler_to_matrix(rng.uniform(-180, 180, (n_joints, 3)), "ZYX")
+    sk = Skeleton(names=[f"j{j}" for j in range(n_joints)], parents=parents,
+                  offsets=rng.normal(size=(n_joints, 3)), channels=channels,
+                  rotation_orders=orders, axes=axes)
+    values = rng.uniform(-180, 180, (n_frames, sk.n_channels))
+    return Take(name="random", format="bvh", fps=30.0, frame_time=1 / 30, channels=values,
+                skeleton=sk)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_it_agrees_with_the_per_frame_oracle_on_random_rotations_and_channel_orders(seed):
+    take = random_take(np.random.default_rng(seed))
+    assert_allclose(motionlib.forward_kinematics(take), oracle(take), atol=1e-9)
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_it_agrees_with_the_oracle_with_asf_axis_frames(seed):
+    take = random_take(np.random.default_rng(100 + seed), with_axes=True)
+    assert_allclose(motionlib.forward_kinematics(take), oracle(take), atol=1e-9)
+
+
+def chain(channel_values, offsets=((0, 0, 0), (1, 0, 0), (1, 0, 0))):
+    sk = Skeleton(names=["root", "a", "b"], parents=[-1, 0, 1], offsets=offsets,
+                  channels=[("Xposition", "Yposition", "Zposition", "Zrotation", "Yrotation",
+                             "Xrotation"), ("Zrotation", "Yrotation", "Xrotation"), ()],
+                  rotation_orders=["ZYX", "ZYX", ""])
+    return Take(name="chain", format="bvh", fps=1.0, frame_time=1.0,
+                channels=np.atleast_2d(np.asarray(channel_values, float)), skeleton=sk)
+
+
+def test_it_places_joints_at_their_offsets_when_every_angle_is_zero():
+    positions = motionlib.forward_kinematics(chain([1, 2, 3, 0, 0, 0, 0, 0, 0]))
+    assert_allclose(positions[0], [[1, 2, 3], [2, 2, 3], [3, 2, 3]])
+
+
+def test_it_turns_a_child_by_its_parents_rotation():
+    # Root turned 90 degrees about Z: +X becomes +Y; joint a bends another 90: +Y becomes -X.
+    positions = motionlib.forward_kinematics(chain([0, 0, 0, 90, 0, 0, 90, 0, 0]))
+    assert_allclose(positions[0], [[0, 0, 0], [0, 1, 0], [-1, 1, 0]], atol=1e-12)
+
+
+def test_it_composes_rotation_channels_in_the_order_they_are_listed():
+    # Z then Y (R = Rz @ Ry) differs from Y then Z; the joint after the rotation shows which.
+    positions = motionlib.forward_kinematics(chain([0, 0, 0, 90, 90, 0, 0, 0, 0]))
+    expected = rot("Z", 90) @ rot("Y", 90) @ np.array([1.0, 0, 0])
+    assert_allclose(positions[0, 1], expected, atol=1e-12)
+
+
+def test_it_keeps_bone_lengths_in_every_frame_of_a_real_take(bvh_13_29):
+    take = motionlib.read(bvh_13_29)
+    positions = motionlib.forward_kinematics(take)
+    for j, p in enumerate(take.skeleton.parents):
+        if p >= 0:
+            length = np.linalg.norm(positions[:, j] - positions[:, p], axis=-1)
+            assert_allclose(length, np.linalg.norm(take.skeleton.offsets[j]), atol=1e-9)
+
+
+def test_it_returns_float64_positions_of_shape_frames_joints_3(bvh_13_29):
+    take = motionlib.read(bvh_13_29)
+    positions = motionlib.forward_kinematics(take)
+    assert positions.shape == (4593, 31, 3) and positions.dtype == np.float64
+
+
+def test_it_recovers_zyx_euler_angles_from_matrices():
+    rng = np.random.default_rng(0)
+    angles = np.column_stack([rng.uniform(-180, 180, 500), rng.uniform(-89, 89, 500),
+                              rng.uniform(-180, 180, 500)])
+    R = euler_to_matrix(angles, "ZYX")
+    assert_allclose(matrix_to_euler_zyx(R), angles, atol=1e-9)
+
+
+def test_it_reproduces_the_matrix_at_gimbal_lock():
+    angles = np.array([[30.0, 90.0, 20.0], [-50.0, -90.0, 45.0]])
+    R = euler_to_matrix(angles, "ZYX")
+    assert_allclose(euler_to_matrix(matrix_to_euler_zyx(R), "ZYX"), R, atol=1e-9)
+
+
+def test_it_measures_skeleton_height_of_a_take_and_of_positions():
+    take = chain([0, 0, 0, 0, 0, 0, 0, 0, 0], offsets=((0, 0, 0), (0, 1, 0), (0, 2, 0)))
+    assert motionlib.skeleton_height(take) == pytest.approx(3.0)
+    positions = motionlib.forward_kinematics(take)
+    assert motionlib.skeleton_height(positions) == pytest.approx(3.0)
+    with pytest.raises(ValueError, match="shape"):
+        motionlib.skeleton_height(np.zeros((4, 3)))
