@@ -365,3 +365,12 @@ class ReviewEvent(models.Model):
 
     def __str__(self):
         return f"{self.action} by {self.user}"
+
+
+# The clip library and agreement records live in their own module (same app, same
+# migrations); importing them here registers them with the app.
+from segmentation.models_library import (  # noqa: E402, F401
+    Adjudication,
+    CaptureAgreement,
+    LibrarySegment,
+)

@@ -1,0 +1,138 @@
+"""Records of the clip library and of agreement between annotators.
+
+- ``LibrarySegment``: one labelled segment of a submitted review, or of a capture's gold
+  version, materialised as a row (frames, duration, label, annotator, agreement and the
+  motion descriptor) when the review is submitted or the gold version saved, so that
+  library queries are plain indexed queries.
+- ``Adjudication``: the gold version of a capture, made by a reviewer.
+- ``CaptureAgreement``: the agreement summary of a capture's submitted reviews at the
+  default tolerance, kept for the project dashboard.
+"""
+
+import numpy as np
+from django.conf import settings
+from django.db import models
+from django.db.models import Q
+from django.utils import timezone
+
+from segmentation.models import Capture, Label, Membership, Project, Review
+
+# A capture whose annotators agree this well needs no adjudication.
+AGREED_BOUNDARY_F1 = 0.8
+AGREED_LABELS = 0.8
+
+
+class LibrarySegmentQuerySet(models.QuerySet):
+    def visible_to(self, user):
+        """Segments of the user's projects: everything for reviewers and admins, own and
+        gold segments for annotators, nothing for anybody else."""
+        if not user.is_authenticated:
+            return self.none()
+        roles = Membership.objects.filter(user=user).values_list("project_id", "role")
+        staff, annotating = [], []
+        for project_id, role in roles:
+            (staff if role in ("reviewer", "admin") else annotating).append(project_id)
+        own = Q(annotator=user) | Q(is_gold=True)
+        return self.filter(Q(project_id__in=staff) | Q(project_id__in=annotating) & own)
+
+    def preferred(self):
+        """The library's default view: gold where a capture has it, else every annotator's."""
+        return self.filter(superseded=False)
+
+
+class LibrarySegment(models.Model):
+    project = models.ForeignKey(Project, models.CASCADE, related_name="+")
+    capture = models.ForeignKey(Capture, models.CASCADE, related_name="library_segments")
+    review = models.ForeignKey(Review, models.CASCADE, null=True, blank=True, related_name="+")
+    annotator = models.ForeignKey(
+        settings.AUTH_USER_MODEL, models.CASCADE, null=True, blank=True, related_name="+"
+    )
+    is_gold = models.BooleanField(default=False)
+    # An annotator's segment of a capture that has a gold version.
+    superseded = models.BooleanField(default=False)
+    label = models.ForeignKey(Label, models.SET_NULL, null=True, blank=True, related_name="+")
+    label_name = models.CharField(max_length=100)
+    start = models.PositiveIntegerField()
+    stop = models.PositiveIntegerField()
+    duration = models.FloatField()
+    # Share of the other annotators' frames that carry the same label (NaN -> null).
+    agreement = models.FloatField(null=True, blank=True)
+    # float32 (rows, cols) motion descriptor, see motionlib.similarity; null when the
+    # skeleton cannot be mapped to body parts.
+    descriptor = models.BinaryField(null=True, blank=True)
+    descriptor_shape = models.JSONField(null=True, blank=True)
+    created_at = models.DateTimeField(default=timezone.now)
+
+    objects = LibrarySegmentQuerySet.as_manager()
+
+    class Meta:
+        ordering = ["-id"]
+        indexes = [
+            models.Index(fields=["project", "superseded", "-id"], name="libseg_project_recent"),
+            models.Index(fields=["project", "label_name", "duration"], name="libseg_label_duration"),
+            models.Index(fields=["project", "annotator", "-id"], name="libseg_annotator"),
+            models.Index(fields=["project", "is_gold", "-id"], name="libseg_gold"),
+            models.Index(fields=["project", "agreement"], name="libseg_agreement"),
+            models.Index(fields=["project", "duration"], name="libseg_duration"),
+        ]
+
+    def __str__(self):
+        return f"{self.label_name} {self.start}-{self.stop} of {self.capture_id}"
+
+    def descriptor_array(self):
+        if self.descriptor is None:
+            return None
+        return np.frombuffer(bytes(self.descriptor), dtype="<f4").reshape(self.descriptor_shape)
+
+
+class Adjudication(models.Model):
+    """The gold version of a capture: cut frames and one label per segment.
+
+    ``labels`` has ``len(cuts) + 1`` entries (label names or null), one per segment in
+    frame order. ``version`` guards against two reviewers overwriting each other.
+    """
+
+    capture = models.OneToOneField(Capture, models.CASCADE, related_name="adjudication")
+    adjudicator = models.ForeignKey(
+        settings.AUTH_USER_MODEL, models.SET_NULL, null=True, related_name="+"
+    )
+    source_review = models.ForeignKey(
+        Review, models.SET_NULL, null=True, blank=True, related_name="+"
+    )
+    cuts = models.JSONField(default=list)
+    labels = models.JSONField(default=list)
+    version = models.PositiveIntegerField(default=1)
+    created_at = models.DateTimeField(default=timezone.now)
+    updated_at = models.DateTimeField(default=timezone.now)
+
+    def __str__(self):
+        return f"gold version of {self.capture}"
+
+    def segments(self):
+        """``[(start, stop, label name or None)]`` in frame order."""
+        bounds = [0, *self.cuts, self.capture.n_frames]
+        return list(zip(bounds[:-1], bounds[1:], self.labels, strict=True))
+
+
+class CaptureAgreement(models.Model):
+    """Agreement of a capture's submitted reviews at the default tolerance."""
+
+    capture = models.OneToOneField(Capture, models.CASCADE, related_name="agreement")
+    n_reviews = models.PositiveIntegerField()
+    boundary_f1 = models.FloatField(null=True, blank=True)
+    # Cohen's kappa for two reviews, Krippendorff's alpha for more.
+    label_agreement = models.FloatField(null=True, blank=True)
+    # {label: {"overlap": IoU, "frames": n}}
+    per_label = models.JSONField(default=dict)
+    computed_at = models.DateTimeField(default=timezone.now)
+
+    def __str__(self):
+        return f"agreement on {self.capture}"
+
+    @property
+    def agreed(self):
+        return (
+            self.n_reviews >= 2
+            and (self.boundary_f1 or 0) >= AGREED_BOUNDARY_F1
+            and (self.label_agreement or 0) >= AGREED_LABELS
+        )
