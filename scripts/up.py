@@ -1,0 +1,249 @@
+"""Run Cutroom on the embedded default: migrate, demo data, a Celery worker and the web server.
+
+``make up`` calls this after installing the Python packages and building the front end::
+
+    python scripts/up.py [--host 127.0.0.1] [--port 8000] [--concurrency 2] [--no-demo]
+
+With no environment set, everything lives under ``var/`` (SQLite, the filesystem broker's
+spool, uploaded originals, logs). The worker and gunicorn run as child processes with
+their logs in ``var/log/``; a worker that dies is reported (with the end of its log) and
+restarted; Ctrl-C (or SIGTERM) stops both and waits for them. Running it again is safe:
+migrations and demo data are only added when missing.
+"""
+
+import argparse
+import os
+import signal
+import socket
+import subprocess
+import sys
+import time
+import urllib.error
+import urllib.request
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parents[1]
+BIN = Path(sys.executable).parent
+MAX_WORKER_DEATHS = 3
+
+
+def parse_args(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--host", default="127.0.0.1")
+    parser.add_argument("--port", type=int, default=8000)
+    parser.add_argument("--concurrency", type=int, default=2, help="worker processes")
+    parser.add_argument("--no-demo", action="store_true", help="skip `manage.py demo`")
+    parser.add_argument(
+        "--no-shared-data", action="store_true", help="demo without the CMU takes"
+    )
+    return parser.parse_args(argv)
+
+
+def say(message):
+    print(f"[up] {message}", flush=True)
+
+
+def var_dir():
+    return Path(os.environ.get("CUTROOM_VAR_DIR") or REPO / "var")
+
+
+def environment():
+    env = {**os.environ, "DJANGO_SETTINGS_MODULE": "cutroom.settings", "PYTHONUNBUFFERED": "1"}
+    if env.get("DATABASE_URL"):
+        say(f"database from DATABASE_URL (…@{env['DATABASE_URL'].split('@')[-1]})")
+    return env
+
+
+def port_problem(host, port):
+    """Why the web server could not listen on host:port, or None."""
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as probe:
+        probe.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        try:
+            probe.bind((host, port))
+        except OSError as exc:
+            return f"cannot listen on {host}:{port} ({exc.strerror}); is Cutroom already " \
+                   f"running? Choose another port: make up PORT={port + 1}"
+    return None
+
+
+def manage(env, *args):
+    """Run a manage.py command in the foreground; exit with its code if it fails."""
+    done = subprocess.run([sys.executable, "manage.py", *args], cwd=REPO, env=env)
+    if done.returncode:
+        say(f"`manage.py {' '.join(args)}` failed (exit code {done.returncode}); stopping")
+        sys.exit(done.returncode)
+
+
+class Child:
+    """A child process in its own process group, logging to a file under var/log/."""
+
+    def __init__(self, name, argv, env, log):
+        self.name, self.argv, self.env, self.log = name, argv, env, log
+        self.proc = None
+
+    def start(self):
+        self.log.parent.mkdir(parents=True, exist_ok=True)
+        self.offset = self.log.stat().st_size if self.log.exists() else 0
+        out = self.log.open("ab")
+        self.proc = subprocess.Popen(
+            self.argv, cwd=REPO, env=self.env, stdout=out, stderr=subprocess.STDOUT,
+            stdin=subprocess.DEVNULL, start_new_session=True,  # Ctrl-C reaches us only
+        )
+        out.close()
+        return self
+
+    def output(self):
+        """What this run of the process has logged so far."""
+        with self.log.open("rb") as handle:
+            handle.seek(self.offset)
+            return handle.read().decode("utf-8", "replace")
+
+    def tail(self, lines=15):
+        return "\n".join("    " + line for line in self.output().splitlines()[-lines:])
+
+    def exited(self):
+        return self.proc.poll()
+
+    def stop(self, sig=signal.SIGTERM):
+        if self.proc and self.proc.poll() is None:
+            try:
+                os.killpg(self.proc.pid, sig)
+            except ProcessLookupError:
+                pass
+
+    def wait(self, timeout):
+        try:
+            self.proc.wait(timeout)
+        except subprocess.TimeoutExpired:
+            say(f"{self.name} did not stop within {timeout:.0f} s; killing it")
+            self.stop(signal.SIGKILL)
+            self.proc.wait(10)
+
+
+def worker(env, logs, concurrency):
+    var = var_dir()
+    argv = [
+        str(BIN / "celery"), "-A", "cutroom", "worker", "--loglevel", "INFO",
+        "--concurrency", str(concurrency), "--hostname", "cutroom-up@%h",
+        "--without-mingle", "--without-gossip",
+        # Embedded beat: the periodic sweep that requeues jobs of a killed worker.
+        "--beat", "--schedule", str(var / "celerybeat-schedule"),
+    ]
+    return Child("worker", argv, env, logs / "worker.log")
+
+
+def web(env, logs, host, port):
+    argv = [
+        str(BIN / "gunicorn"), "cutroom.wsgi:application", "--bind", f"{host}:{port}",
+        "--workers", "2", "--threads", "4", "--timeout", "120",
+        "--access-logfile", "-", "--error-logfile", "-",
+    ]
+    return Child("web server", argv, env, logs / "web.log")
+
+
+def wait_ready(worker_child, web_child, url, timeout=90):
+    """Block until the worker logged "ready" and the web server answers; False if one died."""
+    deadline = time.monotonic() + timeout
+    worker_up = web_up = False
+    while time.monotonic() < deadline:
+        for child in (worker_child, web_child):
+            if child.exited() is not None:
+                say(f"{child.name} exited during start-up (code {child.exited()}); "
+                    f"end of {child.log}:\n{child.tail()}")
+                return False
+        worker_up = worker_up or " ready." in worker_child.output()
+        web_up = web_up or answers(url + "login/")
+        if worker_up and web_up:
+            return True
+        time.sleep(0.2)
+    say(f"not ready after {timeout} s (worker ready: {worker_up}, web ready: {web_up})")
+    return False
+
+
+def answers(url):
+    try:
+        with urllib.request.urlopen(url, timeout=2) as response:
+            return response.status == 200
+    except (urllib.error.URLError, OSError):
+        return False
+
+
+class Stop(Exception):
+    pass
+
+
+def on_signal(signum, frame):
+    raise Stop(signal.Signals(signum).name)
+
+
+def supervise(worker_child, web_child):
+    """Watch both children until a signal arrives; returns the exit code for up.py."""
+    deaths = 0
+    while True:
+        time.sleep(0.5)
+        if web_child.exited() is not None:
+            say(f"the web server stopped unexpectedly (exit code {web_child.exited()}); "
+                f"end of {web_child.log}:\n{web_child.tail()}")
+            return 1
+        code = worker_child.exited()
+        if code is None:
+            continue
+        deaths += 1
+        say(f"the worker died (exit code {code}); end of {worker_child.log}:\n"
+            f"{worker_child.tail()}")
+        if deaths >= MAX_WORKER_DEATHS:
+            say(f"the worker died {deaths} times; stopping (fix the cause above and rerun)")
+            return 1
+        say("restarting the worker; the job it was running is given back to the queue")
+        worker_child.start()
+
+
+def banner(url, worker_child, web_child, logs, demo):
+    say(f"Cutroom is running at {url}")
+    if demo:
+        say("log in as annotator / cutroom-demo (also: reviewer, admin; same password)")
+    say(f"web server pid {web_child.proc.pid}, worker pid {worker_child.proc.pid}; "
+        f"logs in {logs}")
+    say("press Ctrl-C to stop")
+
+
+def main(argv=None):
+    args = parse_args(argv)
+    problem = port_problem(args.host, args.port)
+    if problem:
+        say(problem)
+        return 2
+    env = environment()
+    logs = var_dir() / "log"
+    manage(env, "migrate", "--noinput", "-v", "0")
+    if not args.no_demo:
+        manage(env, "demo", *(["--no-shared-data"] if args.no_shared_data else []))
+    url = f"http://{args.host}:{args.port}/"
+    worker_child = worker(env, logs, args.concurrency)
+    web_child = web(env, logs, args.host, args.port)
+    signal.signal(signal.SIGINT, on_signal)
+    signal.signal(signal.SIGTERM, on_signal)
+    code = 1
+    try:
+        worker_child.start()
+        web_child.start()
+        if wait_ready(worker_child, web_child, url):
+            banner(url, worker_child, web_child, logs, not args.no_demo)
+            code = supervise(worker_child, web_child)
+    except Stop as stop:
+        say(f"{stop} received; stopping the web server and the worker")
+        code = 0
+    finally:
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+        signal.signal(signal.SIGTERM, signal.SIG_IGN)
+        for child in (web_child, worker_child):
+            child.stop()
+        for child in (web_child, worker_child):
+            if child.proc:
+                child.wait(30)
+    say("stopped")
+    return code
+
+
+if __name__ == "__main__":
+    sys.exit(main())
