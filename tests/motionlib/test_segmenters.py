@@ -1,0 +1,147 @@
+import sys
+
+import numpy as np
+import pytest
+
+from motionlib import metrics, synth
+from motionlib.segmenters import ParamError, get_segmenter, list_segmenters
+
+METHODS = ["default", "bone_angle", "joint_distance_pca", "ppca"]
+
+
+@pytest.fixture(scope="module")
+def synth_takes():
+    return [synth.generate(seed=seed, fps=120.0) for seed in range(3)]
+
+
+def mean_scores(name, takes, **params):
+    rows = []
+    for take, segments in takes:
+        truth = [start for start, _, _ in segments[1:]]
+        cuts = get_segmenter(name)(**params).fit_predict(take).cuts
+        rows.append(metrics.boundary_scores(cuts, truth, fps=take.fps, tolerance_s=1.0))
+    return {k: np.mean([r[k] for r in rows]) for k in ("precision", "recall")}
+
+
+def test_it_lists_every_method_with_its_schema_default_first():
+    names = [cls.name for cls in list_segmenters()]
+    assert names[0] == "default"
+    assert sorted(names) == sorted(METHODS)
+    for cls in list_segmenters():
+        assert cls.title and cls.description and cls.params
+        for key, spec in cls.schema()["params"].items():
+            assert spec["type"] in ("float", "int", "bool"), key
+            assert spec["min"] <= spec["default"] <= spec["max"], key
+
+
+def test_it_names_an_unknown_method_and_the_valid_ones():
+    with pytest.raises(ParamError, match=r"method: unknown segmenter 'nope' \(valid: default, "):
+        get_segmenter("nope")
+
+
+def test_it_fills_defaults_and_coerces_strings():
+    values = get_segmenter("bone_angle").validate_params({"param": "0.25"})
+    assert values == {"param": 0.25, "cutoff_hz": 1.0}
+    assert get_segmenter("joint_distance_pca").validate_params({"span": "41"})["span"] == 41
+
+
+def test_it_names_the_parameter_and_value_out_of_range():
+    with pytest.raises(ParamError) as err:
+        get_segmenter("bone_angle").validate_params({"param": 1.5})
+    assert str(err.value) == "param: must be between 0 and 1, got 1.5"
+
+
+@pytest.mark.parametrize(
+    ("params", "message"),
+    [
+        ({"span": 4.5}, "span: must be an integer, got 4.5"),
+        ({"span": "many"}, "span: must be an integer, got 'many'"),
+        ({"delta": "nan"}, "delta: must be a finite number, got 'nan'"),
+        ({"delta": True}, "delta: must be a number, got True"),
+        ({"spam": 1}, "spam: unknown parameter for method 'joint_distance_pca' (valid: "),
+    ],
+)
+def test_it_rejects_bad_parameter_values(params, message):
+    with pytest.raises(ParamError) as err:
+        get_segmenter("joint_distance_pca").validate_params(params)
+    assert str(err.value).startswith(message)
+
+
+def test_it_reports_bad_parameters_at_fit_not_init(synth_takes):
+    seg = get_segmenter("default")(threshold=-1)  # __init__ only stores
+    with pytest.raises(ParamError, match="threshold: must be between 0 and 2, got -1"):
+        seg.fit(synth_takes[0][0])
+
+
+def test_it_refuses_predict_before_fit():
+    with pytest.raises(RuntimeError, match="before fit"):
+        get_segmenter("default")().predict()
+
+
+@pytest.mark.parametrize("name", METHODS)
+def test_it_returns_the_documented_result(name, synth_takes):
+    take, _ = synth_takes[0]
+    result = get_segmenter(name)().fit_predict(take)
+    assert result.cuts.dtype.kind == "i"
+    assert np.all(np.diff(result.cuts) > 0)
+    assert np.all((result.cuts > 0) & (result.cuts < take.n_frames))
+    assert result.confidence.shape == result.cuts.shape
+    assert np.all((result.confidence >= 0) & (result.confidence <= 1))
+    assert result.signals and all(s.shape == (take.n_frames,) for s in result.signals.values())
+    assert all(np.isfinite(s).all() for s in result.signals.values())
+    assert result.timings["total"] > 0
+
+
+@pytest.mark.parametrize(
+    ("name", "min_recall"),
+    [("default", 0.9), ("bone_angle", 0.9), ("joint_distance_pca", 0.8), ("ppca", 0.6)],
+)
+def test_it_finds_the_true_boundaries_of_synthetic_takes(name, min_recall, synth_takes):
+    assert mean_scores(name, synth_takes)["recall"] >= min_recall
+
+
+def test_it_proposes_few_false_cuts_by_default(synth_takes):
+    assert mean_scores("default", synth_takes)["precision"] >= 0.9
+
+
+def test_it_keeps_working_at_another_frame_rate():
+    takes = [synth.generate(seed=seed, fps=60.0) for seed in range(3)]
+    scores = mean_scores("default", takes)
+    assert scores["recall"] >= 0.9 and scores["precision"] >= 0.9
+
+
+def test_it_proposes_fewer_cuts_with_a_higher_threshold(synth_takes):
+    take, _ = synth_takes[0]
+    strict = get_segmenter("default")(threshold=0.5).fit_predict(take)
+    loose = get_segmenter("default")(threshold=0.05).fit_predict(take)
+    assert len(strict.cuts) < len(loose.cuts)
+
+
+def test_it_gives_stronger_changes_higher_confidence(synth_takes):
+    take, _ = synth_takes[0]
+    result = get_segmenter("default")().fit_predict(take)
+    novelty = result.signals["novelty"]
+    order = np.argsort(result.confidence)
+    peaks = [novelty[max(0, c - 60) : c + 60].max() for c in result.cuts[order]]
+    assert peaks == sorted(peaks)
+
+
+def test_it_swings_more_candidates_through_with_a_looser_test(synth_takes):
+    take, _ = synth_takes[0]
+    tight = get_segmenter("bone_angle")(param=0.1).fit_predict(take)
+    loose = get_segmenter("bone_angle")(param=0.9).fit_predict(take)
+    assert set(tight.cuts.tolist()) < set(loose.cuts.tolist())
+
+
+def test_it_rejects_scales_in_the_wrong_order(synth_takes):
+    seg = get_segmenter("default")(scale_min_s=4.0, scale_max_s=2.0)
+    with pytest.raises(ParamError, match=r"scale_max_s: must be at least scale_min_s \(4\), got 2"):
+        seg.fit(synth_takes[0][0])
+
+
+def test_it_never_imports_django():
+    import subprocess
+
+    code = "import motionlib.segmenters, motionlib.metrics, motionlib.benchmark, sys; "
+    code += "assert 'django' not in sys.modules"
+    subprocess.run([sys.executable, "-c", code], check=True)
