@@ -146,7 +146,21 @@ def main(root: Path | None = None, only: list[str] | None = None, out=None) -> i
         truth = len(next(t for t in benchdata.labelled_takes(folder) if t.name == take).truth)
         print(format_table(f"\n{take} ({truth} true cuts)", rows), file=out)
     print(format_table(f"\nmean over {len(results)} takes", mean_rows(results)), file=out)
+    if not only or "default" in only:
+        print(f"\ndefault on a 5-minute 120 fps synthetic take: {long_take_seconds():.2f} s",
+              file=out)
     return 0
+
+
+def long_take_seconds(minutes: float = 5.0) -> float:
+    """Wall time of the default segmenter on a synthetic take of ``minutes`` at 120 fps."""
+    from motionlib import synth
+    from motionlib.segmenters import get_segmenter
+
+    take, _ = synth.generate(seed=0, fps=120.0, duration=60.0 * minutes)
+    start = time.perf_counter()
+    get_segmenter("default")().fit_predict(take)
+    return time.perf_counter() - start
 
 
 def add_bench(subparsers) -> None:
