@@ -1,0 +1,107 @@
+"""Benchmarks that print tables: ``python -m motionlib.bench io``.
+
+``io``: read + forward kinematics of the CMU take 13_29 as BVH and as AMC + ASF, against the
+PyPI ``bvh`` package's parse of the same BVH (median of several runs, one process, same files),
+and peak traced memory of read + FK against the file size.
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import sys
+import time
+import tracemalloc
+from pathlib import Path
+
+DATA = Path(__file__).resolve().parents[1] / ".." / "shared" / "data"
+TARGET_MS, TARGET_SPEEDUP, TARGET_MEMORY = 40.0, 10.0, 5.0
+
+
+def _timed(fn, runs: int) -> list[float]:
+    fn()  # warm up caches and lazy imports
+    times = []
+    for _ in range(runs):
+        started = time.perf_counter()
+        fn()
+        times.append((time.perf_counter() - started) * 1e3)
+    return times
+
+
+def _peak_bytes(fn) -> int:
+    tracemalloc.start()
+    try:
+        fn()
+        return tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+
+
+def _cases(cmu: Path):
+    import bvh as bvh_package
+
+    import motionlib
+
+    bvh_file = cmu / "bvh" / "13_29.bvh"
+    amc_file, asf_file = cmu / "amc" / "13_29.amc", cmu / "asf" / "13.asf"
+    return [
+        ("motionlib read+FK 13_29.bvh", bvh_file,
+         lambda: motionlib.forward_kinematics(motionlib.read(bvh_file))),
+        ("motionlib read+FK 13_29.amc", amc_file,
+         lambda: motionlib.forward_kinematics(motionlib.read(amc_file, asf=asf_file))),
+        ("bvh package parse 13_29.bvh", bvh_file,
+         lambda: bvh_package.Bvh(bvh_file.read_text())),
+    ]
+
+
+def run_io(args) -> int:
+    cmu = Path(args.data) / "cmu"
+    if not (cmu / "bvh" / "13_29.bvh").is_file():
+        print(f"motionlib.bench io: error: CMU captures not found under {cmu}", file=sys.stderr)
+        return 2
+    rows = []
+    for name, path, fn in _cases(cmu):
+        runs = args.runs if "motionlib" in name else max(3, args.runs // 4)
+        times = _timed(fn, runs)
+        peak = _peak_bytes(fn)
+        rows.append((name, statistics.median(times), min(times), runs, peak, path.stat().st_size))
+    _print_table(rows)
+    return 0
+
+
+def _print_table(rows) -> None:
+    print(f"{'case':<30}{'median ms':>10}{'min ms':>9}{'runs':>6}{'peak MiB':>10}"
+          f"{'file MiB':>10}{'peak/file':>10}")
+    for name, median, fastest, runs, peak, size in rows:
+        print(f"{name:<30}{median:>10.1f}{fastest:>9.1f}{runs:>6}{peak / 2**20:>10.2f}"
+              f"{size / 2**20:>10.2f}{peak / size:>10.2f}")
+    ours, theirs = rows[0], rows[2]
+    speedup = theirs[1] / ours[1]
+    print()
+    print(f"read+FK 13_29.bvh median {ours[1]:.1f} ms (target <= {TARGET_MS:.0f} ms): "
+          f"{'ok' if ours[1] <= TARGET_MS else 'MISSED'}")
+    print(f"speed-up over the bvh package's parse alone: {speedup:.1f}x "
+          f"(target >= {TARGET_SPEEDUP:.0f}x): {'ok' if speedup >= TARGET_SPEEDUP else 'MISSED'}")
+    ratio = ours[4] / ours[5]
+    print(f"peak memory of read+FK 13_29.bvh: {ratio:.2f}x the file (target < "
+          f"{TARGET_MEMORY:.0f}x): {'ok' if ratio < TARGET_MEMORY else 'MISSED'}")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="python -m motionlib.bench",
+                                     description="motionlib benchmarks (print tables).")
+    sub = parser.add_subparsers(dest="benchmark", required=True, metavar="benchmark")
+    io = sub.add_parser("io", help="read + FK speed and memory on CMU 13_29")
+    io.add_argument("--runs", type=int, default=21, help="timed runs per motionlib case")
+    io.add_argument("--data", default=str(DATA), help="the shared data folder")
+    io.set_defaults(handler=run_io)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    return args.handler(args)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
