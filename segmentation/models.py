@@ -216,9 +216,11 @@ class Capture(Job):
         return None
 
     def latest_run(self):
-        return self.runs.order_by("-created_at", "-id").first()
+        """The newest detection run (uses ``prefetch_related("runs")`` when present)."""
+        return max(self.runs.all(), key=lambda run: (run.created_at, run.id), default=None)
 
     def latest_finished_run(self):
+        """The newest run that finished; reviews start from its candidates."""
         return self.runs.filter(status="ready").order_by("-created_at", "-id").first()
 
 

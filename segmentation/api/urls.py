@@ -3,7 +3,7 @@ from drf_spectacular.views import SpectacularAPIView, SpectacularSwaggerView
 from rest_framework.authtoken.views import obtain_auth_token
 from rest_framework.routers import SimpleRouter
 
-from segmentation.api import reviews
+from segmentation.api import library, reviews
 from segmentation.api.captures import CaptureViewSet
 from segmentation.api.projects import MethodsView, MeView, ProjectViewSet
 
@@ -25,5 +25,6 @@ urlpatterns = [
     path(review + "submit/", reviews.SubmitView.as_view(), name="api-review-submit"),
     path(review + "events/", reviews.EventsView.as_view(), name="api-review-events"),
     path("captures/<int:pk>/reviews/", reviews.AllReviewsView.as_view(), name="api-reviews"),
+    *library.urlpatterns,
     *router.urls,
 ]

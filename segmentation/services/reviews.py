@@ -147,4 +147,8 @@ def do_submit_review(review, user, version):
         Review.objects.filter(pk=review.pk).update(status="submitted", submitted_at=now)
         review.status, review.submitted_at = "submitted", now
         _log(review, user, "submit", before={"status": "in_progress"}, after={"status": "submitted"})
+        # Materialise the capture's library rows and agreement with the submit itself.
+        from segmentation.library import on_review_submitted
+
+        on_review_submitted(review)
     return review

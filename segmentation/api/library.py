@@ -1,0 +1,278 @@
+"""The clip library, agreement, adjudication and the project dashboard.
+
+- ``GET /api/segments/?project=&label=&capture=&annotator=&min_duration=&max_duration=&min_agreement=&gold=&ordering=``
+- ``GET /api/segments/{id}/``, ``…/export.bvh``, ``…/similar/?k=10``
+- ``GET /api/segments/export.zip?<same filters>`` (streamed)
+- ``GET /api/captures/{id}/agreement/?tolerance=0.25`` (reviewers and admins)
+- ``GET/PUT /api/captures/{id}/adjudication/`` (reviewers and admins)
+- ``GET /api/projects/{id}/dashboard/`` (reviewers and admins)
+
+Who sees what: annotators see their own segments and gold segments; agreement,
+adjudication and the dashboard compare everybody's reviews, so for annotators they do not
+exist (404, like any object the caller may not see).
+"""
+
+from django.http import HttpResponse, StreamingHttpResponse
+from django.urls import path
+from drf_spectacular.utils import extend_schema
+from rest_framework import serializers
+from rest_framework.exceptions import NotFound
+from rest_framework.pagination import PageNumberPagination
+from rest_framework.response import Response
+from rest_framework.views import APIView
+
+from segmentation import agreement, library
+from segmentation.api.captures import capture_for, int_param
+from segmentation.api.projects import project_for
+from segmentation.models import Review
+from segmentation.models_library import Adjudication, LibrarySegment
+
+ORDERINGS = {
+    "recent": ("-id",), "duration": ("duration", "id"), "-duration": ("-duration", "-id"),
+    "agreement": ("agreement", "id"), "-agreement": ("-agreement", "-id"),
+    "label": ("label_name", "id"), "capture": ("capture_id", "start", "id"),
+}
+
+
+class SegmentPagination(PageNumberPagination):
+    page_size = 50
+    page_size_query_param = "page_size"
+    max_page_size = 500
+
+
+class SegmentSerializer(serializers.ModelSerializer):
+    capture = serializers.SerializerMethodField()
+    annotator = serializers.SerializerMethodField()
+    label = serializers.CharField(source="label_name")
+    color = serializers.SerializerMethodField()
+    gold = serializers.BooleanField(source="is_gold")
+    fps = serializers.FloatField(source="capture.fps")
+
+    class Meta:
+        model = LibrarySegment
+        fields = ["id", "project", "capture", "review", "annotator", "gold", "superseded",
+                  "label", "color", "start", "stop", "fps", "duration", "agreement"]
+
+    def get_capture(self, s) -> dict:
+        return {"id": s.capture_id, "name": s.capture.name}
+
+    def get_annotator(self, s) -> dict | None:
+        return {"id": s.annotator_id, "username": s.annotator.username} if s.annotator_id else None
+
+    def get_color(self, s) -> str:
+        return s.label.color if s.label_id else "#888888"
+
+
+def float_param(request, name, low=None, high=None):
+    raw = request.query_params.get(name)
+    if raw is None or raw == "":
+        return None
+    try:
+        value = float(raw)
+    except ValueError:
+        raise ValueError(f"{name}: must be a number, got {raw!r}") from None
+    if low is not None and value < low or high is not None and value > high:
+        raise ValueError(f"{name}: must be between {low} and {high}, got {raw}")
+    return value
+
+
+def bool_param(request, name):
+    raw = request.query_params.get(name)
+    if raw is None or raw == "":
+        return None
+    if raw.lower() in ("true", "1", "yes"):
+        return True
+    if raw.lower() in ("false", "0", "no"):
+        return False
+    raise ValueError(f"{name}: must be true or false, got {raw!r}")
+
+
+def segment_query(request):
+    """The caller's visible segments filtered by the query string (shared by list and zip)."""
+    segments = LibrarySegment.objects.visible_to(request.user)
+    gold = bool_param(request, "gold")
+    if gold is None:
+        segments = segments.preferred()
+    else:
+        segments = segments.filter(is_gold=gold)
+    for name, field in (("project", "project_id"), ("capture", "capture_id"),
+                        ("annotator", "annotator_id")):
+        value = int_param(request, name, None, 1)
+        if value is not None:
+            segments = segments.filter(**{field: value})
+    if request.query_params.get("label"):
+        segments = segments.filter(label_name=request.query_params["label"])
+    for name, lookup, high in (("min_duration", "duration__gte", None),
+                               ("max_duration", "duration__lte", None),
+                               ("min_agreement", "agreement__gte", 1)):
+        value = float_param(request, name, 0, high)
+        if value is not None:
+            segments = segments.filter(**{lookup: value})
+    ordering = request.query_params.get("ordering") or "recent"
+    if ordering not in ORDERINGS:
+        raise ValueError(f"ordering: must be one of {', '.join(ORDERINGS)}, got {ordering!r}")
+    return segments.order_by(*ORDERINGS[ordering])
+
+
+def segment_for(user, pk):
+    segment = (LibrarySegment.objects.visible_to(user).select_related("capture", "annotator", "label")
+               .filter(pk=pk).first())
+    if segment is None:
+        raise NotFound("No such segment.")
+    return segment
+
+
+class SegmentListView(APIView):
+    @extend_schema(responses=SegmentSerializer(many=True))
+    def get(self, request):
+        segments = segment_query(request).select_related("capture", "annotator", "label").defer(
+            "descriptor", "capture__skeleton")
+        paginator = SegmentPagination()
+        page = paginator.paginate_queryset(segments, request, view=self)
+        return paginator.get_paginated_response(SegmentSerializer(page, many=True).data)
+
+
+class SegmentView(APIView):
+    @extend_schema(responses=SegmentSerializer)
+    def get(self, request, pk):
+        return Response(SegmentSerializer(segment_for(request.user, pk)).data)
+
+
+class SegmentBvhView(APIView):
+    @extend_schema(responses={(200, "text/plain"): str})
+    def get(self, request, pk):
+        segment = segment_for(request.user, pk)
+        text = library.bvh_text(library.read_take(segment.capture), segment)
+        response = HttpResponse(text, content_type="application/octet-stream")
+        response["Content-Disposition"] = f'attachment; filename="{library.file_name(segment)}"'
+        return response
+
+
+class SegmentZipView(APIView):
+    @extend_schema(responses={(200, "application/zip"): bytes})
+    def get(self, request):
+        segments = segment_query(request)
+        count = segments.count()
+        if count > library.MAX_EXPORT_SEGMENTS:
+            raise ValueError(f"export: the query matches {count} segments; export at most "
+                             f"{library.MAX_EXPORT_SEGMENTS} at a time (narrow the filters)")
+        rows = (segments.select_related("capture", "annotator").defer("descriptor")
+                .order_by("capture_id", "start", "id").iterator(chunk_size=200))
+        response = StreamingHttpResponse(library.stream_zip(rows), content_type="application/zip")
+        response["Content-Disposition"] = 'attachment; filename="segments.zip"'
+        return response
+
+
+class SimilarView(APIView):
+    @extend_schema(responses=dict)
+    def get(self, request, pk):
+        segment = segment_for(request.user, pk)
+        k = int_param(request, "k", 10, 1, 100)
+        visible = LibrarySegment.objects.visible_to(request.user).preferred()
+        found = library.similar(segment, visible, k=k)
+        return Response({
+            "segment": segment.pk,
+            "results": [{**SegmentSerializer(s).data, "distance": round(d, 4)} for s, d in found],
+        })
+
+
+def staff_capture(user, pk):
+    """A capture whose project the user reviews or administers, else 404."""
+    capture = capture_for(user, pk)
+    if not capture.project.can_see_all_reviews(user):
+        raise NotFound("No such capture.")
+    return capture
+
+
+class AgreementView(APIView):
+    @extend_schema(responses=dict)
+    def get(self, request, pk):
+        capture = staff_capture(request.user, pk)
+        tolerance = float_param(request, "tolerance", 0, 10)
+        tolerance = agreement.DEFAULT_TOLERANCE_S if tolerance is None else tolerance
+        return Response(agreement.capture_agreement(capture, tolerance))
+
+
+class GoldSerializer(serializers.Serializer):
+    cuts = serializers.ListField(child=serializers.IntegerField())
+    labels = serializers.ListField(child=serializers.CharField(allow_null=True))
+    version = serializers.IntegerField(min_value=0)
+    source_review = serializers.IntegerField(required=False, allow_null=True)
+
+
+def gold_body(gold):
+    if gold is None:
+        return None
+    return {
+        "version": gold.version, "cuts": gold.cuts, "labels": gold.labels,
+        "segments": [{"start": a, "stop": b, "label": c} for a, b, c in gold.segments()],
+        "adjudicator": gold.adjudicator.username if gold.adjudicator else None,
+        "source_review": gold.source_review_id, "updated_at": gold.updated_at,
+    }
+
+
+def adjudication_body(capture):
+    reviews = Review.objects.filter(capture=capture).select_related("annotator", "capture")
+    reviews = reviews.prefetch_related("cuts", "segment_labels__label").order_by("id")
+    gold = Adjudication.objects.select_related("adjudicator").filter(capture=capture).first()
+    return {
+        "capture": {"id": capture.pk, "name": capture.name, "fps": capture.fps,
+                    "n_frames": capture.n_frames, "project": capture.project_id},
+        "labels": [{"name": x.name, "color": x.color, "hotkey": x.hotkey}
+                   for x in capture.project.labels.all()],
+        "reviews": [
+            {"id": r.pk, "annotator": {"id": r.annotator_id, "username": r.annotator.username},
+             "status": r.status, "cuts": agreement.review_cuts(r),
+             "segments": [{"start": a, "stop": b, "label": c}
+                          for a, b, c in agreement.review_segments(r)]}
+            for r in reviews
+        ],
+        "gold": gold_body(gold),
+        "agreement": agreement.capture_agreement(capture),
+    }
+
+
+class AdjudicationView(APIView):
+    @extend_schema(responses=dict)
+    def get(self, request, pk):
+        return Response(adjudication_body(staff_capture(request.user, pk)))
+
+    @extend_schema(request=GoldSerializer, responses=dict)
+    def put(self, request, pk):
+        capture = staff_capture(request.user, pk)
+        body = GoldSerializer(data=request.data)
+        body.is_valid(raise_exception=True)
+        data = body.validated_data
+        source = None
+        if data.get("source_review") is not None:
+            source = Review.objects.filter(pk=data["source_review"], capture=capture).first()
+            if source is None:
+                raise ValueError(f"source_review: review {data['source_review']} is not a "
+                                 "review of this capture")
+        try:
+            library.do_save_gold(capture, request.user, data["cuts"], data["labels"],
+                                 data["version"], source)
+        except library.StaleGold as exc:
+            return Response({"detail": str(exc), "gold": gold_body(exc.adjudication)}, status=409)
+        return Response(adjudication_body(capture))
+
+
+class DashboardView(APIView):
+    @extend_schema(responses=dict)
+    def get(self, request, pk):
+        project = project_for(request.user, pk)
+        if not project.can_see_all_reviews(request.user):
+            raise NotFound("No such project.")
+        return Response(agreement.dashboard(project))
+
+
+urlpatterns = [
+    path("segments/", SegmentListView.as_view(), name="api-segments"),
+    path("segments/export.zip", SegmentZipView.as_view(), name="api-segments-zip"),
+    path("segments/<int:pk>/", SegmentView.as_view(), name="api-segment"),
+    path("segments/<int:pk>/export.bvh", SegmentBvhView.as_view(), name="api-segment-bvh"),
+    path("segments/<int:pk>/similar/", SimilarView.as_view(), name="api-segment-similar"),
+    path("captures/<int:pk>/agreement/", AgreementView.as_view(), name="api-agreement"),
+    path("captures/<int:pk>/adjudication/", AdjudicationView.as_view(), name="api-adjudication"),
+    path("projects/<int:pk>/dashboard/", DashboardView.as_view(), name="api-dashboard"),
+]

@@ -1,0 +1,330 @@
+"""The clip library: materialised segments, gold versions, exports, similar clips and
+label suggestions.
+
+Segments become ``LibrarySegment`` rows when a review is submitted or a gold version is
+saved (``refresh_capture_library`` rebuilds one capture's rows: agreement values change
+whenever another review of the capture comes in). Each row carries its motion descriptor
+(``motionlib.similarity``), so "find similar" and label suggestions never re-read takes.
+"""
+
+import csv
+import io
+import json
+import re
+import zipfile
+from collections import Counter
+from pathlib import PurePath
+from types import SimpleNamespace
+
+import numpy as np
+from django.core.cache import cache
+from django.db import transaction
+from django.utils import timezone
+
+import motionlib
+from motionlib import agreement as metrics
+from motionlib import similarity
+from segmentation import agreement, storage
+from segmentation.models_library import Adjudication, LibrarySegment
+
+# Similar-clip search ranks at most this many of a project's most recent segments.
+SIMILAR_POOL = 5000
+SUGGEST_NEIGHBOURS = 5
+MAX_EXPORT_SEGMENTS = 5000
+
+
+class StaleGold(Exception):
+    """A gold version was saved from an old version; ``adjudication`` is the current one."""
+
+    def __init__(self, adjudication):
+        super().__init__(
+            f"the gold version is at version {adjudication.version}; reload it and redo the change"
+        )
+        self.adjudication = adjudication
+
+
+def read_take(capture):
+    """The parsed take of a capture's stored original (BVH, or AMC with its ASF)."""
+    with storage.local_path(capture.original) as path:
+        if capture.asf:
+            with storage.local_path(capture.asf) as asf_path:
+                return motionlib.read(path, asf=asf_path)
+        return motionlib.read(path)
+
+
+def capture_joints(capture):
+    """Canonical joint indices of a capture's skeleton, or None if it cannot be mapped."""
+    names = (capture.skeleton or {}).get("joints") or []
+    try:
+        return motionlib.canonical_indices(SimpleNamespace(names=list(names)))
+    except ValueError:
+        return None
+
+
+def descriptors(capture, spans):
+    """``(bytes or None, shape or None)`` per ``(start, stop)`` span of a capture."""
+    joints = capture_joints(capture) if capture.positions else None
+    if joints is None:
+        return [(None, None)] * len(spans)
+    positions = np.asarray(storage.load_npy(capture.positions), dtype=float)
+    scale = similarity.body_scale(positions, joints)
+    out = []
+    for start, stop in spans:
+        d = similarity.segment_descriptor(positions, joints, start, stop, fps=capture.fps, scale=scale)
+        out.append((d.astype("<f4").tobytes(), list(d.shape)))
+    return out
+
+
+def refresh_capture_library(capture):
+    """Rebuild a capture's library rows from its submitted reviews and gold version.
+
+    Only labelled segments enter the library. An annotator's segment carries the share of
+    the other annotators' frames that agree with its label; a gold segment the share of
+    all annotators' frames. Annotators' segments of a capture with gold are superseded.
+    """
+    reviews = agreement.submitted_reviews(capture)
+    gold = Adjudication.objects.filter(capture=capture).first()
+    lists = [agreement.review_segments(r) for r in reviews]
+    if gold:
+        lists.append(gold.segments())
+    codes, _ = metrics.label_codes(lists, capture.n_frames)
+    labels = {label.name: label for label in capture.project.labels.all()}
+    n = len(reviews)
+    rows = []
+    for row, segments in enumerate(lists):
+        review = reviews[row] if row < n else None
+        for start, stop, name in segments:
+            if name is None or stop <= start:
+                continue
+            support = (metrics.segment_support(codes[:n], row, start, stop) if review
+                       else _gold_support(codes, n, start, stop))
+            rows.append(LibrarySegment(
+                project_id=capture.project_id, capture=capture, review=review,
+                annotator_id=review.annotator_id if review else None, is_gold=review is None,
+                superseded=bool(gold) and review is not None, label=labels.get(name),
+                label_name=name, start=start, stop=stop, duration=(stop - start) / capture.fps,
+                agreement=agreement.finite(support)))
+    for segment, (blob, shape) in zip(rows, descriptors(capture, [(r.start, r.stop) for r in rows]),
+                                      strict=True):
+        segment.descriptor, segment.descriptor_shape = blob, shape
+    with transaction.atomic():
+        LibrarySegment.objects.filter(capture=capture).delete()
+        LibrarySegment.objects.bulk_create(rows, batch_size=500)
+    return rows
+
+
+def _gold_support(codes, n_reviews, start, stop):
+    """Share of all annotators' frames in [start, stop) that carry the gold label."""
+    if n_reviews == 0:
+        return float("nan")
+    gold = codes[n_reviews, start:stop]
+    return float(np.mean(codes[:n_reviews, start:stop] == gold[None, :]))
+
+
+def on_review_submitted(review):
+    """Called by the submit workflow, inside its transaction."""
+    capture = review.capture
+    agreement.refresh_capture_agreement(capture)
+    refresh_capture_library(capture)
+
+
+def check_gold(capture, cuts, labels):
+    """Validated (cuts, labels) of a gold version; ValueError names the bad value."""
+    if not isinstance(cuts, list) or not all(isinstance(c, int) and not isinstance(c, bool)
+                                             for c in cuts):
+        raise ValueError(f"cuts: must be a list of frame numbers, got {cuts!r}")
+    for i, frame in enumerate(cuts):
+        if not 0 < frame < capture.n_frames:
+            raise ValueError(f"cuts: cut {i} at frame {frame} is outside 1..{capture.n_frames - 1}")
+        if i and frame <= cuts[i - 1]:
+            raise ValueError(f"cuts: cut {i} at frame {frame} is not after the previous cut "
+                             f"({cuts[i - 1]}); send cuts in increasing frame order")
+    if not isinstance(labels, list) or len(labels) != len(cuts) + 1:
+        raise ValueError(f"labels: expected {len(cuts) + 1} labels (one per segment), "
+                         f"got {len(labels) if isinstance(labels, list) else repr(labels)}")
+    known = set(capture.project.labels.values_list("name", flat=True))
+    for i, name in enumerate(labels):
+        if name is not None and name not in known:
+            raise ValueError(f"labels: segment {i} has label {name!r}, which is not a label of "
+                             f"this project ({', '.join(sorted(known))})")
+    return cuts, labels
+
+
+def do_save_gold(capture, user, cuts, labels, version, source_review=None):
+    """Create or replace the capture's gold version and rebuild its library rows.
+
+    ``version`` is the gold version the reviewer started from (0 when there was none);
+    anything else than the current version is refused with ``StaleGold``.
+    """
+    cuts, labels = check_gold(capture, cuts, labels)
+    if not capture.reviews.filter(status="submitted").exists():
+        raise ValueError("capture: a gold version needs at least one submitted review")
+    if source_review is not None and source_review.capture_id != capture.pk:
+        raise ValueError(f"source_review: review {source_review.pk} is not of this capture")
+    with transaction.atomic():
+        current = Adjudication.objects.select_for_update().filter(capture=capture).first()
+        if (current.version if current else 0) != version:
+            raise StaleGold(current) if current else ValueError(
+                f"version: there is no gold version yet; send 0, got {version}")
+        gold = current or Adjudication(capture=capture, version=0)
+        gold.adjudicator, gold.source_review = user, source_review
+        gold.cuts, gold.labels = cuts, labels
+        gold.version += 1
+        gold.updated_at = timezone.now()
+        gold.save()
+        refresh_capture_library(capture)
+    return gold
+
+
+def slug(text):
+    return re.sub(r"[^A-Za-z0-9]+", "-", str(text)).strip("-") or "untitled"
+
+
+def file_name(segment):
+    """``capture_label_start-stop.bvh`` with safe characters only."""
+    stem = PurePath(segment.capture.name).stem
+    return f"{slug(stem)}_{slug(segment.label_name)}_{segment.start}-{segment.stop}.bvh"
+
+
+def bvh_text(take, segment):
+    """The segment's frames as BVH with the take's own hierarchy and frame time."""
+    out = io.StringIO()
+    motionlib.write_bvh(take, out, start=segment.start, stop=segment.stop)
+    return out.getvalue()
+
+
+def manifest_row(segment, name):
+    return {
+        "file": name, "segment": segment.pk, "capture": segment.capture.name,
+        "capture_id": segment.capture_id, "start": segment.start, "stop": segment.stop,
+        "label": segment.label_name, "gold": segment.is_gold,
+        "annotator": segment.annotator.username if segment.annotator else None,
+        "agreement": segment.agreement,
+    }
+
+
+class _Sink:
+    """A write-only file for ``zipfile``: it collects bytes until ``drain`` hands them out."""
+
+    def __init__(self):
+        self.parts = []
+
+    def write(self, data):
+        self.parts.append(bytes(data))
+        return len(data)
+
+    def flush(self):
+        pass
+
+    def drain(self):
+        data, self.parts = b"".join(self.parts), []
+        return data
+
+
+def stream_zip(segments):
+    """Yield a zip archive of one BVH per segment plus ``manifest.csv`` and ``manifest.json``.
+
+    ``segments`` should be ordered by capture so each take is read once; the archive is
+    written as it goes (at most one take and one BVH are in memory).
+    """
+    sink = _Sink()
+    manifest, take, take_of = [], None, None
+    with zipfile.ZipFile(sink, "w", compression=zipfile.ZIP_DEFLATED) as archive:
+        for segment in segments:
+            if take_of != segment.capture_id:
+                take, take_of = read_take(segment.capture), segment.capture_id
+            name = file_name(segment)
+            archive.writestr(name, bvh_text(take, segment))
+            manifest.append(manifest_row(segment, name))
+            yield sink.drain()
+        archive.writestr("manifest.json", json.dumps(manifest, indent=1))
+        archive.writestr("manifest.csv", _csv(manifest))
+    yield sink.drain()
+
+
+def _csv(rows):
+    out = io.StringIO()
+    fields = ["file", "segment", "capture", "capture_id", "start", "stop", "label", "gold",
+              "annotator", "agreement"]
+    writer = csv.DictWriter(out, fieldnames=fields)
+    writer.writeheader()
+    writer.writerows(rows)
+    return out.getvalue()
+
+
+def similar(segment, visible, k=10):
+    """The ``k`` visible segments of the same project that move most like ``segment``.
+
+    Segments overlapping it in the same capture are left out (other annotators' versions
+    of the same motion), and so are duplicates of one span. Returns ``[(segment, distance)]``.
+    """
+    query = segment.descriptor_array()
+    if query is None:
+        raise ValueError(f"segment {segment.pk}: its skeleton could not be mapped to body "
+                         "parts, so it has no motion descriptor")
+    pool = (
+        visible.filter(project_id=segment.project_id, descriptor__isnull=False)
+        .exclude(capture_id=segment.capture_id, start__lt=segment.stop, stop__gt=segment.start)
+        .order_by("-id").values_list("id", "capture_id", "start", "stop", "descriptor")
+    )[:SIMILAR_POOL]
+    ids, library, seen = [], [], set()
+    for pk, capture_id, start, stop, blob in pool:
+        if (capture_id, start, stop) in seen:
+            continue
+        seen.add((capture_id, start, stop))
+        ids.append(pk)
+        library.append(np.frombuffer(bytes(blob), dtype="<f4").reshape(query.shape))
+    if not ids:
+        return []
+    order, distances = similarity.rank_similar(query, np.stack(library), k=k, shortlist=max(20, k))
+    rows = LibrarySegment.objects.select_related("capture", "annotator").in_bulk([ids[i] for i in order])
+    return [(rows[ids[i]], float(d)) for i, d in zip(order, distances, strict=True)]
+
+
+def suggest_labels(review, segments):
+    """A suggested label for each unlabelled segment of a review (None where there is none).
+
+    The label most common among the nearest ``SUGGEST_NEIGHBOURS`` labelled segments of
+    the project's library (gold preferred, profile distance). Cached per span and
+    library state, so editing one segment does not recompute the others.
+    """
+    capture = review.capture
+    pending = [(s, e) for _, s, e, label in segments if label is None and e > s]
+    latest = LibrarySegment.objects.filter(project_id=capture.project_id).order_by("-id").first()
+    if not pending or latest is None:
+        return [None] * len(segments)
+    key = f"cutroom:suggest:{capture.pk}:{latest.pk}:"
+    found = cache.get_many([f"{key}{s}-{e}" for s, e in pending])
+    missing = [(s, e) for s, e in pending if f"{key}{s}-{e}" not in found]
+    if missing:
+        computed = _suggest(capture, missing)
+        cache.set_many({f"{key}{s}-{e}": v for (s, e), v in zip(missing, computed, strict=True)},
+                       timeout=3600)
+        found.update({f"{key}{s}-{e}": v for (s, e), v in zip(missing, computed, strict=True)})
+    return [found.get(f"{key}{s}-{e}") if label is None else None for _, s, e, label in segments]
+
+
+def _suggest(capture, spans):
+    pool = (
+        LibrarySegment.objects.preferred()
+        .filter(project_id=capture.project_id, descriptor__isnull=False)
+        .order_by("-is_gold", "-id").values_list("label_name", "descriptor", "descriptor_shape")
+    )[:SIMILAR_POOL]
+    names, library = [], []
+    for name, blob, shape in pool:
+        names.append(name)
+        library.append(np.frombuffer(bytes(blob), dtype="<f4").reshape(shape))
+    queries = descriptors(capture, spans)
+    if not names or queries[0][0] is None:
+        return [None] * len(spans)
+    library = np.stack(library)
+    out = []
+    for blob, shape in queries:
+        query = np.frombuffer(blob, dtype="<f4").reshape(shape)
+        order, _ = similarity.rank_similar(query, library, k=min(SUGGEST_NEIGHBOURS, len(names)),
+                                           shortlist=SUGGEST_NEIGHBOURS)
+        votes = Counter(names[i] for i in order)
+        # Ties go to the nearest neighbour's label.
+        best = max(votes.values())
+        out.append(next(names[i] for i in order if votes[names[i]] == best))
+    return out

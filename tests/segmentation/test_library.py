@@ -1,0 +1,160 @@
+"""The clip library API: segments become rows when a review is submitted, the list
+filters and sorts them, annotators see their own and gold segments only, and the query
+count does not grow with the page."""
+
+from django.contrib.auth import get_user_model
+from django.db import connection
+from django.test.utils import CaptureQueriesContext
+
+from segmentation import services
+from segmentation.models_library import LibrarySegment
+from tests.segmentation.base import BaseTestCase
+
+
+def submit_review(capture, user, cuts, labels):
+    """A review of ``capture`` by ``user`` with exactly ``cuts`` kept and ``labels`` per
+    segment (None leaves a segment unlabelled), submitted."""
+    review = services.get_or_create_review(capture, user)
+    for cut in list(review.cuts.all()):
+        if cut.frame not in cuts:
+            services.do_change_cut(review, user, cut, review.version, fate="deleted")
+    present = set(review.cuts.exclude(fate="deleted").values_list("frame", flat=True))
+    for frame in cuts:
+        if frame not in present:
+            services.do_insert_cut(review, user, frame, review.version)
+    for index, name in enumerate(labels):
+        if name is not None:
+            services.do_label_segment(review, user, index, name, review.version)
+    services.do_submit_review(review, user, review.version)
+    return review
+
+
+class LibraryTestCase(BaseTestCase):
+    """Adds dana, a second annotator, and the two reviews worked out by hand in
+    tests/segmentation/test_agreement.py (400 frames at 120 fps)."""
+
+    @classmethod
+    def setUpTestData(cls):
+        super().setUpTestData()
+        get_user_model().objects.create_user("dana", password="dana-password")
+        cls.dana = get_user_model().objects.get(username="dana")
+        services.do_set_member(cls.project, "dana", "annotator")
+
+    def two_reviews(self, capture=None):
+        capture = capture or self.ready_capture()
+        bob = submit_review(capture, self.bob, [100, 200, 300], ["walk", "punch", "walk", "punch"])
+        dana = submit_review(capture, self.dana, [110, 250], ["walk", "punch", "punch"])
+        return capture, bob, dana
+
+
+class MaterialisationTest(LibraryTestCase):
+    def test_it_materialises_labelled_segments_when_a_review_is_submitted(self):
+        capture = self.ready_capture()
+        review = services.get_or_create_review(capture, self.bob)
+        services.do_label_segment(review, self.bob, 0, "walk", review.version)
+        assert not LibrarySegment.objects.exists()
+        services.do_submit_review(review, self.bob, review.version)
+        rows = list(LibrarySegment.objects.order_by("start"))
+        # Only the labelled first segment [0, 100) enters the library.
+        assert [(s.start, s.stop, s.label_name, s.annotator_id) for s in rows] == [
+            (0, 100, "walk", self.bob.pk)]
+        assert rows[0].duration == 100 / 120
+        assert rows[0].agreement is None  # nobody else reviewed it yet
+
+    def test_it_updates_every_annotators_agreement_when_another_review_comes_in(self):
+        capture, _, _ = self.two_reviews()
+        bob = {(s.start, s.stop): s.agreement for s in LibrarySegment.objects.filter(annotator=self.bob)}
+        # dana labels [0,110) walk, [110,250) punch, [250,400) punch.
+        assert bob == {(0, 100): 1.0, (100, 200): 0.9, (200, 300): 0.0, (300, 400): 1.0}
+
+
+class SegmentListTest(LibraryTestCase):
+    def setUp(self):
+        super().setUp()
+        self.capture, _, _ = self.two_reviews()
+
+    def get(self, query=""):
+        response = self.client.get(f"/api/segments/{query}")
+        assert response.status_code == 200, response.content
+        return response.json()
+
+    def test_it_lists_every_segment_of_the_project_for_a_reviewer(self):
+        self.login(self.rachel)
+        body = self.get()
+        assert body["count"] == 7
+        first = body["results"][0]
+        assert set(first) >= {"id", "capture", "annotator", "gold", "label", "color", "start",
+                              "stop", "fps", "duration", "agreement"}
+        assert first["capture"] == {"id": self.capture.pk, "name": "c.bvh"}
+
+    def test_it_shows_an_annotator_only_their_own_segments(self):
+        self.login(self.bob)
+        body = self.get()
+        assert body["count"] == 4
+        assert {r["annotator"]["username"] for r in body["results"]} == {"bob"}
+
+    def test_it_shows_an_outsider_nothing(self):
+        self.login(self.charlie)
+        assert self.get()["count"] == 0
+        assert self.get(f"?project={self.project.pk}")["count"] == 0
+
+    def test_it_filters_by_label_annotator_duration_and_agreement(self):
+        self.login(self.rachel)
+        assert self.get("?label=walk")["count"] == 3
+        assert self.get(f"?annotator={self.dana.pk}")["count"] == 3
+        # Durations: bob 4 x 100 frames, dana 110, 140, 150 frames at 120 fps.
+        assert self.get("?min_duration=1.0")["count"] == 2
+        assert self.get("?max_duration=0.9")["count"] == 4
+        assert self.get("?min_agreement=0.95")["count"] == 2
+        assert self.get(f"?capture={self.capture.pk}&label=punch&annotator={self.bob.pk}")["count"] == 2
+
+    def test_it_sorts_by_duration_and_agreement(self):
+        self.login(self.rachel)
+        durations = [r["duration"] for r in self.get("?ordering=-duration")["results"]]
+        assert durations == sorted(durations, reverse=True)
+        agreements = [r["agreement"] for r in self.get("?ordering=agreement")["results"]]
+        assert agreements == sorted(agreements)
+
+    def test_it_rejects_bad_filters_naming_them(self):
+        self.login(self.rachel)
+        for query, message in [
+            ("?min_duration=abc", "min_duration: must be a number, got 'abc'"),
+            ("?min_agreement=2", "min_agreement: must be between 0 and 1, got 2"),
+            ("?gold=maybe", "gold: must be true or false, got 'maybe'"),
+            ("?ordering=colour", "ordering: must be one of"),
+            ("?project=x", "project: must be an integer, got 'x'"),
+        ]:
+            response = self.client.get(f"/api/segments/{query}")
+            assert response.status_code == 400, query
+            assert message in response.json()["detail"]
+
+    def test_it_pages_results(self):
+        self.login(self.rachel)
+        body = self.get("?page_size=3&ordering=capture")
+        assert len(body["results"]) == 3 and body["next"]
+        assert [r["start"] for r in body["results"]] == [0, 0, 100]
+
+    def test_it_answers_with_a_fixed_number_of_queries_whatever_the_page_size(self):
+        self.login(self.rachel)
+        counts = []
+        for size in (1, 7):
+            with CaptureQueriesContext(connection) as queries:
+                self.get(f"?page_size={size}")
+            counts.append(len(queries))
+        # Memberships, count, page (with capture, annotator and label joined).
+        assert counts == [3, 3]
+
+    def test_it_requires_login(self):
+        assert self.client.get("/api/segments/").status_code in (401, 403)
+
+
+class SegmentDetailTest(LibraryTestCase):
+    def test_it_shows_a_segment_to_its_annotator_and_hides_it_from_others(self):
+        self.two_reviews()
+        danas = LibrarySegment.objects.filter(annotator=self.dana).first()
+        self.login(self.dana)
+        assert self.client.get(f"/api/segments/{danas.pk}/").json()["label"] == danas.label_name
+        self.login(self.bob)
+        assert self.client.get(f"/api/segments/{danas.pk}/").status_code == 404
+        self.login(self.charlie)
+        assert self.client.get(f"/api/segments/{danas.pk}/").status_code == 404
