@@ -17,6 +17,6 @@ def make_spool_folders(sender, **kwargs):
     # The filesystem broker (embedded default) needs its folders before the first
     # message, in whichever process (web, worker, `celery inspect`) touches it first.
     options = sender.conf.broker_transport_options or {}
-    for key in ("data_folder_in", "data_folder_out", "processed_folder"):
+    for key in ("data_folder_in", "data_folder_out", "processed_folder", "control_folder"):
         if key in options:
             os.makedirs(options[key], exist_ok=True)
