@@ -5,10 +5,12 @@ from django.contrib.auth import logout
 from django.contrib.auth.decorators import login_required
 from django.http import HttpResponse
 from django.shortcuts import redirect, render
+from django.views.decorators.csrf import ensure_csrf_cookie
 from django.views.decorators.http import require_http_methods
 
 
 @login_required
+@ensure_csrf_cookie  # the front end sends it back as X-CSRFToken on writes
 def app(request, path=""):
     """The built front end's index.html; every client-side route gets the same page."""
     index = settings.FRONTEND_DIST / "index.html"

@@ -47,6 +47,10 @@ def services_env():
             "the database is not PostgreSQL; run with "
             "DATABASE_URL=postgres://postgres@127.0.0.1:5432/test (make pytest does)"
         )
+    db = connection.settings_dict
+    problem = _reachable(f"postgres://{db['HOST'] or '127.0.0.1'}:{db['PORT'] or 5432}", 5432)
+    if problem:
+        _unavailable(f"PostgreSQL not reachable at {problem}")
     if not settings.CELERY_BROKER_URL.startswith("redis"):
         _unavailable(
             "the broker is not Redis; run with CELERY_BROKER_URL=redis://127.0.0.1:6379/15"
@@ -54,6 +58,11 @@ def services_env():
     problem = _reachable(settings.CELERY_BROKER_URL, 6379)
     if problem:
         _unavailable(f"Redis not reachable at {problem}")
+
+
+@pytest.fixture(scope="session")
+def django_db_setup(services_env, django_db_setup):
+    """Check the services before pytest-django tries to create the test database."""
 
 
 @pytest.fixture(scope="session")

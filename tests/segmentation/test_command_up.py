@@ -1,0 +1,172 @@
+"""``scripts/up.py`` (``make up``) as a person runs it: a real gunicorn and a real Celery
+worker on the embedded default (SQLite + filesystem broker in a fresh var folder)."""
+
+import json
+import os
+import re
+import signal
+import socket
+import subprocess
+import sys
+import time
+import urllib.request
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parents[2]
+UP = REPO / "scripts" / "up.py"
+
+pytestmark = pytest.mark.slow
+
+
+def free_port():
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        return probe.getsockname()[1]
+
+
+class Up:
+    """One ``up.py`` process with its output in a file."""
+
+    def __init__(self, var, port, *args):
+        env = {k: v for k, v in os.environ.items()
+               if k not in ("DATABASE_URL", "CELERY_BROKER_URL", "CUTROOM_MEDIA_ROOT")}
+        env["CUTROOM_VAR_DIR"] = str(var)
+        self.port, self.out = port, var.parent / f"up-{port}.out"
+        self.proc = subprocess.Popen(
+            [sys.executable, str(UP), "--port", str(port), "--concurrency", "1",
+             "--no-shared-data", *args],
+            cwd=REPO, env=env, stdout=self.out.open("w"), stderr=subprocess.STDOUT,
+            start_new_session=True,
+        )
+
+    def output(self):
+        return self.out.read_text()
+
+    def wait_for(self, text, timeout=120):
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            if text in self.output():
+                return self.output()
+            if self.proc.poll() is not None:
+                raise AssertionError(f"up.py exited ({self.proc.returncode}):\n{self.output()}")
+            time.sleep(0.2)
+        raise AssertionError(f"{text!r} not printed after {timeout}s:\n{self.output()}")
+
+    def pids(self):
+        match = re.search(r"web server pid (\d+), worker pid (\d+)", self.output())
+        return int(match[1]), int(match[2])
+
+    def ctrl_c(self, timeout=60):
+        self.proc.send_signal(signal.SIGINT)
+        return self.proc.wait(timeout)
+
+    def close(self):
+        if self.proc.poll() is None:
+            os.killpg(self.proc.pid, signal.SIGKILL)
+            self.proc.wait(10)
+
+    def api(self, path, token=None, data=None):
+        request = urllib.request.Request(
+            f"http://127.0.0.1:{self.port}{path}",
+            data=None if data is None else json.dumps(data).encode(),
+            headers={"Content-Type": "application/json",
+                     **({"Authorization": f"Token {token}"} if token else {})},
+        )
+        with urllib.request.urlopen(request, timeout=10) as response:
+            return json.loads(response.read())
+
+
+def gone(pgid, timeout=15):
+    """True once no live process is left in process group ``pgid`` (zombies don't count)."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        if not any(_live_in_group(stat, pgid) for stat in Path("/proc").glob("[0-9]*/stat")):
+            return True
+        time.sleep(0.1)
+    return False
+
+
+def _live_in_group(stat, pgid):
+    try:
+        # Fields after the command name: state ppid pgrp ...
+        fields = stat.read_text().rsplit(")", 1)[1].split()
+    except OSError:
+        return False
+    return int(fields[2]) == pgid and fields[0] != "Z"
+
+
+@pytest.fixture
+def up(tmp_path):
+    started = []
+
+    def start(*args, var=tmp_path / "var"):
+        started.append(Up(var, free_port(), *args))
+        return started[-1]
+
+    yield start
+    for process in started:
+        process.close()
+
+
+def test_it_serves_the_demo_processes_it_survives_a_dead_worker_and_stops_on_ctrl_c(up):
+    # One run checks the whole life cycle: each start of up.py costs seconds.
+    server = up()
+    output = server.wait_for("press Ctrl-C to stop")
+    assert f"Cutroom is running at http://127.0.0.1:{server.port}/" in output
+    assert "log in as annotator / cutroom-demo" in output
+    token = server.api("/api/auth/token/", data={"username": "annotator",
+                                                  "password": "cutroom-demo"})["token"]
+    captures = wait_until_detected(server, token, 3)
+    assert all(len(c["latest_run"]["candidates"]) > 0 for c in captures)
+
+    web, worker = server.pids()
+    os.killpg(worker, signal.SIGKILL)
+    output = server.wait_for("restarting the worker")
+    assert "the worker died (exit code -9); end of" in output
+    assert "worker.log" in output
+    output = server.wait_for("worker restarted, pid")
+    new_worker = int(re.search(r"worker restarted, pid (\d+)", output)[1])
+    assert new_worker != worker and gone(worker)
+
+    assert server.ctrl_c() == 0
+    assert "SIGINT received; stopping" in server.output()
+    assert gone(web) and gone(new_worker)
+
+
+def wait_until_detected(server, token, count, timeout=120):
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        captures = server.api("/api/captures/", token)["results"]
+        runs = [c["latest_run"] for c in captures]
+        if len(captures) == count and all(r and r["status"] == "ready" for r in runs):
+            return captures
+        time.sleep(0.5)
+    raise AssertionError(f"captures not detected after {timeout}s: {captures}")
+
+
+def test_a_second_run_on_the_same_folder_adds_nothing_twice(up, tmp_path):
+    first = up()
+    first.wait_for("press Ctrl-C to stop")
+    assert first.ctrl_c() == 0
+    second = up()
+    output = second.wait_for("press Ctrl-C to stop")
+    assert "added" not in output
+    assert output.count("present  synth-") == 3
+    token = second.api("/api/auth/token/", data={"username": "reviewer",
+                                                  "password": "cutroom-demo"})["token"]
+    assert second.api("/api/captures/", token)["count"] == 3
+    assert second.ctrl_c() == 0
+
+
+def test_it_refuses_a_port_in_use_and_says_what_to_do(up, tmp_path):
+    with socket.socket() as busy:
+        busy.bind(("127.0.0.1", 0))
+        busy.listen()
+        port = busy.getsockname()[1]
+        server = Up(tmp_path / "var", port)
+        code = server.proc.wait(60)
+    assert code == 2
+    assert f"cannot listen on 127.0.0.1:{port}" in server.output()
+    assert f"make up PORT={port + 1}" in server.output()
