@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from motionlib.errors import CaptureError
+from motionlib.io.numbers import token_bounds, token_values
 from motionlib.kinematics import euler_to_matrix
 from motionlib.skeleton import Skeleton
 from motionlib.take import Take
@@ -249,11 +250,12 @@ def read_amc(path: str | os.PathLike, asf: str | os.PathLike | Asf) -> Take:
     path = os.fspath(path)
     if not isinstance(asf, Asf):
         asf = read_asf(asf)
-    text = Path(path).read_text(encoding="utf-8", errors="replace")
-    body, first_line = _amc_body(text, path)
+    data = Path(path).read_bytes()
+    offset, first_line = _amc_body(data, path)
     sk = asf.skeleton
-    channels = _amc_fast(body, sk)
+    channels = _amc_fast(data, offset, sk)
     if channels is None:
+        body = data[offset:].decode("utf-8", "replace")
         channels = _amc_lines(body, first_line, asf, path)
     if asf.to_deg != 1.0:
         rot = [sk.channel_starts[j] + k for j, names in enumerate(sk.channels)
@@ -266,47 +268,86 @@ def read_amc(path: str | os.PathLike, asf: str | os.PathLike | Asf) -> Take:
 AMC_FPS = 120.0
 
 
-def _amc_body(text: str, path) -> tuple[str, int]:
-    """Skip the ``#``/``:`` header; return the rest and its first line number."""
-    if not text.strip():
+def _amc_body(data: bytes, path) -> tuple[int, int]:
+    """Skip the ``#``/``:`` header: byte offset and line number of the first frame line."""
+    if not data.strip():
         raise CaptureError("empty file", path=path, line=1)
-    pos = 0
-    for n, line in enumerate(text.splitlines(keepends=True), 1):
-        stripped = line.strip()
-        if stripped and not stripped.startswith(("#", ":")):
-            return text[pos:], n
-        pos += len(line)
-    raise CaptureError("no frames after the header", path=path, line=n)
+    pos, line = 0, 1
+    while pos < len(data):
+        end = data.find(b"\n", pos)
+        end = len(data) if end < 0 else end + 1
+        stripped = data[pos:end].strip()
+        if stripped and not stripped.startswith((b"#", b":")):
+            return pos, line
+        pos, line = end, line + 1
+    raise CaptureError("no frames after the header", path=path, line=line - 1)
 
 
-def _amc_fast(body: str, sk: Skeleton) -> np.ndarray | None:
-    """Vectorised parse when every frame lists the same bones in the same order, else None."""
-    tokens = body.split()
+def _first_frame_layout(data: bytes, offset: int, sk: Skeleton):
+    """Bones of the first frame as [(name, token index)] and the tokens per frame, or None."""
     dof = {name: len(ch) for name, ch in zip(sk.names, sk.channels, strict=True)}
-    layout, i = [], 1
-    while i < len(tokens) and tokens[i] in dof:
-        layout.append((tokens[i], i))
-        i += 1 + dof[tokens[i]]
-    width = i
-    if (not layout or len(tokens) % width or len({name for name, _ in layout}) < len(layout)
-            or (i < len(tokens) and not tokens[i].isdigit())):
+    size = 4096
+    while True:
+        tokens = data[offset:offset + size].decode("utf-8", "replace").split()
+        complete = offset + size >= len(data)
+        if not complete:
+            tokens = tokens[:-1]  # the last one may be cut in half
+        layout, i = [], 1
+        while i < len(tokens) and tokens[i] in dof:
+            layout.append((tokens[i], i))
+            i += 1 + dof[tokens[i]]
+        if i < len(tokens) or complete:
+            break
+        size *= 4
+    names = [name for name, _ in layout]
+    if not layout or len(set(names)) < len(names) or (i < len(tokens) and
+                                                       not tokens[i].isdigit()):
         return None
-    table = np.array(tokens).reshape(-1, width)
-    n = table.shape[0]
-    if not np.array_equal(table[:, 0], np.arange(1, n + 1).astype(str)):
+    return layout, i
+
+
+def _amc_fast(data: bytes, offset: int, sk: Skeleton) -> np.ndarray | None:
+    """Vectorised parse when every frame lists the same bones in the same order, else None.
+
+    Every frame then has the same token pattern (number, name, values, name, values, …):
+    names are checked byte by byte per column and all numbers parsed at once.
+    """
+    found = _first_frame_layout(data, offset, sk)
+    if found is None:
+        return None
+    layout, width = found
+    b = np.frombuffer(data, dtype=np.uint8, offset=offset)
+    starts, ends = token_bounds(b)
+    if starts.size % width:
+        return None
+    n = starts.size // width
+    starts, ends = starts.reshape(n, width), ends.reshape(n, width)
+    name_cols = [col for _, col in layout]
+    for name, col in layout:
+        if not _column_is(b, starts[:, col], ends[:, col], name.encode()):
+            return None
+    number_cols = np.setdiff1d(np.arange(width), name_cols)
+    values = token_values(b, starts[:, number_cols].ravel(), ends[:, number_cols].ravel())
+    if values is None:
+        return None
+    values = values.reshape(n, number_cols.size)
+    if not np.array_equal(values[:, 0], np.arange(1, n + 1)):
         return None
     channels = np.zeros((n, sk.n_channels))
-    starts = sk.channel_starts
+    where = {col: k for k, col in enumerate(number_cols)}
     for name, col in layout:
-        if not np.all(table[:, col] == name):
-            return None
         j = sk.names.index(name)
-        try:
-            block = table[:, col + 1:col + 1 + dof[name]].astype(np.float64)
-        except ValueError:
-            return None
-        channels[:, starts[j]:starts[j] + dof[name]] = block
-    return channels if np.all(np.isfinite(channels)) else None
+        count = len(sk.channels[j])
+        first = where[col + 1] if count else 0
+        channels[:, sk.channel_starts[j]:sk.channel_starts[j] + count] = \
+            values[:, first:first + count]
+    return channels
+
+
+def _column_is(b, starts, ends, name: bytes) -> bool:
+    if not np.all(ends - starts == len(name)):
+        return False
+    return all(np.all(b[starts + i] == byte) for i, byte in enumerate(name))
 
 
 def _amc_lines(body: str, first_line: int, asf: Asf, path) -> np.ndarray:

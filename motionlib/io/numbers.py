@@ -1,11 +1,15 @@
-"""Vectorised parsing of whitespace-separated decimal numbers, line by line counts included.
+"""Vectorised parsing of whitespace-separated numbers, with tokens-per-line counts.
 
 ``float()`` per token or ``np.loadtxt`` cost 40-100 ms for a 4,600-frame BVH; this parser works
-on the raw bytes with a dozen numpy passes per chunk and gives bit-identical results for plain
-decimals (``-17.2528``, ``0``, ``+3.``). Anything else (exponents, ``nan``, stray text, more than
-about 15 digits) makes it return None so the caller can fall back to a careful line-by-line parse that
-can also say what is wrong and where. Work is done in chunks of whole lines so the temporaries
-stay small (peak memory about the size of the text plus the result) and in cache.
+on the raw bytes with numpy passes over all tokens at once and gives bit-identical results to
+``float()`` for decimals with an optional exponent (``-17.2528``, ``0``, ``+3.``,
+``-2.51463e-014``): the digits are summed as an exact integer and scaled by a power of ten in
+one correctly rounded operation (the rare token beyond that exact range, with more than ~15
+digits or a power of ten beyond ±22, goes through ``float()``). Anything that is not such a
+number (``nan``, ``inf``, stray text) makes it return None so the caller can fall back to a
+careful line-by-line parse that can also say what is wrong and where. BVH text is parsed in
+chunks of whole lines so the temporaries stay small (peak memory about the size of the text
+plus the result) and in cache.
 """
 
 from __future__ import annotations
@@ -13,14 +17,15 @@ from __future__ import annotations
 import numpy as np
 
 _POW10 = 10.0 ** np.arange(64)
-_EXACT = 2.0**53  # integer sums below this are exact, so the one division rounds correctly
-_MAX_TOKEN = 17
+_EXACT = 2.0**53  # integers below this are exact in float64
+_MAX_TOKEN = 32
+_MAX_POWER = 22  # 10**22 is the largest power of ten that float64 holds exactly
 CHUNK_BYTES = 1 << 18
 
 
 def parse_decimal_lines(data: bytes, offset: int = 0,
                         chunk_bytes: int = CHUNK_BYTES) -> tuple[np.ndarray, np.ndarray] | None:
-    """Parse ``data[offset:]`` as lines of plain decimal numbers.
+    """Parse ``data[offset:]`` as lines of numbers.
 
     Parameters
     ----------
@@ -28,51 +33,79 @@ def parse_decimal_lines(data: bytes, offset: int = 0,
         ASCII text.
     offset : int
         Byte where the numbers start.
+    chunk_bytes : int
+        Work on about this many bytes (whole lines) at a time.
 
     Returns
     -------
     (values, per_line) or None
         ``values`` float64 of shape (n_tokens,) in reading order; ``per_line`` the number of
-        tokens on each line (blank lines included, as 0). None when some token is not a plain
-        decimal whose digits, read as an integer, stay below 2**53.
+        tokens on each line (blank lines included, as 0). None when some token is not a number
+        this parser reads exactly.
     """
     values, counts = [], []
     pos = offset
     while pos < len(data):
         end = data.find(b"\n", min(pos + chunk_bytes, len(data)) - 1)
         end = len(data) if end < 0 else end + 1
-        parsed = _parse_chunk(np.frombuffer(data, dtype=np.uint8, count=end - pos, offset=pos))
-        if parsed is None:
+        b = np.frombuffer(data, dtype=np.uint8, count=end - pos, offset=pos)
+        starts, ends = token_bounds(b)
+        chunk_values = token_values(b, starts, ends)
+        if chunk_values is None:
             return None
-        values.append(parsed[0])
-        counts.append(parsed[1])
+        values.append(chunk_values)
+        newlines = np.flatnonzero(b == 10)
+        counts.append(np.diff(np.searchsorted(starts, newlines), prepend=0, append=starts.size))
         pos = end
     if not values:
         return np.zeros(0), np.zeros(0, np.intp)
     return np.concatenate(values), np.concatenate(counts)
 
 
-def _parse_chunk(b: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
-    """Values and tokens-per-line of one chunk of whole lines (see parse_decimal_lines)."""
+def token_bounds(b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Start (inclusive) and end (exclusive) byte index of each whitespace-separated token.
+
+    Bytes up to 32 (space, tab, CR, LF and other controls) separate tokens.
+    """
     tok = (b > 32).view(np.int8)
-    # Token edges: +1 where a token starts, -1 where one ends (padded so both always exist).
+    # +1 where a token starts, -1 where one ends (padded so both always exist).
     edges = np.flatnonzero(np.diff(tok, prepend=np.int8(0), append=np.int8(0)))
-    del tok
-    starts, ends = edges[0::2].astype(np.int32), edges[1::2].astype(np.int32)
-    del edges
-    newlines = np.flatnonzero(b == 10)
-    per_line = np.diff(np.searchsorted(starts, newlines), prepend=0, append=starts.size)
-    values = _token_values(b, starts, ends)
-    return None if values is None else (values, per_line)
+    return edges[0::2].astype(np.int32), edges[1::2].astype(np.int32)
 
 
-def _token_values(b, starts, ends) -> np.ndarray | None:
-    """Value of every token, walking all tokens from their last byte backwards in lockstep.
+class _Walk:
+    """Per-token state of the backward walk (see token_values)."""
 
-    Digits are summed with the weight of their byte position (10**(k-1) for the k-th byte from
-    the right) so every pass multiplies by one scalar; the dot is corrected for afterwards:
-    digits left of it were weighted ten times too much. Any byte that is not a digit, a dot or
-    a leading sign rejects the chunk (None).
+    def __init__(self, n: int):
+        self.total = np.zeros(n)        # digits weighted by byte position from the right
+        self.at_dot = np.zeros(n)       # `total` when the dot was met
+        self.at_e = np.zeros(n)         # `total` when the exponent marker was met
+        self.dot = np.zeros(n, np.uint8)      # byte position of the dot from the right, 0 = none
+        self.e = np.zeros(n, np.uint8)        # same for 'e' / 'E'
+        self.inner_sign = np.zeros(n, np.uint8)  # same for a sign that is not in front
+        self.exp_negative = np.zeros(n, bool)
+        self.count = np.zeros(n, np.uint8)    # dots + exponent markers + inner signs seen
+        self.bad = np.zeros(n, bool)
+
+
+def token_values(b: np.ndarray, starts: np.ndarray, ends: np.ndarray) -> np.ndarray | None:
+    """Value of every token, or None if one of them is not a number read exactly here.
+
+    All tokens are walked from their last byte backwards in lockstep. Digits are summed with
+    the weight of their byte position (10**(k-1) for the k-th byte from the right) so a pass
+    multiplies by one scalar; positions taken by the dot, the exponent and its sign are
+    corrected for afterwards.
+
+    Parameters
+    ----------
+    b : ndarray of uint8
+        The text.
+    starts, ends : ndarray of int
+        Byte bounds of the tokens to read (any subset of the tokens of ``b``).
+
+    Returns
+    -------
+    ndarray of float64, shape (n_tokens,), or None
     """
     if starts.size == 0:
         return np.zeros(0)
@@ -81,39 +114,72 @@ def _token_values(b, starts, ends) -> np.ndarray | None:
     if longest > _MAX_TOKEN:
         return None
     length = length.astype(np.uint8)
-    total = np.zeros(starts.size)
-    right = np.zeros(starts.size)  # the sum when the dot is met: the fraction digits
-    dot_at = np.zeros(starts.size, np.uint8)  # byte position of the dot from the right, 0 = none
-    ndots = np.zeros(starts.size, np.uint8)
-    bad = np.zeros(starts.size, bool)
-    pos = ends.copy()
+    w = _Walk(starts.size)
+    pos = ends.astype(np.intp)
     for k in range(1, longest + 1):
         pos -= 1
-        c = b[pos]  # bytes before a token's start (k > length) are masked by `valid`
-        valid = length >= k
-        d = c - np.uint8(48)
-        isdig = d < 10
-        isdot = c == 46
-        sign = ((c == 45) | (c == 43)) & (length == k)
-        bad |= valid & ~(isdig | isdot | sign)
-        isdig &= valid
-        d *= isdig
-        total += d * _POW10[k - 1]
-        isdot &= valid
-        if isdot.any():
-            np.copyto(right, total, where=isdot)
-            dot_at[isdot] = k
-            ndots += isdot
+        _step(w, b[pos], length >= k, length == k, k)
     first = b[starts]
-    has_sign = (first == 45) | (first == 43)
-    no_digit = length == ndots + has_sign
-    if np.any(bad | no_digit | (ndots > 1)) or total.max() >= _EXACT:
+    values = _finish(w, length, first)
+    if values is None:
         return None
-    # Integer mantissa (exact below 2**53), then one correctly rounded division.
-    frac = np.where(dot_at > 0, dot_at.astype(np.intp) - 1, 0)
-    total -= right
-    total /= np.where(dot_at > 0, 10.0, 1.0)
-    total += right
-    total /= _POW10[frac]
-    total[first == 45] *= -1
-    return total
+    values, inexact = values
+    # Well-formed but outside the exact range (huge mantissa or exponent): rare, use float().
+    for i in np.flatnonzero(inexact):
+        values[i] = float(b[starts[i]:ends[i]].tobytes())
+    return values
+
+
+def _step(w: _Walk, c, valid, in_front, k: int) -> None:
+    d = c - np.uint8(48)
+    isdig = d < 10
+    isdot = c == 46
+    ise = (c == 101) | (c == 69)
+    issign = (c == 45) | (c == 43)
+    w.bad |= valid & ~(isdig | isdot | ise | issign)
+    isdig &= valid
+    d *= isdig
+    w.total += d * _POW10[k - 1]
+    isdot &= valid
+    if isdot.any():
+        np.copyto(w.at_dot, w.total, where=isdot)
+        w.dot[isdot] = k
+        w.count += isdot
+    ise &= valid
+    if ise.any():
+        np.copyto(w.at_e, w.total, where=ise)
+        w.e[ise] = k
+        w.count += ise
+        w.bad |= ise & (w.dot > 0)  # a dot in the exponent
+    inner = issign & valid & ~in_front
+    if inner.any():
+        w.inner_sign[inner] = k
+        w.exp_negative |= inner & (c == 45)
+        w.count += inner
+
+
+def _finish(w: _Walk, length, first):
+    """(values, inexact) from the walk, or None if a token is malformed."""
+    has_e = w.e > 0
+    has_dot = w.dot > 0
+    has_sign = (first == 45) | (first == 43)
+    inner = w.inner_sign > 0
+    exp_digits = w.e.astype(np.intp) - 1 - inner
+    mant_digits = length - w.e - has_dot - has_sign
+    bad = w.bad | (mant_digits < 1) | (w.count > has_dot.astype(np.uint8) + has_e + inner)
+    bad |= has_e & (exp_digits < 1)
+    bad |= inner & ~(has_e & (w.inner_sign + 1 == w.e))  # an inner sign must follow the 'e'
+    bad |= ~has_e & inner
+    if bad.any():
+        return None
+    base = _POW10[w.e]  # the mantissa's digits were weighted 10**e too much
+    mant = (w.total - w.at_e) / base
+    right = np.where(has_dot, (w.at_dot - w.at_e) / base, mant)
+    mant = right + (mant - right) / np.where(has_dot, 10.0, 1.0)
+    frac = np.where(has_dot, w.dot.astype(np.intp) - w.e - 1, 0)
+    power = np.where(w.exp_negative, -w.at_e, w.at_e) - frac
+    inexact = (np.abs(power) > _MAX_POWER) | (w.total >= _EXACT)
+    scale = _POW10[np.minimum(np.abs(power), _MAX_POWER).astype(np.intp)]
+    values = np.where(power >= 0, mant * scale, mant / scale)
+    values[first == 45] *= -1
+    return values, inexact
