@@ -12,14 +12,18 @@ repeats every second or so; a boundary is where that distribution changes. So:
 2. The pose stream is averaged into short blocks (``rate_hz``) for speed.
 3. At each instant the poses of the past window and the future window are compared
    with the maximum mean discrepancy (MMD) under a Gaussian kernel whose bandwidth is
-   set by the median heuristic, at several window lengths (``scales_s``; each window
-   must span a few repetitions of a periodic activity). MMD² is 0 for identical
-   distributions and approaches 2 for disjoint ones, whatever the capture's units.
+   set by the median heuristic, at three window lengths from ``scale_min_s`` to
+   ``scale_max_s`` (3 to 6 s: a window must span several repetitions of a periodic
+   activity, about 1 Hz for most exercises, so that the poses inside one activity look
+   alike from window to window; shorter windows also fire on brief changes inside an
+   activity that annotators do not cut). MMD² is 0 for identical distributions and
+   approaches 2 for disjoint ones, whatever the capture's units.
 4. Peaks of the mean novelty curve higher than ``threshold`` and at least
-   ``min_segment_s`` apart become cuts; confidence grows with peak height.
-5. Each cut is placed precisely at full frame rate: inside ``±refine_s`` of the peak,
-   at the split that best separates the poses just before from the poses just after
-   (largest full-rate MMD over windows of the finest scale).
+   ``min_segment_s`` apart become cuts; confidence ``s / (s + threshold)`` grows with
+   the peak height s (0.5 at the threshold), so candidates rank by evidence.
+5. The novelty peak locates a change only to within a window; each cut then moves to
+   the slowest frame (pose speed, low-passed at 1 Hz) within ``refine_s`` of the peak,
+   because performers pause between two activities and that is where annotators cut.
 
 All durations are in seconds, so the same defaults work at any frame rate.
 """
@@ -143,17 +147,17 @@ class Default(Segmenter):
     title = "Cutroom default (multi-scale kernel novelty)"
     description = (
         "Compares the distribution of heading-invariant poses before and after each "
-        "instant (kernel MMD at 2-4 s windows); strong peaks become cuts, placed at the "
+        "instant (kernel MMD at 3-6 s windows); strong peaks become cuts, placed at the "
         "nearby pause. Parameters are in seconds and work at any frame rate."
     )
     params = {
         "threshold": Param(
-            "float", 0.3, 0.0, 2.0,
+            "float", 0.25, 0.0, 2.0,
             "Minimum mean MMD² (0 = same poses, 2 = disjoint) for a peak to become a cut.",
         ),
         "min_segment_s": Param("float", 2.0, 0.1, 60.0, "Minimum time between two cuts (s)."),
-        "scale_min_s": Param("float", 2.0, 0.2, 30.0, "Shortest comparison window (s)."),
-        "scale_max_s": Param("float", 4.0, 0.2, 60.0, "Longest comparison window (s)."),
+        "scale_min_s": Param("float", 3.0, 0.2, 30.0, "Shortest comparison window (s)."),
+        "scale_max_s": Param("float", 6.0, 0.2, 60.0, "Longest comparison window (s)."),
         "bandwidth": Param(
             "float", 0.3, 0.01, 100.0,
             "Kernel width² as a multiple of the median squared pose distance.",
