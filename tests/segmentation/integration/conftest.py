@@ -6,6 +6,7 @@ at pytest-django's test database. If a service is missing the tests fail under C
 (``CI=true``) and skip loudly elsewhere.
 """
 
+import contextlib
 import os
 import signal
 import socket
@@ -65,9 +66,8 @@ def django_db_setup(services_env, django_db_setup):
     """Check the services before pytest-django tries to create the test database."""
 
 
-@pytest.fixture(scope="session")
-def queue():
-    """A queue of this test session's own, so parallel runs sharing Redis never mix."""
+def new_queue():
+    """A queue of its own, so parallel test runs sharing one Redis never mix jobs."""
     return f"cutroom-test-{uuid.uuid4().hex[:8]}"
 
 
@@ -83,15 +83,17 @@ def media_root(settings, shared_media):
     return shared_media
 
 
-@pytest.fixture
-def live_queue(settings, queue, services_env):
-    """Send this test's jobs to the session's queue."""
+@contextlib.contextmanager
+def sending_to(queue):
+    """Jobs enqueued by the test process go to ``queue``."""
     from cutroom.celery import app
 
     previous = app.conf.task_default_queue
     app.conf.task_default_queue = queue
-    yield queue
-    app.conf.task_default_queue = previous
+    try:
+        yield
+    finally:
+        app.conf.task_default_queue = previous
 
 
 class Workers:
@@ -156,10 +158,28 @@ class Workers:
                 proc.wait(5)
 
 
-@pytest.fixture
-def workers(live_queue, shared_media, tmp_path, transactional_db):
-    pool = Workers(live_queue, shared_media, tmp_path, claim_timeout=3)
+@pytest.fixture(scope="session")
+def worker_pair(services_env, django_db_setup, shared_media, tmp_path_factory):
+    """Two workers kept for the whole session (for tests that do not kill them)."""
+    pool = Workers(new_queue(), shared_media, tmp_path_factory.mktemp("worker-logs"), 3)
+    pool.start()
+    pool.start()
     yield pool
+    pool.stop_all()
+
+
+@pytest.fixture
+def running_workers(worker_pair, transactional_db):
+    with sending_to(worker_pair.queue):
+        yield worker_pair
+
+
+@pytest.fixture
+def workers(services_env, shared_media, tmp_path, transactional_db):
+    """Workers of this test only, on a queue of their own; the test may kill them."""
+    pool = Workers(new_queue(), shared_media, tmp_path, claim_timeout=3)
+    with sending_to(pool.queue):
+        yield pool
     pool.stop_all()
 
 

@@ -43,9 +43,8 @@ def settled(capture_id):
     return capture.status == "failed" or (run is not None and run.status in ("ready", "failed"))
 
 
-def test_it_takes_an_upload_to_a_submitted_review(workers, people):
+def test_it_takes_an_upload_to_a_submitted_review(running_workers, people):
     project, alice, bob = people
-    workers.start()
     capture_id = upload(client_for(alice), project, synthetic_bvh(seed=3))
 
     wait_for(lambda: settled(capture_id), what="ingest and detection")
@@ -71,9 +70,8 @@ def test_it_takes_an_upload_to_a_submitted_review(workers, people):
     assert (submitted["status"], submitted["segments"][0]["label"]) == ("submitted", "walk")
 
 
-def test_a_bad_upload_fails_with_its_reason_and_keeps_the_original(workers, people):
+def test_a_bad_upload_fails_with_its_reason_and_keeps_the_original(running_workers, people):
     project, alice, _ = people
-    workers.start()
     good = synthetic_bvh(seed=4)
     truncated = good[: len(good) * 2 // 3].rsplit(b"\n", 1)[0] + b"\n"
     capture_id = upload(client_for(alice), project, truncated, name="cut_short.bvh")
@@ -87,10 +85,9 @@ def test_a_bad_upload_fails_with_its_reason_and_keeps_the_original(workers, peop
         assert handle.read() == truncated
 
 
-def test_two_workers_given_the_same_job_process_it_once(workers, people):
+def test_two_workers_given_the_same_job_process_it_once(running_workers, people):
     project, alice, _ = people
-    workers.start()
-    workers.start()
+    assert len(running_workers.procs) == 2
     capture_id = upload(client_for(alice), project, synthetic_bvh(seed=5))
     for _ in range(3):  # the same job sent again while the first copy is in flight
         tasks.ingest.delay(capture_id)

@@ -23,7 +23,7 @@ def project_and_owner(transactional_db):
     return services.do_create_project(alice, "Studio A"), alice
 
 
-@pytest.fixture
+@pytest.fixture(scope="module")
 def long_take():
     # Long enough that ingest is still running when the test kills the worker.
     return synthetic_bvh(seed=7, duration=240.0)
