@@ -1,7 +1,5 @@
 """motionlib.synth: seeded takes of known actions with known boundaries."""
 
-import time
-
 import numpy as np
 import pytest
 
@@ -77,12 +75,11 @@ def test_it_changes_pose_statistics_at_each_boundary():
             np.abs(before.std(0) - after.std(0)).max() > 5.0
 
 
-def test_it_generates_five_minutes_at_120_fps_in_well_under_a_second():
-    synth.generate(seed=0, n_segments=2)  # warm up imports
-    started = time.perf_counter()
-    take, _ = synth.generate(seed=0, fps=120.0, duration=300.0)
-    assert take.n_frames == 36000
-    assert time.perf_counter() - started < 0.5
+def test_it_generates_a_five_minute_take_at_120_fps():
+    # Its speed is reported by `python -m motionlib.bench io`, not asserted here.
+    take, segments = synth.generate(seed=0, fps=120.0, duration=300.0)
+    assert take.n_frames == 36000 and take.channels.shape == (36000, take.skeleton.n_channels)
+    assert len(segments) >= 300 / 8
 
 
 @pytest.mark.parametrize("kwargs, message", [
