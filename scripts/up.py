@@ -104,20 +104,28 @@ class Child:
     def exited(self):
         return self.proc.poll()
 
-    def stop(self, sig=signal.SIGTERM):
+    def stop(self):
+        """Ask the main process to shut down; it stops its own children in order (a
+        Celery worker lets its running job finish, gunicorn finishes its requests)."""
         if self.proc and self.proc.poll() is None:
-            try:
-                os.killpg(self.proc.pid, sig)
-            except ProcessLookupError:
-                pass
+            self.proc.send_signal(signal.SIGTERM)
+
+    def kill(self):
+        """SIGKILL the whole process group (main process and its children)."""
+        try:
+            os.killpg(self.proc.pid, signal.SIGKILL)
+        except ProcessLookupError:
+            pass
 
     def wait(self, timeout):
         try:
             self.proc.wait(timeout)
         except subprocess.TimeoutExpired:
             say(f"{self.name} did not stop within {timeout:.0f} s; killing it")
-            self.stop(signal.SIGKILL)
+            self.kill()
             self.proc.wait(10)
+        # Children orphaned by a main process that died first (e.g. a killed worker).
+        self.kill()
 
 
 def worker(env, logs, concurrency):
@@ -194,8 +202,10 @@ def supervise(worker_child, web_child):
         if deaths >= MAX_WORKER_DEATHS:
             say(f"the worker died {deaths} times; stopping (fix the cause above and rerun)")
             return 1
-        say("restarting the worker; the job it was running is given back to the queue")
+        say("restarting the worker; a job it had started goes back to the queue")
+        worker_child.kill()  # pool processes the dead main process left behind
         worker_child.start()
+        say(f"worker restarted, pid {worker_child.proc.pid}")
 
 
 def banner(url, worker_child, web_child, logs, demo):
@@ -214,6 +224,8 @@ def main(argv=None):
         say(problem)
         return 2
     env = environment()
+    # SQLite creates its file but not the folder it lives in.
+    var_dir().mkdir(parents=True, exist_ok=True)
     logs = var_dir() / "log"
     manage(env, "migrate", "--noinput", "-v", "0")
     if not args.no_demo:

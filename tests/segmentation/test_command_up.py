@@ -110,8 +110,8 @@ def up(tmp_path):
         process.close()
 
 
-def test_it_serves_the_demo_processes_it_survives_a_dead_worker_and_stops_on_ctrl_c(up):
-    # One run checks the whole life cycle: each start of up.py costs seconds.
+def test_it_serves_the_demo_survives_a_dead_worker_stops_on_ctrl_c_and_runs_again(up):
+    # One test walks the whole life cycle: each start of up.py costs seconds.
     server = up()
     output = server.wait_for("press Ctrl-C to stop")
     assert f"Cutroom is running at http://127.0.0.1:{server.port}/" in output
@@ -134,6 +134,14 @@ def test_it_serves_the_demo_processes_it_survives_a_dead_worker_and_stops_on_ctr
     assert "SIGINT received; stopping" in server.output()
     assert gone(web) and gone(new_worker)
 
+    # Running it again on the same folder adds nothing twice.
+    again = up()
+    output = again.wait_for("press Ctrl-C to stop")
+    assert "added" not in output
+    assert output.count("present  synth-") == 3
+    assert again.api("/api/captures/", token)["count"] == 3
+    assert again.ctrl_c() == 0
+
 
 def wait_until_detected(server, token, count, timeout=120):
     deadline = time.monotonic() + timeout
@@ -144,20 +152,6 @@ def wait_until_detected(server, token, count, timeout=120):
             return captures
         time.sleep(0.5)
     raise AssertionError(f"captures not detected after {timeout}s: {captures}")
-
-
-def test_a_second_run_on_the_same_folder_adds_nothing_twice(up, tmp_path):
-    first = up()
-    first.wait_for("press Ctrl-C to stop")
-    assert first.ctrl_c() == 0
-    second = up()
-    output = second.wait_for("press Ctrl-C to stop")
-    assert "added" not in output
-    assert output.count("present  synth-") == 3
-    token = second.api("/api/auth/token/", data={"username": "reviewer",
-                                                  "password": "cutroom-demo"})["token"]
-    assert second.api("/api/captures/", token)["count"] == 3
-    assert second.ctrl_c() == 0
 
 
 def test_it_refuses_a_port_in_use_and_says_what_to_do(up, tmp_path):
