@@ -177,7 +177,7 @@ def do_save_gold(capture, user, cuts, labels, version, source_review=None):
 
 
 def slug(text):
-    return re.sub(r"[^A-Za-z0-9]+", "-", str(text)).strip("-") or "untitled"
+    return re.sub(r"[^A-Za-z0-9_]+", "-", str(text)).strip("-") or "untitled"
 
 
 def file_name(segment):
@@ -308,6 +308,8 @@ def _suggest(capture, spans):
     pool = (
         LibrarySegment.objects.preferred()
         .filter(project_id=capture.project_id, descriptor__isnull=False)
+        # Other annotators' labels of the same take would make reviews depend on each other.
+        .exclude(capture_id=capture.pk)
         .order_by("-is_gold", "-id").values_list("label_name", "descriptor", "descriptor_shape")
     )[:SIMILAR_POOL]
     names, library = [], []

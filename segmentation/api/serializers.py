@@ -110,9 +110,15 @@ class ReviewSerializer(serializers.ModelSerializer):
         return CutSerializer(review.cuts.order_by("frame", "id"), many=True).data
 
     def get_segments(self, review) -> list[dict]:
+        from segmentation.library import suggest_labels
+
+        segments = review.segments()
+        # Unlabelled segments get the label of the most alike segments in the library.
+        suggested = suggest_labels(review, segments)
         return [
-            {"index": index, "start": start, "stop": stop, "label": label}
-            for index, start, stop, label in review.segments()
+            {"index": index, "start": start, "stop": stop, "label": label,
+             "suggested_label": suggestion}
+            for (index, start, stop, label), suggestion in zip(segments, suggested, strict=True)
         ]
 
 
