@@ -63,9 +63,20 @@ class Up:
         return self.proc.wait(timeout)
 
     def close(self):
+        """After a failed test: up.py stops its children on SIGTERM; force it if not."""
         if self.proc.poll() is None:
-            os.killpg(self.proc.pid, signal.SIGKILL)
-            self.proc.wait(10)
+            self.proc.terminate()
+            try:
+                self.proc.wait(60)
+            except subprocess.TimeoutExpired:
+                os.killpg(self.proc.pid, signal.SIGKILL)
+                self.proc.wait(10)
+        # Children run in their own process groups; none may outlive the test.
+        for pid in map(int, re.findall(r"(?:pid|pid,) (\d+)", self.output())):
+            try:
+                os.killpg(pid, signal.SIGKILL)
+            except ProcessLookupError:
+                pass
 
     def api(self, path, token=None, data=None):
         request = urllib.request.Request(
