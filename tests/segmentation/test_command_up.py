@@ -72,7 +72,7 @@ class Up:
                 os.killpg(self.proc.pid, signal.SIGKILL)
                 self.proc.wait(10)
         # Children run in their own process groups; none may outlive the test.
-        for pid in map(int, re.findall(r"(?:pid|pid,) (\d+)", self.output())):
+        for pid in map(int, re.findall(r"pid (\d+)", self.output())):
             try:
                 os.killpg(pid, signal.SIGKILL)
             except ProcessLookupError:
