@@ -43,6 +43,7 @@ _END_SITES = {"LeftToeBase": (0, 0, 1.2), "RightToeBase": (0, 0, 1.2), "Head": (
 _ROOT = ("Xposition", "Yposition", "Zposition", "Zrotation", "Yrotation", "Xrotation")
 _JOINT = ("Zrotation", "Yrotation", "Xrotation")
 STANDING_HEIGHT = 17.7  # root height with straight legs, feet on Y = 0
+_LEG = (7.6, 7.9)  # thigh and shin lengths
 
 
 def skeleton() -> Skeleton:
@@ -88,10 +89,15 @@ def _jumping_jack(ph, a):
 
 def _squat(ph, a):
     s = a * (1 - np.cos(ph)) / 2
-    return {"LeftUpLeg.Xrotation": -95 * s, "RightUpLeg.Xrotation": -95 * s,
-            "LeftLeg.Xrotation": 110 * s, "RightLeg.Xrotation": 110 * s,
-            "LeftFoot.Xrotation": -20 * s, "RightFoot.Xrotation": -20 * s,
-            "Spine.Xrotation": 20 * s, "Hips.Yposition": -6 * s,
+    hip, knee = 80 * s, 120 * s
+    # Keep the ankles where they stand: drop and shift the hips by what the bent legs lose.
+    thigh, shin = _LEG
+    drop = thigh + shin - thigh * np.cos(np.radians(hip)) - shin * np.cos(np.radians(knee - hip))
+    ahead = thigh * np.sin(np.radians(hip)) - shin * np.sin(np.radians(knee - hip))
+    return {"LeftUpLeg.Xrotation": -hip, "RightUpLeg.Xrotation": -hip,
+            "LeftLeg.Xrotation": knee, "RightLeg.Xrotation": knee,
+            "LeftFoot.Xrotation": hip - knee, "RightFoot.Xrotation": hip - knee,
+            "Spine.Xrotation": 25 * s, "Hips.Yposition": -drop, "Hips.Zposition": -ahead,
             "LeftArm.Yrotation": -85 * s, "RightArm.Yrotation": 85 * s}
 
 
@@ -211,11 +217,20 @@ def generate(seed: int = 0, fps: float = 120.0, *, duration: float | None = None
         for key, values in _segment_angles(rng, label, t[lo:hi], hi - lo).items():
             channels[lo:hi, column[key]] += weight * values
     channels += _noise(rng, t, sk.n_channels, noise_degrees)
-    channels[:, column["Hips.Yrotation"]] += rng.uniform(-180, 180)  # facing
+    _face(channels, column, rng.uniform(-180, 180))
     segments = [(int(bounds[i]), int(bounds[i + 1]), labels[i]) for i in range(len(labels))]
     take = Take(name=f"synth-{seed}", format="bvh", fps=float(fps), frame_time=1.0 / fps,
                 channels=channels, skeleton=sk, rest_pose_frame=None)
     return take, segments
+
+
+def _face(channels, column, heading_deg):
+    """Turn the whole take about the vertical axis: root yaw and root horizontal motion."""
+    h = np.radians(heading_deg)
+    x, z = channels[:, column["Hips.Xposition"]].copy(), channels[:, column["Hips.Zposition"]]
+    channels[:, column["Hips.Xposition"]] = x * np.cos(h) + z * np.sin(h)
+    channels[:, column["Hips.Zposition"]] = z * np.cos(h) - x * np.sin(h)
+    channels[:, column["Hips.Yrotation"]] += heading_deg
 
 
 def _noise(rng, t, n_channels, amplitude):
