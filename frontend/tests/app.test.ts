@@ -3,6 +3,7 @@ import { errorText, isLoggedOut, readCookie } from "../src/api/client";
 import { filtersFrom, queryOf } from "../src/captures/list";
 import { pairFiles } from "../src/captures/upload";
 import { match, registerRoute } from "../src/router";
+import { eventDetail } from "../src/review/events";
 import { columnExtremes, finiteRange, readableOn } from "../src/review/timeline";
 
 describe("api client", () => {
@@ -74,5 +75,15 @@ describe("timeline helpers", () => {
   it("test_it_picks_readable_text_on_label_colours", () => {
     expect(readableOn("#ffeb3b")).toBe("#111418");
     expect(readableOn("#1a237e")).toBe("#ffffff");
+  });
+});
+
+describe("audit log lines", () => {
+  it("test_it_describes_each_kind_of_event_in_words", () => {
+    expect(eventDetail({ action: "create", before: null, after: { run: 3, candidates: 12 } })).toBe("12 candidates");
+    expect(eventDetail({ action: "delete", before: { frame: 2088, fate: "pending" }, after: { frame: 2088, fate: "deleted" } })).toBe("frame 2088: pending → deleted");
+    expect(eventDetail({ action: "move", before: { frame: 700, fate: "pending" }, after: { frame: 760, fate: "moved" } })).toBe("frame 700 → 760");
+    expect(eventDetail({ action: "insert", before: null, after: { frame: 3018, fate: "accepted" } })).toBe("at frame 3018");
+    expect(eventDetail({ action: "label", before: { index: 0, label: null }, after: { index: 0, label: "walk" } })).toBe("segment 1: — → walk");
   });
 });

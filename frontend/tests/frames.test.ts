@@ -59,3 +59,12 @@ describe("FrameStore", () => {
     expect(() => store.put(chunk(0, 5, 2, () => 0))).toThrow(/Frames 0–5: expected 5 × 3 joints × 3 values, got 30/);
   });
 });
+
+describe("floorLevel", () => {
+  it("test_it_puts_the_floor_at_the_lowest_loaded_joint", () => {
+    const store = new FrameStore(8, 2);
+    expect(store.floorLevel()).toBeNull();
+    store.put(chunk(0, 8, 2, (f, k) => (k % 3 === 1 ? -3 - f / 4 : 50)));
+    expect(store.floorLevel()).toBe(-3 - 4 / 4);
+  });
+});

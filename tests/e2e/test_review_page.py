@@ -154,9 +154,18 @@ def test_it_saves_every_edit_and_restores_the_review_exactly_after_reload(live_s
     shown = page.locator("[data-testid=events] li").evaluate_all("els => els.map(e => e.dataset.action)")
     assert shown == list(reversed(actions))
 
-    page.get_by_test_id("zoom-in").click()
-    page.get_by_test_id("zoom-in").click()
+    # For the README: label two more segments by hotkey, then leave the playhead mid-take
+    # on a selected cut, zoomed in a little.
+    page.keyboard.press("Home")
+    for key in ("3", "4"):
+        page.keyboard.press("Shift+ArrowRight")
+        page.keyboard.press(key)
+        screen.saved()
+    assert [s["label"] for s in screen.review()["segments"]][:3] == ["walk", "squat", "kick"]
+    page.keyboard.press("Shift+ArrowRight")
+    page.keyboard.press("ArrowRight")
     page.keyboard.press("Shift+ArrowLeft")
+    page.get_by_test_id("zoom-in").click()
     page.wait_for_timeout(300)
     SCREENSHOT.parent.mkdir(parents=True, exist_ok=True)
     page.screenshot(path=str(SCREENSHOT))

@@ -34,6 +34,8 @@ export class SkeletonView {
   private readonly boneList: [number, number][];
   private readonly radius: number;
   private lastRoot: THREE.Vector3 | null = null;
+  private readonly floor: THREE.Object3D;
+  private readonly cell: number;
   private pending = false;
   follow = true;
 
@@ -47,19 +49,24 @@ export class SkeletonView {
     container.appendChild(this.canvas);
     const height = skeleton.height > 0 ? skeleton.height : 1.8;
     this.radius = height * 0.018;
+    // Units are the capture's own (cm, inches, metres…): scale clipping to the body.
+    this.camera.near = height * 0.01;
+    this.camera.far = height * 60;
+    this.camera.updateProjectionMatrix();
     this.scene.background = new THREE.Color("#161a21");
-    this.scene.fog = new THREE.Fog("#161a21", height * 6, height * 18);
     this.scene.add(new THREE.HemisphereLight("#ffffff", "#2a3140", 2.2));
     const sun = new THREE.DirectionalLight("#ffffff", 1.4);
     sun.position.set(height, height * 3, height * 2);
     this.scene.add(sun);
-    this.scene.add(floor(height));
+    this.cell = height / 2;
+    this.floor = floor(height);
+    this.scene.add(this.floor);
     this.boneList = skeleton.parents.flatMap((p, j) => (p >= 0 ? [[p, j] as [number, number]] : []));
     this.joints = this.instanced(new THREE.SphereGeometry(1, 14, 10), skeleton.joints.length, (i) => skeleton.joints[i]);
     this.bones = this.instanced(new THREE.CylinderGeometry(1, 1, 1, 10), this.boneList.length, (i) => skeleton.joints[this.boneList[i][1]]);
-    this.camera.position.set(height * 1.6, height * 1.0, height * 3.2);
+    this.camera.position.set(height * 0.95, height * 0.8, height * 2.0);
     this.controls = new OrbitControls(this.camera, this.canvas);
-    this.controls.target.set(0, height * 0.5, 0);
+    this.controls.target.set(0, height * 0.45, 0);
     this.controls.enableDamping = false;
     this.controls.addEventListener("change", () => this.requestRender());
     new ResizeObserver(() => this.resize()).observe(container);
@@ -121,6 +128,22 @@ export class SkeletonView {
       this.controls.update();
     }
     this.lastRoot = root;
+    // The floor plane is finite: keep it under the actor (its lines are in world
+    // coordinates, so moving it by whole cells changes nothing on screen).
+    const cell = this.cell;
+    this.floor.position.x = Math.round(root.x / cell) * cell;
+    this.floor.position.z = Math.round(root.z / cell) * cell;
+  }
+
+  /** Put the floor at height `y` (the take's lowest joint) and aim the camera above it. */
+  setFloor(y: number): void {
+    const dy = y - this.floor.position.y;
+    if (Math.abs(dy) < 1e-9) return;
+    this.floor.position.y = y;
+    this.camera.position.y += dy;
+    this.controls.target.y += dy;
+    this.controls.update();
+    this.requestRender();
   }
 
   requestRender(): void {
@@ -150,17 +173,48 @@ export class SkeletonView {
   }
 }
 
+/**
+ * A floor with grid lines drawn in the fragment shader: a line primitive crossing the
+ * camera's near plane is dropped by some software rasterisers (headless Chromium's
+ * SwiftShader), a triangle is not. Lines every half body height, a stronger one every
+ * 2.5, fading into the background with distance.
+ */
 function floor(height: number): THREE.Object3D {
-  const group = new THREE.Group();
-  const size = height * 20;
-  const grid = new THREE.GridHelper(size, 40, "#3b4556", "#262d39");
-  group.add(grid);
-  const plane = new THREE.Mesh(
-    new THREE.PlaneGeometry(size, size),
-    new THREE.MeshStandardMaterial({ color: "#1b2029", roughness: 1 }),
-  );
+  const size = height * 200;
+  const material = new THREE.ShaderMaterial({
+    uniforms: {
+      cell: { value: height / 2 },
+      fadeDistance: { value: height * 14 },
+      background: { value: new THREE.Color("#161a21") },
+      base: { value: new THREE.Color("#1b2029") },
+      minor: { value: new THREE.Color("#323a47") },
+      major: { value: new THREE.Color("#4b5669") },
+    },
+    vertexShader: `
+      varying vec3 vWorld;
+      void main() {
+        vec4 world = modelMatrix * vec4(position, 1.0);
+        vWorld = world.xyz;
+        gl_Position = projectionMatrix * viewMatrix * world;
+      }`,
+    fragmentShader: `
+      uniform float cell;
+      uniform float fadeDistance;
+      uniform vec3 background, base, minor, major;
+      varying vec3 vWorld;
+      float gridLine(vec2 coord) {
+        vec2 g = abs(fract(coord - 0.5) - 0.5) / fwidth(coord);
+        return 1.0 - min(min(g.x, g.y), 1.0);
+      }
+      void main() {
+        vec3 colour = mix(base, minor, gridLine(vWorld.xz / cell));
+        colour = mix(colour, major, gridLine(vWorld.xz / (cell * 5.0)));
+        float fade = smoothstep(fadeDistance * 0.3, fadeDistance, distance(vWorld.xz, cameraPosition.xz));
+        gl_FragColor = vec4(mix(colour, background, fade), 1.0);
+        #include <colorspace_fragment>
+      }`,
+  });
+  const plane = new THREE.Mesh(new THREE.PlaneGeometry(size, size), material);
   plane.rotation.x = -Math.PI / 2;
-  plane.position.y = -0.001 * height;
-  group.add(plane);
-  return group;
+  return plane;
 }

@@ -62,6 +62,18 @@ export class FrameStore {
     return null;
   }
 
+  /** The lowest joint height (Y) over the loaded frames: where the floor is. */
+  floorLevel(): number | null {
+    let low = Infinity;
+    const size = this.nJoints * 3;
+    // Every 4th frame is plenty for a floor and keeps this cheap on long takes.
+    for (let f = 0; f < this.nFrames; f += 4) {
+      if (!this.loaded[f]) continue;
+      for (let j = 1; j < size; j += 3) low = Math.min(low, this.positions[f * size + j]);
+    }
+    return Number.isFinite(low) ? low : null;
+  }
+
   put(response: FramesResponse): void {
     const values = decodeFloat32(response.data);
     const count = response.n_frames;

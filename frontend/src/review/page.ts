@@ -7,11 +7,13 @@ import type { Capture, Cut, Label, Me, Project, Review, ReviewEvent, Signal, Sig
 import { advance, frameOf, nextSpeed, seek, SPEEDS, togglePlay, type Playback } from "../player/clock";
 import { SkeletonView } from "../player/skeletonView";
 import { clear, dialog, formatDuration, h, toast } from "../ui/dom";
+import { icon } from "../ui/icons";
 import { FrameStore, loadFrames } from "./frames";
 import { changeFor, emptyHistory, record, redo, undo, type Change, type History } from "./history";
 import { commandFor, HELP, isTypingTarget, type Command } from "./keymap";
 import { Saver } from "./saver";
 import { applyEdit, clampFrame, describeDifferences, EditError, FATE_TEXT, neighbourCut, segmentAt, type Edit } from "./state";
+import { eventDetail } from "./events";
 import { Timeline } from "./timeline";
 import { formatTime } from "./timescale";
 
@@ -62,6 +64,7 @@ class ReviewPage {
   private lastTick = 0;
   private raf = 0;
   private shownFrame = -1;
+  private floorSet = false;
   private readonly saver: Saver;
   private readonly store: FrameStore;
   private readonly player: SkeletonView | null;
@@ -118,7 +121,7 @@ class ReviewPage {
 
   private build(): HTMLElement {
     const c = this.capture;
-    const btn = (id: string, text: string, title: string, action: () => void, extra = "") =>
+    const btn = (id: string, text: string | Node, title: string, action: () => void, extra = "") =>
       (this.el[id] = h("button", { class: `btn ${extra}`, title, "data-testid": id, onclick: action }, text));
     this.el.viewport = h("div", { class: "viewport", "data-testid": "viewport" });
     this.el.hudFrame = h("div", { class: "hud-frame", "data-testid": "hud-frame" });
@@ -174,13 +177,13 @@ class ReviewPage {
         h(
           "div",
           { class: "group" },
-          btn("prev-cut", "⏮", "Previous cut (Shift+←)", () => this.command({ kind: "jump", direction: -1 })),
-          btn("step-back", "◂", "Previous frame (←)", () => this.command({ kind: "step", frames: -1 })),
-          btn("play", "▶", "Play / pause (Space)", () => this.command({ kind: "play" }), "btn-play"),
-          btn("step-forward", "▸", "Next frame (→)", () => this.command({ kind: "step", frames: 1 })),
-          btn("next-cut", "⏭", "Next cut (Shift+→)", () => this.command({ kind: "jump", direction: 1 })),
+          btn("prev-cut", icon("prevCut"), "Previous cut (Shift+←)", () => this.command({ kind: "jump", direction: -1 })),
+          btn("step-back", icon("stepBack"), "Previous frame (←)", () => this.command({ kind: "step", frames: -1 })),
+          btn("play", icon("play"), "Play / pause (Space)", () => this.command({ kind: "play" }), "btn-play"),
+          btn("step-forward", icon("stepForward"), "Next frame (→)", () => this.command({ kind: "step", frames: 1 })),
+          btn("next-cut", icon("nextCut"), "Next cut (Shift+→)", () => this.command({ kind: "jump", direction: 1 })),
           this.el.speed,
-          btn("loop", "⟲ Loop", "Loop the segment under the playhead (L)", () => this.command({ kind: "loop" })),
+          btn("loop", "Loop", "Loop the segment under the playhead (L)", () => this.command({ kind: "loop" })),
           btn("follow", "Follow", "Camera follows the root", () => this.toggleFollow(), "active"),
         ),
         h(
@@ -235,7 +238,7 @@ class ReviewPage {
     });
     this.showFrame(frame);
     this.renderSide();
-    this.el.play.textContent = this.playback.playing ? "❚❚" : "▶";
+    this.el.play.replaceChildren(icon(this.playback.playing ? "pause" : "play"));
     this.el.loop.classList.toggle("active", this.playback.loop !== null);
     this.el.undo.toggleAttribute("disabled", this.readOnly || this.history.past.length === 0);
     this.el.redo.toggleAttribute("disabled", this.readOnly || this.history.future.length === 0);
@@ -251,6 +254,8 @@ class ReviewPage {
     if (shown === null) return;
     this.player.setPose(this.store.pose(shown));
     this.shownFrame = shown === frame ? frame : -1;
+    // Milliseconds from navigation to the first pose on screen: the "opens in" figure.
+    this.el.viewport.dataset.firstPoseMs ??= String(Math.round(performance.now()));
   }
 
   private renderSide(): void {
@@ -336,6 +341,11 @@ class ReviewPage {
     this.el.loading.toggleAttribute("hidden", share >= 1 && !s.error);
     if (s.error) this.el.loading.replaceChildren(h("span", { class: "error-text" }, `Could not load frames: ${s.error}`));
     if (share >= 1) this.el.loading.dataset.done = `${Math.round(performance.now() - started)}`;
+    const floor = s.floorLevel();
+    if (floor !== null && !this.floorSet) {
+      this.player?.setFloor(floor);
+      this.floorSet = true;
+    }
     this.shownFrame = -1;
     this.showFrame(this.frame());
   }
@@ -617,11 +627,3 @@ class ReviewPage {
     clear(this.el.reviewPicker, select);
   }
 }
-
-function eventDetail(e: ReviewEvent): string {
-  const show = (v: unknown) => (v && typeof v === "object" ? Object.entries(v).map(([k, x]) => `${k} ${x}`).join(", ") : v === null || v === undefined ? "" : String(v));
-  const before = show(e.before);
-  const after = show(e.after);
-  return before && after ? `${before} → ${after}` : before || after;
-}
-

@@ -160,15 +160,18 @@ export class Timeline {
     }
     ctx.font = "11px ui-monospace, SFMono-Regular, Menlo, monospace";
     ctx.textBaseline = "middle";
-    for (const frame of ticks(this.view, m.fps)) {
+    for (const frame of ticks(this.view, m.fps, 130)) {
       const x = Math.round(this.x(frame)) + 0.5;
       ctx.strokeStyle = "#3a4350";
       ctx.beginPath();
-      ctx.moveTo(x, RULER - 8);
+      ctx.moveTo(x, RULER - 10);
       ctx.lineTo(x, RULER);
       ctx.stroke();
-      ctx.fillStyle = "#8b96a8";
-      ctx.fillText(`${formatTime(frame, m.fps)}  ${frame}`, x + 4, RULER / 2 - 2);
+      const time = formatTime(frame, m.fps);
+      ctx.fillStyle = "#aab4c3";
+      ctx.fillText(time, x + 4, RULER / 2 - 2);
+      ctx.fillStyle = "#5f6b7c";
+      ctx.fillText(String(frame), x + 10 + ctx.measureText(time).width, RULER / 2 - 2);
     }
   }
 

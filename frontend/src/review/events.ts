@@ -1,0 +1,20 @@
+// The audit log in words.
+
+import type { ReviewEvent } from "../api/types";
+
+/** One line per audit event: "frame 2088: pending → deleted", "segment 1: — → walk". */
+export function eventDetail(e: Pick<ReviewEvent, "action" | "before" | "after">): string {
+  const before = (e.before ?? {}) as Record<string, unknown>;
+  const after = (e.after ?? {}) as Record<string, unknown>;
+  if (e.action === "create") return `${after.candidates ?? 0} candidates`;
+  if ("index" in after || "index" in before) {
+    const index = Number(after.index ?? before.index);
+    return `segment ${index + 1}: ${before.label ?? "—"} → ${after.label ?? "—"}`;
+  }
+  if (e.action === "insert") return `at frame ${after.frame}`;
+  if (before.frame !== undefined && after.frame !== undefined && before.frame !== after.frame) {
+    return `frame ${before.frame} → ${after.frame}`;
+  }
+  if (after.frame !== undefined) return `frame ${after.frame}: ${before.fate ?? "—"} → ${after.fate}`;
+  return "";
+}
