@@ -75,18 +75,25 @@ def joint_distances(positions: np.ndarray, joints: dict[str, int]) -> np.ndarray
     return np.linalg.norm(a - b, axis=-1)
 
 
-def body_frame_positions(positions: np.ndarray, joints: dict[str, int]) -> np.ndarray:
+def body_frame_positions(
+    positions: np.ndarray, joints: dict[str, int], which: list[int] | None = None
+) -> np.ndarray:
     """Joint positions relative to the root, with the body's heading removed.
 
     The heading is the horizontal direction of the hip axis (left hip -> right hip)
     turned a quarter turn; each frame is rotated about Y so that it faces +Z. The
     result does not change when the performer walks somewhere else or turns round.
 
+    Parameters
+    ----------
+    which : joint indices to return (all joints when None).
+
     Returns
     -------
-    (n_frames, n_joints, 3) positions, same unit as the input.
+    (n_frames, n_joints or len(which), 3) positions, same unit as the input.
     """
-    rel = positions - positions[:, joints["root"]][:, None, :]
+    chosen = positions if which is None else positions[:, which]
+    rel = chosen - positions[:, joints["root"]][:, None, :]
     hips = positions[:, joints["right_hip"]] - positions[:, joints["left_hip"]]
     angle = np.arctan2(hips[:, 2], hips[:, 0])  # hip axis angle in the ground plane
     c, s = np.cos(angle), np.sin(angle)

@@ -62,8 +62,8 @@ def pose_features(
     (minus its median) and, when ``velocity_s > 0``, their velocities times
     ``velocity_s`` seconds (a length, so both parts share one unit).
     """
-    body = features.body_frame_positions(positions, joints)
-    pose = body[:, [joints[j] for j in POSE_JOINTS]].reshape(len(positions), -1)
+    body = features.body_frame_positions(positions, joints, [joints[j] for j in POSE_JOINTS])
+    pose = body.reshape(len(positions), -1)
     height = positions[:, joints["root"], 1:2]
     x = np.concatenate([pose, height - np.median(height)], axis=1)
     if velocity_s > 0:
@@ -78,7 +78,7 @@ def block_mean(x: np.ndarray, step: int) -> np.ndarray:
     return x[: n * step].reshape(n, step, -1).mean(axis=1)
 
 
-def median_sq_distance(x: np.ndarray, max_points: int = 2000) -> float:
+def median_sq_distance(x: np.ndarray, max_points: int = 1000) -> float:
     """Median squared distance between rows (on an even subsample for long inputs)."""
     sub = x[:: max(1, len(x) // max_points)]
     sq = (sub * sub).sum(axis=1)
