@@ -64,7 +64,7 @@ def run_io(args) -> int:
         return 2
     rows = []
     for name, path, fn in _cases(cmu):
-        runs = args.runs if "motionlib" in name else max(3, args.runs // 4)
+        runs = args.runs if "bvh package" not in name else max(2, args.runs // 4)
         times = _timed(fn, runs)
         peak = _peak_bytes(fn)
         size = path.stat().st_size if path is not None else None

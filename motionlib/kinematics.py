@@ -171,8 +171,10 @@ def _rotate(G, rots, channels, axes, j):
         G = _times_constant(G, axes[j])
     if rots:
         theta = np.deg2rad(np.ascontiguousarray(channels[:, [col for _, col in rots]].T))
-        cos, sin = np.cos(theta), np.sin(theta)
-        for k, (axis, _) in enumerate(rots):
+        moving = theta.any(axis=1)  # converters fill unused channels with zeros: skip them
+        cos, sin = np.cos(theta[moving]), np.sin(theta[moving])
+        turns = [axis for (axis, _), m in zip(rots, moving, strict=True) if m]
+        for k, axis in enumerate(turns):
             _turn(G, axis, cos[k], sin[k])
     if axes is not None:
         G = _times_constant(G, axes[j].T)
