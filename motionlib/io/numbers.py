@@ -91,10 +91,11 @@ class _Walk:
 def token_values(b: np.ndarray, starts: np.ndarray, ends: np.ndarray) -> np.ndarray | None:
     """Value of every token, or None if one of them is not a number read exactly here.
 
-    All tokens are walked from their last byte backwards in lockstep. Digits are summed with
-    the weight of their byte position (10**(k-1) for the k-th byte from the right) so a pass
-    multiplies by one scalar; positions taken by the dot, the exponent and its sign are
-    corrected for afterwards.
+    All tokens are walked from their last byte backwards in lockstep, longest first so that
+    pass k only touches the tokens that still have a k-th byte (a prefix, no masking). Digits
+    are summed with the weight of their byte position (10**(k-1) for the k-th byte from the
+    right) so a pass multiplies by one scalar; positions taken by the dot, the exponent and its
+    sign are corrected for afterwards.
 
     Parameters
     ----------
@@ -114,48 +115,55 @@ def token_values(b: np.ndarray, starts: np.ndarray, ends: np.ndarray) -> np.ndar
     if longest > _MAX_TOKEN:
         return None
     length = length.astype(np.uint8)
+    order = np.argsort(length, kind="stable")[::-1]  # radix sort of small ints: cheap
+    # at_least[k]: how many tokens have a k-th byte; they are the first ones in `order`.
+    at_least = np.cumsum(np.bincount(length, minlength=longest + 2)[::-1])[::-1]
     w = _Walk(starts.size)
-    pos = ends.astype(np.intp)
+    pos = ends[order].astype(np.intp)
     for k in range(1, longest + 1):
-        pos -= 1
-        _step(w, b[pos], length >= k, length == k, k)
-    first = b[starts]
-    values = _finish(w, length, first)
-    if values is None:
+        m = int(at_least[k])
+        p = pos[:m]
+        p -= 1
+        _step(w, b[p], m, int(at_least[k + 1]), k)
+    first = b[starts[order]]
+    found = _finish(w, length[order], first)
+    if found is None:
         return None
-    values, inexact = values
+    sorted_values, inexact = found
     # Well-formed but outside the exact range (huge mantissa or exponent): rare, use float().
     for i in np.flatnonzero(inexact):
-        values[i] = float(b[starts[i]:ends[i]].tobytes())
+        t = order[i]
+        sorted_values[i] = float(b[starts[t]:ends[t]].tobytes())
+    values = np.empty_like(sorted_values)
+    values[order] = sorted_values
     return values
 
 
-def _step(w: _Walk, c, valid, in_front, k: int) -> None:
+def _step(w: _Walk, c, m: int, inner_end: int, k: int) -> None:
+    """Pass k over the first m tokens (those with a k-th byte); the first ``inner_end`` of them
+    are longer than k, so byte k is not their first byte."""
     d = c - np.uint8(48)
     isdig = d < 10
     isdot = c == 46
     ise = (c == 101) | (c == 69)
     issign = (c == 45) | (c == 43)
-    w.bad |= valid & ~(isdig | isdot | ise | issign)
-    isdig &= valid
+    w.bad[:m] |= ~(isdig | isdot | ise | issign)
     d *= isdig
-    w.total += d * _POW10[k - 1]
-    isdot &= valid
+    w.total[:m] += d * _POW10[k - 1]
     if isdot.any():
-        np.copyto(w.at_dot, w.total, where=isdot)
-        w.dot[isdot] = k
-        w.count += isdot
-    ise &= valid
+        np.copyto(w.at_dot[:m], w.total[:m], where=isdot)
+        w.dot[:m][isdot] = k
+        w.count[:m] += isdot
     if ise.any():
-        np.copyto(w.at_e, w.total, where=ise)
-        w.e[ise] = k
-        w.count += ise
-        w.bad |= ise & (w.dot > 0)  # a dot in the exponent
-    inner = issign & valid & ~in_front
+        np.copyto(w.at_e[:m], w.total[:m], where=ise)
+        w.e[:m][ise] = k
+        w.count[:m] += ise
+        w.bad[:m] |= ise & (w.dot[:m] > 0)  # a dot in the exponent
+    inner = issign[:inner_end]
     if inner.any():
-        w.inner_sign[inner] = k
-        w.exp_negative |= inner & (c == 45)
-        w.count += inner
+        w.inner_sign[:inner_end][inner] = k
+        w.exp_negative[:inner_end] |= inner & (c[:inner_end] == 45)
+        w.count[:inner_end] += inner
 
 
 def _finish(w: _Walk, length, first):
