@@ -124,6 +124,13 @@ class ClaimQuerySet(models.QuerySet):
         limit = timezone.now() - timezone.timedelta(seconds=settings.CUTROOM_CLAIM_TIMEOUT)
         return self.filter(status="processing", claimed_at__lt=limit)
 
+    def waiting_too_long(self):
+        """Queued rows nobody claimed within the claim timeout: their message may be lost
+        (broker down at upload time, queue purged), so they are sent again."""
+        limit = timezone.now() - timezone.timedelta(seconds=settings.CUTROOM_CLAIM_TIMEOUT)
+        last_sent = Q(claimed_at__lt=limit) | Q(claimed_at__isnull=True, created_at__lt=limit)
+        return self.filter(last_sent, status="queued")
+
 
 class Job(models.Model):
     """State shared by the two kinds of background work (ingest, detect)."""
@@ -131,6 +138,7 @@ class Job(models.Model):
     status = models.CharField(max_length=20, choices=JOB_STATUSES, default="queued")
     error = models.TextField(blank=True)
     claim_token = models.CharField(max_length=64, blank=True)
+    # Time of the last claim, or of the last requeue while queued.
     claimed_at = models.DateTimeField(null=True, blank=True)
     attempts = models.PositiveIntegerField(default=0)
 

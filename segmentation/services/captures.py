@@ -111,10 +111,19 @@ def do_start_run(capture, user, method, params):
 
 
 def _enqueue(task_name, pk):
+    """Send the job once the row is committed (a worker must be able to see it)."""
     from segmentation import tasks
 
-    task = getattr(tasks, task_name)
-    transaction.on_commit(lambda: task.delay(pk))
+    transaction.on_commit(lambda: _send(getattr(tasks, task_name), pk))
+
+
+def _send(task, pk):
+    try:
+        task.delay(pk)
+    except Exception:
+        # The row is stored and stays queued; the sweep sends it again later, so an
+        # unreachable broker costs a delay, never the upload.
+        log.exception("could not send %s(%s); the sweep will retry", task.name, pk)
 
 
 def _read(capture):
@@ -232,21 +241,39 @@ def give_up(job):
 
 
 def sweep_stale_claims():
-    """Requeue jobs whose worker vanished mid-way; fail those already retried too often.
+    """Requeue jobs whose worker vanished mid-way (failing those retried too often) and
+    resend jobs queued for longer than the claim timeout.
 
-    Returns the number of jobs requeued or failed.
+    Returns the number of jobs requeued, failed or resent.
     """
     count = 0
     for model, task_name in ((Capture, "ingest"), (DetectionRun, "detect")):
-        for job in model.objects.stale():
-            if job.attempts >= settings.CUTROOM_MAX_ATTEMPTS:
-                count += give_up(job)
-                continue
-            with transaction.atomic():
-                requeued = model.objects.filter(
-                    pk=job.pk, status="processing", claim_token=job.claim_token
-                ).update(status="queued", claim_token="")
-                if requeued:
-                    _enqueue(task_name, job.pk)
-            count += requeued
+        count += _resend_waiting(model, task_name)
+        count += _rescue_stale(model, task_name)
+    return count
+
+
+def _resend_waiting(model, task_name):
+    count = 0
+    for job in model.objects.waiting_too_long():
+        with transaction.atomic():
+            model.objects.filter(pk=job.pk, status="queued").update(claimed_at=timezone.now())
+            _enqueue(task_name, job.pk)
+        count += 1
+    return count
+
+
+def _rescue_stale(model, task_name):
+    count = 0
+    for job in model.objects.stale():
+        if job.attempts >= settings.CUTROOM_MAX_ATTEMPTS:
+            count += give_up(job)
+            continue
+        with transaction.atomic():
+            requeued = model.objects.filter(
+                pk=job.pk, status="processing", claim_token=job.claim_token
+            ).update(status="queued", claim_token="", claimed_at=timezone.now())
+            if requeued:
+                _enqueue(task_name, job.pk)
+        count += requeued
     return count

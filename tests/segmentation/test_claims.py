@@ -92,3 +92,43 @@ class SweepTestCase(BaseTestCase):
         call_command("sweep_claims", stdout=out)
         self.assertEqual(out.getvalue().strip(), "1 stale job(s) requeued or failed")
         self.assertEqual(DetectionRun.objects.get(pk=self.run.pk).status, "queued")
+
+
+class LostMessageTestCase(BaseTestCase):
+    """A job whose message never reached a worker (broker down at upload time)."""
+
+    def setUp(self):
+        super().setUp()
+        self.capture = self.ready_capture()
+        Capture.objects.filter(pk=self.capture.pk).update(
+            status="queued", created_at=timezone.now() - timezone.timedelta(hours=1)
+        )
+
+    def test_the_sweep_sends_it_again_once(self):
+        with self.captureOnCommitCallbacks() as first:
+            services.sweep_stale_claims()
+        with self.captureOnCommitCallbacks() as second:
+            services.sweep_stale_claims()
+        self.assertEqual((len(first), len(second)), (1, 0))
+
+    def test_an_unreachable_broker_does_not_fail_the_upload(self):
+        from cutroom.celery import app
+
+        def reset_connections():
+            # Connections are pooled per broker URL at first use; start afresh.
+            if app._pool is not None:
+                app._pool.force_close_all()
+            app._pool = app.amqp._producer_pool = None
+
+        unreachable = {"broker_url": "redis://127.0.0.1:1/0", "broker_connection_max_retries": 0}
+        self.addCleanup(reset_connections)
+        self.addCleanup(app.conf.update, {key: app.conf[key] for key in unreachable})
+        reset_connections()
+        app.conf.update(unreachable)
+        self.login(self.bob)
+        with self.assertLogs("segmentation.services.captures", "ERROR") as logs:
+            with self.captureOnCommitCallbacks(execute=True):
+                r = self.upload(b"HIERARCHY\n", name="offline.bvh")
+        self.assertEqual(r.status_code, 201)
+        self.assertIn("the sweep will retry", logs.output[0])
+        self.assertEqual(Capture.objects.get(pk=r.json()["id"]).status, "queued")
