@@ -239,3 +239,27 @@ def test_it_explains_a_capture_that_does_not_exist(live_server, new_page, studio
     page.goto(f"{live_server.url}{path}")
     expect(page.locator(".loading-page")).to_contain_text("Something went wrong")
     expect(page.locator(".loading-page .error-text")).not_to_be_empty()
+
+
+def test_it_lists_the_shortcuts_and_locks_the_review_once_submitted(live_server, new_page, ingested_capture, studio):
+    page = new_page("ann")
+    screen = ReviewScreen(page, live_server.url, ingested_capture)
+    screen.open()
+    page.keyboard.press("?")
+    help_box = page.get_by_test_id("help")
+    for text in ("play / pause", "jump to previous / next cut", "undo", "redo", "label the segment"):
+        expect(help_box).to_contain_text(text)
+    page.keyboard.press("Escape")
+    expect(help_box).to_have_count(0)
+
+    page.get_by_test_id("submit").click()
+    expect(page.get_by_test_id("readonly-banner")).to_contain_text("You submitted this review")
+    assert screen.review()["status"] == "submitted"
+    version = screen.review()["version"]
+    page.keyboard.press("i")
+    expect(page.locator(".toast-error")).to_contain_text("submitted")
+    page.reload()
+    screen.wait_ready()
+    expect(page.get_by_test_id("submit")).to_be_disabled()
+    assert screen.review()["version"] == version
+    assert page.errors == []

@@ -154,6 +154,7 @@ class ReviewPage {
         h("span", { class: "spacer" }),
         this.el.reviewPicker,
         this.el.saveState,
+        btn("submit", "Submit review", "Mark this review finished; it can no longer be edited", () => void this.submit(), "btn-primary"),
         h("button", { class: "btn btn-ghost", title: "Keyboard shortcuts (?)", "data-testid": "help-button", onclick: () => this.toggleHelp() }, "?"),
         h("span", { class: "user" }, this.me.username),
       ),
@@ -234,15 +235,20 @@ class ReviewPage {
       playhead: frame,
       selectedCutId: this.selectedCutId,
       loop: this.playback.loop,
-      readOnly: this.readOnly,
+      readOnly: this.locked() !== null,
     });
     this.showFrame(frame);
     this.renderSide();
     this.el.play.replaceChildren(icon(this.playback.playing ? "pause" : "play"));
     this.el.loop.classList.toggle("active", this.playback.loop !== null);
-    this.el.undo.toggleAttribute("disabled", this.readOnly || this.history.past.length === 0);
-    this.el.redo.toggleAttribute("disabled", this.readOnly || this.history.future.length === 0);
-    for (const id of ["accept", "delete", "insert"]) this.el[id].toggleAttribute("disabled", this.readOnly);
+    const locked = this.locked() !== null;
+    this.el.undo.toggleAttribute("disabled", locked || this.history.past.length === 0);
+    this.el.redo.toggleAttribute("disabled", locked || this.history.future.length === 0);
+    for (const id of ["accept", "delete", "insert", "submit"]) this.el[id].toggleAttribute("disabled", locked);
+    this.el.submit.textContent = this.review.status === "submitted" ? "Submitted" : "Submit review";
+    const banner = this.readOnly ? `Viewing ${this.review.annotator.username}'s review — read-only.` : locked ? "You submitted this review — read-only." : "";
+    this.el.banner.textContent = banner;
+    this.el.banner.toggleAttribute("hidden", !banner);
   }
 
   private showFrame(frame: number): void {
@@ -285,7 +291,7 @@ class ReviewPage {
           {
             class: `label-chip${segment?.label === label.name ? " current" : ""}`,
             "data-testid": `label-${label.name}`,
-            disabled: this.readOnly,
+            disabled: this.locked() !== null,
             title: `Label the segment under the playhead${label.hotkey ? ` (${label.hotkey})` : ""}`,
             onclick: () => this.labelCurrent(label.name),
           },
@@ -352,9 +358,17 @@ class ReviewPage {
 
   // ---- editing -------------------------------------------------------------------------
 
+  /** Why this review cannot be edited now, or null if it can. */
+  private locked(): string | null {
+    if (this.readOnly) return `You are viewing ${this.review.annotator.username}'s review, read-only.`;
+    if (this.review.status === "submitted") return "This review was submitted; it is read-only now.";
+    return null;
+  }
+
   private perform(edit: Edit): void {
-    if (this.readOnly) {
-      toast(`You are viewing ${this.review.annotator.username}'s review, read-only.`, "error");
+    const locked = this.locked();
+    if (locked) {
+      toast(locked, "error");
       return;
     }
     try {
@@ -384,6 +398,20 @@ class ReviewPage {
       toast(`${verb[0].toUpperCase()}${verb.slice(1)}: ${step.change.title}`);
     } catch (err) {
       toast(err instanceof Error ? err.message : String(err), "error");
+    }
+    this.refresh();
+  }
+
+  private async submit(): Promise<void> {
+    if (this.locked() || this.saver.pending) return;
+    try {
+      this.review = await post<Review>(`/api/captures/${this.capture.id}/review/submit/`, { version: this.saver.server.version });
+      this.saver.server = this.review;
+      this.history = emptyHistory();
+      toast("Review submitted.");
+      void this.loadEvents();
+    } catch (err) {
+      toast(`Not submitted: ${err instanceof Error ? err.message : String(err)}`, "error");
     }
     this.refresh();
   }
@@ -469,7 +497,7 @@ class ReviewPage {
     return {
       nFrames: this.capture.n_frames, fps: this.capture.fps, signals: this.signals, cuts: this.review.cuts,
       segments: this.review.segments, labels: this.labels, playhead: this.frame(),
-      selectedCutId: this.selectedCutId, loop: this.playback.loop, readOnly: this.readOnly,
+      selectedCutId: this.selectedCutId, loop: this.playback.loop, readOnly: this.locked() !== null,
     };
   }
 
@@ -525,10 +553,10 @@ class ReviewPage {
         this.labelCurrent(null);
         break;
       case "undo":
-        if (!this.readOnly) this.replay(undo(this.history, this.review, this.saver.resolve), "undo");
+        if (!this.locked()) this.replay(undo(this.history, this.review, this.saver.resolve), "undo");
         break;
       case "redo":
-        if (!this.readOnly) this.replay(redo(this.history, this.review, this.saver.resolve), "redo");
+        if (!this.locked()) this.replay(redo(this.history, this.review, this.saver.resolve), "redo");
         break;
       case "loop": {
         const segment = segmentAt(this.review.segments, frame);
@@ -620,8 +648,6 @@ class ReviewPage {
       this.readOnly = other !== undefined;
       this.review = other ?? this.saver.server ?? this.own;
       this.selectedCutId = null;
-      this.el.banner.toggleAttribute("hidden", !this.readOnly);
-      this.el.banner.textContent = other ? `Viewing ${other.annotator.username}'s review — read-only.` : "";
       this.refresh();
     });
     clear(this.el.reviewPicker, select);

@@ -1,0 +1,84 @@
+"""The capture list: drop files to upload them, watch their status change as the worker
+gets to them, filter by status, project and name, and open one."""
+
+from playwright.sync_api import expect
+
+from tests.e2e.conftest import synthetic_bvh
+
+DROP = """([name, text]) => {
+    const data = new DataTransfer();
+    data.items.add(new File([text], name));
+    const zone = document.querySelector("[data-testid=dropzone]");
+    for (const type of ["dragover", "drop"]) {
+        zone.dispatchEvent(new DragEvent(type, { dataTransfer: data, bubbles: true, cancelable: true }));
+    }
+}"""
+
+
+def run_worker_jobs():
+    """Do what a worker would: ingest queued captures, then run queued detections."""
+    from segmentation import tasks
+    from segmentation.models import Capture, DetectionRun
+
+    for capture in Capture.objects.filter(status="queued"):
+        tasks.ingest(capture.pk)
+    for run in DetectionRun.objects.filter(status="queued"):
+        tasks.detect(run.pk)
+
+
+def test_it_uploads_dropped_files_and_shows_their_status_as_it_changes(live_server, new_page, studio):
+    page = new_page("ann")
+    good = synthetic_bvh(seed=3, duration=12.0).decode()
+    page.evaluate(DROP, ["warmup_short.bvh", good])
+    page.evaluate(DROP, ["broken_take.bvh", "HIERARCHY\nROOT Hips\n{\n  OFFSET 0 0 oops\n"])
+    rows = page.get_by_test_id("capture-rows")
+    expect(rows.locator("tr", has_text="warmup_short.bvh")).to_contain_text("queued")
+    expect(rows.locator("tr", has_text="broken_take.bvh")).to_contain_text("queued")
+
+    run_worker_jobs()
+    # The list refreshes itself while anything is queued or processing.
+    expect(rows.locator("tr", has_text="warmup_short.bvh")).to_contain_text("ready", timeout=10_000)
+    broken = rows.locator("tr", has_text="broken_take.bvh")
+    expect(broken).to_contain_text("failed")
+    expect(broken.locator(".error-text")).not_to_be_empty()
+
+    # Dropping the same file again is recognised as a duplicate, not a second capture.
+    page.evaluate(DROP, ["warmup_short.bvh", good])
+    expect(page.get_by_test_id("uploads")).to_contain_text("already uploaded")
+    # A file that is not a capture is refused before anything is sent.
+    page.evaluate(DROP, ["notes.txt", "hello"])
+    expect(page.locator(".toast-error")).to_contain_text("notes.txt: not a .bvh or .amc file.")
+    expect(rows.locator("tr.capture-row")).to_have_count(2)
+
+    page.get_by_test_id("filter-status").select_option("failed")
+    expect(rows.locator("tr.capture-row")).to_have_count(1)
+    expect(rows).to_contain_text("broken_take.bvh")
+    assert "status=failed" in page.url
+    page.get_by_test_id("filter-status").select_option("")
+    page.get_by_test_id("filter-search").fill("warmup")
+    expect(rows.locator("tr.capture-row")).to_have_count(1)
+    expect(rows).to_contain_text("warmup_short.bvh")
+
+    rows.locator("tr", has_text="warmup_short.bvh").click()
+    expect(page.get_by_test_id("capture-name")).to_have_text("warmup_short.bvh")
+    page.go_back()
+    expect(page.get_by_test_id("filter-search")).to_have_value("warmup")
+    assert page.errors == []
+
+
+def test_it_lists_only_captures_of_projects_the_user_belongs_to(live_server, new_page, studio):
+    from django.contrib.auth import get_user_model
+    from django.core.files.uploadedfile import SimpleUploadedFile
+
+    from segmentation import services
+
+    outsider = get_user_model().objects.create_user("olga", password="olga-password")
+    elsewhere = services.do_create_project(outsider, "Olga's studio")
+    services.do_upload_capture(elsewhere, outsider, SimpleUploadedFile("secret.bvh", synthetic_bvh(seed=1, duration=6.0)))
+    services.do_upload_capture(studio["project"], studio["alice"], SimpleUploadedFile("shared.bvh", synthetic_bvh(seed=2, duration=6.0)))
+
+    page = new_page("ann")
+    rows = page.get_by_test_id("capture-rows")
+    expect(rows.locator("tr.capture-row")).to_have_count(1)
+    expect(rows).to_contain_text("shared.bvh")
+    expect(page.get_by_test_id("filter-project").locator("option")).to_have_text(["All projects", "Studio A"])
