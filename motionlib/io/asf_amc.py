@@ -371,9 +371,10 @@ def _amc_lines(body: str, first_line: int, asf: Asf, path) -> np.ndarray:
             continue
         name = tokens[0]
         if not frames:
-            raise CaptureError(f"{name!r} before the first frame number", path=path, line=n)
+            raise CaptureError(f"{name[:40]!r} before the first frame number", path=path,
+                               line=n)
         if name not in index:
-            raise CaptureError(f"bone {name!r} is not in the skeleton "
+            raise CaptureError(f"bone {name[:40]!r} is not in the skeleton "
                                f"{os.path.basename(asf.path)}", path=path, line=n)
         if name in seen:
             raise CaptureError(f"bone {name!r} listed twice in frame {len(frames)}",

@@ -24,13 +24,18 @@ _CHANNEL_BY_LOWER = {c.lower(): c for c in CHANNEL_NAMES}
 _MOTION = re.compile(rb"^[ \t]*MOTION\b", re.MULTILINE)
 
 
+def _short(token: str) -> str:
+    """A token for an error message: quoted, and cut if it is binary junk or very long."""
+    return repr(token if len(token) <= 40 else token[:40] + "...")
+
+
 class _Tokens:
     """The HIERARCHY as a stream of (token, line number), braces split off."""
 
     def __init__(self, text: str, path):
-        self.path = path
         self.items = [(tok, n) for n, line in enumerate(text.splitlines(), 1)
                       for tok in line.replace("{", " { ").replace("}", " } ").split()]
+        self.path = path
         self.pos = 0
         self.last_line = max(1, text.count("\n") + 1)
 
@@ -51,16 +56,16 @@ class _Tokens:
     def expect(self, keyword: str) -> None:
         tok, line = self.next(repr(keyword))
         if tok.upper() != keyword.upper():
-            raise self.error(f"expected {keyword!r}, found {tok!r}", line)
+            raise self.error(f"expected {keyword!r}, found {_short(tok)}", line)
 
     def number(self, what: str) -> float:
         tok, line = self.next(what)
         try:
             value = float(tok)
         except ValueError:
-            raise self.error(f"{what} must be a number, found {tok!r}", line) from None
+            raise self.error(f"{what} must be a number, found {_short(tok)}", line) from None
         if not math.isfinite(value):
-            raise self.error(f"{what} must be finite, found {tok!r}", line)
+            raise self.error(f"{what} must be finite, found {_short(tok)}", line)
         return value
 
 
@@ -92,19 +97,19 @@ def _parse_joint(tokens: _Tokens, b: _Builder, parent: int) -> None:
         elif tok.upper() == "END":
             _parse_end_site(tokens, b, j)
         else:
-            raise tokens.error(f"unexpected {tok!r} in joint {name}", line)
+            raise tokens.error(f"unexpected {_short(tok)} in joint {name}", line)
 
 
 def _parse_channels(tokens: _Tokens, name: str) -> tuple[str, ...]:
     tokens.next("CHANNELS")
     tok, line = tokens.next("a channel count")
     if not tok.isdigit() or int(tok) > 6:
-        raise tokens.error(f"channel count of {name} must be 0 to 6, found {tok!r}", line)
+        raise tokens.error(f"channel count of {name} must be 0 to 6, found {_short(tok)}", line)
     channels = []
     for _ in range(int(tok)):
         tok, line = tokens.next(f"a channel name of {name}")
         if tok.lower() not in _CHANNEL_BY_LOWER:
-            raise tokens.error(f"unknown channel {tok!r} for joint {name} (expected one of "
+            raise tokens.error(f"unknown channel {_short(tok)} for joint {name} (expected one of "
                                f"{', '.join(CHANNEL_NAMES)})", line)
         channels.append(_CHANNEL_BY_LOWER[tok.lower()])
     if len(set(channels)) != len(channels):
@@ -133,7 +138,7 @@ def parse_hierarchy(text: str, path=None) -> Skeleton:
     if tokens.peek() is not None:
         tok, line = tokens.next("")
         what = "a second ROOT (only one skeleton per file is supported)" if tok.upper() == "ROOT" \
-            else f"{tok!r}"
+            else _short(tok)
         raise tokens.error(f"unexpected {what} after the root joint closed", line)
     orders = ["".join(c[0] for c in chans if c in ROTATION_CHANNELS) for chans in b.channels]
     return Skeleton(names=b.names, parents=b.parents, offsets=b.offsets, channels=b.channels,
@@ -275,7 +280,7 @@ def read_bvh(path: str | os.PathLike) -> Take:
         raise CaptureError("empty file", path=path, line=1)
     m = _MOTION.search(data)
     header = data[:m.start()] if m else data
-    skeleton = parse_hierarchy(header.decode("utf-8", "replace"), path)
+    skeleton = parse_hierarchy(header.decode("utf-8-sig", "replace"), path)
     if m is None:
         raise CaptureError("no MOTION section after the HIERARCHY", path=path,
                            line=header.count(b"\n") + 1)

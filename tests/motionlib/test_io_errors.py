@@ -207,3 +207,17 @@ def test_it_rejects_an_unsupported_asf_dof(tmp_path):
     (tmp_path / "s.asf").write_text(ASF.replace("dof rx ry rz", "dof rx ry l"))
     with pytest.raises(CaptureError, match=r"s\.asf:19: unsupported dof 'l' of bone lowerback"):
         motionlib.read(motion, asf=tmp_path / "s.asf")
+
+
+def test_it_rejects_a_binary_file_without_dumping_it(tmp_path):
+    path = tmp_path / "photo.bvh"
+    path.write_bytes(b"\x89PNG\r\n\x1a\n" + bytes(range(256)) * 400)
+    with pytest.raises(CaptureError, match=r"photo\.bvh:1: expected 'HIERARCHY'") as caught:
+        motionlib.read(path)
+    assert len(str(caught.value)) < 200
+
+
+def test_it_reads_a_file_that_starts_with_a_byte_order_mark(tmp_path):
+    path = tmp_path / "bom.bvh"
+    path.write_bytes(b"\xef\xbb\xbf" + (HEADER + "Frames: 1\nFrame Time: 0.01\n" + FRAME).encode())
+    assert motionlib.read(path).skeleton.names == ["Hips", "Head"]
