@@ -21,9 +21,10 @@ repeats every second or so; a boundary is where that distribution changes. So:
 4. Peaks of the mean novelty curve higher than ``threshold`` and at least
    ``min_segment_s`` apart become cuts; confidence ``s / (s + threshold)`` grows with
    the peak height s (0.5 at the threshold), so candidates rank by evidence.
-5. The novelty peak locates a change only to within a window; each cut then moves to
-   the slowest frame (pose speed, low-passed at 1 Hz) within ``refine_s`` of the peak,
-   because performers pause between two activities and that is where annotators cut.
+5. Performers often pause between two activities and annotators cut there, so a cut
+   moves to the slowest frame (pose speed, low-passed at 1 Hz) within ``refine_s`` of
+   the peak when that frame is a real pause (below half the typical speed around it);
+   otherwise it stays at the peak, where the statistics change.
 
 All durations are in seconds, so the same defaults work at any frame rate.
 """
@@ -135,11 +136,24 @@ def mirrored_novelty(x: np.ndarray, w: int, gamma: float) -> np.ndarray:
     return mmd_novelty(padded, w, gamma)[w : w + len(x)]
 
 
-def settle_frame(speed: np.ndarray, cut: int, radius: int) -> int:
-    """The slowest frame within ``radius`` frames of ``cut``: where the body pauses
-    between two activities, which is where an animator would cut."""
+# A pause is a slowest frame at most this fraction of the typical speed around it.
+PAUSE_RATIO = 0.5
+
+
+def settle_frame(speed: np.ndarray, cut: int, radius: int, context: int) -> int:
+    """Move ``cut`` to a pause within ``radius`` frames, if there is one.
+
+    Performers often stop briefly between two activities and annotators cut there. The
+    slowest frame near the cut counts as such a pause only when it is well below the
+    median speed over ``±context`` frames: every periodic movement slows down at its
+    turning points, and those must not pull a cut away from the statistical change.
+    """
     a, b = max(1, cut - radius), min(len(speed) - 1, cut + radius + 1)
-    return a + int(np.argmin(speed[a:b])) if b > a else cut
+    if b <= a:
+        return cut
+    slowest = a + int(np.argmin(speed[a:b]))
+    typical = np.median(speed[max(0, cut - context) : cut + context])
+    return slowest if speed[slowest] < PAUSE_RATIO * typical else cut
 
 
 class Default(Segmenter):
@@ -167,7 +181,7 @@ class Default(Segmenter):
             "Weight (s) of joint velocities beside the poses; 0 compares poses only.",
         ),
         "refine_s": Param(
-            "float", 0.5, 0.0, 5.0, "Move each cut to the slowest frame within this many s.",
+            "float", 0.5, 0.0, 5.0, "Move each cut to a pause (slowest frame) within this many s.",
         ),
         "rate_hz": Param("float", 10.0, 1.0, 60.0, "Pose rate (Hz) for the novelty curve."),
     }
@@ -190,7 +204,10 @@ class Default(Segmenter):
         cuts = peaks * step + step // 2
         speed = features.lowpass(features.frame_speed(x, fps=fps), fps=fps, cutoff_hz=1.0)
         radius = int(round(p["refine_s"] * fps))
-        cuts = np.array([settle_frame(speed, int(c), radius) for c in cuts], dtype=np.int64)
+        context = int(round(p["scale_min_s"] * fps))
+        cuts = np.array(
+            [settle_frame(speed, int(c), radius, context) for c in cuts], dtype=np.int64
+        )
         t3 = time.perf_counter()
         centres = np.arange(len(novelty)) * step + step / 2
         curve = np.interp(np.arange(len(x)), centres, novelty) if len(novelty) else np.zeros(len(x))

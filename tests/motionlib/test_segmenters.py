@@ -145,3 +145,18 @@ def test_it_never_imports_django():
     code = "import motionlib.segmenters, motionlib.metrics, motionlib.benchmark, sys; "
     code += "assert 'django' not in sys.modules"
     subprocess.run([sys.executable, "-c", code], check=True)
+
+
+def test_it_moves_a_cut_to_a_nearby_pause():
+    from motionlib.segmenters.default import settle_frame
+
+    speed = np.full(1000, 10.0)
+    speed[530] = 1.0
+    assert settle_frame(speed, 500, radius=60, context=300) == 530
+
+
+def test_it_leaves_a_cut_where_nothing_pauses():
+    from motionlib.segmenters.default import settle_frame
+
+    speed = 10.0 + np.sin(np.arange(1000) / 10.0)  # slows a little, never stops
+    assert settle_frame(speed, 500, radius=60, context=300) == 500
