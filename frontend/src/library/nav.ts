@@ -1,3 +1,4 @@
+import "./library.css";
 // The top bar of the library pages: breadcrumbs plus links to the library and, for a
 // project, its dashboard.
 

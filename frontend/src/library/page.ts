@@ -1,0 +1,188 @@
+// The clip library: filter and sort labelled segments, play one in place, find clips
+// that move like it, open it in its capture, export one BVH or the whole query as a zip.
+
+import { get } from "../api/client";
+import type { Capture, FramesResponse, Page, Project } from "../api/types";
+import { SkeletonView } from "../player/skeletonView";
+import { decodeFloat32 } from "../review/frames";
+import { clear, formatDuration, h, toast } from "../ui/dom";
+import { topbar } from "./nav";
+import type { LibrarySegment } from "./types";
+
+export interface LibraryFilters {
+  project: string;
+  label: string;
+  annotator: string;
+  min_duration: string;
+  max_duration: string;
+  min_agreement: string;
+  gold: string;
+  ordering: string;
+  page: number;
+}
+
+const KEYS = ["project", "label", "annotator", "min_duration", "max_duration", "min_agreement", "gold", "ordering"] as const;
+export const ORDERINGS: [string, string][] = [["recent", "Newest"], ["-duration", "Longest"], ["duration", "Shortest"], ["-agreement", "Most agreed"], ["agreement", "Least agreed"], ["label", "Label"], ["capture", "Capture"]];
+
+export function libraryFiltersFrom(search: string): LibraryFilters {
+  const q = new URLSearchParams(search);
+  const f = Object.fromEntries(KEYS.map((k) => [k, q.get(k) ?? ""])) as Omit<LibraryFilters, "page">;
+  return { ...f, page: Math.max(Number(q.get("page")) || 1, 1) };
+}
+
+/** The API query string of the filters (empty values left out), without "?". */
+export function libraryQuery(f: LibraryFilters, withPage = true): string {
+  const q = new URLSearchParams();
+  for (const k of KEYS) if (f[k]) q.set(k, f[k]);
+  if (withPage && f.page > 1) q.set("page", String(f.page));
+  return q.toString();
+}
+
+/** Playback step so a clip preview downloads at most `maxFrames` poses. */
+export function previewStep(frames: number, maxFrames = 1500): number {
+  return Math.max(1, Math.ceil(frames / maxFrames));
+}
+
+const pct = (v: number | null) => (v === null ? "—" : `${Math.round(v * 100)} %`);
+
+export async function renderLibrary(root: HTMLElement): Promise<() => void> {
+  const projectsRaw = await get<Project[] | Page<Project>>("/api/projects/");
+  const projects = Array.isArray(projectsRaw) ? projectsRaw : projectsRaw.results;
+  const labelNames = [...new Set(projects.flatMap((p) => p.labels.map((l) => l.name)))].sort();
+  let filters = libraryFiltersFrom(location.search);
+  const rows = h("tbody", { "data-testid": "segment-rows" });
+  const pager = h("div", { class: "pager" });
+  const exportZip = h("a", { class: "btn", "data-testid": "export-zip", download: "" }, "Export these as zip");
+  const preview = h("aside", { class: "lib-preview", "data-testid": "preview" }, h("p", { class: "muted" }, "Play a segment to preview it here."));
+  let stopPreview: () => void = () => undefined;
+
+  const field = (key: (typeof KEYS)[number], el: HTMLInputElement | HTMLSelectElement) => {
+    el.value = filters[key];
+    el.setAttribute("data-testid", `lib-${key}`);
+    el.setAttribute("aria-label", key.replace("_", " "));
+    el.addEventListener("change", () => apply({ ...filters, [key]: el.value.trim(), page: 1 }));
+    return el;
+  };
+  const options = (pairs: [string, string][]) => pairs.map(([v, t]) => h("option", { value: v }, t));
+  const controls = h(
+    "div",
+    { class: "filters lib-filters" },
+    field("project", h("select", { class: "select" }, ...options([["", "All projects"], ...projects.map((p) => [String(p.id), p.name] as [string, string])]))),
+    field("label", h("select", { class: "select" }, ...options([["", "Any label"], ...labelNames.map((l) => [l, l] as [string, string])]))),
+    field("min_duration", h("input", { class: "input num-input", type: "number", step: "0.1", min: "0", placeholder: "min s" })),
+    field("max_duration", h("input", { class: "input num-input", type: "number", step: "0.1", min: "0", placeholder: "max s" })),
+    field("min_agreement", h("input", { class: "input num-input", type: "number", step: "0.05", min: "0", max: "1", placeholder: "min agreement" })),
+    field("gold", h("select", { class: "select" }, ...options([["", "Gold where made"], ["true", "Gold only"], ["false", "Annotators' versions"]]))),
+    field("ordering", h("select", { class: "select" }, ...options(ORDERINGS))),
+    exportZip,
+  );
+
+  clear(
+    root,
+    h(
+      "div",
+      { class: "list-page" },
+      topbar([["Captures", "/"], ["Library", null]], Number(filters.project) || projects.find((p) => p.role !== "annotator")?.id),
+      h(
+        "main",
+        { class: "list-main lib-main" },
+        controls,
+        h(
+          "div",
+          { class: "lib-layout" },
+          h("div", {}, h("table", { class: "captures" }, h("thead", {}, h("tr", {}, ...["Label", "Capture", "Frames", "Duration", "Annotator", "Agreement", ""].map((t) => h("th", {}, t)))), rows), pager),
+          preview,
+        ),
+      ),
+    ),
+  );
+
+  function row(s: LibrarySegment): HTMLElement {
+    return h(
+      "tr",
+      { "data-testid": `segment-${s.id}` },
+      h("td", {}, h("span", { class: "label-dot", style: `background:${s.color}` }), s.label, s.gold ? h("span", { class: "badge badge-ready gold-badge" }, "gold") : null),
+      h("td", {}, h("a", { href: `/captures/${s.capture.id}/?frame=${s.start}`, title: "Open in its capture" }, s.capture.name)),
+      h("td", { class: "num" }, `${s.start}–${s.stop}`),
+      h("td", { class: "num" }, formatDuration(s.duration)),
+      h("td", {}, s.annotator?.username ?? "—"),
+      h("td", { class: "num" }, s.distance !== undefined ? `d ${s.distance.toFixed(2)}` : pct(s.agreement)),
+      h(
+        "td",
+        { class: "lib-actions" },
+        h("button", { class: "btn", "data-testid": `play-${s.id}`, onclick: () => void play(s) }, "▶ Play"),
+        h("button", { class: "btn", "data-testid": `similar-${s.id}`, onclick: () => void similar(s) }, "Similar"),
+        h("a", { class: "btn", href: `/api/segments/${s.id}/export.bvh`, download: "" }, "BVH"),
+      ),
+    );
+  }
+
+  async function load(): Promise<void> {
+    const query = libraryQuery(filters);
+    exportZip.setAttribute("href", `/api/segments/export.zip?${libraryQuery(filters, false)}`);
+    const data = await get<Page<LibrarySegment>>(`/api/segments/?${query}`).catch((err: Error) => {
+      clear(rows, h("tr", {}, h("td", { colspan: 7, class: "error-text", "data-testid": "lib-error" }, err.message)));
+      return null;
+    });
+    if (!data) return;
+    clear(rows, ...data.results.map(row));
+    if (!data.results.length) rows.append(h("tr", {}, h("td", { colspan: 7, class: "muted empty" }, "No segments match. Segments appear here when reviews are submitted.")));
+    clear(
+      pager,
+      h("span", { class: "muted", "data-testid": "segment-count" }, `${data.count} segment${data.count === 1 ? "" : "s"}`),
+      data.previous ? h("button", { class: "btn", onclick: () => apply({ ...filters, page: filters.page - 1 }) }, "← Previous") : null,
+      data.next ? h("button", { class: "btn", onclick: () => apply({ ...filters, page: filters.page + 1 }) }, "Next →") : null,
+    );
+  }
+
+  async function similar(s: LibrarySegment): Promise<void> {
+    try {
+      const body = await get<{ results: LibrarySegment[] }>(`/api/segments/${s.id}/similar/?k=10`);
+      clear(rows, h("tr", {}, h("td", { colspan: 7, class: "lib-similar-head" }, `Clips that move like ${s.label} ${s.start}–${s.stop} of ${s.capture.name} `, h("button", { class: "btn btn-ghost", onclick: () => void load() }, "× back to the list"))), ...body.results.map(row));
+    } catch (err) {
+      toast((err as Error).message, "error");
+    }
+  }
+
+  async function play(s: LibrarySegment): Promise<void> {
+    stopPreview();
+    const capture = await get<Capture>(`/api/captures/${s.capture.id}/`);
+    if (!capture.skeleton) return toast("This capture has no skeleton yet.", "error");
+    const step = previewStep(s.stop - s.start);
+    const frames = await get<FramesResponse>(`/api/captures/${s.capture.id}/frames/?start=${s.start}&stop=${s.stop}&step=${step}`);
+    const poses = decodeFloat32(frames.data);
+    const size = frames.n_joints * 3;
+    const stage = h("div", { class: "lib-stage" });
+    const caption = h("div", { class: "muted small", "data-testid": "preview-caption" }, `${s.label} · ${s.capture.name} · frames ${s.start}–${s.stop}`);
+    clear(preview, stage, caption);
+    let view: SkeletonView | null = null;
+    try {
+      view = new SkeletonView(stage, capture.skeleton);
+    } catch {
+      stage.append(h("p", { class: "muted" }, "WebGL is not available to draw the skeleton."));
+    }
+    preview.setAttribute("data-playing", String(s.id));
+    let raf = 0;
+    const started = performance.now();
+    const tick = (now: number) => {
+      const i = Math.floor((((now - started) / 1000) * capture.fps) / step) % frames.n_frames;
+      view?.setPose(poses.subarray(i * size, (i + 1) * size));
+      raf = requestAnimationFrame(tick);
+    };
+    raf = requestAnimationFrame(tick);
+    stopPreview = () => {
+      cancelAnimationFrame(raf);
+      view?.dispose();
+    };
+  }
+
+  function apply(next: LibraryFilters): void {
+    filters = next;
+    const query = libraryQuery(filters);
+    history.replaceState(null, "", `/library/${query ? `?${query}` : ""}`);
+    void load();
+  }
+
+  await load();
+  return () => stopPreview();
+}

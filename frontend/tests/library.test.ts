@@ -1,0 +1,61 @@
+import { describe, expect, it } from "vitest";
+import { addCut, fromSpans, moveCut, removeCut, segmentAt, setLabel, toSpans } from "../src/library/gold";
+import { libraryFiltersFrom, libraryQuery, previewStep } from "../src/library/page";
+
+const spans = [
+  { start: 0, stop: 100, label: "walk" },
+  { start: 100, stop: 250, label: "punch" },
+  { start: 250, stop: 400, label: null },
+];
+
+describe("gold draft", () => {
+  it("round-trips an annotator's segments", () => {
+    const draft = fromSpans(spans);
+    expect(draft).toEqual({ cuts: [100, 250], labels: ["walk", "punch", null] });
+    expect(toSpans(draft, 400)).toEqual(spans);
+  });
+
+  it("splits the segment under a frame, both halves keeping its label", () => {
+    const draft = addCut(fromSpans(spans), 180, 400);
+    expect(draft).toEqual({ cuts: [100, 180, 250], labels: ["walk", "punch", "punch", null] });
+  });
+
+  it("ignores a split on an existing cut or at the ends", () => {
+    const draft = fromSpans(spans);
+    expect(addCut(draft, 100, 400)).toBe(draft);
+    expect(addCut(draft, 0, 400)).toBe(draft);
+    expect(addCut(draft, 400, 400)).toBe(draft);
+  });
+
+  it("merges two segments when a cut is removed, keeping the earlier label", () => {
+    expect(removeCut(fromSpans(spans), 0)).toEqual({ cuts: [250], labels: ["walk", null] });
+  });
+
+  it("moves a cut but never past its neighbours", () => {
+    const draft = fromSpans(spans);
+    expect(moveCut(draft, 0, 120, 400).cuts).toEqual([120, 250]);
+    expect(moveCut(draft, 0, 300, 400).cuts).toEqual([249, 250]);
+    expect(moveCut(draft, 1, 9999, 400).cuts).toEqual([100, 399]);
+  });
+
+  it("finds the segment of a frame and relabels it", () => {
+    const draft = fromSpans(spans);
+    expect([segmentAt(draft, 0), segmentAt(draft, 99), segmentAt(draft, 100), segmentAt(draft, 399)]).toEqual([0, 0, 1, 2]);
+    expect(setLabel(draft, 2, "walk").labels).toEqual(["walk", "punch", "walk"]);
+  });
+});
+
+describe("library filters", () => {
+  it("reads filters from the address and writes back only the set ones", () => {
+    const f = libraryFiltersFrom("?label=squat&min_duration=1.5&page=3");
+    expect(f.label).toBe("squat");
+    expect(f.page).toBe(3);
+    expect(libraryQuery(f)).toBe("label=squat&min_duration=1.5&page=3");
+    expect(libraryQuery(f, false)).toBe("label=squat&min_duration=1.5");
+  });
+
+  it("thins long clips for preview", () => {
+    expect(previewStep(1000)).toBe(1);
+    expect(previewStep(4500)).toBe(3);
+  });
+});
