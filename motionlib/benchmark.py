@@ -146,10 +146,41 @@ def main(root: Path | None = None, only: list[str] | None = None, out=None) -> i
         truth = len(next(t for t in benchdata.labelled_takes(folder) if t.name == take).truth)
         print(format_table(f"\n{take} ({truth} true cuts)", rows), file=out)
     print(format_table(f"\nmean over {len(results)} takes", mean_rows(results)), file=out)
+    if not only or "joint_distance_pca" in only:
+        print("\n" + patent_comparison(folder), file=out)
     if not only or "default" in only:
         print(f"\ndefault on a 5-minute 120 fps synthetic take: {long_take_seconds():.2f} s",
               file=out)
     return 0
+
+
+# CN102867300A's published run on CMU 13_30 (1-based AMC frames, first and last frame
+# included as the patent lists them).
+PATENT_13_30 = {
+    "initial": [1, 196, 800, 1384, 1966, 2425, 2465],
+    "final": [1, 208, 803, 1364, 1949, 2384, 2465],
+}
+
+
+def patent_comparison(root: Path) -> str:
+    """joint_distance_pca's initial and final cuts on 13_30 beside the published ones."""
+    from motionlib.segmenters import get_segmenter
+
+    take = next(t for t in benchdata.labelled_takes(root) if t.name == "13_30").read()
+    seg = get_segmenter("joint_distance_pca")()
+    final = seg.fit_predict(take).cuts
+    ours = {
+        "initial": (seg.initial_cuts_ + 1).tolist(),
+        "final": [1, *(final + 1).tolist(), take.n_frames],
+    }
+    lines = ["joint_distance_pca on 13_30 (AMC, 1-based frames) vs the patent's published run"]
+    for stage in ("initial", "final"):
+        lines.append(f"  {stage + ' published:':<19}{PATENT_13_30[stage]}")
+        lines.append(f"  {stage + ' ours:':<19}{ours[stage]}")
+        if len(ours[stage]) == len(PATENT_13_30[stage]):
+            diff = np.abs(np.subtract(ours[stage], PATENT_13_30[stage]))
+            lines.append(f"  {'max difference:':<19}{int(diff.max())} frames")
+    return "\n".join(lines)
 
 
 def long_take_seconds(minutes: float = 5.0) -> float:

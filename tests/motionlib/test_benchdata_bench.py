@@ -41,3 +41,12 @@ def test_it_scores_a_method_on_every_labelled_take():
     for take in results.values():
         assert 0 <= take["bone_angle"]["f1@1s"] <= 1
         assert take["bone_angle"]["n_cuts"] > 0
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not DATA.is_dir(), reason=f"CMU benchmark data not found at {DATA}")
+def test_it_reports_the_patent_run_beside_the_published_cuts():
+    lines = benchmark.patent_comparison(DATA).splitlines()
+    assert lines[1].split(":", 1)[1].strip() == str(benchmark.PATENT_13_30["initial"])
+    final_diff = [line for line in lines if "max difference" in line][-1]
+    assert int(final_diff.split(":")[1].split()[0]) <= 30
