@@ -37,3 +37,17 @@ class ProjectsTestCase(BaseTestCase):
         me = self.client.get("/api/me/").json()
         self.assertEqual(me["username"], "rachel")
         self.assertEqual(me["projects"], [{"id": self.project.pk, "name": "Studio A", "role": "reviewer"}])
+
+
+class ProjectIsolationTestCase(BaseTestCase):
+    def test_an_annotator_cannot_see_a_project_they_are_not_in(self):
+        self.login(self.charlie)
+        theirs = self.upload(b"HIERARCHY\n", name="secret.bvh", project=self.other_project).json()
+        self.login(self.bob)
+        self.assertEqual(self.client.get(f"/api/projects/{self.other_project.pk}/").status_code, 404)
+        self.assertEqual(self.client.get(f"/api/captures/{theirs['id']}/").status_code, 404)
+        self.assertEqual(self.client.get(f"/api/captures/{theirs['id']}/frames/").status_code, 404)
+        names = [c["name"] for c in self.client.get("/api/captures/").json()["results"]]
+        self.assertNotIn("secret.bvh", names)
+        r = self.upload(b"HIERARCHY\n", name="sneaky.bvh", project=self.other_project)
+        self.assertEqual(r.status_code, 404)
