@@ -58,6 +58,8 @@ export async function renderLibrary(root: HTMLElement): Promise<() => void> {
 
   const field = (key: (typeof KEYS)[number], el: HTMLInputElement | HTMLSelectElement) => {
     el.value = filters[key];
+    // An unknown or empty value shows the first choice rather than a blank select.
+    if (el instanceof HTMLSelectElement && el.selectedIndex < 0) el.selectedIndex = 0;
     el.setAttribute("data-testid", `lib-${key}`);
     el.setAttribute("aria-label", key.replace("_", " "));
     el.addEventListener("change", () => apply({ ...filters, [key]: el.value.trim(), page: 1 }));
@@ -90,7 +92,7 @@ export async function renderLibrary(root: HTMLElement): Promise<() => void> {
         h(
           "div",
           { class: "lib-layout" },
-          h("div", {}, h("table", { class: "captures" }, h("thead", {}, h("tr", {}, ...["Label", "Capture", "Frames", "Duration", "Annotator", "Agreement", ""].map((t) => h("th", {}, t)))), rows), pager),
+          h("div", { class: "lib-table" }, h("table", { class: "captures" }, h("thead", {}, h("tr", {}, ...["Label", "Capture", "Frames", "Duration", "Annotator", "Agreement", ""].map((t) => h("th", {}, t)))), rows), pager),
           preview,
         ),
       ),

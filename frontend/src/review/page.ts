@@ -122,7 +122,11 @@ class ReviewPage {
   private build(): HTMLElement {
     const c = this.capture;
     const btn = (id: string, text: string | Node, title: string, action: () => void, extra = "") =>
-      (this.el[id] = h("button", { class: `btn ${extra}`, title, "data-testid": id, onclick: action }, text));
+      (this.el[id] = h("button", { class: `btn ${extra}`, title, "data-testid": id, onclick: (e: Event) => {
+        // Keys belong to the editor, not to the last button clicked (Space would click it again).
+        (e.currentTarget as HTMLElement).blur();
+        action();
+      } }, text));
     this.el.viewport = h("div", { class: "viewport", "data-testid": "viewport" });
     this.el.hudFrame = h("div", { class: "hud-frame", "data-testid": "hud-frame" });
     this.el.hudTime = h("div", { class: "hud-time", "data-testid": "hud-time" });
@@ -293,7 +297,10 @@ class ReviewPage {
             "data-testid": `label-${label.name}`,
             disabled: this.locked() !== null,
             title: `Label the segment under the playhead${label.hotkey ? ` (${label.hotkey})` : ""}`,
-            onclick: () => this.labelCurrent(label.name),
+            onclick: (e: Event) => {
+              (e.currentTarget as HTMLElement).blur();
+              this.labelCurrent(label.name);
+            },
           },
           h("span", { class: "swatch", style: `background:${label.color}` }),
           h("span", { class: "name" }, label.name),
