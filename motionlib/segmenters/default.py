@@ -198,6 +198,9 @@ class Default(Segmenter):
         t1 = time.perf_counter()
         x = pose_features(positions, joints, fps=fps, velocity_s=p["velocity_s"])
         step = max(1, int(round(fps / p["rate_hz"])))
+        if len(x) < 2 * step:  # too short to compare anything: no cuts
+            flat = full_length(np.zeros(len(x)), first)
+            return Segmentation(np.zeros(0, np.int64), np.zeros(0), {"novelty": flat})
         novelty = self._novelty(block_mean(x, step), fps / step, p)
         t2 = time.perf_counter()
         peaks, strength = self._peaks(novelty, fps / step, p)
@@ -235,4 +238,8 @@ class Default(Segmenter):
         distance = max(1, int(round(p["min_segment_s"] * rate)))
         peaks, _ = find_peaks(padded, height=max(p["threshold"], 1e-12), distance=distance)
         peaks = peaks - 1
+        # The first and last segment may be shorter than the others, but not absurdly:
+        # at least half the minimum segment.
+        edge = p["min_segment_s"] * rate / 2
+        peaks = peaks[(peaks + 0.5 >= edge) & (len(novelty) - peaks - 0.5 >= edge)]
         return peaks, novelty[peaks]

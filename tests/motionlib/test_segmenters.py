@@ -160,3 +160,13 @@ def test_it_leaves_a_cut_where_nothing_pauses():
 
     speed = 10.0 + np.sin(np.arange(1000) / 10.0)  # slows a little, never stops
     assert settle_frame(speed, 500, radius=60, context=300) == 500
+
+
+@pytest.mark.parametrize("name", METHODS)
+@pytest.mark.parametrize("n_frames", [1, 2, 13, 200])
+def test_it_handles_takes_too_short_to_cut(name, n_frames, synth_takes):
+    take = synth_takes[0][0].slice(0, n_frames)
+    result = get_segmenter(name)().fit_predict(take)
+    assert all(len(s) == n_frames for s in result.signals.values())
+    if name == "default":
+        assert len(result.cuts) == 0  # 1.7 s is shorter than one minimum segment
