@@ -164,7 +164,8 @@ CUTROOM_MAX_ATTEMPTS = envint("CUTROOM_MAX_ATTEMPTS", 3)
 CUTROOM_FRAMES_PER_REQUEST = 5000
 
 # Celery. No result backend: a job's state is its row (status, error, timings).
-CELERY_BROKER_URL = os.environ.get("CELERY_BROKER_URL") or "filesystem://"
+# (the host part only keeps kombu from warning that none was given)
+CELERY_BROKER_URL = os.environ.get("CELERY_BROKER_URL") or "filesystem://localhost//"
 CELERY_BROKER_DIR = Path(os.environ.get("CELERY_BROKER_DIR") or VAR_DIR / "broker")
 CELERY_TASK_IGNORE_RESULT = True
 # Separate deployments (or test sessions) can share one Redis by using their own queue.
