@@ -18,9 +18,11 @@ class ProjectViewSet(
     mixins.ListModelMixin,
     mixins.RetrieveModelMixin,
     mixins.CreateModelMixin,
+    mixins.UpdateModelMixin,
     viewsets.GenericViewSet,
 ):
     serializer_class = ProjectSerializer
+    http_method_names = ["get", "post", "patch", "head", "options"]
 
     def get_queryset(self):
         return Project.objects.for_user(self.request.user).prefetch_related("labels").order_by("id")
@@ -28,10 +30,14 @@ class ProjectViewSet(
     def perform_create(self, serializer):
         serializer.instance = services.do_create_project(self.request.user, **serializer.validated_data)
 
+    def perform_update(self, serializer):
+        project = self._admin_project()
+        serializer.instance = services.do_update_project(project, **serializer.validated_data)
+
     def _admin_project(self):
         project = self.get_object()
         if self.request.method != "GET" and not project.can_manage(self.request.user):
-            raise PermissionDenied("Only the project's admins can change its labels and members.")
+            raise PermissionDenied("Only the project's admins can change it, its labels and members.")
         return project
 
     @extend_schema(request=LabelSerializer, responses=LabelSerializer(many=True))

@@ -12,7 +12,12 @@ from segmentation.services.captures import (
     ingest_capture,
     sweep_stale_claims,
 )
-from segmentation.services.projects import do_add_label, do_create_project, do_set_member
+from segmentation.services.projects import (
+    do_add_label,
+    do_create_project,
+    do_set_member,
+    do_update_project,
+)
 from segmentation.services.reviews import (
     do_change_cut,
     do_insert_cut,
@@ -32,6 +37,7 @@ __all__ = [
     "do_set_member",
     "do_start_run",
     "do_submit_review",
+    "do_update_project",
     "do_upload_capture",
     "get_or_create_review",
     "ingest_capture",

@@ -13,14 +13,32 @@ COLOR = re.compile(r"^#[0-9a-fA-F]{6}$")
 
 def do_create_project(user, name, default_method="", default_params=None):
     """A new project with ``user`` as its admin; ParamError names a bad default."""
-    if default_method or default_params:
-        validate_method(default_method, default_params)
+    params = checked_defaults(default_method, default_params)
     with transaction.atomic():
         project = Project.objects.create(
-            name=name, default_method=default_method or "", default_params=default_params or {}
+            name=name, default_method=default_method or "", default_params=params
         )
         Membership.objects.create(project=project, user=user, role="admin")
     return project
+
+
+def do_update_project(project, **fields):
+    """Rename a project or change its default method and parameters."""
+    method = fields.get("default_method", project.default_method)
+    if "default_method" in fields or "default_params" in fields:
+        params = fields.get("default_params", project.default_params)
+        fields["default_params"] = checked_defaults(method, params)
+    for name, value in fields.items():
+        setattr(project, name, value)
+    project.save(update_fields=list(fields))
+    return project
+
+
+def checked_defaults(method, params):
+    """The given parameters, coerced to the method's schema (an empty method means the
+    registry's default). Unset parameters stay unset so they follow the method's defaults."""
+    validated = validate_method(method, params)[1]
+    return {key: validated[key] for key in params or {}}
 
 
 def do_set_member(project, username, role):

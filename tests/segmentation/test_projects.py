@@ -51,3 +51,40 @@ class ProjectIsolationTestCase(BaseTestCase):
         self.assertNotIn("secret.bvh", names)
         r = self.upload(b"HIERARCHY\n", name="sneaky.bvh", project=self.other_project)
         self.assertEqual(r.status_code, 404)
+
+
+class ProjectUpdateTestCase(BaseTestCase):
+    def url(self):
+        return f"/api/projects/{self.project.pk}/"
+
+    def test_admin_sets_the_default_method_and_params(self):
+        self.login(self.alice)
+        r = self.client.patch(self.url(), {"default_method": "bone_angle", "default_params": {"param": "0.25"}}, format="json")
+        self.assertEqual(r.status_code, 200)
+        self.assertEqual((r.json()["default_method"], r.json()["default_params"]), ("bone_angle", {"param": 0.25}))
+
+    def test_it_refuses_params_the_method_does_not_take(self):
+        self.login(self.alice)
+        r = self.client.patch(self.url(), {"default_method": "bone_angle", "default_params": {"window": 3}}, format="json")
+        self.assertEqual(r.status_code, 400)
+        self.assertIn("window", r.json()["params"])
+        self.project.refresh_from_db()
+        self.assertEqual(self.project.default_method, "")
+
+    def test_annotator_cannot_change_the_project(self):
+        self.login(self.bob)
+        r = self.client.patch(self.url(), {"name": "Bob's now"}, format="json")
+        self.assertEqual(r.status_code, 403)
+        self.project.refresh_from_db()
+        self.assertEqual(self.project.name, "Studio A")
+
+    def test_outsider_gets_404(self):
+        self.login(self.charlie)
+        self.assertEqual(self.client.patch(self.url(), {"name": "mine"}, format="json").status_code, 404)
+
+    def test_renaming_keeps_the_defaults(self):
+        self.login(self.alice)
+        self.client.patch(self.url(), {"default_method": "bone_angle"}, format="json")
+        self.client.patch(self.url(), {"name": "Studio B"}, format="json")
+        self.project.refresh_from_db()
+        self.assertEqual((self.project.name, self.project.default_method), ("Studio B", "bone_angle"))
