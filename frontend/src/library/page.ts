@@ -167,7 +167,8 @@ export async function renderLibrary(root: HTMLElement): Promise<() => void> {
     let raf = 0;
     const started = performance.now();
     const tick = (now: number) => {
-      const i = Math.floor((((now - started) / 1000) * capture.fps) / step) % frames.n_frames;
+      // The first animation frame can be stamped before `started`: never go negative.
+      const i = Math.floor(((Math.max(now - started, 0) / 1000) * capture.fps) / step) % frames.n_frames;
       view?.setPose(poses.subarray(i * size, (i + 1) * size));
       raf = requestAnimationFrame(tick);
     };
