@@ -23,10 +23,11 @@ Deviations, stated:
   is fitted to barely one window of frames) inflate the deviation so much that no later
   boundary ever stands out; on the labelled CMU takes the literal rule finds one cut in
   fifteen. The evident intent, "a jump unusual for this segment", is kept.
-- The paper represents a pose by joint-rotation quaternions; this
-implementation uses joint positions in the body frame (relative to the root, heading
-removed, ``features.body_frame_positions``), which are likewise smooth and do not
-change when the performer walks or turns.
+- The paper represents a pose by joint-rotation quaternions; this implementation uses
+  joint positions in the body frame (relative to the root, heading removed,
+  ``features.body_frame_positions``) of the 18 canonical joints other than the root
+  (54 numbers, close to the paper's 56), which are likewise smooth and do not change
+  when the performer walks or turns.
 """
 
 from __future__ import annotations
@@ -144,7 +145,8 @@ class PPCA(Segmenter):
         t0 = time.perf_counter()
         positions, joints, first = take_positions(take)
         t1 = time.perf_counter()
-        x = features.body_frame_positions(positions, joints).reshape(len(positions), -1)
+        named = [index for name, index in sorted(joints.items()) if name != "root"]
+        x = features.body_frame_positions(positions, joints, named).reshape(len(positions), -1)
         window = max(2, int(round(window_s * take.fps)))
         step = max(1, int(round(step_s * take.fps)))
         cuts, scores, curve = [], [], np.full(len(x), np.nan)
