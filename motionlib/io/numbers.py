@@ -74,12 +74,10 @@ def token_bounds(b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 class _Walk:
-    """Per-token state of the backward walk (see token_values)."""
+    """Per-token state of the backward walk (see token_values), in walking order."""
 
     def __init__(self, n: int):
         self.total = np.zeros(n)        # digits weighted by byte position from the right
-        self.at_dot = np.zeros(n)       # `total` when the dot was met
-        self.at_e = np.zeros(n)         # `total` when the exponent marker was met
         self.dot = np.zeros(n, np.uint8)      # byte position of the dot from the right, 0 = none
         self.e = np.zeros(n, np.uint8)        # same for 'e' / 'E'
         self.inner_sign = np.zeros(n, np.uint8)  # same for a sign that is not in front
@@ -94,8 +92,9 @@ def token_values(b: np.ndarray, starts: np.ndarray, ends: np.ndarray) -> np.ndar
     All tokens are walked from their last byte backwards in lockstep, longest first so that
     pass k only touches the tokens that still have a k-th byte (a prefix, no masking). Digits
     are summed with the weight of their byte position (10**(k-1) for the k-th byte from the
-    right) so a pass multiplies by one scalar; positions taken by the dot, the exponent and its
-    sign are corrected for afterwards.
+    right) so a pass multiplies by one scalar; the positions of the dot, the exponent marker
+    and its sign are recorded and corrected for afterwards. Text without exponents (BVH as
+    written by most tools) takes a lighter walk validated by byte counts.
 
     Parameters
     ----------
@@ -118,25 +117,75 @@ def token_values(b: np.ndarray, starts: np.ndarray, ends: np.ndarray) -> np.ndar
     order = np.argsort(length, kind="stable")[::-1]  # radix sort of small ints: cheap
     # at_least[k]: how many tokens have a k-th byte; they are the first ones in `order`.
     at_least = np.cumsum(np.bincount(length, minlength=longest + 2)[::-1])[::-1]
+    plain = _is_plain(b)
     w = _Walk(starts.size)
     pos = ends[order].astype(np.intp)
     for k in range(1, longest + 1):
         m = int(at_least[k])
         p = pos[:m]
         p -= 1
-        _step(w, b[p], m, int(at_least[k + 1]), k)
+        if plain:
+            _plain_step(w, b[p], m, k)
+        else:
+            _step(w, b[p], m, int(at_least[k + 1]), k)
     first = b[starts[order]]
-    found = _finish(w, length[order], first)
+    if plain:
+        found = _finish_plain(w, length[order], b, first)
+    else:
+        found = _finish(w, length[order], first)
     if found is None:
         return None
-    sorted_values, inexact = found
-    # Well-formed but outside the exact range (huge mantissa or exponent): rare, use float().
-    for i in np.flatnonzero(inexact):
-        t = order[i]
-        sorted_values[i] = float(b[starts[t]:ends[t]].tobytes())
-    values = np.empty_like(sorted_values)
-    values[order] = sorted_values
-    return values
+    return _unsort(found, order, b, starts, ends)
+
+
+def _is_plain(b: np.ndarray) -> bool:
+    """Only whitespace, digits, '.', '+' and '-' (no exponents, no text)."""
+    ok = (b - np.uint8(43)) < 15  # + , - . / and digits
+    ok &= b != 44
+    ok &= b != 47
+    ok |= b <= 32
+    return bool(ok.all())
+
+
+def _plain_step(w: _Walk, c, m: int, k: int) -> None:
+    """Pass k without exponents: digits and dots only (validated by counts afterwards)."""
+    d = c - np.uint8(48)
+    d *= d < 10
+    w.total[:m] += d * _POW10[k - 1]
+    np.copyto(w.dot[:m], k, where=c == 46)
+
+
+def _finish_plain(w: _Walk, length, b, first):
+    """(values, inexact) after a plain walk, or None if a token is malformed."""
+    has_sign = (first == 45) | (first == 43)
+    # Every sign byte must start a token and no token may hold two dots (whole-text counts).
+    if np.count_nonzero(b == 45) + np.count_nonzero(b == 43) != np.count_nonzero(has_sign):
+        return None
+    has_dot = w.dot > 0
+    if np.count_nonzero(b == 46) != np.count_nonzero(has_dot):
+        return None
+    if np.any(length <= has_dot + has_sign.view(np.uint8)):  # no digit at all
+        return None
+    frac = w.dot.astype(np.intp)
+    frac -= has_dot
+    values = _drop_marker(w.total, frac, has_dot)
+    values /= _POW10[frac]
+    values[first == 45] *= -1
+    return values, w.total >= _EXACT
+
+
+def _below(total: np.ndarray, digits: np.ndarray) -> np.ndarray:
+    """``total mod 10**digits`` for exact integers below 2**53 (floor of the quotient is exact
+    there, and is much faster than fmod)."""
+    scale = _POW10[digits]
+    return total - np.floor(total / scale) * scale
+
+
+def _drop_marker(total, right_digits, has_marker):
+    """Remove a zero-weight marker byte sitting left of ``right_digits`` digits: the digits left
+    of it were weighted ten times too much."""
+    right = _below(total, right_digits)
+    return np.where(has_marker, right + (total - right) / 10.0, total)
 
 
 def _step(w: _Walk, c, m: int, inner_end: int, k: int) -> None:
@@ -151,11 +200,9 @@ def _step(w: _Walk, c, m: int, inner_end: int, k: int) -> None:
     d *= isdig
     w.total[:m] += d * _POW10[k - 1]
     if isdot.any():
-        np.copyto(w.at_dot[:m], w.total[:m], where=isdot)
         w.dot[:m][isdot] = k
         w.count[:m] += isdot
     if ise.any():
-        np.copyto(w.at_e[:m], w.total[:m], where=ise)
         w.e[:m][ise] = k
         w.count[:m] += ise
         w.bad[:m] |= ise & (w.dot[:m] > 0)  # a dot in the exponent
@@ -180,14 +227,27 @@ def _finish(w: _Walk, length, first):
     bad |= ~has_e & inner
     if bad.any():
         return None
-    base = _POW10[w.e]  # the mantissa's digits were weighted 10**e too much
-    mant = (w.total - w.at_e) / base
-    right = np.where(has_dot, (w.at_dot - w.at_e) / base, mant)
-    mant = right + (mant - right) / np.where(has_dot, 10.0, 1.0)
+    # What lies right of a marker at byte position p is total mod 10**(p-1): the digits there
+    # weigh less, those left of it are multiples of 10**p and the marker itself counts 0.
+    e_digits = np.maximum(w.e.astype(np.intp) - 1, 0)
+    at_e = np.where(has_e, _below(w.total, e_digits), 0.0)
+    mant = (w.total - at_e) / _POW10[w.e]  # exact: the mantissa digits, re-based
     frac = np.where(has_dot, w.dot.astype(np.intp) - w.e - 1, 0)
-    power = np.where(w.exp_negative, -w.at_e, w.at_e) - frac
+    mant = _drop_marker(mant, frac, has_dot)
+    power = np.where(w.exp_negative, -at_e, at_e) - frac
     inexact = (np.abs(power) > _MAX_POWER) | (w.total >= _EXACT)
     scale = _POW10[np.minimum(np.abs(power), _MAX_POWER).astype(np.intp)]
     values = np.where(power >= 0, mant * scale, mant / scale)
     values[first == 45] *= -1
     return values, inexact
+
+
+def _unsort(found, order, b, starts, ends) -> np.ndarray:
+    sorted_values, inexact = found
+    # Well-formed but outside the exact range (huge mantissa or exponent): rare, use float().
+    for i in np.flatnonzero(inexact):
+        t = order[i]
+        sorted_values[i] = float(b[starts[t]:ends[t]].tobytes())
+    values = np.empty_like(sorted_values)
+    values[order] = sorted_values
+    return values
