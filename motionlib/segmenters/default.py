@@ -204,22 +204,25 @@ class Default(Segmenter):
         novelty = self._novelty(block_mean(x, step), fps / step, p)
         t2 = time.perf_counter()
         peaks, strength = self._peaks(novelty, fps / step, p)
-        cuts = peaks * step + step // 2
-        speed = features.lowpass(features.frame_speed(x, fps=fps), fps=fps, cutoff_hz=1.0)
-        radius = int(round(p["refine_s"] * fps))
-        context = int(round(p["scale_min_s"] * fps))
-        cuts = np.array(
-            [settle_frame(speed, int(c), radius, context) for c in cuts], dtype=np.int64
-        )
+        cuts, speed = self._place(x, peaks * step + step // 2, fps, p)
         t3 = time.perf_counter()
         centres = np.arange(len(novelty)) * step + step / 2
-        curve = np.interp(np.arange(len(x)), centres, novelty) if len(novelty) else np.zeros(len(x))
+        curve = np.interp(np.arange(len(x)), centres, novelty)
         return Segmentation(
             cuts=cuts + first,
             confidence=strength / (strength + p["threshold"] + 1e-12),
             signals={"novelty": full_length(curve, first), "speed": full_length(speed, first)},
             timings={"kinematics": t1 - t0, "novelty": t2 - t1, "cuts": t3 - t2},
         )
+
+    @staticmethod
+    def _place(x: np.ndarray, cuts: np.ndarray, fps: float, p: dict):
+        """Move each cut to a nearby pause (``settle_frame``); also return the speed."""
+        speed = features.lowpass(features.frame_speed(x, fps=fps), fps=fps, cutoff_hz=1.0)
+        radius = int(round(p["refine_s"] * fps))
+        context = int(round(p["scale_min_s"] * fps))
+        placed = [settle_frame(speed, int(c), radius, context) for c in cuts]
+        return np.asarray(placed, dtype=np.int64), speed
 
     @staticmethod
     def _novelty(x: np.ndarray, rate: float, p: dict) -> np.ndarray:
