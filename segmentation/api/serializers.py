@@ -57,7 +57,9 @@ class RunRequestSerializer(serializers.Serializer):
 class CaptureSerializer(serializers.ModelSerializer):
     error = serializers.SerializerMethodField()
     duration = serializers.FloatField(read_only=True)
-    latest_run = serializers.SerializerMethodField()
+    # A nested field, not RunSerializer(run) per row: that rebuilt the run's fields from
+    # the model for every capture and was most of the capture list's time.
+    latest_run = RunSerializer(read_only=True, allow_null=True)
     skeleton = serializers.SerializerMethodField()
 
     class Meta:
@@ -70,10 +72,6 @@ class CaptureSerializer(serializers.ModelSerializer):
 
     def get_error(self, capture) -> str | None:
         return capture.error or None
-
-    def get_latest_run(self, capture) -> dict | None:
-        run = capture.latest_run()
-        return RunSerializer(run).data if run else None
 
     def get_skeleton(self, capture) -> dict | None:
         return capture.skeleton if capture.status == "ready" else None
