@@ -138,8 +138,8 @@ def forward_kinematics(take, channels: np.ndarray | None = None) -> np.ndarray:
             G = np.broadcast_to(np.eye(3)[:, :, None], (3, 3, n)).copy()
         else:
             Gp = glob[p]
-            here = pos[p] + Gp[:, 0] * t[0] + Gp[:, 1] * t[1] + Gp[:, 2] * t[2]
-            G = Gp.copy() if j in last_child else None
+            here = pos[p] + _apply(Gp, t) if t.any() else pos[p]
+            G = Gp if j in last_child else None
         out[:, j] = here.T
         if G is not None:  # leaves need neither a rotation nor a kept position
             glob[j] = _rotate(G, rots, channels, skeleton.axes, j)
@@ -147,6 +147,13 @@ def forward_kinematics(take, channels: np.ndarray | None = None) -> np.ndarray:
         if p >= 0 and last_child[p] == j:
             del glob[p], pos[p]
     return out
+
+
+def _apply(G: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """``G @ t`` for G laid out (3, 3, n) and t (3, 1) or (3, n); result (3, n)."""
+    if t.shape[1] == 1:
+        return np.einsum("ijn,j->in", G, t[:, 0])
+    return np.einsum("ijn,jn->in", G, t)
 
 
 def _turn(G: np.ndarray, axis: int, c: np.ndarray, s: np.ndarray) -> None:
@@ -165,17 +172,20 @@ def _times_constant(G: np.ndarray, C: np.ndarray) -> np.ndarray:
     return np.einsum("ikn,kj->ijn", G, C)
 
 
-def _rotate(G, rots, channels, axes, j):
-    """``G @ C @ R(channels) @ C.T`` with C the ASF axis frame (identity for BVH)."""
-    if axes is not None:
-        G = _times_constant(G, axes[j])
-    if rots:
-        theta = np.deg2rad(np.ascontiguousarray(channels[:, [col for _, col in rots]].T))
-        moving = theta.any(axis=1)  # converters fill unused channels with zeros: skip them
-        cos, sin = np.cos(theta[moving]), np.sin(theta[moving])
-        turns = [axis for (axis, _), m in zip(rots, moving, strict=True) if m]
-        for k, axis in enumerate(turns):
-            _turn(G, axis, cos[k], sin[k])
+def _rotate(Gp, rots, channels, axes, j):
+    """``Gp @ C @ R(channels) @ C.T`` with C the ASF axis frame (identity for BVH).
+
+    Returns ``Gp`` itself (not a copy) when the joint never rotates; never modifies it.
+    """
+    theta = np.deg2rad(np.ascontiguousarray(channels[:, [col for _, col in rots]].T))
+    moving = theta.any(axis=1)  # converters fill unused channels with zeros: skip them
+    if not moving.any():
+        return Gp
+    G = _times_constant(Gp, axes[j]) if axes is not None else Gp.copy()
+    cos, sin = np.cos(theta[moving]), np.sin(theta[moving])
+    turns = [axis for (axis, _), m in zip(rots, moving, strict=True) if m]
+    for k, axis in enumerate(turns):
+        _turn(G, axis, cos[k], sin[k])
     if axes is not None:
         G = _times_constant(G, axes[j].T)
     return G
