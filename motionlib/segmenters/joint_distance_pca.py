@@ -25,7 +25,7 @@ Where the seed text is ambiguous this implementation takes the evident intent:
   ``beta`` means the same for skeletons with different numbers of channels.
 - p1 is the previous cut *after* its own refinement; the take's first and last frames
   are segment ends, not cuts, and are not moved. The window is clipped to the take and
-  to the previous cut.
+  to the neighbouring cuts, so refined cuts stay in order.
 - The PCA input is centred but not scaled (all nine distances share one unit).
 
 Frame parameters are in frames of the take, as in the patent (its figures are for
