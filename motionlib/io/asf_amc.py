@@ -266,6 +266,7 @@ def read_amc(path: str | os.PathLike, asf: str | os.PathLike | Asf) -> Take:
 
 
 AMC_FPS = 120.0
+_FRAMES_PER_BLOCK = 512
 
 
 def _amc_body(data: bytes, path) -> tuple[int, int]:
@@ -327,10 +328,14 @@ def _amc_fast(data: bytes, offset: int, sk: Skeleton) -> np.ndarray | None:
         if not _column_is(b, starts[:, col], ends[:, col], name.encode()):
             return None
     number_cols = np.setdiff1d(np.arange(width), name_cols)
-    values = token_values(b, starts[:, number_cols].ravel(), ends[:, number_cols].ravel())
-    if values is None:
-        return None
-    values = values.reshape(n, number_cols.size)
+    values = np.empty((n, number_cols.size))
+    for lo in range(0, n, _FRAMES_PER_BLOCK):  # blocks keep the parser's temporaries small
+        block = slice(lo, lo + _FRAMES_PER_BLOCK)
+        parsed = token_values(b, starts[block, number_cols].ravel(),
+                              ends[block, number_cols].ravel())
+        if parsed is None:
+            return None
+        values[block] = parsed.reshape(-1, number_cols.size)
     if not np.array_equal(values[:, 0], np.arange(1, n + 1)):
         return None
     channels = np.zeros((n, sk.n_channels))
