@@ -135,12 +135,24 @@ def _read(capture):
         return motionlib.read(path)
 
 
-def _internal_error(what, exc):
-    log.exception("%s failed", what)
-    return (
-        f"{what} failed with an internal error ({type(exc).__name__}: {exc}). "
-        "The original upload is kept; report this to the service's administrators."
-    )
+def _guarded(job, what, work, **fail_fields):
+    """Run ``work()``; any error fails the job with a message a person can act on, so a
+    job never stays "processing" because of its input or a bug.
+
+    A ValueError is the input's fault (motionlib names file, line and value); anything
+    else is ours and is logged with its traceback.
+    """
+    try:
+        work()
+    except ValueError as exc:
+        job.fail(str(exc), **fail_fields)
+    except Exception as exc:
+        log.exception("%s failed", what)
+        job.fail(
+            f"{what} failed with an internal error ({type(exc).__name__}: {exc}). "
+            "The original upload is kept; report this to the service's administrators.",
+            **fail_fields,
+        )
 
 
 def ingest_capture(capture):
@@ -148,20 +160,16 @@ def ingest_capture(capture):
 
     A bad file marks the capture failed with motionlib's message (file, line, value).
     """
-    try:
-        take = _read(capture)
-        positions = np.asarray(motionlib.forward_kinematics(take), dtype="<f4")
-        height = float(motionlib.skeleton_height(take))
-    except ValueError as exc:
-        capture.fail(str(exc))
-        return
-    except Exception as exc:
-        capture.fail(_internal_error("Reading the capture", exc))
-        return
+    _guarded(capture, "Ingest", lambda: _ingest(capture))
+
+
+def _ingest(capture):
+    take = _read(capture)
+    positions = np.asarray(motionlib.forward_kinematics(take), dtype="<f4")
+    height = float(motionlib.skeleton_height(take))
     storage.save_npy(capture.positions, "positions.npy", positions)
     with transaction.atomic():
-        done = capture.finish(**_metadata(take, height), positions=capture.positions.name)
-        if done:
+        if capture.finish(**_metadata(take, height), positions=capture.positions.name):
             _start_default_run(capture)
 
 
@@ -201,16 +209,13 @@ def _start_default_run(capture):
 
 def detect_run(run):
     """Run a claimed detection and store candidates, signals and timings on the row."""
-    try:
-        take = _read(run.capture)
-        segmenter = get_segmenter(run.method)
-        result = segmenter(**segmenter.validate_params(run.params)).fit_predict(take)
-    except ValueError as exc:
-        run.fail(str(exc), finished_at=timezone.now())
-        return
-    except Exception as exc:
-        run.fail(_internal_error("Detection", exc), finished_at=timezone.now())
-        return
+    _guarded(run, "Detection", lambda: _detect(run), finished_at=timezone.now())
+
+
+def _detect(run):
+    take = _read(run.capture)
+    segmenter = get_segmenter(run.method)
+    result = segmenter(**segmenter.validate_params(run.params)).fit_predict(take)
     candidates = [
         {"frame": int(f), "confidence": round(float(c), 4)}
         for f, c in zip(result.cuts, result.confidence, strict=True)

@@ -107,3 +107,13 @@ class IngestTestCase(BaseTestCase):
         run = DetectionRun.objects.get(capture=capture)
         self.assertEqual(run.status, "failed")
         self.assertIn("project default parameters: param", run.error)
+
+    def test_a_storage_failure_fails_the_capture_instead_of_leaving_it_processing(self):
+        capture_id = self.upload(BVH_13_29.read_bytes(), name="13_29.bvh").json()["id"]
+        # A file where the derived-arrays folder should be: saving positions fails.
+        (self.media_root / "derived").write_text("not a folder")
+        with self.assertLogs("segmentation.services.captures", "ERROR"):
+            capture = self.ingest(capture_id)
+        self.assertEqual(capture.status, "failed")
+        self.assertIn("Ingest failed with an internal error", capture.error)
+        self.assertTrue(capture.original.storage.exists(capture.original.name))
