@@ -66,11 +66,12 @@ def _isolated_storage(settings, tmp_path):
     settings.MEDIA_ROOT = tmp_path / "media"
 
 
-@pytest.fixture(autouse=True, scope="session")
+@pytest.fixture(autouse=True)
 def _in_memory_broker():
     """The upload and ingest services queue follow-up jobs on commit; these tests run
     those jobs in-process themselves, so queued messages go to an in-memory broker
-    instead of the embedded spool folder under var/."""
+    instead of the embedded spool folder under var/. Restored after each test, so
+    the integration tests that follow still see their real broker."""
     from cutroom.celery import app
 
     saved = app.conf.broker_url, app.conf.broker_transport_options

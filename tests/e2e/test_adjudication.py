@@ -85,3 +85,40 @@ def test_it_refuses_the_adjudication_view_to_an_annotator(live_server, new_page,
                                 data={"cuts": [], "labels": ["walk"], "version": 0},
                                 headers={"X-CSRFToken": csrf})
     assert response.status == 404, response.text()
+
+
+def test_it_accepts_a_suggested_label_with_one_key(live_server, new_page, ingested_capture, studio):
+    """Once the library has labelled segments of one take, the segments of the next take
+    come with suggested labels; S on the review page accepts the one under the playhead."""
+    from django.core.files.uploadedfile import SimpleUploadedFile
+
+    from segmentation import services, tasks
+    from segmentation.models import Capture, DetectionRun
+    from tests.e2e.conftest import synthetic_bvh
+
+    # Take one (seed 5): punch | arm circles | squat | walk | punch | jumping jack | idle.
+    submit_review(ingested_capture, studio["ann"], [868, 1595, 2101, 2765, 3267, 3770],
+                  ["punch", None, "squat", "walk", "punch", "jumping_jack", None])
+    # Take two (seed 6): squat | punch | squat | jumping jack | squat, cut but not labelled.
+    upload = SimpleUploadedFile("second_session.bvh", synthetic_bvh(seed=6, duration=30.0))
+    capture, _ = services.do_upload_capture(studio["project"], studio["alice"], upload)
+    tasks.ingest(capture.pk)
+    for run in DetectionRun.objects.filter(capture=capture, status="queued"):
+        tasks.detect(run.pk)
+    capture = Capture.objects.get(pk=capture.pk)
+    review = services.get_or_create_review(capture, studio["bob"])
+    for cut in list(review.cuts.all()):
+        review = services.do_change_cut(review, studio["bob"], cut, review.version, fate="deleted")
+    for frame in (645, 1302, 2256, 3040):
+        review = services.do_insert_cut(review, studio["bob"], frame, review.version)
+
+    page = new_page("bob")
+    page.goto(f"{live_server.url}/captures/{capture.pk}/")
+    expect(page.get_by_test_id("suggested-label")).to_have_text("suggested: squat (S accepts)")
+    page.keyboard.press("s")
+    expect(page.get_by_test_id("save-state")).to_have_text("Saved")
+    segments = page.request.get(f"{live_server.url}/api/captures/{capture.pk}/review/").json()["segments"]
+    assert segments[0]["label"] == "squat" and segments[0]["suggested_label"] is None
+    suggested = [s["suggested_label"] for s in segments[1:]]
+    assert suggested == ["punch", "squat", "jumping_jack", "squat"]
+    assert page.errors == []

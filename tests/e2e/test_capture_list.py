@@ -56,6 +56,7 @@ def test_it_uploads_dropped_files_and_shows_their_status_as_it_changes(live_serv
     assert "status=failed" in page.url
     page.get_by_test_id("filter-status").select_option("")
     page.get_by_test_id("filter-search").fill("warmup")
+    page.wait_for_url("**/?search=warmup")
     expect(rows.locator("tr.capture-row")).to_have_count(1)
     expect(rows).to_contain_text("warmup_short.bvh")
 

@@ -110,6 +110,8 @@ export interface Segment {
   start: number;
   stop: number;
   label: string | null;
+  /** Label of the most alike library segments, for an unlabelled segment (server-side). */
+  suggested_label?: string | null;
 }
 
 export interface Review {

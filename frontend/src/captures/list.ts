@@ -37,6 +37,8 @@ export async function renderCaptureList(root: HTMLElement): Promise<() => void> 
   let filters = filtersFrom(location.search);
   let timer = 0;
   let searchDelay = 0;
+  let latest = 0; // only the newest list request may draw (answers can arrive out of order)
+  let mounted = true;
   const rows = h("tbody", { "data-testid": "capture-rows" });
   const pager = h("div", { class: "pager" });
   const uploads = h("div", { class: "uploads", "data-testid": "uploads" });
@@ -130,12 +132,13 @@ export async function renderCaptureList(root: HTMLElement): Promise<() => void> 
 
   async function load(): Promise<void> {
     clearTimeout(timer);
+    const request = ++latest;
     const q = new URLSearchParams(queryOf(filters).slice(1));
     const data = await get<Page<Capture>>(`/api/captures/?${q}`).catch((err: Error) => {
-      clear(rows, h("tr", {}, h("td", { colspan: 9, class: "error-text" }, `Could not load captures: ${err.message}`)));
+      if (request === latest) clear(rows, h("tr", {}, h("td", { colspan: 9, class: "error-text" }, `Could not load captures: ${err.message}`)));
       return null;
     });
-    if (!data) return;
+    if (!data || request !== latest || !mounted) return;
     clear(rows, ...data.results.map((c) => row(c, projectName.get(c.project) ?? String(c.project))));
     if (!data.results.length) rows.append(h("tr", {}, h("td", { colspan: 9, class: "muted empty" }, "No captures match. Drop a file above to add one.")));
     clear(
@@ -148,6 +151,7 @@ export async function renderCaptureList(root: HTMLElement): Promise<() => void> 
   }
 
   function apply(next: Filters): void {
+    if (!mounted) return;
     filters = next;
     history.replaceState(null, "", `/${queryOf(filters)}`);
     void load();
@@ -155,7 +159,9 @@ export async function renderCaptureList(root: HTMLElement): Promise<() => void> 
 
   await load();
   return () => {
+    mounted = false;
     clearTimeout(timer);
+    clearTimeout(searchDelay);
     document.removeEventListener("dragover", onDrag);
     document.removeEventListener("dragleave", onDrag);
     document.removeEventListener("drop", onDrop);

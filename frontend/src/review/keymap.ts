@@ -10,6 +10,7 @@ export type Command =
   | { kind: "insert" }
   | { kind: "label"; hotkey: string }
   | { kind: "clearLabel" }
+  | { kind: "acceptSuggestion" }
   | { kind: "undo" }
   | { kind: "redo" }
   | { kind: "loop" }
@@ -47,6 +48,7 @@ const SIMPLE: Record<string, Command> = {
   d: { kind: "delete" },
   Delete: { kind: "delete" },
   i: { kind: "insert" },
+  s: { kind: "acceptSuggestion" },
   z: { kind: "undo" },
   "shift+z": { kind: "redo" },
   l: { kind: "loop" },
@@ -75,6 +77,7 @@ export const HELP: [string, string][] = [
   ["I", "insert a cut at the playhead"],
   ["1 – 9", "label the segment under the playhead"],
   ["0 or Backspace", "clear that segment's label"],
+  ["S", "accept that segment's suggested label"],
   ["Z or Ctrl+Z", "undo"],
   ["Shift+Z or Ctrl+Shift+Z", "redo"],
   ["L", "loop the segment under the playhead"],

@@ -333,6 +333,7 @@ class ReviewPage {
             h("b", {}, `Segment ${segment.index + 1}`),
             ` · ${segment.start}–${segment.stop} · ${formatDuration((segment.stop - segment.start) / fps)}`,
             h("div", {}, segment.label ? `labelled ${segment.label}` : h("span", { class: "muted" }, "unlabelled")),
+            !segment.label && segment.suggested_label ? h("div", { class: "muted", "data-testid": "suggested-label" }, `suggested: ${segment.suggested_label} (S accepts)`) : null,
           )
         : null,
     );
@@ -559,6 +560,12 @@ class ReviewPage {
       case "clearLabel":
         this.labelCurrent(null);
         break;
+      case "acceptSuggestion": {
+        const suggested = segmentAt(this.review.segments, frame)?.suggested_label;
+        if (suggested) this.labelCurrent(suggested);
+        else toast("No suggested label for the segment under the playhead.");
+        break;
+      }
       case "undo":
         if (!this.locked()) this.replay(undo(this.history, this.review, this.saver.resolve), "undo");
         break;
