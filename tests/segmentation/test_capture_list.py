@@ -44,3 +44,17 @@ class CaptureListTestCase(BaseTestCase):
         r = self.client.get("/api/captures/", {"project": "abc"})
         self.assertEqual(r.status_code, 400)
         self.assertIn("project", r.json()["detail"])
+
+    def test_the_list_costs_the_same_queries_for_more_captures(self):
+        def queries():
+            from django.db import connection
+            from django.test.utils import CaptureQueriesContext
+
+            with CaptureQueriesContext(connection) as ctx:
+                self.assertEqual(self.client.get("/api/captures/").status_code, 200)
+            return len(ctx.captured_queries)
+
+        before = queries()
+        for i in range(4):
+            self.ready_capture(name=f"more{i}.bvh")
+        self.assertEqual(queries(), before)

@@ -118,3 +118,9 @@ class ReviewTestCase(BaseTestCase):
         r = self.client.get(self.url)
         self.assertEqual(r.status_code, 400)
         self.assertIn("processing", r.json()["detail"])
+
+    def test_without_a_finished_run_it_starts_empty_for_manual_cutting(self):
+        self.capture.runs.update(status="failed", error="boom")
+        review = self.start()
+        self.assertEqual((review["run"], review["cuts"]), (None, []))
+        self.assertEqual([(s["start"], s["stop"]) for s in review["segments"]], [(0, 400)])
