@@ -284,8 +284,9 @@ def similar(segment, visible, k=10):
 def suggest_labels(review, segments):
     """A suggested label for each unlabelled segment of a review (None where there is none).
 
-    The label most common among the nearest ``SUGGEST_NEIGHBOURS`` labelled segments of
-    the project's library (gold preferred, profile distance). Cached per span and
+    The label with the most votes among the nearest ``SUGGEST_NEIGHBOURS`` labelled
+    segments of the project's other captures, each vote weighted by 1 / distance^2 (gold
+    preferred when the pool is capped). Cached per span and
     library state, so editing one segment does not recompute the others.
     """
     capture = review.capture
@@ -323,10 +324,12 @@ def _suggest(capture, spans):
     out = []
     for blob, shape in queries:
         query = np.frombuffer(blob, dtype="<f4").reshape(shape)
-        order, _ = similarity.rank_similar(query, library, k=min(SUGGEST_NEIGHBOURS, len(names)),
-                                           shortlist=SUGGEST_NEIGHBOURS)
-        votes = Counter(names[i] for i in order)
-        # Ties go to the nearest neighbour's label.
-        best = max(votes.values())
-        out.append(next(names[i] for i in order if votes[names[i]] == best))
+        order, distances = similarity.rank_similar(
+            query, library, k=min(SUGGEST_NEIGHBOURS, len(names)), shortlist=SUGGEST_NEIGHBOURS)
+        # Votes weigh 1 / distance^2: with a small library a plain majority would name
+        # whichever label is most common rather than the one that moves alike.
+        votes = Counter()
+        for i, d in zip(order, distances, strict=True):
+            votes[names[i]] += 1.0 / (d * d + 1e-9)
+        out.append(votes.most_common(1)[0][0])
     return out

@@ -59,3 +59,13 @@ describe("library filters", () => {
     expect(previewStep(4500)).toBe(3);
   });
 });
+
+describe("suggested labels on the review page", () => {
+  it("accepts the suggestion with S", async () => {
+    const { commandFor, HELP } = await import("../src/review/keymap");
+    const key = { shiftKey: false, ctrlKey: false, metaKey: false, altKey: false };
+    expect(commandFor({ ...key, key: "s" })).toEqual({ kind: "acceptSuggestion" });
+    expect(commandFor({ ...key, key: "S", shiftKey: true })).toEqual({ kind: "acceptSuggestion" });
+    expect(HELP.some(([k]) => k === "S")).toBe(true);
+  });
+});
