@@ -68,8 +68,9 @@ class Skeleton:
                 == len(self.rotation_orders) == n):
             raise ValueError("names, parents, offsets, channels and rotation_orders "
                              f"must all have one entry per joint ({n})")
-        if n and (self.parents[0] != -1 or np.any(self.parents[1:] >= np.arange(1, n))):
-            raise ValueError("joints must be depth-first: root first, parents before children")
+        if n and not _is_preorder(self.parents):
+            raise ValueError("joints must be in depth-first order (as BVH nests them): root "
+                             "first, each joint right after its parent or a sibling's subtree")
 
     @property
     def n_joints(self) -> int:
@@ -94,6 +95,20 @@ class Skeleton:
 
     def children(self, j: int) -> list[int]:
         return [int(c) for c in np.flatnonzero(self.parents == j)]
+
+
+def _is_preorder(parents: np.ndarray) -> bool:
+    """True if joint j's parent is joint j-1 or one of its ancestors, for every j > 0."""
+    if parents[0] != -1:
+        return False
+    chain = [0]  # ancestors of the previous joint, itself last
+    for j in range(1, len(parents)):
+        while chain and chain[-1] != parents[j]:
+            chain.pop()
+        if not chain:
+            return False
+        chain.append(j)
+    return True
 
 
 # Candidate joint names per canonical part, per naming convention; compared after lower-casing

@@ -156,3 +156,20 @@ def test_it_slices_a_take_keeping_the_rest_pose_only_when_inside(bvh_13_29):
     part = take.slice(1, 11)
     assert part.rest_pose_frame is None and part.n_frames == 10
     assert_array_equal(part.channels, take.channels[1:11])
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_it_round_trips_random_skeletons_and_channel_orders(tmp_path, seed):
+    from .test_kinematics import random_take
+
+    take = random_take(np.random.default_rng(seed), n_frames=12, n_joints=8)
+    take.skeleton.end_sites[take.skeleton.n_joints - 1] = np.array([0.5, -1.25, 2.0])
+    path = tmp_path / "random.bvh"
+    motionlib.write_bvh(take, path)
+    again = motionlib.read(path)
+    assert again.skeleton.channels == take.skeleton.channels
+    assert list(again.skeleton.parents) == list(take.skeleton.parents)
+    assert_allclose(again.skeleton.offsets, take.skeleton.offsets, atol=5e-7)
+    assert_allclose(again.channels, take.channels, atol=5e-7)
+    assert_allclose(motionlib.forward_kinematics(again), motionlib.forward_kinematics(take),
+                    atol=1e-4)

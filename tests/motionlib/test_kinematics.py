@@ -47,7 +47,11 @@ def oracle(take: Take) -> np.ndarray:
 
 
 def random_take(rng, n_frames=7, n_joints=9, with_axes=False) -> Take:
-    parents = [-1] + [int(rng.integers(0, j)) for j in range(1, n_joints)]
+    parents, chain = [-1], [0]  # depth-first: attach to the previous joint or an ancestor
+    for j in range(1, n_joints):
+        del chain[int(rng.integers(1, len(chain) + 1)):]
+        parents.append(chain[-1])
+        chain.append(j)
     channels, orders = [], []
     for j in range(n_joints):
         rots = [f"{a}rotation" for a in rng.permutation(list("XYZ"))[:rng.integers(1, 4)]]

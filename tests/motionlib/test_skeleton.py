@@ -66,10 +66,12 @@ def test_it_refuses_a_skeleton_it_cannot_map_naming_the_missing_parts():
         motionlib.canonical_indices(take_with(["pelvis", "thigh_l", "calf_l"]))
 
 
-def test_it_refuses_joints_out_of_depth_first_order():
+@pytest.mark.parametrize("parents", [[1, -1], [-1, 0, 0, 1]])
+def test_it_refuses_joints_out_of_depth_first_order(parents):
+    n = len(parents)
     with pytest.raises(ValueError, match="depth-first"):
-        Skeleton(names=["a", "b"], parents=[1, -1], offsets=np.zeros((2, 3)),
-                 channels=[(), ()], rotation_orders=["", ""])
+        Skeleton(names=[f"j{i}" for i in range(n)], parents=parents, offsets=np.zeros((n, 3)),
+                 channels=[()] * n, rotation_orders=[""] * n)
 
 
 def test_it_finds_joints_by_name_and_lists_children(bvh_13_29):
