@@ -298,7 +298,8 @@ class Review(models.Model):
         first segment), so labels follow their cut when it is moved.
         """
         kept = sorted(self.kept_cuts(), key=lambda c: c.frame)
-        labels = {s.cut_id: s.label.name for s in self.segment_labels.all() if s.label_id}
+        rows = self.segment_labels.select_related("label")
+        labels = {s.cut_id: s.label.name for s in rows if s.label_id}
         starts = [(None, 0)] + [(c.id, c.frame) for c in kept]
         stops = [c.frame for c in kept] + [self.capture.n_frames or 0]
         return [
