@@ -53,6 +53,10 @@ pytest: install
 bench: install
 	$(PY) -m motionlib.bench io
 	$(PY) -m motionlib bench
+	$(PY) benchmarks/upload_to_candidates.py
+	@command -v wrk >/dev/null || { apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq wrk; } \
+		|| echo "wrk not installed: the capture list benchmark uses its Python client"
+	$(PY) benchmarks/capture_list_load.py
 
 clean:
 	rm -rf .venv frontend/node_modules frontend/dist var
