@@ -1,0 +1,31 @@
+# Cutroom image: the built front end plus the Python package. One image runs every
+# role of docker-compose.yml (migrate, web, worker, beat); the command picks the role.
+
+# --- front end: TypeScript -> frontend/dist ---
+FROM node:20-bookworm-slim AS frontend
+WORKDIR /app/frontend
+COPY frontend/package.json frontend/package-lock.json ./
+RUN npm ci --no-audit --no-fund
+COPY frontend/ ./
+RUN npm run build
+
+# --- service ---
+FROM python:3.11-slim-bookworm
+ENV PYTHONDONTWRITEBYTECODE=1 \
+    PYTHONUNBUFFERED=1 \
+    PIP_NO_CACHE_DIR=1 \
+    PIP_DISABLE_PIP_VERSION_CHECK=1 \
+    CUTROOM_VAR_DIR=/data/var \
+    CUTROOM_MEDIA_ROOT=/data/media
+RUN useradd --create-home --uid 1000 cutroom \
+    && mkdir -p /data/var /data/media && chown -R cutroom:cutroom /data
+WORKDIR /app
+COPY --chown=cutroom:cutroom . .
+# Editable, so the code, its templates and migrations stay where settings expect them.
+RUN pip install -e . && rm -rf frontend/node_modules
+COPY --from=frontend --chown=cutroom:cutroom /app/frontend/dist frontend/dist
+USER cutroom
+EXPOSE 8000
+# gunicorn reads WEB_CONCURRENCY for its number of worker processes.
+CMD ["gunicorn", "cutroom.wsgi:application", "--bind", "0.0.0.0:8000", \
+     "--access-logfile", "-", "--error-logfile", "-", "--timeout", "120"]

@@ -1,0 +1,93 @@
+"""docker-compose.yml and the Dockerfile, checked without a Docker engine: the compose file
+parses, its services wait for healthy dependencies, workers can be scaled, and every
+variable it passes to the app is one that the settings actually read."""
+
+import re
+from pathlib import Path
+
+import yaml
+
+REPO = Path(__file__).resolve().parents[2]
+APP_SERVICES = ("migrate", "web", "worker", "beat")
+
+
+def compose():
+    return yaml.safe_load((REPO / "docker-compose.yml").read_text())
+
+
+def settings_variables():
+    """Names the settings module reads from the environment."""
+    text = (REPO / "cutroom" / "settings.py").read_text()
+    return set(re.findall(r'(?:environ\.get|env\w+)\(\s*"([A-Z][A-Z0-9_]+)"', text))
+
+
+def test_it_parses_and_has_the_production_services():
+    services = compose()["services"]
+    assert set(services) == {"postgres", "redis", *APP_SERVICES}
+
+
+def test_it_runs_the_app_on_postgresql_and_redis():
+    for name in APP_SERVICES:
+        env = compose()["services"][name]["environment"]
+        assert env["DATABASE_URL"].startswith("postgres://"), name
+        assert env["CELERY_BROKER_URL"].startswith("redis://redis:"), name
+
+
+def test_every_variable_given_to_the_app_is_read_by_the_settings():
+    known = settings_variables() | {"WEB_CONCURRENCY"}  # WEB_CONCURRENCY is gunicorn's
+    assert {"DATABASE_URL", "SECRET_KEY", "CELERY_BROKER_URL"} <= known
+    for name in APP_SERVICES:
+        unknown = set(compose()["services"][name]["environment"]) - known
+        assert not unknown, f"{name} sets variables nothing reads: {sorted(unknown)}"
+
+
+def test_every_variable_given_to_the_app_is_documented_in_env_example():
+    documented = set(re.findall(r"^([A-Z][A-Z0-9_]+)=", (REPO / ".env.example").read_text(), re.M))
+    for name in APP_SERVICES:
+        missing = set(compose()["services"][name]["environment"]) - documented
+        assert not missing - {"WEB_CONCURRENCY"}, f"{name}: {sorted(missing)}"
+
+
+def test_the_secret_key_must_be_set_rather_than_defaulted():
+    env = compose()["services"]["web"]["environment"]
+    assert env["SECRET_KEY"].startswith("${SECRET_KEY:?")
+
+
+def test_web_and_workers_start_after_healthy_services_and_migrations():
+    services = compose()["services"]
+    for name in ("web", "worker", "beat"):
+        depends = services[name]["depends_on"]
+        assert depends["postgres"]["condition"] == "service_healthy", name
+        assert depends["redis"]["condition"] == "service_healthy", name
+        assert depends["migrate"]["condition"] == "service_completed_successfully", name
+    assert "migrate" not in services["migrate"]["depends_on"]
+
+
+def test_every_long_running_service_has_a_health_check():
+    services = compose()["services"]
+    for name in ("postgres", "redis", "web", "worker"):
+        assert services[name]["healthcheck"]["test"], name
+
+
+def test_the_worker_can_be_scaled():
+    # A fixed container name or a published port would stop `--scale worker=3`.
+    worker = compose()["services"]["worker"]
+    assert "container_name" not in worker and "ports" not in worker
+    assert worker["command"][:4] == ["celery", "-A", "cutroom", "worker"]
+
+
+def test_web_and_workers_share_the_originals_and_the_database_persists():
+    data = compose()
+    for name in ("web", "worker"):
+        assert "media:/data/media" in data["services"][name]["volumes"], name
+    assert "pgdata:/var/lib/postgresql/data" in data["services"]["postgres"]["volumes"]
+    assert {"pgdata", "media"} <= set(data["volumes"])
+
+
+def test_the_image_builds_the_front_end_and_installs_the_package():
+    dockerfile = (REPO / "Dockerfile").read_text()
+    assert "npm ci" in dockerfile and "npm run build" in dockerfile
+    assert "COPY --from=frontend" in dockerfile and "frontend/dist" in dockerfile
+    assert re.search(r"^RUN pip install -e \.", dockerfile, re.M)
+    ignored = (REPO / ".dockerignore").read_text().split()
+    assert {".venv", "frontend/node_modules", "var", ".env"} <= set(ignored)
