@@ -1,9 +1,14 @@
 """The capture list: drop files to upload them, watch their status change as the worker
 gets to them, filter by status, project and name, and open one."""
 
+from pathlib import Path
+
+import pytest
 from playwright.sync_api import expect
 
 from tests.e2e.conftest import synthetic_bvh
+
+SHARED_DATA = Path(__file__).resolve().parents[2] / ".." / "shared" / "data"
 
 DROP = """([name, text]) => {
     const data = new DataTransfer();
@@ -12,6 +17,14 @@ DROP = """([name, text]) => {
     for (const type of ["dragover", "drop"]) {
         zone.dispatchEvent(new DragEvent(type, { dataTransfer: data, bubbles: true, cancelable: true }));
     }
+}"""
+
+
+DROP_MANY = """(files) => {
+    const data = new DataTransfer();
+    for (const [name, text] of files) data.items.add(new File([text], name));
+    const zone = document.querySelector("[data-testid=dropzone]");
+    zone.dispatchEvent(new DragEvent("drop", { dataTransfer: data, bubbles: true, cancelable: true }));
 }"""
 
 
@@ -83,3 +96,26 @@ def test_it_lists_only_captures_of_projects_the_user_belongs_to(live_server, new
     expect(rows.locator("tr.capture-row")).to_have_count(1)
     expect(rows).to_contain_text("shared.bvh")
     expect(page.get_by_test_id("filter-project").locator("option")).to_have_text(["All projects", "Studio A"])
+
+
+def test_it_pairs_a_dropped_cmu_amc_with_its_asf_and_plays_the_real_take(live_server, new_page, studio):
+    cmu = SHARED_DATA / "cmu"
+    if not (cmu / "amc" / "13_29.amc").is_file():
+        pytest.skip(f"real CMU captures not found under {cmu} (the shared/ folder beside the repository)")
+    page = new_page("ann")
+    page.evaluate(DROP_MANY, [
+        ["13_29.amc", (cmu / "amc" / "13_29.amc").read_text()],
+        ["13.asf", (cmu / "asf" / "13.asf").read_text()],
+    ])
+    row = page.get_by_test_id("capture-rows").locator("tr", has_text="13_29.amc")
+    expect(row).to_contain_text("queued", timeout=15_000)
+    run_worker_jobs()
+    expect(row).to_contain_text("ready", timeout=10_000)
+    expect(row).to_contain_text("4,592")
+    row.click()
+    expect(page.get_by_test_id("capture-name")).to_have_text("13_29.amc")
+    page.wait_for_selector("[data-testid=frames-loading][data-done]", state="attached")
+    page.keyboard.press("End")
+    expect(page.get_by_test_id("hud-frame")).to_have_text("Frame 4591 / 4591")
+    expect(page.get_by_test_id("hud-time")).to_contain_text("0:38.26 / 0:38.26 · 120 fps")
+    assert page.errors == []

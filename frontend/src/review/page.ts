@@ -130,6 +130,7 @@ class ReviewPage {
     this.el.viewport = h("div", { class: "viewport", "data-testid": "viewport" });
     this.el.hudFrame = h("div", { class: "hud-frame", "data-testid": "hud-frame" });
     this.el.hudTime = h("div", { class: "hud-time", "data-testid": "hud-time" });
+    this.el.hudState = h("div", { class: "hud-state", "data-testid": "hud-state" });
     this.el.loading = h("div", { class: "hud-loading", "data-testid": "frames-loading" });
     this.el.loadingBar = h("div", { class: "hud-loading-bar" });
     this.el.loading.append(this.el.loadingBar);
@@ -143,7 +144,11 @@ class ReviewPage {
     this.el.events = h("ol", { class: "events", "data-testid": "events" });
     this.el.speed = h(
       "select",
-      { class: "select", title: "Playback speed ([ and ])", "data-testid": "speed", onchange: (e: Event) => this.setSpeed(Number((e.target as HTMLSelectElement).value)) },
+      { class: "select", title: "Playback speed ([ and ])", "data-testid": "speed", onchange: (e: Event) => {
+        const select = e.target as HTMLSelectElement;
+        select.blur();
+        this.setSpeed(Number(select.value));
+      } },
       ...SPEEDS.map((s) => h("option", { value: s, selected: s === 1 }, `${s}×`)),
     );
     return h(
@@ -166,14 +171,14 @@ class ReviewPage {
       h(
         "div",
         { class: "workspace" },
-        h("div", { class: "stage" }, this.el.viewport, h("div", { class: "hud" }, this.el.hudFrame, this.el.hudTime), this.el.loading),
+        h("div", { class: "stage" }, this.el.viewport, h("div", { class: "hud" }, this.el.hudFrame, this.el.hudTime, this.el.hudState), this.el.loading),
         h(
           "aside",
           { class: "side" },
           h("section", {}, h("h3", {}, "Labels"), this.el.labels),
           h("section", {}, h("h3", {}, "Selection"), this.el.selection),
           h("section", {}, h("h3", {}, "Review"), this.el.stats),
-          h("section", { class: "grow" }, h("h3", {}, "Activity"), this.el.events),
+          h("section", { class: "grow" }, (this.el.eventsTitle = h("h3", {}, "Activity")), this.el.events),
         ),
       ),
       h(
@@ -244,6 +249,12 @@ class ReviewPage {
     this.showFrame(frame);
     this.renderSide();
     this.el.play.replaceChildren(icon(this.playback.playing ? "pause" : "play"));
+    const loop = this.playback.loop;
+    this.el.hudState.textContent = [
+      this.playback.playing ? "playing" : "paused",
+      `${this.playback.speed}×`,
+      loop ? `loop ${loop.start}–${loop.stop - 1}` : null,
+    ].filter(Boolean).join(" · ");
     this.el.loop.classList.toggle("active", this.playback.loop !== null);
     const locked = this.locked() !== null;
     this.el.undo.toggleAttribute("disabled", locked || this.history.past.length === 0);
@@ -544,6 +555,8 @@ class ReviewPage {
       case "delete": {
         const cut = this.selectedCut();
         if (!cut) toast("Select a cut first: click it, or jump to it with Shift+←/→.");
+        // Accepting a kept cut would only rewrite its fate (and lose "moved"): say so instead.
+        else if (c.kind === "accept" && cut.fate !== "pending") toast(`The cut at ${cut.frame} is already kept (${cut.origin === "inserted" ? "inserted" : cut.fate}).`);
         else this.perform({ kind: "fate", cutId: cut.id, fate: c.kind === "accept" ? "accepted" : "deleted" });
         if (cut && c.kind === "delete") this.selectedCutId = null;
         break;
@@ -658,6 +671,8 @@ class ReviewPage {
       ...others.map((r) => h("option", { value: String(r.id) }, `${r.annotator.username} (read-only)`)),
     );
     select.addEventListener("change", () => {
+      select.blur();
+      this.el.eventsTitle.textContent = select.value ? "Activity (of your own review)" : "Activity";
       const other = others.find((r) => String(r.id) === select.value);
       this.readOnly = other !== undefined;
       this.review = other ?? this.saver.server ?? this.own;

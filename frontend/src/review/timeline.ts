@@ -209,8 +209,13 @@ export class Timeline {
     ctx.lineWidth = 1.25;
     ctx.stroke();
     ctx.lineWidth = 1;
-    ctx.fillStyle = "#5c6778";
-    ctx.fillText(signal.name, 8, lane.top + 10);
+    // The lane's name on a backing plate, so the curve never runs through it.
+    ctx.font = "11px system-ui, sans-serif";
+    const w = ctx.measureText(signal.name).width;
+    ctx.fillStyle = "rgba(22, 27, 34, 0.85)";
+    ctx.fillRect(4, lane.top + 3, w + 8, 15);
+    ctx.fillStyle = "#8792a3";
+    ctx.fillText(signal.name, 8, lane.top + 11);
   }
 
   private drawSegments(ctx: CanvasRenderingContext2D, m: TimelineModel, top: number): void {
@@ -248,6 +253,7 @@ export class Timeline {
       const x = Math.round(this.x(frame)) + 0.5;
       if (x < -4 || x > this.width + 4) continue;
       const selected = cut.id === m.selectedCutId;
+      if (cut.fate === "moved" && cut.candidate_frame !== null) this.drawGhost(ctx, cut.candidate_frame, x, top);
       const pending = cut.fate === "pending";
       const confidence = cut.confidence ?? 0.6;
       ctx.setLineDash(pending ? [5, 4] : []);
@@ -275,6 +281,23 @@ export class Timeline {
       ctx.font = "600 11px ui-monospace, monospace";
       ctx.fillText(`→ ${drag.frame}`, this.x(drag.frame) + 6, top + 12);
     }
+  }
+
+  /** Where a moved cut was proposed: a hollow marker in the ruler joined to the cut. */
+  private drawGhost(ctx: CanvasRenderingContext2D, frame: number, cutX: number, top: number): void {
+    const x = Math.round(this.x(frame)) + 0.5;
+    ctx.setLineDash([2, 3]);
+    ctx.strokeStyle = "#7f8a9b";
+    ctx.lineWidth = 1;
+    ctx.beginPath();
+    ctx.moveTo(x - 4, top - 8);
+    ctx.lineTo(x + 4, top - 8);
+    ctx.lineTo(x, top - 1);
+    ctx.closePath();
+    ctx.moveTo(x, top - 4);
+    ctx.lineTo(cutX, top - 4);
+    ctx.stroke();
+    ctx.setLineDash([]);
   }
 
   private drawPlayhead(ctx: CanvasRenderingContext2D, m: TimelineModel, bottom: number): void {
