@@ -25,6 +25,7 @@ import psycopg
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
+N_DESCRIBED = 20000
 LABELS = ["walk", "run", "jump", "punch", "kick", "squat", "wave", "turn", "sit", "idle"]
 
 
@@ -70,14 +71,21 @@ def populate(n_segments, seed=6):
         for i in range(400)
     )
     gold_captures = {c.pk for c in captures[::10]}
-    rows = []
+    rows, described = [], 0
     for k in range(n_segments):
         capture = captures[int(rng.integers(len(captures)))]
         is_gold = capture.pk in gold_captures and rng.random() < 0.25
         label = labels[capture.project_id][int(rng.integers(len(LABELS)))]
         start = int(rng.integers(0, 19000))
         length = int(rng.integers(30, 1000))
+        # Project 0's first segments carry motion descriptors for the similar-clip search.
+        with_descriptor = capture.project_id == projects[0].pk and described < N_DESCRIBED
+        described += with_descriptor
+        descriptor = rng.normal(size=(35, 35)).astype("<f4") if with_descriptor else None
         rows.append(LibrarySegment(
+            descriptor=descriptor.tobytes() if with_descriptor else None,
+            descriptor_shape=[35, 35] if with_descriptor else None,
+            profile=descriptor[:3].tobytes() if with_descriptor else None,
             project_id=capture.project_id, capture=capture,
             annotator=None if is_gold else annotators[int(rng.integers(20))], is_gold=is_gold,
             superseded=not is_gold and capture.pk in gold_captures, label=label,
@@ -148,6 +156,28 @@ def run_query(user, query, repeat):
     return response.data["count"], times, len(captured), plan_of(captured[-1]["sql"])
 
 
+def similar_table(ctx, repeat):
+    """``GET /api/segments/{id}/similar/?k=10`` over the described segments of project 0."""
+    from rest_framework.test import APIRequestFactory, force_authenticate
+
+    from segmentation.api.library import SimilarView
+    from segmentation.models_library import LibrarySegment
+
+    query = LibrarySegment.objects.filter(descriptor__isnull=False).order_by("id").first()
+    view, factory, times = SimilarView.as_view(), APIRequestFactory(), []
+    for i in range(min(repeat, 5) + 1):
+        request = factory.get(f"/api/segments/{query.pk}/similar/?k=10")
+        force_authenticate(request, user=ctx["reviewer"])
+        started = time.perf_counter()
+        response = view(request, pk=query.pk)
+        response.render()
+        if i:
+            times.append((time.perf_counter() - started) * 1000)
+    assert response.status_code == 200, response.content[:200]
+    print(f"similar clips: pool of {N_DESCRIBED:,} described segments (35 x 35 float32), k=10: "
+          f"median {statistics.median(times):.0f} ms over {len(times)} runs")
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--segments", type=int, default=100_000)
@@ -173,6 +203,8 @@ def main():
             p90 = statistics.quantiles(times, n=10)[-1]
             print(f"{who:<10} {title:<32} {count:>8,} {statistics.median(times):>10.1f} "
                   f"{p90:>8.1f} {n_sql:>4}  {plan}")
+        print()
+        similar_table(ctx, args.repeat)
     finally:
         from django.db import connections
 

@@ -158,6 +158,19 @@ def descriptor_distance(a: np.ndarray, b: np.ndarray) -> float:
     return profile + DTW_WEIGHT * dtw_distance(a[PROFILE_ROWS:], b[PROFILE_ROWS:])
 
 
+def shortlist_by_profile(query: np.ndarray, profiles: np.ndarray, n: int) -> np.ndarray:
+    """Indices of the ``n`` profiles nearest to ``query``'s, nearest first.
+
+    Parameters
+    ----------
+    query : (PROFILE_ROWS or more, n_features) descriptor or profile.
+    profiles : (n_items, PROFILE_ROWS, n_features) profiles (or whole descriptors).
+    """
+    profiles = np.asarray(profiles, dtype=float)[:, :PROFILE_ROWS]
+    diff = (profiles - np.asarray(query, dtype=float)[None, :PROFILE_ROWS]).reshape(len(profiles), -1)
+    return np.argsort(np.einsum("ij,ij->i", diff, diff), kind="stable")[:n]
+
+
 def rank_similar(query: np.ndarray, library: np.ndarray, *, k: int = 10,
                  shortlist: int = 50) -> tuple[np.ndarray, np.ndarray]:
     """The ``k`` library descriptors that move most like ``query``.
@@ -181,9 +194,7 @@ def rank_similar(query: np.ndarray, library: np.ndarray, *, k: int = 10,
                          f"descriptors, got shape {library.shape}")
     if k < 1:
         raise ValueError(f"k: must be at least 1, got {k}")
-    diff = (library[:, :PROFILE_ROWS] - query[None, :PROFILE_ROWS]).reshape(len(library), -1)
-    coarse = np.einsum("ij,ij->i", diff, diff)
-    keep = np.argsort(coarse, kind="stable")[: max(shortlist, k)]
+    keep = shortlist_by_profile(query, library, max(shortlist, k))
     fine = np.array([descriptor_distance(query, library[i]) for i in keep])
     order = np.argsort(fine, kind="stable")[:k]
     return keep[order], fine[order]

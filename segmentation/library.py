@@ -27,9 +27,11 @@ from motionlib import similarity
 from segmentation import agreement, storage
 from segmentation.models_library import Adjudication, LibrarySegment
 
-# Similar-clip search ranks at most this many of a project's most recent segments.
-SIMILAR_POOL = 5000
+# Similar clips and suggestions search at most this many of a project's recent segments.
+SIMILAR_POOL = 20000
 SUGGEST_NEIGHBOURS = 5
+# Profile-nearest segments whose full descriptors are compared (DTW) in both searches.
+SHORTLIST = 20
 MAX_EXPORT_SEGMENTS = 5000
 
 
@@ -62,17 +64,45 @@ def capture_joints(capture):
 
 
 def descriptors(capture, spans):
-    """``(bytes or None, shape or None)`` per ``(start, stop)`` span of a capture."""
+    """The float32 descriptor of each ``(start, stop)`` span of a capture, or Nones when
+    its skeleton cannot be mapped to body parts."""
     joints = capture_joints(capture) if capture.positions else None
     if joints is None:
-        return [(None, None)] * len(spans)
+        return [None] * len(spans)
     positions = np.asarray(storage.load_npy(capture.positions), dtype=float)
     scale = similarity.body_scale(positions, joints)
-    out = []
-    for start, stop in spans:
-        d = similarity.segment_descriptor(positions, joints, start, stop, fps=capture.fps, scale=scale)
-        out.append((d.astype("<f4").tobytes(), list(d.shape)))
-    return out
+    return [
+        similarity.segment_descriptor(positions, joints, start, stop, fps=capture.fps, scale=scale)
+        for start, stop in spans
+    ]
+
+
+def store_descriptor(segment, descriptor):
+    if descriptor is not None:
+        segment.descriptor = descriptor.astype("<f4").tobytes()
+        segment.descriptor_shape = list(descriptor.shape)
+        segment.profile = descriptor[: similarity.PROFILE_ROWS].astype("<f4").tobytes()
+
+
+def load_descriptors(ids):
+    """(len(ids), rows, cols) full descriptors of the given segments, in order (one query)."""
+    found = {pk: (blob, shape) for pk, blob, shape in LibrarySegment.objects.filter(pk__in=ids)
+             .values_list("id", "descriptor", "descriptor_shape")}
+    return np.stack([np.frombuffer(bytes(found[pk][0]), dtype="<f4").reshape(found[pk][1])
+                     for pk in ids])
+
+
+def profile_pool(segments, n_features):
+    """(ids, (n, PROFILE_ROWS, n_features) profiles) of ``segments`` (a values_list of
+    id, profile)."""
+    ids, profiles = [], []
+    for pk, blob in segments:
+        ids.append(pk)
+        profiles.append(np.frombuffer(bytes(blob), dtype="<f4").reshape(similarity.PROFILE_ROWS, -1))
+    if profiles and profiles[0].shape[1] != n_features:
+        raise ValueError(f"library descriptors have {profiles[0].shape[1]} features, the query "
+                         f"{n_features}; rebuild the library")
+    return ids, np.stack(profiles) if profiles else np.zeros((0, similarity.PROFILE_ROWS, n_features))
 
 
 def refresh_capture_library(capture):
@@ -104,9 +134,9 @@ def refresh_capture_library(capture):
                 superseded=bool(gold) and review is not None, label=labels.get(name),
                 label_name=name, start=start, stop=stop, duration=(stop - start) / capture.fps,
                 agreement=agreement.finite(support)))
-    for segment, (blob, shape) in zip(rows, descriptors(capture, [(r.start, r.stop) for r in rows]),
-                                      strict=True):
-        segment.descriptor, segment.descriptor_shape = blob, shape
+    for segment, descriptor in zip(rows, descriptors(capture, [(r.start, r.stop) for r in rows]),
+                                   strict=True):
+        store_descriptor(segment, descriptor)
     with transaction.atomic():
         LibrarySegment.objects.filter(capture=capture).delete()
         LibrarySegment.objects.bulk_create(rows, batch_size=500)
@@ -256,29 +286,32 @@ def similar(segment, visible, k=10):
     """The ``k`` visible segments of the same project that move most like ``segment``.
 
     Segments overlapping it in the same capture are left out (other annotators' versions
-    of the same motion), and so are duplicates of one span. Returns ``[(segment, distance)]``.
+    of the same motion), and so are duplicates of one span. Two stages: profiles of up to
+    ``SIMILAR_POOL`` recent segments pick a shortlist, whose full descriptors are ranked.
+    Returns ``[(segment, distance)]``, most similar first.
     """
     query = segment.descriptor_array()
     if query is None:
         raise ValueError(f"segment {segment.pk}: its skeleton could not be mapped to body "
                          "parts, so it has no motion descriptor")
     pool = (
-        visible.filter(project_id=segment.project_id, descriptor__isnull=False)
+        visible.filter(project_id=segment.project_id, profile__isnull=False)
         .exclude(capture_id=segment.capture_id, start__lt=segment.stop, stop__gt=segment.start)
-        .order_by("-id").values_list("id", "capture_id", "start", "stop", "descriptor")
+        .order_by("-id").values_list("id", "capture_id", "start", "stop", "profile")
     )[:SIMILAR_POOL]
-    ids, library, seen = [], [], set()
+    seen, unique = set(), []
     for pk, capture_id, start, stop, blob in pool:
-        if (capture_id, start, stop) in seen:
-            continue
-        seen.add((capture_id, start, stop))
-        ids.append(pk)
-        library.append(np.frombuffer(bytes(blob), dtype="<f4").reshape(query.shape))
+        if (capture_id, start, stop) not in seen:
+            seen.add((capture_id, start, stop))
+            unique.append((pk, blob))
+    ids, profiles = profile_pool(unique, query.shape[1])
     if not ids:
         return []
-    order, distances = similarity.rank_similar(query, np.stack(library), k=k, shortlist=max(20, k))
-    rows = LibrarySegment.objects.select_related("capture", "annotator").in_bulk([ids[i] for i in order])
-    return [(rows[ids[i]], float(d)) for i, d in zip(order, distances, strict=True)]
+    short = [ids[i] for i in similarity.shortlist_by_profile(query, profiles, max(SHORTLIST, k))]
+    order, distances = similarity.rank_similar(query, load_descriptors(short), k=k,
+                                               shortlist=len(short))
+    rows = LibrarySegment.objects.select_related("capture", "annotator").in_bulk([short[i] for i in order])
+    return [(rows[short[i]], float(d)) for i, d in zip(order, distances, strict=True)]
 
 
 def suggest_labels(review, segments):
@@ -306,30 +339,35 @@ def suggest_labels(review, segments):
 
 
 def _suggest(capture, spans):
+    queries = descriptors(capture, spans)
+    if queries[0] is None:
+        return [None] * len(spans)
     pool = (
         LibrarySegment.objects.preferred()
-        .filter(project_id=capture.project_id, descriptor__isnull=False)
+        .filter(project_id=capture.project_id, profile__isnull=False)
         # Other annotators' labels of the same take would make reviews depend on each other.
         .exclude(capture_id=capture.pk)
-        .order_by("-is_gold", "-id").values_list("label_name", "descriptor", "descriptor_shape")
+        .order_by("-is_gold", "-id").values_list("id", "profile", "label_name")
     )[:SIMILAR_POOL]
-    names, library = [], []
-    for name, blob, shape in pool:
-        names.append(name)
-        library.append(np.frombuffer(bytes(blob), dtype="<f4").reshape(shape))
-    queries = descriptors(capture, spans)
-    if not names or queries[0][0] is None:
+    names = {pk: name for pk, _, name in pool}
+    ids, profiles = profile_pool([(pk, blob) for pk, blob, _ in pool], queries[0].shape[1])
+    if not ids:
         return [None] * len(spans)
-    library = np.stack(library)
-    out = []
-    for blob, shape in queries:
-        query = np.frombuffer(blob, dtype="<f4").reshape(shape)
-        order, distances = similarity.rank_similar(
-            query, library, k=min(SUGGEST_NEIGHBOURS, len(names)), shortlist=SUGGEST_NEIGHBOURS)
-        # Votes weigh 1 / distance^2: with a small library a plain majority would name
-        # whichever label is most common rather than the one that moves alike.
-        votes = Counter()
-        for i, d in zip(order, distances, strict=True):
-            votes[names[i]] += 1.0 / (d * d + 1e-9)
-        out.append(votes.most_common(1)[0][0])
-    return out
+    shortlists = [[ids[i] for i in similarity.shortlist_by_profile(q, profiles, SHORTLIST)]
+                  for q in queries]
+    union = sorted({pk for short in shortlists for pk in short})
+    full = dict(zip(union, load_descriptors(union), strict=True))
+    return [_vote(q, short, full, names) for q, short in zip(queries, shortlists, strict=True)]
+
+
+def _vote(query, short, full, names):
+    """The label with most votes among the nearest neighbours, a vote weighing 1 / d^2:
+    with a small library a plain majority would name whichever label is most common
+    rather than the one that moves alike."""
+    order, distances = similarity.rank_similar(
+        query, np.stack([full[pk] for pk in short]), k=min(SUGGEST_NEIGHBOURS, len(short)),
+        shortlist=len(short))
+    votes = Counter()
+    for i, d in zip(order, distances, strict=True):
+        votes[names[short[i]]] += 1.0 / (d * d + 1e-9)
+    return votes.most_common(1)[0][0]

@@ -61,6 +61,9 @@ class LibrarySegment(models.Model):
     # skeleton cannot be mapped to body parts.
     descriptor = models.BinaryField(null=True, blank=True)
     descriptor_shape = models.JSONField(null=True, blank=True)
+    # The descriptor's first rows (motionlib.similarity.PROFILE_ROWS), kept apart so the
+    # first stage of a similar-clip search reads a tenth of the bytes.
+    profile = models.BinaryField(null=True, blank=True)
     created_at = models.DateTimeField(default=timezone.now)
 
     objects = LibrarySegmentQuerySet.as_manager()
