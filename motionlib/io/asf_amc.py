@@ -332,7 +332,7 @@ def _amc_fast(data: bytes, offset: int, sk: Skeleton) -> np.ndarray | None:
     for lo in range(0, n, _FRAMES_PER_BLOCK):  # blocks keep the parser's temporaries small
         block = slice(lo, lo + _FRAMES_PER_BLOCK)
         parsed = token_values(b, starts[block, number_cols].ravel(),
-                              ends[block, number_cols].ravel())
+                              ends[block, number_cols].ravel(), plain=False)
         if parsed is None:
             return None
         values[block] = parsed.reshape(-1, number_cols.size)
@@ -350,9 +350,11 @@ def _amc_fast(data: bytes, offset: int, sk: Skeleton) -> np.ndarray | None:
 
 
 def _column_is(b, starts, ends, name: bytes) -> bool:
+    """Whether every token starting at ``starts`` (and ending at ``ends``) spells ``name``."""
     if not np.all(ends - starts == len(name)):
         return False
-    return all(np.all(b[starts + i] == byte) for i, byte in enumerate(name))
+    spelled = b[starts[:, None] + np.arange(len(name))]
+    return bool(np.all(spelled == np.frombuffer(name, dtype=np.uint8)))
 
 
 def _amc_lines(body: str, first_line: int, asf: Asf, path) -> np.ndarray:

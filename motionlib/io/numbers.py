@@ -86,7 +86,8 @@ class _Walk:
         self.bad = np.zeros(n, bool)
 
 
-def token_values(b: np.ndarray, starts: np.ndarray, ends: np.ndarray) -> np.ndarray | None:
+def token_values(b: np.ndarray, starts: np.ndarray, ends: np.ndarray, *,
+                 plain: bool | None = None) -> np.ndarray | None:
     """Value of every token, or None if one of them is not a number read exactly here.
 
     All tokens are walked from their last byte backwards in lockstep, longest first so that
@@ -102,6 +103,9 @@ def token_values(b: np.ndarray, starts: np.ndarray, ends: np.ndarray) -> np.ndar
         The text.
     starts, ends : ndarray of int
         Byte bounds of the tokens to read (any subset of the tokens of ``b``).
+    plain : bool, optional
+        Whether ``b`` holds nothing but these numbers, whitespace, digits, dots and signs
+        (checked when not given). Pass False for a subset of a text with other tokens.
 
     Returns
     -------
@@ -117,7 +121,7 @@ def token_values(b: np.ndarray, starts: np.ndarray, ends: np.ndarray) -> np.ndar
     order = np.argsort(length, kind="stable")[::-1]  # radix sort of small ints: cheap
     # at_least[k]: how many tokens have a k-th byte; they are the first ones in `order`.
     at_least = np.cumsum(np.bincount(length, minlength=longest + 2)[::-1])[::-1]
-    plain = _is_plain(b)
+    plain = _is_plain(b) if plain is None else plain
     w = _Walk(starts.size)
     pos = ends[order].astype(np.intp)
     for k in range(1, longest + 1):
