@@ -202,10 +202,34 @@ def supervise(worker_child, web_child):
         if deaths >= MAX_WORKER_DEATHS:
             say(f"the worker died {deaths} times; stopping (fix the cause above and rerun)")
             return 1
-        say("restarting the worker; a job it had started goes back to the queue")
         worker_child.kill()  # pool processes the dead main process left behind
+        requeue_abandoned(worker_child.env)
+        say("restarting the worker")
         worker_child.start()
         say(f"worker restarted, pid {worker_child.proc.pid}")
+
+
+def requeue_abandoned(env):
+    """Send the jobs of a worker that died back to the queue, at once.
+
+    The filesystem broker hands a message over when a worker takes it, so a killed
+    worker's jobs live on only as rows marked processing. The worker up.py runs is the
+    only one, so every claim is abandoned: sweeping with a claim timeout of 0 s requeues
+    them (and fails a job that keeps killing workers, after CUTROOM_MAX_ATTEMPTS).
+    Redis gives unacknowledged jobs back by itself, so nothing is done there.
+    """
+    if not (env.get("CELERY_BROKER_URL") or "filesystem").startswith("filesystem"):
+        return
+    done = subprocess.run(
+        [sys.executable, "manage.py", "sweep_claims"], cwd=REPO,
+        env={**env, "CUTROOM_CLAIM_TIMEOUT": "0"}, capture_output=True, text=True,
+    )
+    lines = (done.stdout + done.stderr).strip().splitlines()
+    if done.returncode:
+        say(f"could not requeue the dead worker's jobs (`manage.py sweep_claims` exit code "
+            f"{done.returncode}): {lines[-1] if lines else 'no output'}")
+    else:
+        say(f"the dead worker's jobs: {lines[-1] if lines else 'no output'}")
 
 
 def banner(url, worker_child, web_child, logs, demo):

@@ -6,10 +6,12 @@ import os
 import re
 import signal
 import socket
+import sqlite3
 import subprocess
 import sys
 import time
 import urllib.request
+from datetime import UTC, datetime
 from pathlib import Path
 
 import pytest
@@ -33,7 +35,7 @@ class Up:
         env = {k: v for k, v in os.environ.items()
                if k not in ("DATABASE_URL", "CELERY_BROKER_URL", "CUTROOM_MEDIA_ROOT")}
         env["CUTROOM_VAR_DIR"] = str(var)
-        self.port, self.out = port, var.parent / f"up-{port}.out"
+        self.var, self.port, self.out = var, port, var.parent / f"up-{port}.out"
         self.proc = subprocess.Popen(
             [sys.executable, str(UP), "--port", str(port), "--concurrency", "1",
              "--no-shared-data", *args],
@@ -132,14 +134,21 @@ def test_it_serves_the_demo_survives_a_dead_worker_stops_on_ctrl_c_and_runs_agai
     captures = wait_until_detected(server, token, 3)
     assert all(len(c["latest_run"]["candidates"]) > 0 for c in captures)
 
+    # The worker dies holding a job: the row says processing, the broker has no message.
+    held = captures[0]["id"]
+    mark_processing(server.var / "cutroom.sqlite3", held)
     web, worker = server.pids()
     os.killpg(worker, signal.SIGKILL)
     output = server.wait_for("restarting the worker")
     assert "the worker died (exit code -9); end of" in output
     assert "worker.log" in output
+    assert "the dead worker's jobs: 1 stale job(s) requeued" in output
     output = server.wait_for("worker restarted, pid")
     new_worker = int(re.search(r"worker restarted, pid (\d+)", output)[1])
     assert new_worker != worker and gone(worker)
+    # The restarted worker ingests the held capture again and detects on it again.
+    wait_until(lambda: len(server.api(f"/api/captures/{held}/runs/", token)) == 2
+               and server.api(f"/api/captures/{held}/", token)["status"] == "ready")
 
     assert server.ctrl_c() == 0
     assert "SIGINT received; stopping" in server.output()
@@ -152,6 +161,25 @@ def test_it_serves_the_demo_survives_a_dead_worker_stops_on_ctrl_c_and_runs_agai
     assert output.count("present  synth-") == 3
     assert again.api("/api/captures/", token)["count"] == 3
     assert again.ctrl_c() == 0
+
+
+def mark_processing(database, capture_id):
+    """What a worker's claim leaves on a capture row (written straight to the SQLite file)."""
+    with sqlite3.connect(database, timeout=20) as db:
+        db.execute(
+            "UPDATE segmentation_capture SET status = 'processing', claim_token = 'dead-worker', "
+            "claimed_at = ?, attempts = attempts + 1 WHERE id = ?",
+            (datetime.now(UTC).strftime("%Y-%m-%d %H:%M:%S.%f"), capture_id),
+        )
+
+
+def wait_until(predicate, timeout=120):
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        if predicate():
+            return
+        time.sleep(0.5)
+    raise AssertionError(f"condition not met after {timeout}s")
 
 
 def wait_until_detected(server, token, count, timeout=120):
