@@ -161,7 +161,9 @@ class Workers:
 @pytest.fixture(scope="session")
 def worker_pair(services_env, django_db_setup, shared_media, tmp_path_factory):
     """Two workers kept for the whole session (for tests that do not kill them)."""
-    pool = Workers(new_queue(), shared_media, tmp_path_factory.mktemp("worker-logs"), 3)
+    # A long claim timeout: a slow ingest on a busy machine must not look abandoned,
+    # or the duplicate deliveries of the same job would rightly take it over.
+    pool = Workers(new_queue(), shared_media, tmp_path_factory.mktemp("worker-logs"), 300)
     pool.start()
     pool.start()
     yield pool
