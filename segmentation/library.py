@@ -255,20 +255,31 @@ def stream_zip(segments):
     """Yield a zip archive of one BVH per segment plus ``manifest.csv`` and ``manifest.json``.
 
     ``segments`` should be ordered by capture so each take is read once; the archive is
-    written as it goes (at most one take and one BVH are in memory).
+    written as it goes (at most one take and one BVH are in memory). A take that cannot
+    be read any more cannot turn into an error response once streaming has begun: its
+    segments are left out and ``errors.txt`` says why.
     """
     sink = _Sink()
-    manifest, take, take_of = [], None, None
+    manifest, errors, take, take_of = [], [], None, None
     with zipfile.ZipFile(sink, "w", compression=zipfile.ZIP_DEFLATED) as archive:
         for segment in segments:
             if take_of != segment.capture_id:
-                take, take_of = read_take(segment.capture), segment.capture_id
+                take_of = segment.capture_id
+                try:
+                    take = read_take(segment.capture)
+                except ValueError as exc:
+                    take = None
+                    errors.append(f"capture {segment.capture_id} ({segment.capture.name}): {exc}")
+            if take is None:
+                continue
             name = file_name(segment)
             archive.writestr(name, bvh_text(take, segment))
             manifest.append(manifest_row(segment, name))
             yield sink.drain()
         archive.writestr("manifest.json", json.dumps(manifest, indent=1))
         archive.writestr("manifest.csv", _csv(manifest))
+        if errors:
+            archive.writestr("errors.txt", "\n".join(errors) + "\n")
     yield sink.drain()
 
 

@@ -126,7 +126,7 @@ class SegmentListView(APIView):
     @extend_schema(responses=SegmentSerializer(many=True))
     def get(self, request):
         segments = segment_query(request).select_related("capture", "annotator", "label").defer(
-            "descriptor", "capture__skeleton")
+            "descriptor", "profile", "capture__skeleton")
         paginator = SegmentPagination()
         page = paginator.paginate_queryset(segments, request, view=self)
         return paginator.get_paginated_response(SegmentSerializer(page, many=True).data)
@@ -156,7 +156,7 @@ class SegmentZipView(APIView):
         if count > library.MAX_EXPORT_SEGMENTS:
             raise ValueError(f"export: the query matches {count} segments; export at most "
                              f"{library.MAX_EXPORT_SEGMENTS} at a time (narrow the filters)")
-        rows = (segments.select_related("capture", "annotator").defer("descriptor")
+        rows = (segments.select_related("capture", "annotator").defer("descriptor", "profile")
                 .order_by("capture_id", "start", "id").iterator(chunk_size=200))
         response = StreamingHttpResponse(library.stream_zip(rows), content_type="application/zip")
         response["Content-Disposition"] = 'attachment; filename="segments.zip"'

@@ -158,3 +158,44 @@ class SegmentDetailTest(LibraryTestCase):
         assert self.client.get(f"/api/segments/{danas.pk}/").status_code == 404
         self.login(self.charlie)
         assert self.client.get(f"/api/segments/{danas.pk}/").status_code == 404
+
+
+class UnreadableTakeTest(LibraryTestCase):
+    """``ready_capture`` stores a file that is not a valid BVH and a skeleton with no
+    recognisable body parts: the library must say so rather than fail."""
+
+    def setUp(self):
+        super().setUp()
+        self.capture, _, _ = self.two_reviews()
+        self.segment = LibrarySegment.objects.filter(annotator=self.bob).first()
+        self.login(self.rachel)
+
+    def test_it_explains_why_a_segment_cannot_be_exported(self):
+        response = self.client.get(f"/api/segments/{self.segment.pk}/export.bvh")
+        assert response.status_code == 400
+        assert response.json()["detail"].startswith("c.bvh")
+
+    def test_it_lists_unreadable_takes_in_the_zip_instead_of_breaking_it(self):
+        import io
+        import zipfile
+
+        response = self.client.get("/api/segments/export.zip")
+        archive = zipfile.ZipFile(io.BytesIO(b"".join(response.streaming_content)))
+        assert sorted(archive.namelist()) == ["errors.txt", "manifest.csv", "manifest.json"]
+        assert archive.read("errors.txt").decode().startswith(f"capture {self.capture.pk} (c.bvh): c.bvh")
+
+    def test_it_explains_why_a_segment_has_no_similar_clips(self):
+        response = self.client.get(f"/api/segments/{self.segment.pk}/similar/")
+        assert response.status_code == 400
+        assert "could not be mapped to body parts" in response.json()["detail"]
+
+    def test_it_refuses_an_export_of_more_than_the_limit(self):
+        from segmentation import library
+
+        saved, library.MAX_EXPORT_SEGMENTS = library.MAX_EXPORT_SEGMENTS, 3
+        try:
+            response = self.client.get("/api/segments/export.zip")
+        finally:
+            library.MAX_EXPORT_SEGMENTS = saved
+        assert response.status_code == 400
+        assert response.json()["detail"].startswith("export: the query matches 7 segments")
