@@ -22,6 +22,10 @@ CHROMIUM_ARGS = [
     "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
 ]
 
+# CI shares two cores among the web server, the browser and the tests: give the page
+# more time than Playwright's default 5 s before calling it stuck.
+EXPECT_TIMEOUT_MS = 15_000
+
 # Playwright's sync API runs an event loop in this thread; the ORM calls the tests make
 # between browser steps are still plain synchronous code.
 os.environ.setdefault("DJANGO_ALLOW_ASYNC_UNSAFE", "true")
@@ -53,8 +57,9 @@ def browser(built_frontend):
         if os.environ.get("CI", "").lower() == "true":
             pytest.fail(message)
         pytest.skip(message)
-    from playwright.sync_api import sync_playwright
+    from playwright.sync_api import expect, sync_playwright
 
+    expect.set_options(timeout=EXPECT_TIMEOUT_MS)
     with sync_playwright() as p:
         browser = p.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS, headless=True)
         yield browser
@@ -158,6 +163,7 @@ def new_page(browser, live_server):
         context = browser.new_context(viewport={"width": width, "height": height})
         contexts.append(context)
         page = context.new_page()
+        page.set_default_timeout(EXPECT_TIMEOUT_MS)
         page.errors = []
         page.on("pageerror", lambda exc: page.errors.append(str(exc)))
         login(page, live_server.url, username)

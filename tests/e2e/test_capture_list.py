@@ -28,6 +28,13 @@ DROP_MANY = """(files) => {
 }"""
 
 
+def open_list(new_page, username):
+    """The capture list, once it has drawn its first answer (so drops are heard)."""
+    page = new_page(username)
+    expect(page.locator(".pager")).to_contain_text("capture")
+    return page
+
+
 def run_worker_jobs():
     """Do what a worker would: ingest queued captures, then run queued detections."""
     from segmentation import tasks
@@ -40,7 +47,7 @@ def run_worker_jobs():
 
 
 def test_it_uploads_dropped_files_and_shows_their_status_as_it_changes(live_server, new_page, studio):
-    page = new_page("ann")
+    page = open_list(new_page, "ann")
     good = synthetic_bvh(seed=3, duration=12.0).decode()
     page.evaluate(DROP, ["warmup_short.bvh", good])
     page.evaluate(DROP, ["broken_take.bvh", "HIERARCHY\nROOT Hips\n{\n  OFFSET 0 0 oops\n"])
@@ -50,7 +57,7 @@ def test_it_uploads_dropped_files_and_shows_their_status_as_it_changes(live_serv
 
     run_worker_jobs()
     # The list refreshes itself while anything is queued or processing.
-    expect(rows.locator("tr", has_text="warmup_short.bvh")).to_contain_text("ready", timeout=10_000)
+    expect(rows.locator("tr", has_text="warmup_short.bvh")).to_contain_text("ready", timeout=20_000)
     broken = rows.locator("tr", has_text="broken_take.bvh")
     expect(broken).to_contain_text("failed")
     expect(broken.locator(".error-text")).not_to_be_empty()
@@ -102,15 +109,15 @@ def test_it_pairs_a_dropped_cmu_amc_with_its_asf_and_plays_the_real_take(live_se
     cmu = SHARED_DATA / "cmu"
     if not (cmu / "amc" / "13_29.amc").is_file():
         pytest.skip(f"real CMU captures not found under {cmu} (the shared/ folder beside the repository)")
-    page = new_page("ann")
+    page = open_list(new_page, "ann")
     page.evaluate(DROP_MANY, [
         ["13_29.amc", (cmu / "amc" / "13_29.amc").read_text()],
         ["13.asf", (cmu / "asf" / "13.asf").read_text()],
     ])
     row = page.get_by_test_id("capture-rows").locator("tr", has_text="13_29.amc")
-    expect(row).to_contain_text("queued", timeout=15_000)
+    expect(row).to_contain_text("queued", timeout=20_000)
     run_worker_jobs()
-    expect(row).to_contain_text("ready", timeout=10_000)
+    expect(row).to_contain_text("ready", timeout=20_000)
     expect(row).to_contain_text("4,592")
     row.click()
     expect(page.get_by_test_id("capture-name")).to_have_text("13_29.amc")
