@@ -252,6 +252,25 @@ def test_it_lists_the_shortcuts_and_locks_the_review_once_submitted(live_server,
     page.keyboard.press("Escape")
     expect(help_box).to_have_count(0)
 
+    # Shift+drag on the ruler loops a range; playback then stays inside it.
+    n = ingested_capture.n_frames
+    page.keyboard.down("Shift")
+    page.mouse.move(screen.x(n * 0.25), screen.ruler_y())
+    page.mouse.down()
+    page.mouse.move(screen.x(n * 0.3), screen.ruler_y(), steps=4)
+    page.mouse.up()
+    page.keyboard.up("Shift")
+    state = page.get_by_test_id("hud-state")
+    expect(state).to_contain_text("loop")
+    start, stop = (int(v) for v in state.inner_text().split("loop ")[1].split("–"))
+    assert abs(start - n * 0.25) <= n / screen.box()["width"] + 1 and stop > start
+    page.keyboard.press("Space")
+    page.wait_for_timeout(1500)
+    page.keyboard.press("Space")
+    assert start <= screen.frame_shown() <= stop
+    page.keyboard.press("l")
+    expect(state).not_to_contain_text("loop")
+
     page.get_by_test_id("submit").click()
     expect(page.get_by_test_id("readonly-banner")).to_contain_text("You submitted this review")
     assert screen.review()["status"] == "submitted"

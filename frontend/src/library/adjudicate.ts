@@ -7,6 +7,7 @@ import { clear, h, toast } from "../ui/dom";
 import { addCut, type Draft, fromSpans, moveCut, removeCut, sameDraft, setLabel, toSpans } from "./gold";
 import type { Adjudication, Agreement, Span } from "./types";
 import { topbar } from "./nav";
+import { ClipPreview } from "./preview";
 
 const fmt = (v: number | null | undefined, digits = 2) => (v === null || v === undefined ? "—" : v.toFixed(digits));
 
@@ -25,7 +26,12 @@ export async function renderAdjudication(root: HTMLElement, captureId: number): 
   const saveButton = h("button", { class: "btn btn-primary", "data-testid": "save-gold", onclick: () => void save() }, "Save gold version");
   const seconds = (frame: number) => `${(frame / data.capture.fps).toFixed(2)} s`;
 
-  const track = (spans: Span[], testid: string, onPick?: (i: number) => void) =>
+  const preview = h("aside", { class: "lib-preview", "data-testid": "preview" }, h("p", { class: "muted" }, "Click a segment on any track to play it here."));
+  const player = new ClipPreview(preview);
+  const play = (who: string, s: Span) =>
+    void player.play(captureId, s.start, s.stop, `${who} · ${s.label ?? "unlabelled"} · frames ${s.start}–${s.stop}`, `${who}:${s.start}`);
+
+  const track = (spans: Span[], testid: string, onPick: (i: number) => void, selectable = false) =>
     h(
       "div",
       { class: "adj-track", "data-testid": testid },
@@ -33,11 +39,11 @@ export async function renderAdjudication(root: HTMLElement, captureId: number): 
         h(
           "div",
           {
-            class: `adj-seg${onPick && i === selected ? " selected" : ""}${s.label ? "" : " unlabelled"}`,
+            class: `adj-seg${selectable && i === selected ? " selected" : ""}${s.label ? "" : " unlabelled"}`,
             style: `left:${(s.start / n) * 100}%;width:${((s.stop - s.start) / n) * 100}%;background:${s.label ? colors.get(s.label) ?? "#888" : "transparent"}`,
             title: `${s.label ?? "unlabelled"} · ${s.start}–${s.stop} (${seconds(s.stop - s.start)})`,
             "data-testid": `${testid}-seg-${i}`,
-            onclick: onPick ? () => onPick(i) : undefined,
+            onclick: () => onPick(i),
           },
           h("span", {}, s.label ?? ""),
         ),
@@ -52,7 +58,7 @@ export async function renderAdjudication(root: HTMLElement, captureId: number): 
           "div",
           { class: "adj-row" },
           h("div", { class: "adj-who" }, h("b", {}, r.annotator.username), h("span", { class: "muted small" }, ` ${r.status.replace("_", " ")}, ${r.cuts.length} cuts`)),
-          track(r.segments, `track-${r.annotator.username}`),
+          track(r.segments, `track-${r.annotator.username}`, (i) => play(r.annotator.username, r.segments[i])),
           h("button", { class: "btn", "data-testid": `use-${r.annotator.username}`, onclick: () => use(r.id, r.segments) }, "Start gold from this"),
         ),
       ),
@@ -60,10 +66,16 @@ export async function renderAdjudication(root: HTMLElement, captureId: number): 
         "div",
         { class: "adj-row adj-gold" },
         h("div", { class: "adj-who" }, h("b", {}, "Gold"), h("span", { class: "muted small" }, data.gold ? ` v${data.gold.version} by ${data.gold.adjudicator ?? "?"}` : " not saved yet")),
-        track(toSpans(draft, n), "track-gold", (i) => {
-          selected = i;
-          redraw();
-        }),
+        track(
+          toSpans(draft, n),
+          "track-gold",
+          (i) => {
+            selected = i;
+            redraw();
+            play("gold", toSpans(draft, n)[i]);
+          },
+          true,
+        ),
         status,
       ),
     );
@@ -143,12 +155,12 @@ export async function renderAdjudication(root: HTMLElement, captureId: number): 
         summary,
         tracks,
         h("div", { class: "adj-actions" }, saveButton),
-        editor,
+        h("div", { class: "lib-layout" }, editor, preview),
       ),
     ),
   );
   redraw();
-  return () => undefined;
+  return () => player.stop();
 }
 
 function agreementBox(a: Agreement): HTMLElement {

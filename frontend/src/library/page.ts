@@ -2,11 +2,10 @@
 // that move like it, open it in its capture, export one BVH or the whole query as a zip.
 
 import { get } from "../api/client";
-import type { Capture, FramesResponse, Page, Project } from "../api/types";
-import { SkeletonView } from "../player/skeletonView";
-import { decodeFloat32 } from "../review/frames";
+import type { Page, Project } from "../api/types";
 import { clear, formatDuration, h, toast } from "../ui/dom";
 import { topbar } from "./nav";
+import { ClipPreview } from "./preview";
 import type { LibrarySegment } from "./types";
 
 export interface LibraryFilters {
@@ -38,11 +37,6 @@ export function libraryQuery(f: LibraryFilters, withPage = true): string {
   return q.toString();
 }
 
-/** Playback step so a clip preview downloads at most `maxFrames` poses. */
-export function previewStep(frames: number, maxFrames = 1500): number {
-  return Math.max(1, Math.ceil(frames / maxFrames));
-}
-
 const pct = (v: number | null) => (v === null ? "—" : `${Math.round(v * 100)} %`);
 
 export async function renderLibrary(root: HTMLElement): Promise<() => void> {
@@ -54,7 +48,7 @@ export async function renderLibrary(root: HTMLElement): Promise<() => void> {
   const pager = h("div", { class: "pager" });
   const exportZip = h("a", { class: "btn", "data-testid": "export-zip", download: "" }, "Export these as zip");
   const preview = h("aside", { class: "lib-preview", "data-testid": "preview" }, h("p", { class: "muted" }, "Play a segment to preview it here."));
-  let stopPreview: () => void = () => undefined;
+  const player = new ClipPreview(preview);
 
   const field = (key: (typeof KEYS)[number], el: HTMLInputElement | HTMLSelectElement) => {
     el.value = filters[key];
@@ -147,36 +141,7 @@ export async function renderLibrary(root: HTMLElement): Promise<() => void> {
   }
 
   async function play(s: LibrarySegment): Promise<void> {
-    stopPreview();
-    const capture = await get<Capture>(`/api/captures/${s.capture.id}/`);
-    if (!capture.skeleton) return toast("This capture has no skeleton yet.", "error");
-    const step = previewStep(s.stop - s.start);
-    const frames = await get<FramesResponse>(`/api/captures/${s.capture.id}/frames/?start=${s.start}&stop=${s.stop}&step=${step}`);
-    const poses = decodeFloat32(frames.data);
-    const size = frames.n_joints * 3;
-    const stage = h("div", { class: "lib-stage" });
-    const caption = h("div", { class: "muted small", "data-testid": "preview-caption" }, `${s.label} · ${s.capture.name} · frames ${s.start}–${s.stop}`);
-    clear(preview, stage, caption);
-    let view: SkeletonView | null = null;
-    try {
-      view = new SkeletonView(stage, capture.skeleton);
-    } catch {
-      stage.append(h("p", { class: "muted" }, "WebGL is not available to draw the skeleton."));
-    }
-    preview.setAttribute("data-playing", String(s.id));
-    let raf = 0;
-    const started = performance.now();
-    const tick = (now: number) => {
-      // The first animation frame can be stamped before `started`: never go negative.
-      const i = Math.floor(((Math.max(now - started, 0) / 1000) * capture.fps) / step) % frames.n_frames;
-      view?.setPose(poses.subarray(i * size, (i + 1) * size));
-      raf = requestAnimationFrame(tick);
-    };
-    raf = requestAnimationFrame(tick);
-    stopPreview = () => {
-      cancelAnimationFrame(raf);
-      view?.dispose();
-    };
+    await player.play(s.capture.id, s.start, s.stop, `${s.label} · ${s.capture.name} · frames ${s.start}–${s.stop}`, String(s.id));
   }
 
   function apply(next: LibraryFilters): void {
@@ -187,5 +152,5 @@ export async function renderLibrary(root: HTMLElement): Promise<() => void> {
   }
 
   await load();
-  return () => stopPreview();
+  return () => player.stop();
 }

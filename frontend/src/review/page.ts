@@ -100,6 +100,10 @@ class ReviewPage {
       acceptCut: (id) => this.perform({ kind: "fate", cutId: id, fate: "accepted" }),
       moveCut: (id, frame) => this.perform({ kind: "move", cutId: id, frame }),
       insertAt: (frame) => this.perform({ kind: "insert", frame, tempId: this.nextTempId-- }),
+      setLoop: (range) => {
+        this.playback = range ? seek({ ...this.playback, loop: range }, range.start) : { ...this.playback, loop: null };
+        this.refresh();
+      },
     });
     this.store = new FrameStore(capture.n_frames, capture.n_joints || capture.skeleton!.joints.length);
     const started = performance.now();

@@ -25,6 +25,7 @@ export interface TimelineHandlers {
   acceptCut(id: number): void;
   moveCut(id: number, frame: number): void;
   insertAt(frame: number): void;
+  setLoop(range: { start: number; stop: number } | null): void;
 }
 
 const RULER = 26;
@@ -45,6 +46,8 @@ interface Layout {
 type Gesture =
   | { kind: "scrub" }
   | { kind: "overview" }
+  | { kind: "pan"; lastX: number }
+  | { kind: "loop"; from: number; to: number }
   | { kind: "drag"; cut: Cut; startX: number; moved: boolean; frame: number };
 
 export class Timeline {
@@ -53,6 +56,7 @@ export class Timeline {
   private model: TimelineModel | null = null;
   private ranges = new Map<Signal, [number, number]>();
   private gesture: Gesture | null = null;
+  private loopPreview: { start: number; stop: number } | null = null;
   private queued = false;
   private width = 1;
   onViewChange: (() => void) | null = null;
@@ -154,9 +158,10 @@ export class Timeline {
   private drawRuler(ctx: CanvasRenderingContext2D, m: TimelineModel): void {
     ctx.fillStyle = "#1a1f27";
     ctx.fillRect(0, 0, this.width, RULER);
-    if (m.loop) {
+    const loop = this.loopPreview ?? m.loop;
+    if (loop) {
       ctx.fillStyle = "rgba(126, 226, 168, 0.25)";
-      ctx.fillRect(this.x(m.loop.start), 0, this.x(m.loop.stop) - this.x(m.loop.start), RULER);
+      ctx.fillRect(this.x(loop.start), 0, this.x(loop.stop) - this.x(loop.start), RULER);
     }
     ctx.font = "11px ui-monospace, SFMono-Regular, Menlo, monospace";
     ctx.textBaseline = "middle";
@@ -354,9 +359,19 @@ export class Timeline {
   }
 
   private onDown(e: PointerEvent): void {
-    if (!this.model || e.button !== 0) return;
+    if (!this.model || (e.button !== 0 && e.button !== 1)) return;
     const [x, y] = this.point(e);
     this.canvas.setPointerCapture(e.pointerId);
+    if (e.button === 1 || e.altKey) {
+      e.preventDefault();
+      this.gesture = { kind: "pan", lastX: x };
+      return;
+    }
+    if (e.shiftKey && y < RULER) {
+      const frame = snapFrame(this.view, x);
+      this.gesture = { kind: "loop", from: frame, to: frame };
+      return;
+    }
     if (y >= this.layout().overviewTop) {
       this.gesture = { kind: "overview" };
       this.centreOverview(x);
@@ -380,6 +395,14 @@ export class Timeline {
     }
     if (g.kind === "overview") this.centreOverview(x);
     else if (g.kind === "scrub") this.handlers.seek(snapFrame(this.view, x));
+    else if (g.kind === "pan") {
+      this.setView(panBy(this.view, x - g.lastX));
+      g.lastX = x;
+    } else if (g.kind === "loop") {
+      g.to = snapFrame(this.view, x);
+      this.loopPreview = { start: Math.min(g.from, g.to), stop: Math.max(g.from, g.to) + 1 };
+      this.schedule();
+    }
     else if (!this.model?.readOnly && (g.moved || Math.abs(x - g.startX) > 3)) {
       g.moved = true;
       g.frame = Math.min(Math.max(snapFrame(this.view, x), 1), this.model!.nFrames - 1);
@@ -391,6 +414,13 @@ export class Timeline {
     const g = this.gesture;
     this.gesture = null;
     if (this.canvas.hasPointerCapture(e.pointerId)) this.canvas.releasePointerCapture(e.pointerId);
+    if (g?.kind === "loop") {
+      this.loopPreview = null;
+      const [start, stop] = [Math.min(g.from, g.to), Math.max(g.from, g.to) + 1];
+      // A shift-click without a drag clears the loop.
+      this.handlers.setLoop(stop - start >= 2 ? { start, stop } : null);
+      return;
+    }
     if (g?.kind !== "drag") return;
     this.handlers.selectCut(g.cut.id);
     if (g.moved && g.frame !== g.cut.frame) this.handlers.moveCut(g.cut.id, g.frame);
