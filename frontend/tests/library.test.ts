@@ -1,6 +1,7 @@
 import { describe, expect, it } from "vitest";
 import { addCut, fromSpans, moveCut, removeCut, segmentAt, setLabel, toSpans } from "../src/library/gold";
-import { libraryFiltersFrom, libraryQuery, previewStep } from "../src/library/page";
+import { libraryFiltersFrom, libraryQuery } from "../src/library/page";
+import { previewStep } from "../src/library/preview";
 
 const spans = [
   { start: 0, stop: 100, label: "walk" },

@@ -36,6 +36,10 @@ def test_it_makes_a_gold_version_from_two_annotators_reviews(live_server, new_pa
     gold = page.get_by_test_id("track-gold")
     expect(gold.locator(".adj-seg")).to_have_count(4)
     gold.get_by_test_id("track-gold-seg-2").click()
+    # Picking a segment also plays it beside the editor.
+    expect(page.get_by_test_id("preview")).to_have_attribute("data-playing", f"gold:{cuts[1]}")
+    page.get_by_test_id("track-bob-seg-1").click()
+    expect(page.get_by_test_id("preview-caption")).to_have_text(f"bob · punch · frames {cuts[0]}–{cuts[2]}")
     page.get_by_test_id("gold-label").select_option("walk")
     expect(gold.get_by_test_id("track-gold-seg-2")).to_have_text("walk")
     page.get_by_test_id("save-gold").click()
