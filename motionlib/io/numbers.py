@@ -67,9 +67,15 @@ def token_bounds(b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
     Bytes up to 32 (space, tab, CR, LF and other controls) separate tokens.
     """
-    tok = (b > 32).view(np.int8)
-    # +1 where a token starts, -1 where one ends (padded so both always exist).
-    edges = np.flatnonzero(np.diff(tok, prepend=np.int8(0), append=np.int8(0)))
+    if b.size == 0:
+        return np.zeros(0, np.int32), np.zeros(0, np.int32)
+    tok = b > 32
+    # Edge i lies between bytes i-1 and i; the text is padded with whitespace at both ends so
+    # edges alternate start, end, start, end...
+    edge = np.empty(b.size + 1, bool)
+    edge[0], edge[-1] = tok[0], tok[-1]
+    np.not_equal(tok[1:], tok[:-1], out=edge[1:-1])
+    edges = np.flatnonzero(edge)
     return edges[0::2].astype(np.int32), edges[1::2].astype(np.int32)
 
 
