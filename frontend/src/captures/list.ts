@@ -92,7 +92,7 @@ export async function renderCaptureList(root: HTMLElement): Promise<() => void> 
   const page = h(
     "div",
     { class: "list-page" },
-    h("header", { class: "topbar" }, h("a", { class: "brand", href: "/" }, "Cutroom"), h("nav", { class: "crumbs" }, h("strong", {}, "Captures")), h("span", { class: "spacer" }), h("span", { class: "user" }, me.username), h("a", { class: "btn btn-ghost", href: "/logout/" }, "Log out")),
+    h("header", { class: "topbar" }, h("a", { class: "brand", href: "/" }, "Cutroom"), h("nav", { class: "crumbs" }, h("strong", {}, "Captures")), h("span", { class: "spacer" }), h("a", { class: "btn btn-ghost", href: "/library/", "data-testid": "nav-library" }, "Library"), h("span", { class: "user" }, me.username), h("a", { class: "btn btn-ghost", href: "/logout/" }, "Log out")),
     h(
       "main",
       { class: "list-main" },
