@@ -21,7 +21,7 @@ from motionlib.skeleton import CHANNEL_NAMES, ROTATION_CHANNELS, Skeleton
 from motionlib.take import Take, frame_range
 
 _CHANNEL_BY_LOWER = {c.lower(): c for c in CHANNEL_NAMES}
-_MOTION = re.compile(rb"^[ \t]*MOTION\b", re.MULTILINE)
+_MOTION = re.compile(rb"^[ \t]*MOTION\b", re.MULTILINE | re.IGNORECASE)
 
 
 def _short(token: str) -> str:
