@@ -3,6 +3,7 @@
 import hashlib
 import logging
 import os
+import uuid
 
 import numpy as np
 from django.conf import settings
@@ -168,9 +169,22 @@ def _ingest(capture):
     positions = np.asarray(motionlib.forward_kinematics(take), dtype="<f4")
     height = float(motionlib.skeleton_height(take))
     storage.save_npy(capture.positions, "positions.npy", positions)
+    run = None
     with transaction.atomic():
         if capture.finish(**_metadata(take, height), positions=capture.positions.name):
-            _start_default_run(capture)
+            run = _start_default_run(capture)
+    if run is not None:
+        _detect_here(run, take)
+
+
+def _detect_here(run, take):
+    """Run the default detection now, on the take this worker has just parsed (saves
+    reading the file again and a trip through the queue), unless a worker claimed the run
+    first. The queued message stays as the fallback: if this process dies the claim goes
+    stale and the sweep requeues the run; otherwise its delivery finds the run claimed."""
+    if DetectionRun.objects.claim(run.pk, uuid.uuid4().hex):
+        run.refresh_from_db()
+        _guarded(run, "Detection", lambda: _detect(run, take), finished_at=timezone.now())
 
 
 def _metadata(take, height):
@@ -202,9 +216,10 @@ def _start_default_run(capture):
             status="failed",
             error=f"project default parameters: {exc}",
         )
-        return
+        return None
     run = DetectionRun.objects.create(capture=capture, method=method, params=params)
     _enqueue("detect", run.pk)
+    return run
 
 
 def detect_run(run):
@@ -212,8 +227,8 @@ def detect_run(run):
     _guarded(run, "Detection", lambda: _detect(run), finished_at=timezone.now())
 
 
-def _detect(run):
-    take = _read(run.capture)
+def _detect(run, take=None):
+    take = _read(run.capture) if take is None else take
     segmenter = get_segmenter(run.method)
     result = segmenter(**segmenter.validate_params(run.params)).fit_predict(take)
     candidates = [
