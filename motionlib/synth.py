@@ -156,6 +156,29 @@ def _segment_angles(rng, label, t, n):
     return pattern(phase, rng.uniform(0.85, 1.15))
 
 
+def _add_actions(channels, column, rng, labels, bounds, t, half):
+    """Add each segment's action, faded in and out over ``half`` frames either side of its
+    bounds (the fades of neighbours sum to one)."""
+    n = len(channels)
+    for i, label in enumerate(labels):
+        lo, hi = max(0, int(bounds[i] - half)), min(n, int(np.ceil(bounds[i + 1] + half)))
+        frames = np.arange(lo, hi)
+        weight = np.ones(hi - lo)
+        if i > 0:
+            weight *= _ramp(frames, bounds[i], half)
+        if i < len(labels) - 1:
+            weight *= 1 - _ramp(frames, bounds[i + 1], half)
+        for key, values in _segment_angles(rng, label, t[lo:hi], hi - lo).items():
+            channels[lo:hi, column[key]] += weight * values
+
+
+def _ramp(frames, boundary, half):
+    """0 before ``boundary - half``, 1 after ``boundary + half``, smooth in between."""
+    if half <= 0:
+        return (frames >= boundary).astype(float)
+    return _smoothstep((frames - boundary + half) / (2 * half))
+
+
 def _smoothstep(x):
     x = np.clip(x, 0.0, 1.0)
     return x * x * (3 - 2 * x)
@@ -207,15 +230,7 @@ def generate(seed: int = 0, fps: float = 120.0, *, duration: float | None = None
     channels = np.zeros((n, sk.n_channels))
     for key, values in _rest(n).items():
         channels[:, column[key]] = values
-    half = transition_seconds * fps / 2
-    for i, label in enumerate(labels):
-        lo, hi = max(0, int(bounds[i] - half)), min(n, int(np.ceil(bounds[i + 1] + half)))
-        frames = np.arange(lo, hi)
-        weight = (_smoothstep((frames - bounds[i] + half) / (2 * half)) if i else 1.0) * \
-            (1 - _smoothstep((frames - bounds[i + 1] + half) / (2 * half)) if i < len(labels) - 1
-             else 1.0)
-        for key, values in _segment_angles(rng, label, t[lo:hi], hi - lo).items():
-            channels[lo:hi, column[key]] += weight * values
+    _add_actions(channels, column, rng, labels, bounds, t, transition_seconds * fps / 2)
     channels += _noise(rng, t, sk.n_channels, noise_degrees)
     _face(channels, column, rng.uniform(-180, 180))
     segments = [(int(bounds[i]), int(bounds[i + 1]), labels[i]) for i in range(len(labels))]

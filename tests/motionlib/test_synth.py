@@ -93,3 +93,13 @@ def test_it_generates_a_five_minute_take_at_120_fps():
 def test_it_rejects_bad_parameters_naming_them(kwargs, message):
     with pytest.raises(ValueError, match=message):
         synth.generate(seed=0, **kwargs)
+
+
+def test_it_cuts_without_a_transition_when_asked():
+    take, segments = synth.generate(seed=3, n_segments=3, transition_seconds=0.0,
+                                    noise_degrees=0.0)
+    assert np.all(np.isfinite(take.channels))
+    boundary = segments[1][0]
+    jump = np.abs(take.channels[boundary] - take.channels[boundary - 1]).max()
+    typical = np.abs(np.diff(take.channels[:boundary - 1], axis=0)).max()
+    assert jump > typical
