@@ -70,9 +70,9 @@ def matrix_to_euler_zyx(R: np.ndarray) -> np.ndarray:
         Columns z, y, x; y in [-90, 90]. At y = ±90 (gimbal lock) x is set to 0 and z carries
         the whole remaining rotation, so the matrix is still reproduced exactly.
     """
-    sy = np.clip(-R[:, 2, 0], -1.0, 1.0)
-    y = np.arcsin(sy)
-    locked = np.abs(sy) > 1 - 1e-12
+    cy = np.hypot(R[:, 0, 0], R[:, 1, 0])
+    y = np.arctan2(-R[:, 2, 0], cy)  # better conditioned near ±90 than arcsin
+    locked = cy < 1e-12
     z = np.where(locked, np.arctan2(-R[:, 0, 1], R[:, 1, 1]), np.arctan2(R[:, 1, 0], R[:, 0, 0]))
     x = np.where(locked, 0.0, np.arctan2(R[:, 2, 1], R[:, 2, 2]))
     return np.rad2deg(np.stack([z, y, x], axis=1))

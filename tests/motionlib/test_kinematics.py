@@ -145,3 +145,10 @@ def test_it_measures_skeleton_height_of_a_take_and_of_positions():
     assert motionlib.skeleton_height(positions) == pytest.approx(3.0)
     with pytest.raises(ValueError, match="shape"):
         motionlib.skeleton_height(np.zeros((4, 3)))
+
+
+def test_it_reproduces_matrices_close_to_gimbal_lock():
+    angles = np.array([[30.0, 90.0 - 1e-7, 20.0], [-50.0, -90.0 + 1e-9, 45.0],
+                       [10.0, 89.9999, -170.0]])
+    R = euler_to_matrix(angles, "ZYX")
+    assert_allclose(euler_to_matrix(matrix_to_euler_zyx(R), "ZYX"), R, atol=1e-9)
