@@ -142,7 +142,8 @@ def upload_and_wait(client, project, name, content, timeout=120):
 def report(rows, n_frames, args):
     print(f"upload -> candidates, embedded default (SQLite + filesystem broker + 1 worker), "
           f"{args.minutes:g} min at {args.fps:g} fps = {n_frames} frames, "
-          f"{len(rows)} repeats")
+          f"{len(rows)} repeats; machine: {os.cpu_count()} cores, load average "
+          f"{os.getloadavg()[0]:.1f}")
     columns = [("POST", "post"), ("queue", "to_ingest"), ("ingest", "ingest"),
                ("queue", "to_detect"), ("detect", "detect"), ("(segmenter)", "segmenter")]
     print(f"{'repeat':>6} {'MB':>5} " + " ".join(f"{c:>11}" for c, _ in columns)
@@ -153,7 +154,8 @@ def report(rows, n_frames, args):
     totals = np.array([row["total"] for row in rows])
     median, p95 = np.median(totals), np.percentile(totals, 95)
     verdict = "meets" if p95 <= TARGET_SECONDS else "MISSES"
-    print("(seconds; queue = from the previous stage to a worker claiming the job)")
+    print("(seconds; queue = from the previous stage to a worker claiming the job, negative "
+          "when the worker claimed the capture before the POST had returned)")
     print(f"median {median:.3f} s, p95 {p95:.3f} s, max {totals.max():.3f} s "
           f"({verdict} the {TARGET_SECONDS:g} s target at p95)")
 
