@@ -13,6 +13,7 @@ import json
 import re
 import zipfile
 from collections import Counter
+from functools import lru_cache
 from pathlib import PurePath
 from types import SimpleNamespace
 
@@ -330,38 +331,37 @@ def suggest_labels(review, segments):
 
     The label with the most votes among the nearest ``SUGGEST_NEIGHBOURS`` labelled
     segments of the project's other captures, each vote weighted by 1 / distance^2 (gold
-    preferred when the pool is capped). Cached per span and
-    library state, so editing one segment does not recompute the others.
+    preferred when the pool is capped). Cached per span and library state, so editing one
+    segment does not recompute the others.
     """
     capture = review.capture
     pending = [(s, e) for _, s, e, label in segments if label is None and e > s]
-    latest = LibrarySegment.objects.filter(project_id=capture.project_id).order_by("-id").first()
-    if not pending or latest is None:
+    if not pending:
         return [None] * len(segments)
-    key = f"cutroom:suggest:{capture.pk}:{latest.pk}:"
+    latest = (LibrarySegment.objects.filter(project_id=capture.project_id).order_by("-id")
+              .values_list("id", "created_at").first())
+    if latest is None:
+        return [None] * len(segments)
+    # The newest row's id and time identify the library's state (ids alone can be reused
+    # after a rollback).
+    state = f"{latest[0]}@{latest[1].timestamp()}"
+    key = f"cutroom:suggest:{capture.pk}:{state}:"
     found = cache.get_many([f"{key}{s}-{e}" for s, e in pending])
     missing = [(s, e) for s, e in pending if f"{key}{s}-{e}" not in found]
     if missing:
-        computed = _suggest(capture, missing)
-        cache.set_many({f"{key}{s}-{e}": v for (s, e), v in zip(missing, computed, strict=True)},
-                       timeout=3600)
-        found.update({f"{key}{s}-{e}": v for (s, e), v in zip(missing, computed, strict=True)})
+        computed = _suggest(capture, missing, state)
+        fresh = {f"{key}{s}-{e}": v for (s, e), v in zip(missing, computed, strict=True)}
+        cache.set_many(fresh, timeout=3600)
+        found.update(fresh)
     return [found.get(f"{key}{s}-{e}") if label is None else None for _, s, e, label in segments]
 
 
-def _suggest(capture, spans):
+def _suggest(capture, spans, latest):
     queries = descriptors(capture, spans)
     if queries[0] is None:
         return [None] * len(spans)
-    pool = (
-        LibrarySegment.objects.preferred()
-        .filter(project_id=capture.project_id, profile__isnull=False)
-        # Other annotators' labels of the same take would make reviews depend on each other.
-        .exclude(capture_id=capture.pk)
-        .order_by("-is_gold", "-id").values_list("id", "profile", "label_name")
-    )[:SIMILAR_POOL]
-    names = {pk: name for pk, _, name in pool}
-    ids, profiles = profile_pool([(pk, blob) for pk, blob, _ in pool], queries[0].shape[1])
+    ids, profiles, names = suggestion_pool(capture.project_id, capture.pk, latest,
+                                           queries[0].shape[1])
     if not ids:
         return [None] * len(spans)
     shortlists = [[ids[i] for i in similarity.shortlist_by_profile(q, profiles, SHORTLIST)]
@@ -369,6 +369,25 @@ def _suggest(capture, spans):
     union = sorted({pk for short in shortlists for pk in short})
     full = dict(zip(union, load_descriptors(union), strict=True))
     return [_vote(q, short, full, names) for q, short in zip(queries, shortlists, strict=True)]
+
+
+@lru_cache(maxsize=4)
+def suggestion_pool(project_id, capture_id, latest, n_features):
+    """(ids, profiles, {id: label}) of the labelled segments suggestions draw on.
+
+    Kept per process for the library state ``latest`` (see ``suggest_labels``), because
+    every edit of a review asks again and the pool is up to ``SIMILAR_POOL`` rows.
+    """
+    pool = (
+        LibrarySegment.objects.preferred()
+        .filter(project_id=project_id, profile__isnull=False)
+        # Other annotators' labels of the same take would make reviews depend on each other.
+        .exclude(capture_id=capture_id)
+        .order_by("-is_gold", "-id").values_list("id", "profile", "label_name")
+    )[:SIMILAR_POOL]
+    names = {pk: name for pk, _, name in pool}
+    ids, profiles = profile_pool([(pk, blob) for pk, blob, _ in pool], n_features)
+    return ids, profiles, names
 
 
 def _vote(query, short, full, names):
