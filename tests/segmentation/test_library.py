@@ -2,6 +2,7 @@
 filters and sorts them, annotators see their own and gold segments only, and the query
 count does not grow with the page."""
 
+import pytest
 from django.contrib.auth import get_user_model
 from django.db import connection
 from django.test.utils import CaptureQueriesContext
@@ -199,3 +200,21 @@ class UnreadableTakeTest(LibraryTestCase):
             library.MAX_EXPORT_SEGMENTS = saved
         assert response.status_code == 400
         assert response.json()["detail"].startswith("export: the query matches 7 segments")
+
+
+@pytest.mark.integration
+class PostgresSegmentListTest(LibraryTestCase):
+    """The same query count on PostgreSQL, where the library lives in production
+    (``make pytest`` runs the integration tests there)."""
+
+    def test_it_answers_with_three_queries_on_postgresql(self):
+        if connection.vendor != "postgresql":
+            pytest.skip("needs PostgreSQL: DATABASE_URL=postgres://… (make pytest sets it)")
+        self.two_reviews()
+        self.login(self.rachel)
+        for size in (1, 7):
+            with CaptureQueriesContext(connection) as queries:
+                response = self.client.get(f"/api/segments/?page_size={size}&label=walk&min_agreement=0")
+            assert response.status_code == 200
+            assert response.json()["count"] == 3
+            assert len(queries) == 3
