@@ -212,6 +212,9 @@ class Capture(Job):
         constraints = [
             models.UniqueConstraint(fields=["project", "checksum"], name="unique_capture_checksum")
         ]
+        # The capture list's order: a page is read from the index instead of sorting
+        # every visible capture.
+        indexes = [models.Index(fields=["-created_at", "-id"], name="capture_newest_first")]
 
     def __str__(self):
         return self.name
