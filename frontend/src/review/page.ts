@@ -4,16 +4,17 @@
 
 import { get, post } from "../api/client";
 import type { Capture, Cut, Label, Me, Project, Review, ReviewEvent, Signal, SignalResponse } from "../api/types";
-import { advance, frameOf, nextSpeed, seek, SPEEDS, togglePlay, type Playback } from "../player/clock";
+import { advance, frameOf, nextSpeed, seek, togglePlay, type Playback } from "../player/clock";
 import { SkeletonView } from "../player/skeletonView";
-import { clear, dialog, formatDuration, h, toast } from "../ui/dom";
+import { clear, dialog, h, toast } from "../ui/dom";
 import { icon } from "../ui/icons";
 import { FrameStore, loadFrames } from "./frames";
 import { changeFor, emptyHistory, record, redo, undo, type Change, type History } from "./history";
 import { commandFor, HELP, isTypingTarget, type Command } from "./keymap";
 import { Saver } from "./saver";
-import { applyEdit, clampFrame, describeDifferences, EditError, FATE_TEXT, neighbourCut, segmentAt, type Edit } from "./state";
-import { eventDetail } from "./events";
+import { applyEdit, clampFrame, describeDifferences, EditError, neighbourCut, segmentAt, type Edit } from "./state";
+import { buildLayout, type Elements } from "./layout";
+import { renderEvents, renderLabels, renderSelection, renderStats } from "./panels";
 import { Timeline } from "./timeline";
 import { formatTime } from "./timescale";
 
@@ -71,7 +72,7 @@ class ReviewPage {
   private readonly timeline: Timeline;
   private readonly abort = new AbortController();
   private readonly labels: Label[];
-  private readonly el: Record<string, HTMLElement> = {};
+  private readonly el: Elements;
   private readonly onKey = (e: KeyboardEvent) => this.handleKey(e);
 
   constructor(
@@ -92,7 +93,16 @@ class ReviewPage {
       failed: (r, unsaved, message) => this.onFailed(r, unsaved, message),
       busy: (n) => this.showSaveState(n),
     });
-    clear(root, this.build());
+    const layout = buildLayout(capture, me, {
+      command: (c) => this.command(c),
+      submit: () => void this.submit(),
+      help: () => this.toggleHelp(),
+      follow: () => this.toggleFollow(),
+      speed: (v) => this.setSpeed(v),
+      zoom: (factor) => this.timeline.zoom(factor, this.frame()),
+    });
+    this.el = layout.el;
+    clear(root, layout.root);
     this.player = this.makePlayer();
     this.timeline = new Timeline(this.el.timeline, {
       seek: (f) => this.seekTo(f),
@@ -122,104 +132,6 @@ class ReviewPage {
   }
 
   // ---- layout --------------------------------------------------------------------------
-
-  private build(): HTMLElement {
-    const c = this.capture;
-    const btn = (id: string, text: string | Node, title: string, action: () => void, extra = "") =>
-      (this.el[id] = h("button", { class: `btn ${extra}`, title, "data-testid": id, onclick: (e: Event) => {
-        // Keys belong to the editor, not to the last button clicked (Space would click it again).
-        (e.currentTarget as HTMLElement).blur();
-        action();
-      } }, text));
-    this.el.viewport = h("div", { class: "viewport", "data-testid": "viewport" });
-    this.el.hudFrame = h("div", { class: "hud-frame", "data-testid": "hud-frame" });
-    this.el.hudTime = h("div", { class: "hud-time", "data-testid": "hud-time" });
-    this.el.hudState = h("div", { class: "hud-state", "data-testid": "hud-state" });
-    this.el.loading = h("div", { class: "hud-loading", "data-testid": "frames-loading" });
-    this.el.loadingBar = h("div", { class: "hud-loading-bar" });
-    this.el.loading.append(this.el.loadingBar);
-    this.el.timeline = h("div", { class: "timeline", "data-testid": "timeline" });
-    this.el.saveState = h("span", { class: "save-state", "data-testid": "save-state" }, "Saved");
-    this.el.reviewPicker = h("span", { class: "review-picker" });
-    this.el.banner = h("div", { class: "readonly-banner", hidden: true, "data-testid": "readonly-banner" });
-    this.el.labels = h("div", { class: "label-list", "data-testid": "labels" });
-    this.el.selection = h("div", { class: "selection", "data-testid": "selection" });
-    this.el.stats = h("div", { class: "stats", "data-testid": "stats" });
-    this.el.events = h("ol", { class: "events", "data-testid": "events" });
-    this.el.speed = h(
-      "select",
-      { class: "select", title: "Playback speed ([ and ])", "data-testid": "speed", onchange: (e: Event) => {
-        const select = e.target as HTMLSelectElement;
-        select.blur();
-        this.setSpeed(Number(select.value));
-      } },
-      ...SPEEDS.map((s) => h("option", { value: s, selected: s === 1 }, `${s}×`)),
-    );
-    return h(
-      "div",
-      { class: "review-page" },
-      h(
-        "header",
-        { class: "topbar" },
-        h("a", { class: "brand", href: "/" }, "Cutroom"),
-        h("nav", { class: "crumbs" }, h("a", { href: "/" }, "Captures"), h("span", {}, "/"), h("strong", { "data-testid": "capture-name" }, c.name)),
-        h("span", { class: "meta" }, `${c.n_frames.toLocaleString()} frames · ${c.fps} fps · ${formatDuration(c.duration ?? c.n_frames / c.fps)} · ${c.format.toUpperCase()}`),
-        h("span", { class: "spacer" }),
-        this.el.reviewPicker,
-        this.el.saveState,
-        btn("submit", "Submit review", "Mark this review finished; it can no longer be edited", () => void this.submit(), "btn-primary"),
-        h("button", { class: "btn btn-ghost", title: "Keyboard shortcuts (?)", "data-testid": "help-button", onclick: () => this.toggleHelp() }, "?"),
-        h("span", { class: "user" }, this.me.username),
-      ),
-      this.el.banner,
-      h(
-        "div",
-        { class: "workspace" },
-        h("div", { class: "stage" }, this.el.viewport, h("div", { class: "hud" }, this.el.hudFrame, this.el.hudTime, this.el.hudState), this.el.loading),
-        h(
-          "aside",
-          { class: "side" },
-          h("section", {}, h("h3", {}, "Labels"), this.el.labels),
-          h("section", {}, h("h3", {}, "Selection"), this.el.selection),
-          h("section", {}, h("h3", {}, "Review"), this.el.stats),
-          h("section", { class: "grow" }, (this.el.eventsTitle = h("h3", {}, "Activity")), this.el.events),
-        ),
-      ),
-      h(
-        "div",
-        { class: "transport" },
-        h(
-          "div",
-          { class: "group" },
-          btn("prev-cut", icon("prevCut"), "Previous cut (Shift+←)", () => this.command({ kind: "jump", direction: -1 })),
-          btn("step-back", icon("stepBack"), "Previous frame (←)", () => this.command({ kind: "step", frames: -1 })),
-          btn("play", icon("play"), "Play / pause (Space)", () => this.command({ kind: "play" }), "btn-play"),
-          btn("step-forward", icon("stepForward"), "Next frame (→)", () => this.command({ kind: "step", frames: 1 })),
-          btn("next-cut", icon("nextCut"), "Next cut (Shift+→)", () => this.command({ kind: "jump", direction: 1 })),
-          this.el.speed,
-          btn("loop", "Loop", "Loop the segment under the playhead (L)", () => this.command({ kind: "loop" })),
-          btn("follow", "Follow", "Camera follows the root", () => this.toggleFollow(), "active"),
-        ),
-        h(
-          "div",
-          { class: "group" },
-          btn("accept", "Accept", "Accept the selected candidate (A)", () => this.command({ kind: "accept" })),
-          btn("delete", "Delete", "Delete the selected cut (D)", () => this.command({ kind: "delete" })),
-          btn("insert", "Insert", "Insert a cut at the playhead (I)", () => this.command({ kind: "insert" })),
-          btn("undo", "Undo", "Undo (Z)", () => this.command({ kind: "undo" })),
-          btn("redo", "Redo", "Redo (Shift+Z)", () => this.command({ kind: "redo" })),
-        ),
-        h(
-          "div",
-          { class: "group" },
-          btn("zoom-out", "−", "Zoom out (-)", () => this.timeline.zoom(1.5, this.frame())),
-          btn("zoom-fit", "Fit", "Show the whole take", () => this.timeline.zoom(1e9)),
-          btn("zoom-in", "+", "Zoom in (+)", () => this.timeline.zoom(1 / 1.5, this.frame())),
-        ),
-      ),
-      this.el.timeline,
-    );
-  }
 
   private makePlayer(): SkeletonView | null {
     try {
@@ -284,74 +196,10 @@ class ReviewPage {
   }
 
   private renderSide(): void {
-    this.renderLabels();
-    this.renderSelection();
-    const counts: Record<string, number> = { pending: 0, accepted: 0, moved: 0, inserted: 0, deleted: 0 };
-    for (const cut of this.review.cuts) counts[cut.origin === "inserted" && cut.fate !== "deleted" ? "inserted" : cut.fate]++;
-    const labelled = this.review.segments.filter((s) => s.label).length;
-    clear(
-      this.el.stats,
-      h("div", { class: "stat-grid" }, ...Object.entries(counts).map(([k, v]) => h("div", { class: `stat stat-${k}` }, h("b", {}, v), h("span", {}, k)))),
-      h("div", { class: "muted" }, `${labelled} of ${this.review.segments.length} segments labelled · version ${this.review.version} · ${this.review.status.replace("_", " ")}`),
-    );
-  }
-
-  private renderLabels(): void {
     const segment = segmentAt(this.review.segments, this.frame());
-    if (!this.labels.length) {
-      clear(this.el.labels, h("p", { class: "muted" }, "This project has no labels yet."));
-      return;
-    }
-    clear(
-      this.el.labels,
-      ...this.labels.map((label) =>
-        h(
-          "button",
-          {
-            class: `label-chip${segment?.label === label.name ? " current" : ""}`,
-            "data-testid": `label-${label.name}`,
-            disabled: this.locked() !== null,
-            title: `Label the segment under the playhead${label.hotkey ? ` (${label.hotkey})` : ""}`,
-            onclick: (e: Event) => {
-              (e.currentTarget as HTMLElement).blur();
-              this.labelCurrent(label.name);
-            },
-          },
-          h("span", { class: "swatch", style: `background:${label.color}` }),
-          h("span", { class: "name" }, label.name),
-          label.hotkey ? h("kbd", {}, label.hotkey) : null,
-        ),
-      ),
-    );
-  }
-
-  private renderSelection(): void {
-    const cut = this.selectedCut();
-    const segment = segmentAt(this.review.segments, this.frame());
-    const fps = this.capture.fps;
-    clear(
-      this.el.selection,
-      cut
-        ? h(
-            "div",
-            { class: "sel-cut", "data-testid": "selected-cut" },
-            h("div", {}, h("b", {}, `Cut at ${cut.frame}`), ` · ${formatTime(cut.frame, fps)}`),
-            h("div", { class: `fate fate-${cut.fate}` }, cut.origin === "inserted" ? "inserted" : FATE_TEXT[cut.fate]),
-            cut.candidate_frame !== null && cut.candidate_frame !== cut.frame ? h("div", { class: "muted" }, `proposed at ${cut.candidate_frame}`) : null,
-            cut.confidence !== null ? h("div", { class: "muted" }, `confidence ${(cut.confidence * 100).toFixed(0)} %`) : null,
-          )
-        : h("div", { class: "muted" }, "No cut selected: click one, or Shift+←/→."),
-      segment
-        ? h(
-            "div",
-            { class: "sel-seg", "data-testid": "current-segment" },
-            h("b", {}, `Segment ${segment.index + 1}`),
-            ` · ${segment.start}–${segment.stop} · ${formatDuration((segment.stop - segment.start) / fps)}`,
-            h("div", {}, segment.label ? `labelled ${segment.label}` : h("span", { class: "muted" }, "unlabelled")),
-            !segment.label && segment.suggested_label ? h("div", { class: "muted", "data-testid": "suggested-label" }, `suggested: ${segment.suggested_label} (S accepts)`) : null,
-          )
-        : null,
-    );
+    renderLabels(this.el.labels, this.labels, segment?.label ?? null, this.locked() !== null, (name) => this.labelCurrent(name));
+    renderSelection(this.el.selection, this.selectedCut(), segment, this.capture.fps);
+    renderStats(this.el.stats, this.review);
   }
 
   private selectedCut(): Cut | undefined {
@@ -535,6 +383,12 @@ class ReviewPage {
   }
 
   private command(c: Command): void {
+    if (!this.editCommand(c)) this.viewCommand(c);
+    this.refresh();
+  }
+
+  /** Playback, navigation and view commands. */
+  private viewCommand(c: Command): void {
     const frame = this.frame();
     switch (c.kind) {
       case "play":
@@ -543,52 +397,21 @@ class ReviewPage {
         if (this.playback.playing) this.raf = requestAnimationFrame(this.tick);
         break;
       case "step":
-        this.playback = { ...seek(this.playback, clampFrame(frame + c.frames, this.capture.n_frames)), playing: false };
+      case "home":
+      case "end": {
+        const target = c.kind === "step" ? frame + c.frames : c.kind === "home" ? 0 : this.capture.n_frames - 1;
+        this.playback = { ...seek(this.playback, clampFrame(target, this.capture.n_frames)), playing: false };
         this.timeline.reveal(this.frame());
         break;
+      }
       case "jump": {
         const cut = neighbourCut(this.review.cuts, frame, c.direction);
-        if (cut) {
-          this.playback = { ...seek(this.playback, cut.frame), playing: false };
-          this.selectedCutId = cut.id;
-          this.timeline.reveal(cut.frame);
-        }
+        if (!cut) break;
+        this.playback = { ...seek(this.playback, cut.frame), playing: false };
+        this.selectedCutId = cut.id;
+        this.timeline.reveal(cut.frame);
         break;
       }
-      case "accept":
-      case "delete": {
-        const cut = this.selectedCut();
-        if (!cut) toast("Select a cut first: click it, or jump to it with Shift+←/→.");
-        // Accepting a kept cut would only rewrite its fate (and lose "moved"): say so instead.
-        else if (c.kind === "accept" && cut.fate !== "pending") toast(`The cut at ${cut.frame} is already kept (${cut.origin === "inserted" ? "inserted" : cut.fate}).`);
-        else this.perform({ kind: "fate", cutId: cut.id, fate: c.kind === "accept" ? "accepted" : "deleted" });
-        if (cut && c.kind === "delete") this.selectedCutId = null;
-        break;
-      }
-      case "insert":
-        this.perform({ kind: "insert", frame, tempId: this.nextTempId-- });
-        break;
-      case "label": {
-        const label = this.labels.find((l) => l.hotkey === c.hotkey) ?? (this.labels.some((l) => l.hotkey) ? undefined : this.labels[Number(c.hotkey) - 1]);
-        if (label) this.labelCurrent(label.name);
-        else toast(`No label has hotkey ${c.hotkey}.`);
-        break;
-      }
-      case "clearLabel":
-        this.labelCurrent(null);
-        break;
-      case "acceptSuggestion": {
-        const suggested = segmentAt(this.review.segments, frame)?.suggested_label;
-        if (suggested) this.labelCurrent(suggested);
-        else toast("No suggested label for the segment under the playhead.");
-        break;
-      }
-      case "undo":
-        if (!this.locked()) this.replay(undo(this.history, this.review, this.saver.resolve), "undo");
-        break;
-      case "redo":
-        if (!this.locked()) this.replay(redo(this.history, this.review, this.saver.resolve), "redo");
-        break;
       case "loop": {
         const segment = segmentAt(this.review.segments, frame);
         this.playback = { ...this.playback, loop: this.playback.loop || !segment ? null : { start: segment.start, stop: segment.stop } };
@@ -600,11 +423,6 @@ class ReviewPage {
       case "zoom":
         this.timeline.zoom(c.factor, frame);
         break;
-      case "home":
-      case "end":
-        this.playback = seek(this.playback, c.kind === "home" ? 0 : this.capture.n_frames - 1);
-        this.timeline.reveal(this.frame());
-        break;
       case "help":
         this.toggleHelp();
         break;
@@ -613,7 +431,49 @@ class ReviewPage {
         else this.selectedCutId = null;
         break;
     }
-    this.refresh();
+  }
+
+  /** Commands that change the review; false if `c` is not one of them. */
+  private editCommand(c: Command): boolean {
+    const segment = segmentAt(this.review.segments, this.frame());
+    switch (c.kind) {
+      case "accept":
+      case "delete":
+        this.changeSelectedCut(c.kind);
+        return true;
+      case "insert":
+        this.perform({ kind: "insert", frame: this.frame(), tempId: this.nextTempId-- });
+        return true;
+      case "label": {
+        // Labels without hotkeys answer to their position in the taxonomy instead.
+        const label = this.labels.find((l) => l.hotkey === c.hotkey) ?? (this.labels.some((l) => l.hotkey) ? undefined : this.labels[Number(c.hotkey) - 1]);
+        if (label) this.labelCurrent(label.name);
+        else toast(`No label has hotkey ${c.hotkey}.`);
+        return true;
+      }
+      case "clearLabel":
+        this.labelCurrent(null);
+        return true;
+      case "acceptSuggestion":
+        if (segment?.suggested_label) this.labelCurrent(segment.suggested_label);
+        else toast("No suggested label for the segment under the playhead.");
+        return true;
+      case "undo":
+      case "redo":
+        if (!this.locked()) this.replay((c.kind === "undo" ? undo : redo)(this.history, this.review, this.saver.resolve), c.kind);
+        return true;
+      default:
+        return false;
+    }
+  }
+
+  private changeSelectedCut(action: "accept" | "delete"): void {
+    const cut = this.selectedCut();
+    if (!cut) toast("Select a cut first: click it, or jump to it with Shift+←/→.");
+    // Accepting a kept cut would only rewrite its fate (and lose "moved"): say so instead.
+    else if (action === "accept" && cut.fate !== "pending") toast(`The cut at ${cut.frame} is already kept (${cut.origin === "inserted" ? "inserted" : cut.fate}).`);
+    else this.perform({ kind: "fate", cutId: cut.id, fate: action === "accept" ? "accepted" : "deleted" });
+    if (cut && action === "delete") this.selectedCutId = null;
   }
 
   private select(id: number | null): void {
@@ -646,20 +506,7 @@ class ReviewPage {
     if (this.readOnly) return;
     const events = await get<ReviewEvent[] | { results: ReviewEvent[] }>(`/api/captures/${this.capture.id}/review/events/`).catch(() => null);
     if (!events) return;
-    const list = listOf(events).slice().reverse();
-    clear(
-      this.el.events,
-      ...list.map((e) =>
-        h(
-          "li",
-          { "data-action": e.action },
-          h("span", { class: "ev-action" }, e.action.replace(/_/g, " ")),
-          h("span", { class: "ev-detail" }, eventDetail(e)),
-          h("time", { datetime: e.created_at, title: e.created_at }, new Date(e.created_at).toLocaleTimeString()),
-        ),
-      ),
-    );
-    if (!list.length) this.el.events.append(h("li", { class: "muted" }, "No edits yet."));
+    renderEvents(this.el.events, listOf(events));
   }
 
   private async loadOtherReviews(): Promise<void> {

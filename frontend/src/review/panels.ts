@@ -1,0 +1,90 @@
+// The side panels of the review page, each redrawn whole from the current state.
+
+import type { Cut, Label, Review, ReviewEvent, Segment } from "../api/types";
+import { clear, formatDuration, h } from "../ui/dom";
+import { eventDetail } from "./events";
+import { FATE_TEXT } from "./state";
+import { formatTime } from "./timescale";
+
+export function renderLabels(el: HTMLElement, labels: Label[], current: string | null, disabled: boolean, pick: (name: string) => void): void {
+  if (!labels.length) {
+    clear(el, h("p", { class: "muted" }, "This project has no labels yet."));
+    return;
+  }
+  const chip = (label: Label) =>
+    h(
+      "button",
+      {
+        class: `label-chip${current === label.name ? " current" : ""}`,
+        "data-testid": `label-${label.name}`,
+        disabled,
+        title: `Label the segment under the playhead${label.hotkey ? ` (${label.hotkey})` : ""}`,
+        onclick: (e: Event) => {
+          (e.currentTarget as HTMLElement).blur();
+          pick(label.name);
+        },
+      },
+      h("span", { class: "swatch", style: `background:${label.color}` }),
+      h("span", { class: "name" }, label.name),
+      label.hotkey ? h("kbd", {}, label.hotkey) : null,
+    );
+  clear(el, ...labels.map(chip));
+}
+
+export function renderSelection(el: HTMLElement, cut: Cut | undefined, segment: Segment | undefined, fps: number): void {
+  clear(
+    el,
+    cut ? cutPanel(cut, fps) : h("div", { class: "muted" }, "No cut selected: click one, or Shift+←/→."),
+    segment ? segmentPanel(segment, fps) : null,
+  );
+}
+
+function cutPanel(cut: Cut, fps: number): HTMLElement {
+  return h(
+    "div",
+    { class: "sel-cut", "data-testid": "selected-cut" },
+    h("div", {}, h("b", {}, `Cut at ${cut.frame}`), ` · ${formatTime(cut.frame, fps)}`),
+    h("div", { class: `fate fate-${cut.fate}` }, cut.origin === "inserted" ? "inserted" : FATE_TEXT[cut.fate]),
+    cut.candidate_frame !== null && cut.candidate_frame !== cut.frame ? h("div", { class: "muted" }, `proposed at ${cut.candidate_frame}`) : null,
+    cut.confidence !== null ? h("div", { class: "muted" }, `confidence ${(cut.confidence * 100).toFixed(0)} %`) : null,
+  );
+}
+
+function segmentPanel(segment: Segment, fps: number): HTMLElement {
+  return h(
+    "div",
+    { class: "sel-seg", "data-testid": "current-segment" },
+    h("b", {}, `Segment ${segment.index + 1}`),
+    ` · ${segment.start}–${segment.stop} · ${formatDuration((segment.stop - segment.start) / fps)}`,
+    h("div", {}, segment.label ? `labelled ${segment.label}` : h("span", { class: "muted" }, "unlabelled")),
+    !segment.label && segment.suggested_label
+      ? h("div", { class: "muted", "data-testid": "suggested-label" }, `suggested: ${segment.suggested_label} (S accepts)`)
+      : null,
+  );
+}
+
+/** Cut counts by fate (inserted cuts counted apart) and how much is labelled. */
+export function renderStats(el: HTMLElement, review: Review): void {
+  const counts: Record<string, number> = { pending: 0, accepted: 0, moved: 0, inserted: 0, deleted: 0 };
+  for (const cut of review.cuts) counts[cut.origin === "inserted" && cut.fate !== "deleted" ? "inserted" : cut.fate]++;
+  const labelled = review.segments.filter((s) => s.label).length;
+  clear(
+    el,
+    h("div", { class: "stat-grid" }, ...Object.entries(counts).map(([k, v]) => h("div", { class: `stat stat-${k}` }, h("b", {}, v), h("span", {}, k)))),
+    h("div", { class: "muted" }, `${labelled} of ${review.segments.length} segments labelled · version ${review.version} · ${review.status.replace("_", " ")}`),
+  );
+}
+
+/** The audit log, newest first. */
+export function renderEvents(el: HTMLElement, events: ReviewEvent[]): void {
+  const item = (e: ReviewEvent) =>
+    h(
+      "li",
+      { "data-action": e.action },
+      h("span", { class: "ev-action" }, e.action.replace(/_/g, " ")),
+      h("span", { class: "ev-detail" }, eventDetail(e)),
+      h("time", { datetime: e.created_at, title: e.created_at }, new Date(e.created_at).toLocaleTimeString()),
+    );
+  clear(el, ...events.slice().reverse().map(item));
+  if (!events.length) el.append(h("li", { class: "muted" }, "No edits yet."));
+}
