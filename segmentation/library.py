@@ -10,6 +10,7 @@ whenever another review of the capture comes in). Each row carries its motion de
 import csv
 import io
 import json
+import logging
 import re
 import zipfile
 from collections import Counter
@@ -27,6 +28,8 @@ from motionlib import agreement as metrics
 from motionlib import similarity
 from segmentation import agreement, storage
 from segmentation.models_library import Adjudication, LibrarySegment
+
+log = logging.getLogger(__name__)
 
 # Similar clips and suggestions search at most this many of a project's recent segments.
 SIMILAR_POOL = 20000
@@ -70,12 +73,18 @@ def descriptors(capture, spans):
     joints = capture_joints(capture) if capture.positions else None
     if joints is None:
         return [None] * len(spans)
-    positions = np.asarray(storage.load_npy(capture.positions), dtype=float)
-    scale = similarity.body_scale(positions, joints)
-    return [
-        similarity.segment_descriptor(positions, joints, start, stop, fps=capture.fps, scale=scale)
-        for start, stop in spans
-    ]
+    try:
+        positions = np.asarray(storage.load_npy(capture.positions), dtype=float)
+        scale = similarity.body_scale(positions, joints)
+        return [
+            similarity.segment_descriptor(positions, joints, start, stop, fps=capture.fps, scale=scale)
+            for start, stop in spans
+        ]
+    except (OSError, ValueError) as exc:
+        # A lost positions file must not stop a review from being submitted; the segments
+        # are still listed and exported, only similarity has nothing to go on.
+        log.warning("no motion descriptors for capture %s: %s", capture.pk, exc)
+        return [None] * len(spans)
 
 
 def store_descriptor(segment, descriptor):

@@ -218,3 +218,20 @@ class PostgresSegmentListTest(LibraryTestCase):
             assert response.status_code == 200
             assert response.json()["count"] == 3
             assert len(queries) == 3
+
+
+class LostPositionsTest(LibraryTestCase):
+    def test_it_still_submits_a_review_when_the_positions_file_is_gone(self):
+        from pathlib import Path
+
+        from motionlib import synth
+
+        capture = self.ready_capture()
+        # A skeleton that maps to body parts, so the library does try to read positions.
+        take, _ = synth.generate(seed=0, fps=120.0, duration=2.0)
+        capture.skeleton = {**capture.skeleton, "joints": list(take.skeleton.names)}
+        capture.save()
+        Path(capture.positions.path).unlink()
+        submit_review(capture, self.bob, [100], ["walk", "punch"])
+        rows = LibrarySegment.objects.order_by("start")
+        assert [(r.label_name, r.descriptor) for r in rows] == [("walk", None), ("punch", None)]
