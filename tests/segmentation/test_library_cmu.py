@@ -127,7 +127,10 @@ class ExportTest(CmuLibraryTestCase):
 
     def test_it_puts_every_matching_segment_in_the_zip(self):
         response = self.client.get(f"/api/segments/export.zip?capture={self.capture.pk}")
-        names = zipfile.ZipFile(io.BytesIO(b"".join(response.streaming_content))).namelist()
+        chunks = list(response.streaming_content)
+        # Streamed: a chunk per segment as it is written, then the manifests.
+        assert len(chunks) == 6 + 1 and all(chunks[:6])
+        names = zipfile.ZipFile(io.BytesIO(b"".join(chunks))).namelist()
         assert len(names) == 6 + 2
         assert "13_29_JumpJack_1-469.bvh" in names
 
