@@ -289,6 +289,9 @@ def main():
         worst = 0.0
         for label, path in paths:
             target = f"http://127.0.0.1:{port}{path}"
+            # Unmeasured warm-up: every gunicorn thread opens its database connection.
+            if tool == "wrk":
+                run_wrk(target, token, 2, args.connections, script)
             if tool == "wrk":
                 row = run_wrk(target, token, args.seconds, args.connections, script)
             else:
