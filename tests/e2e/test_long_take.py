@@ -59,6 +59,8 @@ def test_it_opens_a_ten_minute_take_in_under_two_seconds_and_plays_it(live_serve
     loading = page.get_by_test_id("frames-loading")
     expect(loading).to_have_attribute("data-done", re.compile(r"^\d+$"), timeout=30_000)
     print(f"all {N_FRAMES} frames loaded after {loading.get_attribute('data-done')} ms")
+    # Then the feature signal is fetched again at full resolution (first paint used ~4,000 points).
+    expect(page.get_by_test_id("timeline")).to_have_attribute("data-signal-step", "1")
 
     # Scrub across the whole take on the ruler: the frame readout follows the pointer.
     box = page.locator("[data-testid=timeline] canvas").bounding_box()

@@ -81,7 +81,7 @@ class ReviewPage {
     private readonly me: Me,
     private readonly project: Project | null,
     review: Review,
-    private readonly signals: Signal[],
+    private signals: Signal[],
   ) {
     this.review = review;
     this.own = review;
@@ -117,7 +117,7 @@ class ReviewPage {
     });
     this.store = new FrameStore(capture.n_frames, capture.n_joints || capture.skeleton!.joints.length);
     const started = performance.now();
-    void loadFrames(capture.id, this.store, 0, () => this.onFramesLoaded(started), this.abort.signal);
+    void loadFrames(capture.id, this.store, 0, () => this.onFramesLoaded(started), this.abort.signal).then(() => this.loadFullSignals());
     document.addEventListener("keydown", this.onKey);
     this.refresh();
     void this.loadEvents();
@@ -225,6 +225,19 @@ class ReviewPage {
     }
     this.shownFrame = -1;
     this.showFrame(this.frame());
+  }
+
+  /**
+   * The first paint uses signals decimated to a few thousand points; once the poses are
+   * in, fetch them at full frame resolution so zooming in shows every frame.
+   */
+  private async loadFullSignals(): Promise<void> {
+    if (this.abort.signal.aborted || !this.signals.some((sig) => sig.step > 1)) return;
+    const full = await get<SignalResponse>(`/api/captures/${this.capture.id}/signal/?max_points=${this.capture.n_frames}`).catch(() => null);
+    if (!full || this.abort.signal.aborted) return;
+    this.signals = full.signals;
+    this.el.timeline.dataset.signalStep = String(Math.max(1, ...this.signals.map((sig) => sig.step)));
+    this.refresh();
   }
 
   // ---- editing -------------------------------------------------------------------------
