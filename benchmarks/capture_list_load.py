@@ -256,6 +256,12 @@ def run_python_client(url, token, seconds, connections):
     return p50, p95, p99, len(ms) / (time.monotonic() - started), errors[0]
 
 
+def load(tool, url, token, seconds, connections, script):
+    if tool == "wrk":
+        return run_wrk(url, token, seconds, connections, script)
+    return run_python_client(url, token, seconds, connections)
+
+
 def main():
     args = parse_args()
     name = f"cutroom_bench_captures_{os.getpid()}"
@@ -289,14 +295,10 @@ def main():
         worst = 0.0
         for label, path in paths:
             target = f"http://127.0.0.1:{port}{path}"
-            # Unmeasured warm-up: every gunicorn thread opens its database connection.
-            if tool == "wrk":
-                run_wrk(target, token, 2, args.connections, script)
-            if tool == "wrk":
-                row = run_wrk(target, token, args.seconds, args.connections, script)
-            else:
-                row = run_python_client(target, token, args.seconds, args.connections)
-            p50, p95, p99, rate, errors = row
+            load(tool, target, token, 2, args.connections, script)  # warm-up, not measured
+            p50, p95, p99, rate, errors = load(
+                tool, target, token, args.seconds, args.connections, script
+            )
             worst = max(worst, p95)
             print(f"{label:<20} {costs[path][0]:>7} {costs[path][1]:>7.1f} {p50:>8.1f} {p95:>8.1f} {p99:>8.1f} "
                   f"{rate:>8.1f} {errors:>6}")
