@@ -124,6 +124,13 @@ class ClaimQuerySet(models.QuerySet):
         limit = timezone.now() - timezone.timedelta(seconds=settings.CUTROOM_CLAIM_TIMEOUT)
         return self.filter(status="processing", claimed_at__lt=limit)
 
+    def requeue_failed(self, pk):
+        """Put a failed job back in the queue with a fresh attempt count; 0 rows updated
+        means it was not failed (a concurrent retry, or nothing to retry)."""
+        return self.filter(pk=pk, status="failed").update(
+            status="queued", error="", claim_token="", claimed_at=timezone.now(), attempts=0
+        ) == 1
+
     def waiting_too_long(self):
         """Queued rows nobody claimed within the claim timeout: their message may be lost
         (broker down at upload time, queue purged), so they are sent again."""

@@ -118,6 +118,15 @@ class CaptureViewSet(
             "dtype": "float32", "data": base64.b64encode(block.tobytes()).decode("ascii"),
         })
 
+    @extend_schema(request=None, responses=CaptureSerializer)
+    @action(detail=True, methods=["post"])
+    def retry(self, request, pk=None):
+        """Queue a failed capture's ingest again from its stored original."""
+        capture = self.get_object()
+        services.do_retry_capture(capture)
+        capture.refresh_from_db()
+        return Response(CaptureSerializer(capture).data, status=202)
+
     @extend_schema(request=RunRequestSerializer, responses=RunSerializer(many=True))
     @action(detail=True, methods=["get", "post"], serializer_class=RunRequestSerializer)
     def runs(self, request, pk=None):

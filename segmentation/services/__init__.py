@@ -7,6 +7,7 @@ once their transaction commits, so a worker never sees a row that is not there y
 from segmentation.services.captures import (
     default_method,
     detect_run,
+    do_retry_capture,
     do_start_run,
     do_upload_capture,
     ingest_capture,
@@ -34,6 +35,7 @@ __all__ = [
     "do_create_project",
     "do_insert_cut",
     "do_label_segment",
+    "do_retry_capture",
     "do_set_member",
     "do_start_run",
     "do_submit_review",

@@ -82,6 +82,10 @@ def do_upload_capture(project, user, upload, asf=None):
     digest = checksum(upload, asf)
     existing = Capture.objects.filter(project=project, checksum=digest).first()
     if existing:
+        if existing.status == "failed":
+            # Uploading a failed take again is the natural way to ask for another try.
+            do_retry_capture(existing)
+            existing.refresh_from_db()
         return existing, False
     capture = Capture(project=project, uploaded_by=user, name=upload.name, format=fmt)
     capture.checksum = digest
@@ -96,6 +100,21 @@ def do_upload_capture(project, user, upload, asf=None):
         # The same file arrived twice at once; the other request stored it.
         return Capture.objects.get(project=project, checksum=digest), False
     return capture, True
+
+
+def do_retry_capture(capture):
+    """Queue the ingest of a failed capture again, from its stored original.
+
+    For a failure that was not the file's fault (a worker lost too often, storage down,
+    a parser bug since fixed); the error of the last try is cleared when it is queued.
+    """
+    with transaction.atomic():
+        if not Capture.objects.requeue_failed(capture.pk):
+            capture.refresh_from_db(fields=["status"])
+            raise NotReady(
+                f"capture {capture.pk} is {capture.status}; only a failed capture can be retried"
+            )
+        _enqueue("ingest", capture.pk)
 
 
 def do_start_run(capture, user, method, params):
