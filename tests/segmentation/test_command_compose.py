@@ -41,11 +41,20 @@ def test_every_variable_given_to_the_app_is_read_by_the_settings():
         assert not unknown, f"{name} sets variables nothing reads: {sorted(unknown)}"
 
 
+def documented():
+    return set(re.findall(r"^([A-Z][A-Z0-9_]+)=", (REPO / ".env.example").read_text(), re.M))
+
+
 def test_every_variable_given_to_the_app_is_documented_in_env_example():
-    documented = set(re.findall(r"^([A-Z][A-Z0-9_]+)=", (REPO / ".env.example").read_text(), re.M))
     for name in APP_SERVICES:
-        missing = set(compose()["services"][name]["environment"]) - documented
-        assert not missing - {"WEB_CONCURRENCY"}, f"{name}: {sorted(missing)}"
+        missing = set(compose()["services"][name]["environment"]) - documented()
+        assert not missing, f"{name}: {sorted(missing)}"
+
+
+def test_every_variable_the_compose_file_reads_is_documented_in_env_example():
+    used = set(re.findall(r"\$\{([A-Z][A-Z0-9_]+)", (REPO / "docker-compose.yml").read_text()))
+    assert {"SECRET_KEY", "POSTGRES_PASSWORD", "WORKER_CONCURRENCY"} <= used
+    assert not used - documented(), sorted(used - documented())
 
 
 def test_the_secret_key_must_be_set_rather_than_defaulted():
