@@ -17,6 +17,7 @@ from __future__ import annotations
 import numpy as np
 
 _POW10 = 10.0 ** np.arange(64)
+_DOT_SCALE = np.concatenate([[1.0], _POW10[:-1]])  # by dot position from the right: 10**(p-1)
 _EXACT = 2.0**53  # integers below this are exact in float64
 _MAX_TOKEN = 32
 _MAX_POWER = 22  # 10**22 is the largest power of ten that float64 holds exactly
@@ -176,12 +177,18 @@ def _finish_plain(w: _Walk, length, b, first):
         return None
     if np.any(length <= has_dot + has_sign.view(np.uint8)):  # no digit at all
         return None
-    frac = w.dot.astype(np.intp)
-    frac -= has_dot
-    values = _drop_marker(w.total, frac, has_dot)
-    values /= _POW10[frac]
-    values[first == 45] *= -1
-    return values, w.total >= _EXACT
+    # total = 10*I*P + F with P = 10**(dot-1), F the fraction digits and I the integer part,
+    # so the mantissa I*P + F is (total + 9*F) / 10, exact while below 2**53. Without a dot,
+    # P = 10**63 (index -1) makes F = total and the mantissa total itself.
+    fraction = _below(w.total, w.dot.astype(np.intp) - 1)
+    mantissa = fraction
+    mantissa *= 9
+    mantissa += w.total
+    inexact = mantissa >= _EXACT
+    mantissa /= 10
+    mantissa /= _DOT_SCALE[w.dot]
+    mantissa[first == 45] *= -1
+    return mantissa, inexact
 
 
 def _below(total: np.ndarray, digits: np.ndarray) -> np.ndarray:
