@@ -216,6 +216,8 @@ def best_split(x: np.ndarray, cut: int, lo: int, hi: int, *, step: int, radius: 
     ``x`` is averaged into blocks of ``step`` frames first, so the split is found to
     within one block; ``cut`` itself is returned when no block boundary is in reach.
     """
+    if hi - lo < 2 * step:  # not two blocks: nothing to split
+        return cut
     blocks = block_mean(x[lo:hi], step)
     frames = lo + step * np.arange(1, len(blocks))
     near = np.abs(frames - cut) <= radius

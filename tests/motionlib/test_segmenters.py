@@ -170,3 +170,79 @@ def test_it_handles_takes_too_short_to_cut(name, n_frames, synth_takes):
     assert all(len(s) == n_frames for s in result.signals.values())
     if name == "default":
         assert len(result.cuts) == 0  # 1.7 s is shorter than one minimum segment
+
+
+def test_it_scores_every_split_by_the_kernel_variance_it_leaves():
+    from motionlib.segmenters.default import split_gains
+
+    x = np.random.default_rng(0).standard_normal((23, 4))
+    gamma = 0.3
+    k = np.exp(-gamma * ((x[:, None] - x[None, :]) ** 2).sum(axis=-1))
+
+    def within_variance(t):  # slow oracle: each segment's kernel variance, summed
+        return sum(
+            len(idx) - k[np.ix_(idx, idx)].sum() / len(idx)
+            for idx in (np.arange(t), np.arange(t, len(x)))
+        )
+
+    expected = [len(x) - within_variance(t) for t in range(1, len(x))]
+    np.testing.assert_allclose(split_gains(x, gamma), expected, rtol=1e-12)
+
+
+@pytest.mark.parametrize("step", [1, 4])
+def test_it_splits_two_pose_distributions_where_they_meet(step):
+    from motionlib.segmenters.default import best_split
+
+    rng = np.random.default_rng(1)
+    x = np.concatenate([rng.normal(0.0, 1.0, (400, 3)), rng.normal(1.5, 1.0, (400, 3))])
+    split = best_split(x, 380, 100, 700, step=step, radius=60, gamma=0.2)
+    assert abs(split - 400) <= step
+
+
+def test_it_searches_for_the_split_only_within_the_radius():
+    from motionlib.segmenters.default import best_split
+
+    x = np.concatenate([np.zeros((100, 2)), np.ones((100, 2))])
+    assert best_split(x, 150, 0, 200, step=1, radius=20, gamma=1.0) == 130
+    assert best_split(x, 150, 149, 151, step=4, radius=20, gamma=1.0) == 150  # too short
+
+
+def test_it_finds_the_turning_points_of_a_periodic_movement():
+    from motionlib.segmenters.default import turning_points
+
+    fps = 120.0
+    t = np.arange(int(4 * fps)) / fps
+    x = np.stack([np.sin(2 * np.pi * 0.5 * t), np.zeros_like(t)], axis=1)  # a 2 s swing
+    # The swing stops at its extremes, every second from 0.5 s on.
+    np.testing.assert_array_equal(turning_points(x, fps=fps), [60, 180, 300, 420])
+
+
+def test_it_moves_a_cut_to_the_nearest_turning_point_within_reach():
+    from motionlib.segmenters.default import nearest
+
+    points = np.array([100, 180, 260])
+    assert nearest(points, 200, radius=30) == 180
+    assert nearest(points, 220, radius=30) == 220  # both are 40 frames away
+    assert nearest(np.zeros(0, np.int64), 220, radius=30) == 220
+
+
+@pytest.mark.parametrize("fps", [120.0, 30.0])
+def test_it_places_synthetic_cuts_close_to_the_truth(fps):
+    errors = []
+    for seed in range(3):
+        take, segments = synth.generate(seed=seed, fps=fps)
+        truth = [start for start, _, _ in segments[1:]]
+        cuts = get_segmenter("default")().fit_predict(take).cuts
+        errors.append(metrics.median_error_s(cuts, truth, fps=fps))
+    # The truth is the middle of a 0.5 s cross-fade; the cut goes to where the motion
+    # turns, at most a quarter of a ~1 s movement cycle away.
+    assert np.mean(errors) <= 0.3
+
+
+@pytest.mark.parametrize("fps", [120.0, 10.0])
+def test_it_places_cuts_with_the_finest_allowed_parameters(fps):
+    take, _ = synth.generate(seed=0, fps=fps)
+    params = {"min_segment_s": 0.1, "rate_hz": 60.0, "scale_min_s": 0.2, "scale_max_s": 0.2}
+    result = get_segmenter("default")(**params).fit_predict(take)
+    assert len(result.cuts) > 0
+    assert np.all((result.cuts >= 0) & (result.cuts < take.n_frames))

@@ -51,3 +51,16 @@ def test_it_cuts_the_labelled_takes_with_fewer_edits_than_the_bone_angle_method(
             for method in ("default", "bone_angle")
         }
         assert edits["default"] < edits["bone_angle"], name
+
+
+def test_it_places_cuts_on_the_labelled_takes_within_0_15_s_median(takes):
+    rows = [
+        metrics.evaluate(get_segmenter("default")().fit_predict(take).cuts, labelled.truth,
+                         fps=take.fps)
+        for labelled, take in takes.values()
+    ]
+    mean = {key: np.mean([row[key] for row in rows]) for key in rows[0]}
+    # Issue #3's targets, means over the three takes with default parameters.
+    assert mean["median_error_s"] <= 0.15
+    assert mean["f1@1s"] >= 0.9
+    assert mean["edits_per_cut"] <= 0.5
