@@ -38,18 +38,21 @@ repeats every second or so; a boundary is where that distribution changes. So:
       its typical value around the cut), the cut moves to that pause, where
       annotators cut too (``settle_frame``).
 
-   Tried on the three labelled CMU takes and the synthetic takes, choosing only
-   between these principled settings: the split alone (a) places synthetic cuts
-   within 0.05 s (their truth is the middle of a cross-fade, a statistical midpoint)
-   but real ones 0.24 s off (median), worse than before, because annotators cut
-   between movements, not at the midpoint of the statistics; (a)+(b) takes the real
-   median error to 0.09 s (synthetic 0.19 s: the turning point lies up to a quarter
-   cycle from the cross-fade's middle); (c) then fixes one more real cut (fewer
-   edits, same median). Not kept: the turning point with the best split statistic
-   instead of the nearest (0.19 s), joint velocities in the split statistic (no
-   gain), a linear (mean-pose) cost instead of the kernel (0.54 s: periodic
-   activities share a mean pose), and the full frame rate for the split (same
-   result, seven times the time).
+   Tried on the three labelled CMU takes (mean of the per-take median cut errors; it
+   was 0.23 s with the peak moved only to a pause) and on synthetic takes, choosing
+   only between these principled settings, with no per-take or per-count knowledge:
+   the split alone (a) places synthetic cuts within 0.05 s (their truth is the
+   middle of a cross-fade, a statistical midpoint) but real ones 0.24 s off, because
+   annotators cut between movements, not at the midpoint of the statistics; (a)+(b)
+   takes the real error to 0.09 s; (c) then fixes one more real cut (fewer edits,
+   same median). On synthetic takes (10 seeds at 120, 60 and 30 fps) F1 is unchanged
+   and the median error stays about where it was (0.22 -> 0.24 s): there the turning
+   point lies up to a quarter cycle from the cross-fade's middle. Not kept: the
+   turning point with the best split statistic instead of the nearest (0.19 s),
+   joint velocities in the split statistic (no gain), a linear (mean-pose) cost
+   instead of the kernel (0.54 s: periodic activities share a mean pose), a context
+   of ``scale_max_s`` instead of ``scale_min_s`` (same or worse), and the native
+   frame rate for the split (same result, several times the time).
 
 All durations are in seconds, so the same defaults work at any frame rate.
 """
