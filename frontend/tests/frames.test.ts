@@ -38,6 +38,15 @@ describe("planChunks", () => {
     covered.slice(1).forEach((c, i) => expect(c.start).toBe(covered[i].stop));
   });
 
+  it("test_it_asks_for_a_small_head_first_then_the_rest_of_its_chunk", () => {
+    expect(planChunks(72000, 0, 5000, 600).slice(0, 3)).toEqual([{ start: 0, stop: 600 }, { start: 600, stop: 5000 }, { start: 5000, stop: 10000 }]);
+    const mid = planChunks(30000, 12345, 5000, 600);
+    expect(mid.slice(0, 3)).toEqual([{ start: 12345, stop: 12945 }, { start: 10000, stop: 12345 }, { start: 12945, stop: 15000 }]);
+    const covered = mid.slice().sort((a, b) => a.start - b.start);
+    covered.slice(1).forEach((c, i) => expect(c.start).toBe(covered[i].stop));
+    expect(planChunks(400, 0, 5000, 600)).toEqual([{ start: 0, stop: 400 }]);
+  });
+
   it("test_it_fetches_the_chunk_under_the_playhead_first_then_its_neighbours", () => {
     expect(planChunks(30000, 12345).slice(0, 3).map((c) => c.start)).toEqual([10000, 5000, 15000]);
   });

@@ -5,7 +5,7 @@ import { get } from "../api/client";
 import type { Capture, Me, Page, Project } from "../api/types";
 import { clear, formatDuration, h, toast } from "../ui/dom";
 import { navigate } from "../router";
-import { pairFiles, upload } from "./upload";
+import { pairFiles, upload, type UploadItem } from "./upload";
 
 const STATUSES = ["", "queued", "processing", "ready", "failed"];
 
@@ -64,23 +64,27 @@ export async function renderCaptureList(root: HTMLElement): Promise<() => void> 
     problems.forEach((p) => toast(p, "error"));
     for (const item of items) {
       const bar = h("div", { class: "bar" });
-      const state = h("span", { class: "state" }, "0 %");
-      const row = h("div", { class: "upload" }, h("span", { class: "name" }, item.file.name), h("div", { class: "progress" }, bar), state);
-      uploads.append(row);
-      upload(item, project, (share) => {
+      const state = h("span", { class: "state" }, "waiting");
+      uploads.append(h("div", { class: "upload" }, h("span", { class: "name" }, item.file.name), h("div", { class: "progress" }, bar), state));
+      // One upload at a time: the first file is ready sooner than if all shared the line.
+      uploadChain = uploadChain.then(() => sendOne(item, project, bar, state));
+    }
+  };
+  let uploadChain = Promise.resolve();
+  const sendOne = async (item: UploadItem, project: number, bar: HTMLElement, state: HTMLElement) => {
+    const row = state.parentElement!;
+    try {
+      const capture = await upload(item, project, (share) => {
         bar.style.width = `${share * 100}%`;
         state.textContent = `${Math.round(share * 100)} %`;
-      })
-        .then((capture) => {
-          state.textContent = capture.duplicate ? "already uploaded" : "uploaded";
-          row.classList.add("done");
-          setTimeout(() => row.remove(), 4000);
-          void load();
-        })
-        .catch((err: Error) => {
-          state.textContent = err.message;
-          row.classList.add("failed");
-        });
+      });
+      state.textContent = capture.duplicate ? "already uploaded" : "uploaded";
+      row.classList.add("done");
+      setTimeout(() => row.remove(), 4000);
+      if (mounted) void load();
+    } catch (err) {
+      state.textContent = err instanceof Error ? err.message : String(err);
+      row.classList.add("failed");
     }
   };
   fileInput.addEventListener("change", () => {

@@ -22,13 +22,27 @@ export function decodeFloat32(base64: string): Float32Array {
   return out;
 }
 
-/** Chunk ranges [start, stop) covering the take, nearest to `firstFrame` first. */
-export function planChunks(nFrames: number, firstFrame = 0, chunk = CHUNK): { start: number; stop: number }[] {
+/** Frames in the very first request: enough to show a pose and play a few seconds. */
+export const HEAD = 600;
+
+/**
+ * Chunk ranges [start, stop) covering the take, nearest to `firstFrame` first. The chunk
+ * holding `firstFrame` is split so that its first `head` frames come alone: a small first
+ * answer puts a pose on screen sooner.
+ */
+export function planChunks(nFrames: number, firstFrame = 0, chunk = CHUNK, head = 0): { start: number; stop: number }[] {
   const ranges = [];
   for (let start = 0; start < nFrames; start += chunk) ranges.push({ start, stop: Math.min(start + chunk, nFrames) });
   const centre = (r: { start: number; stop: number }) =>
     firstFrame >= r.start && firstFrame < r.stop ? -1 : Math.min(Math.abs(r.start - firstFrame), Math.abs(r.stop - 1 - firstFrame));
-  return ranges.sort((a, b) => centre(a) - centre(b) || a.start - b.start);
+  ranges.sort((a, b) => centre(a) - centre(b) || a.start - b.start);
+  const first = ranges[0];
+  if (head > 0 && first && first.stop - first.start > head) {
+    const from = Math.min(Math.max(firstFrame, first.start), first.stop - head);
+    const rest = [{ start: first.start, stop: from }, { start: from + head, stop: first.stop }].filter((r) => r.stop > r.start);
+    ranges.splice(0, 1, { start: from, stop: from + head }, ...rest);
+  }
+  return ranges;
 }
 
 export class FrameStore {
@@ -98,7 +112,7 @@ export class FrameStore {
  * `onChunk` after each so the player and progress bar can update.
  */
 export async function loadFrames(captureId: number, store: FrameStore, firstFrame: number, onChunk: () => void, signal?: AbortSignal): Promise<void> {
-  const queue = planChunks(store.nFrames, firstFrame);
+  const queue = planChunks(store.nFrames, firstFrame, CHUNK, HEAD);
   const worker = async () => {
     for (let range = queue.shift(); range && !signal?.aborted; range = queue.shift()) {
       const response = await get<FramesResponse>(`/api/captures/${captureId}/frames/?start=${range.start}&stop=${range.stop}&step=1`);

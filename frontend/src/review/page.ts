@@ -27,12 +27,33 @@ export async function renderReview(root: HTMLElement, captureId: number): Promis
   ]);
   const project = listOf(projects).find((p) => p.id === capture.project);
   if (capture.status !== "ready" || !capture.skeleton) return renderNotReady(root, capture);
-  const [review, signal] = await Promise.all([
-    post<Review>(`/api/captures/${captureId}/review/`),
-    get<SignalResponse>(`/api/captures/${captureId}/signal/?max_points=4000`).catch(() => null),
-  ]);
-  const page = new ReviewPage(root, capture, me, project ?? null, review, signal?.signals ?? []);
-  return () => page.dispose();
+  // Poses start streaming now, in parallel with the review and the signal.
+  const frames = new FrameFeed(capture);
+  try {
+    const [review, signal] = await Promise.all([
+      post<Review>(`/api/captures/${captureId}/review/`),
+      get<SignalResponse>(`/api/captures/${captureId}/signal/?max_points=4000`).catch(() => null),
+    ]);
+    const page = new ReviewPage(root, capture, me, project ?? null, review, signal?.signals ?? [], frames);
+    return () => page.dispose();
+  } catch (err) {
+    frames.abort.abort();
+    throw err;
+  }
+}
+
+/** A capture's poses loading in the background, with a hook for each chunk that lands. */
+class FrameFeed {
+  readonly store: FrameStore;
+  readonly abort = new AbortController();
+  readonly started = performance.now();
+  readonly done: Promise<void>;
+  onChunk: () => void = () => {};
+
+  constructor(capture: Capture) {
+    this.store = new FrameStore(capture.n_frames, capture.n_joints || capture.skeleton!.joints.length);
+    this.done = loadFrames(capture.id, this.store, 0, () => this.onChunk(), this.abort.signal);
+  }
 }
 
 function listOf<T>(value: T[] | { results: T[] }): T[] {
@@ -70,7 +91,7 @@ class ReviewPage {
   private readonly store: FrameStore;
   private readonly player: SkeletonView | null;
   private readonly timeline: Timeline;
-  private readonly abort = new AbortController();
+  private readonly abort: AbortController;
   private readonly labels: Label[];
   private readonly el: Elements;
   private readonly onKey = (e: KeyboardEvent) => this.handleKey(e);
@@ -82,6 +103,7 @@ class ReviewPage {
     private readonly project: Project | null,
     review: Review,
     private signals: Signal[],
+    frames: FrameFeed,
   ) {
     this.review = review;
     this.own = review;
@@ -115,9 +137,11 @@ class ReviewPage {
         this.refresh();
       },
     });
-    this.store = new FrameStore(capture.n_frames, capture.n_joints || capture.skeleton!.joints.length);
-    const started = performance.now();
-    void loadFrames(capture.id, this.store, 0, () => this.onFramesLoaded(started), this.abort.signal).then(() => this.loadFullSignals());
+    this.store = frames.store;
+    this.abort = frames.abort;
+    frames.onChunk = () => this.onFramesLoaded(frames.started);
+    if (this.store.loadedFrames) this.onFramesLoaded(frames.started);
+    void frames.done.then(() => this.loadFullSignals());
     document.addEventListener("keydown", this.onKey);
     this.refresh();
     void this.loadEvents();
