@@ -79,6 +79,16 @@ class IngestTestCase(BaseTestCase):
         self.assertEqual((again.attempts, again.positions.name), (1, capture.positions.name))
         self.assertEqual(DetectionRun.objects.filter(capture=capture).count(), 1)
 
+    def test_the_ingest_job_detects_at_once_and_the_queued_detect_job_then_does_nothing(self):
+        capture_id = self.upload(BVH_13_29.read_bytes(), name="13_29.bvh").json()["id"]
+        tasks.ingest(capture_id)
+        run = DetectionRun.objects.get(capture_id=capture_id)
+        self.assertEqual((run.status, run.attempts), ("ready", 1))
+        # The detect message queued on commit arrives afterwards.
+        tasks.detect(run.pk)
+        again = DetectionRun.objects.get(pk=run.pk)
+        self.assertEqual((again.attempts, again.signals.name), (1, run.signals.name))
+
     def test_a_run_on_demand_uses_its_own_params(self):
         capture = self.ingest(self.upload(BVH_13_29.read_bytes(), name="13_29.bvh").json()["id"])
         r = self.client.post(f"/api/captures/{capture.pk}/runs/", {"method": "bone_angle", "params": {"param": 0.2}}, format="json")
