@@ -3,12 +3,13 @@
 ``make up`` calls this after installing the Python packages and building the front end::
 
     python scripts/up.py [--host 127.0.0.1] [--port 8000] [--concurrency 2] [--no-demo]
+                         [--no-shared-data]
 
 With no environment set, everything lives under ``var/`` (SQLite, the filesystem broker's
 spool, uploaded originals, logs). The worker and gunicorn run as child processes with
-their logs in ``var/log/``; a worker that dies is reported (with the end of its log) and
-restarted; Ctrl-C (or SIGTERM) stops both and waits for them. Running it again is safe:
-migrations and demo data are only added when missing.
+their logs in ``var/log/``; a worker that dies is reported (with the end of its log),
+its jobs are requeued and it is restarted; Ctrl-C (or SIGTERM) stops both and waits for
+them. Running it again is safe: migrations and demo data are only added when missing.
 """
 
 import argparse
