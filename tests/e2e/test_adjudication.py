@@ -76,6 +76,7 @@ def test_it_makes_a_gold_version_from_two_annotators_reviews(live_server, new_pa
     page.goto(f"{live_server.url}/projects/{studio['project'].pk}/dashboard/")
     expect(page.get_by_test_id("state-adjudicated")).to_have_text("1")
     expect(page.get_by_test_id("dash-annotators")).to_contain_text("ann")
+    page.screenshot(path=str(SCREENSHOTS / "dashboard.png"))
     assert page.errors == []
 
 

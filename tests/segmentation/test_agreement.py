@@ -180,6 +180,10 @@ class DashboardApiTest(LibraryTestCase):
         labels = {entry["label"]: entry for entry in body["labels"]}
         assert labels["walk"]["captures"] == 3 and 0 < labels["walk"]["overlap"] <= 1
         assert body["library"]["gold"] == 2
+        # The dashboard's stored summary says what the agreement endpoint says.
+        row = next(c for c in body["captures"] if c["name"] == "disputed.bvh")
+        live = self.client.get(f"/api/captures/{disputed.pk}/agreement/").json()
+        assert (row["boundary_f1"], row["label_agreement"]) == (live["boundary_f1"], live["labels"]["value"])
 
     def test_it_hides_the_dashboard_from_annotators_and_outsiders(self):
         for user in (self.bob, self.charlie):
