@@ -35,10 +35,20 @@ def run_info(args) -> int:
     rows = [("file", args.file), ("format", take.format), ("fps", f"{take.fps:g}"),
             ("frames", str(take.n_frames)), ("duration", f"{take.duration:.3f} s"),
             ("joints", str(take.skeleton.n_joints)), ("channels", str(take.skeleton.n_channels)),
-            ("rest pose frame", rest)]
+            ("rest pose frame", rest), ("body parts", _body_parts(take))]
     for key, value in rows:
         print(f"{key + ':':<17}{value}")
     return 0
+
+
+def _body_parts(take) -> str:
+    """How many canonical body parts the joint names map to (segmenters need them)."""
+    from motionlib.skeleton import CANONICAL_PARTS, match_parts
+
+    found, missing = match_parts(take)
+    if missing:
+        return f"not mapped (no joint found for {', '.join(missing)})"
+    return f"{len(found)} of {len(CANONICAL_PARTS)} mapped"
 
 
 def add_convert(subparsers) -> None:

@@ -201,6 +201,27 @@ def canonical_indices(take) -> dict[str, int]:
         If no known naming convention (CMU ASF, cgspeed BVH, DAZ, Mixamo) covers the skeleton;
         the message lists the parts that could not be found.
     """
+    found, missing = match_parts(take)
+    if missing:
+        names = _skeleton_of(take).names
+        raise CaptureError(
+            "cannot map the skeleton to body parts (known namings: CMU ASF, cgspeed BVH, DAZ, "
+            f"Mixamo); no joint found for {', '.join(missing)}; joints are "
+            f"{', '.join(names[:40])}",
+            path=getattr(take, "path", None))
+    return found
+
+
+def match_parts(take) -> tuple[dict[str, int], list[str]]:
+    """The best mapping any known naming gives, and the required parts it leaves unmapped.
+
+    Returns
+    -------
+    found : dict of str to int
+        ``{part: joint index}`` in :data:`CANONICAL_PARTS` order.
+    missing : list of str
+        Required parts (all but the toes) without a joint.
+    """
     skeleton = _skeleton_of(take)
     best: dict[str, int] = {}
     for table in CONVENTIONS.values():
@@ -208,13 +229,7 @@ def canonical_indices(take) -> dict[str, int]:
         if len(found) > len(best):
             best = found
     missing = [p for p in CANONICAL_PARTS if p not in best and p not in OPTIONAL_PARTS]
-    if missing:
-        raise CaptureError(
-            "cannot map the skeleton to body parts (known namings: CMU ASF, cgspeed BVH, DAZ, "
-            f"Mixamo); no joint found for {', '.join(missing)}; joints are "
-            f"{', '.join(skeleton.names[:40])}",
-            path=getattr(take, "path", None))
-    return {p: best[p] for p in CANONICAL_PARTS if p in best}
+    return {p: best[p] for p in CANONICAL_PARTS if p in best}, missing
 
 
 def canonical_joints(take) -> dict[str, str]:

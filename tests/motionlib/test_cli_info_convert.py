@@ -30,6 +30,17 @@ def test_it_describes_a_bvh(capsys, bvh_13_29):
     assert lines["format"] == "bvh" and lines["fps"] == "120"
     assert lines["frames"] == "4593" and lines["joints"] == "31"
     assert lines["duration"] == "38.275 s" and lines["rest pose frame"] == "0"
+    assert lines["body parts"] == "19 of 19 mapped"
+
+
+def test_it_says_when_joint_names_cannot_be_mapped(capsys, tmp_path):
+    path = tmp_path / "robot.bvh"
+    path.write_text("HIERARCHY\nROOT base\n{\n OFFSET 0 0 0\n CHANNELS 1 Xposition\n"
+                    " End Site\n {\n  OFFSET 0 1 0\n }\n}\nMOTION\nFrames: 1\n"
+                    "Frame Time: 0.1\n0\n")
+    status, out, _ = run(capsys, "info", path)
+    assert status == 0
+    assert "body parts:      not mapped (no joint found for root, spine, chest" in out
 
 
 def test_it_describes_an_amc_with_its_asf(capsys, amc_13_29):
