@@ -80,30 +80,31 @@ def run_io(args) -> int:
     for name, path, fn in cases:
         wall, cpu = timings[name]
         size = path.stat().st_size if path is not None else None
-        rows.append((name, statistics.median(wall), statistics.median(cpu), len(wall),
+        rows.append((name, statistics.median(wall), min(wall), statistics.median(cpu), len(wall),
                      _peak_bytes(fn), size))
     _print_table(rows)
     return 0
 
 
 def _print_table(rows) -> None:
-    print(f"{'case':<30}{'wall ms':>9}{'cpu ms':>8}{'runs':>6}{'peak MiB':>10}"
+    print(f"{'case':<30}{'wall ms':>9}{'min ms':>8}{'cpu ms':>8}{'runs':>6}{'peak MiB':>10}"
           f"{'file MiB':>10}{'peak/file':>10}")
-    for name, median, cpu, runs, peak, size in rows:
+    for name, median, fastest, cpu, runs, peak, size in rows:
         file_mib, ratio = (f"{size / 2**20:>10.2f}", f"{peak / size:>10.2f}") if size else \
             (f"{'-':>10}", f"{'-':>10}")
-        print(f"{name:<30}{median:>9.1f}{cpu:>8.1f}{runs:>6}{peak / 2**20:>10.2f}"
-              f"{file_mib}{ratio}")
+        print(f"{name:<30}{median:>9.1f}{fastest:>8.1f}{cpu:>8.1f}{runs:>6}"
+              f"{peak / 2**20:>10.2f}{file_mib}{ratio}")
     ours, theirs = rows[0], rows[2]
     speedup = theirs[1] / ours[1]
-    print("(medians; wall = elapsed time, cpu = this process's CPU time)")
+    print("(wall = median elapsed time, min = fastest run, cpu = median CPU time of this "
+          "process)")
     print(f"load average during the run: {' '.join(f'{x:.2f}' for x in os.getloadavg())}")
     print()
     print(f"read+FK 13_29.bvh median {ours[1]:.1f} ms (target <= {TARGET_MS:.0f} ms): "
           f"{'ok' if ours[1] <= TARGET_MS else 'MISSED'}")
     print(f"speed-up over the bvh package's parse alone: {speedup:.1f}x "
           f"(target >= {TARGET_SPEEDUP:.0f}x): {'ok' if speedup >= TARGET_SPEEDUP else 'MISSED'}")
-    ratio = ours[4] / ours[5]
+    ratio = ours[5] / ours[6]
     print(f"peak memory of read+FK 13_29.bvh: {ratio:.2f}x the file (target < "
           f"{TARGET_MEMORY:.0f}x): {'ok' if ratio < TARGET_MEMORY else 'MISSED'}")
 

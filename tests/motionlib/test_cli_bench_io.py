@@ -13,7 +13,7 @@ def test_it_prints_the_io_table(bvh_13_29):
                              "--data", str(data)], capture_output=True, text=True, timeout=300)
     assert result.returncode == 0, result.stderr
     lines = result.stdout.splitlines()
-    assert lines[0].split()[:5] == ["case", "wall", "ms", "cpu", "ms"]
+    assert lines[0].split()[:7] == ["case", "wall", "ms", "min", "ms", "cpu", "ms"]
     for case in ("read+FK 13_29.bvh", "read+FK 13_29.amc", "bvh package parse 13_29.bvh",
                  "synth.generate 5 min"):
         assert any(case in line for line in lines), case
