@@ -70,3 +70,14 @@ describe("suggested labels on the review page", () => {
     expect(HELP.some(([k]) => k === "S")).toBe(true);
   });
 });
+
+describe("opening a capture at a segment", () => {
+  it("reads ?frame= and keeps it inside the take", async () => {
+    const { frameFromUrl } = await import("../src/review/page");
+    expect(frameFromUrl(1000, "?frame=250")).toBe(250);
+    expect(frameFromUrl(1000, "?frame=5000")).toBe(999);
+    expect(frameFromUrl(1000, "?frame=-3")).toBe(0);
+    expect(frameFromUrl(1000, "?frame=abc")).toBe(0);
+    expect(frameFromUrl(1000, "")).toBe(0);
+  });
+});

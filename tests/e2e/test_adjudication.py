@@ -77,6 +77,11 @@ def test_it_makes_a_gold_version_from_two_annotators_reviews(live_server, new_pa
     expect(page.get_by_test_id("state-adjudicated")).to_have_text("1")
     expect(page.get_by_test_id("dash-annotators")).to_contain_text("ann")
     page.screenshot(path=str(SCREENSHOTS / "dashboard.png"))
+
+    # A library row opens its capture's review page at the segment's first frame.
+    page.goto(f"{live_server.url}/library/")
+    page.get_by_test_id(f"segment-{first.pk}").get_by_role("link", name=ingested_capture.name).click()
+    expect(page.get_by_test_id("hud-frame")).to_contain_text(f"Frame {first.start}")
     assert page.errors == []
 
 

@@ -52,8 +52,14 @@ class FrameFeed {
 
   constructor(capture: Capture) {
     this.store = new FrameStore(capture.n_frames, capture.n_joints || capture.skeleton!.joints.length);
-    this.done = loadFrames(capture.id, this.store, 0, () => this.onChunk(), this.abort.signal);
+    this.done = loadFrames(capture.id, this.store, frameFromUrl(capture.n_frames), () => this.onChunk(), this.abort.signal);
   }
+}
+
+/** The frame asked for by `?frame=N` (the library links a segment's start this way), else 0. */
+export function frameFromUrl(nFrames: number, search = location.search): number {
+  const frame = Number(new URLSearchParams(search).get("frame"));
+  return Number.isInteger(frame) && frame > 0 ? Math.min(frame, Math.max(nFrames - 1, 0)) : 0;
 }
 
 function listOf<T>(value: T[] | { results: T[] }): T[] {
@@ -108,7 +114,7 @@ class ReviewPage {
     this.review = review;
     this.own = review;
     this.labels = project?.labels ?? [];
-    this.playback = { position: 0, playing: false, speed: 1, fps: capture.fps, nFrames: capture.n_frames, loop: null };
+    this.playback = { position: frameFromUrl(capture.n_frames), playing: false, speed: 1, fps: capture.fps, nFrames: capture.n_frames, loop: null };
     this.saver = new Saver(capture.id, review, {
       saved: (r, idle, renamed) => this.onSaved(r, idle, renamed),
       conflict: (r, unsaved, message) => void this.onConflict(r, unsaved, message),
