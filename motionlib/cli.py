@@ -78,9 +78,16 @@ def run_convert(args) -> int:
 COMMANDS = [add_info, add_convert, add_segment, add_bench]
 
 
+class _Parser(argparse.ArgumentParser):
+    """Usage errors in one line (``--help`` still shows the full usage)."""
+
+    def error(self, message: str):
+        self.exit(EXIT_USAGE, f"{self.prog}: error: {message} (see --help)\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="python -m motionlib",
-                                     description="Motion-capture takes: inspect, convert.")
+    parser = _Parser(prog="python -m motionlib",
+                     description="Motion-capture takes: inspect, convert, segment, benchmark.")
     subparsers = parser.add_subparsers(dest="command", required=True, metavar="command")
     for add in COMMANDS:
         add(subparsers)

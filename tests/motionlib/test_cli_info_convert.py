@@ -92,4 +92,14 @@ def test_it_shows_usage_for_an_unknown_command(capsys):
     with pytest.raises(SystemExit) as caught:
         main(["dance"])
     assert caught.value.code == 2
-    assert "invalid choice: 'dance'" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert "invalid choice: 'dance'" in err and err.count("\n") == 1
+
+
+def test_it_reports_a_missing_argument_in_one_line(capsys):
+    with pytest.raises(SystemExit) as caught:
+        main(["convert", "only_input.amc"])
+    assert caught.value.code == 2
+    err = capsys.readouterr().err
+    assert err.startswith("python -m motionlib convert: error: the following arguments are "
+                          "required: output") and err.count("\n") == 1
