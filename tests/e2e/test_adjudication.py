@@ -72,6 +72,11 @@ def test_it_makes_a_gold_version_from_two_annotators_reviews(live_server, new_pa
     page.wait_for_timeout(400)
     assert page.evaluate(snapshot) != before
     page.screenshot(path=str(SCREENSHOTS / "library.png"))
+    # "Similar" lists the other gold segments, nearest first, by motion distance.
+    page.get_by_test_id(f"similar-{first.pk}").click()
+    similar_rows = page.locator("[data-testid=segment-rows] tr[data-testid^=segment-]")
+    expect(similar_rows).to_have_count(3)
+    expect(similar_rows.first).to_contain_text("d ")
 
     page.goto(f"{live_server.url}/projects/{studio['project'].pk}/dashboard/")
     expect(page.get_by_test_id("state-adjudicated")).to_have_text("1")
