@@ -10,8 +10,11 @@ transition. Used by tests, segmenter tests and the service demo.
 Example
 -------
 >>> take, segments = generate(seed=3, duration=60.0)
->>> segments[0]
-(0, 611, 'squat')
+>>> take.n_frames, len(segments), segments[0]
+(7200, 10, (0, 594, 'arm_circles'))
+
+The skeleton starts facing a random heading; its rest pose is a T-pose with zero channels, but
+generated takes always stand with the arms down, so ``rest_pose_frame`` is None.
 """
 
 from __future__ import annotations
