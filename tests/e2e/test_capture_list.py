@@ -1,6 +1,7 @@
 """The capture list: drop files to upload them, watch their status change as the worker
 gets to them, filter by status, project and name, and open one."""
 
+import time
 from pathlib import Path
 
 import pytest
@@ -35,15 +36,29 @@ def open_list(new_page, username):
     return page
 
 
-def run_worker_jobs():
-    """Do what a worker would: ingest queued captures, then run queued detections."""
+def run_worker_jobs(attempts=20):
+    """Do what a worker would: ingest queued captures, then run queued detections.
+
+    The test database is SQLite in memory with a shared cache, where a write meets
+    "table is locked" at once (no busy wait) while the page's polling request reads;
+    a real worker has its own connection and waits. So: wait and try again.
+    """
+    from django.db import OperationalError
+
     from segmentation import tasks
     from segmentation.models import Capture, DetectionRun
 
-    for capture in Capture.objects.filter(status="queued"):
-        tasks.ingest(capture.pk)
-    for run in DetectionRun.objects.filter(status="queued"):
-        tasks.detect(run.pk)
+    for attempt in range(attempts):
+        try:
+            for capture in Capture.objects.filter(status="queued"):
+                tasks.ingest(capture.pk)
+            for run in DetectionRun.objects.filter(status="queued"):
+                tasks.detect(run.pk)
+            return
+        except OperationalError as exc:
+            if "locked" not in str(exc) or attempt == attempts - 1:
+                raise
+            time.sleep(0.25)
 
 
 def test_it_uploads_dropped_files_and_shows_their_status_as_it_changes(live_server, new_page, studio):

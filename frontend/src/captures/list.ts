@@ -139,7 +139,9 @@ export async function renderCaptureList(root: HTMLElement): Promise<() => void> 
     const request = ++latest;
     const q = new URLSearchParams(queryOf(filters).slice(1));
     const data = await get<Page<Capture>>(`/api/captures/?${q}`).catch((err: Error) => {
-      if (request === latest) clear(rows, h("tr", {}, h("td", { colspan: 9, class: "error-text" }, `Could not load captures: ${err.message}`)));
+      if (request !== latest || !mounted) return null;
+      clear(rows, h("tr", {}, h("td", { colspan: 9, class: "error-text" }, `Could not load captures: ${err.message} (trying again)`)));
+      timer = window.setTimeout(() => void load(), 4000);
       return null;
     });
     if (!data || request !== latest || !mounted) return;
