@@ -39,9 +39,10 @@ def open_list(new_page, username):
 def run_worker_jobs(attempts=20):
     """Do what a worker would: ingest queued captures, then run queued detections.
 
-    The test database is SQLite in memory with a shared cache, where a write meets
-    "table is locked" at once (no busy wait) while the page's polling request reads;
-    a real worker has its own connection and waits. So: wait and try again.
+    The e2e conftest gives SQLite sessions a test database file, where writers wait for
+    each other. If another folder's tests set the session's database up first it is
+    shared-cache memory instead, where a write meets "table is locked" at once while the
+    page's polling request reads: then wait and try again.
     """
     from django.db import OperationalError
 

@@ -166,6 +166,7 @@ def test_it_saves_every_edit_and_restores_the_review_exactly_after_reload(live_s
     page.keyboard.press("ArrowRight")
     page.keyboard.press("Shift+ArrowLeft")
     page.get_by_test_id("zoom-in").click()
+    page.mouse.move(300, 300)
     page.wait_for_timeout(300)
     SCREENSHOT.parent.mkdir(parents=True, exist_ok=True)
     page.screenshot(path=str(SCREENSHOT))

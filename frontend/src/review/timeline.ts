@@ -57,6 +57,7 @@ export class Timeline {
   private ranges = new Map<Signal, [number, number]>();
   private gesture: Gesture | null = null;
   private loopPreview: { start: number; stop: number } | null = null;
+  private hoverX: number | null = null;
   private queued = false;
   private width = 1;
   onViewChange: (() => void) | null = null;
@@ -75,6 +76,10 @@ export class Timeline {
     this.canvas.addEventListener("pointerup", (e) => this.onUp(e));
     this.canvas.addEventListener("dblclick", (e) => this.onDoubleClick(e));
     this.canvas.addEventListener("wheel", (e) => this.onWheel(e), { passive: false });
+    this.canvas.addEventListener("pointerleave", () => {
+      this.hoverX = null;
+      this.schedule();
+    });
   }
 
   update(model: TimelineModel): void {
@@ -147,6 +152,7 @@ export class Timeline {
     L.lanes.forEach((lane, i) => this.drawSignal(ctx, m.signals[i], lane, SIGNAL_COLOURS[i % SIGNAL_COLOURS.length]));
     this.drawSegments(ctx, m, L.segTop);
     this.drawCuts(ctx, m, RULER, L.segTop + SEGMENTS);
+    this.drawHover(ctx, m, L.segTop + SEGMENTS);
     this.drawPlayhead(ctx, m, L.segTop + SEGMENTS);
     this.drawOverview(ctx, m, L.overviewTop);
   }
@@ -196,11 +202,15 @@ export class Timeline {
     ctx.beginPath();
     if (last - first > this.width * 2) {
       // More samples than pixels: draw each pixel column's min-max, the classic waveform view.
+      // Joined column to column, so a smooth curve stays a line and a noisy one a band.
       const columns = columnExtremes(signal, first, last, (i) => this.x(signal.start + i * step), this.width);
+      let started = false;
       columns.forEach(([a, b], px) => {
         if (Number.isNaN(a)) return;
-        ctx.moveTo(px + 0.5, y(a));
+        if (started) ctx.lineTo(px + 0.5, y(a));
+        else ctx.moveTo(px + 0.5, y(a));
         ctx.lineTo(px + 0.5, y(b) + 0.5);
+        started = true;
       });
     } else {
       for (let i = first; i <= last; i++) {
@@ -305,6 +315,26 @@ export class Timeline {
     ctx.setLineDash([]);
   }
 
+  /** A faint line under the pointer with its frame and time, so a cut can be aimed. */
+  private drawHover(ctx: CanvasRenderingContext2D, m: TimelineModel, bottom: number): void {
+    if (this.hoverX === null || this.gesture) return;
+    const frame = snapFrame(this.view, this.hoverX);
+    const x = Math.round(this.x(frame)) + 0.5;
+    ctx.strokeStyle = "rgba(255, 255, 255, 0.25)";
+    ctx.beginPath();
+    ctx.moveTo(x, RULER);
+    ctx.lineTo(x, bottom);
+    ctx.stroke();
+    const text = `${frame} · ${formatTime(frame, m.fps)}`;
+    ctx.font = "11px ui-monospace, SFMono-Regular, Menlo, monospace";
+    const w = ctx.measureText(text).width + 8;
+    const left = Math.min(Math.max(x + 4, 0), this.width - w);
+    ctx.fillStyle = "#2a3340";
+    ctx.fillRect(left, RULER + 2, w, 15);
+    ctx.fillStyle = "#dfe5ee";
+    ctx.fillText(text, left + 4, RULER + 10);
+  }
+
   private drawPlayhead(ctx: CanvasRenderingContext2D, m: TimelineModel, bottom: number): void {
     const x = Math.round(this.x(m.playhead)) + 0.5;
     ctx.strokeStyle = "#ff5a5f";
@@ -391,6 +421,8 @@ export class Timeline {
     const g = this.gesture;
     if (!g) {
       this.canvas.style.cursor = this.hitCut(x, y) ? (this.model?.readOnly ? "pointer" : "ew-resize") : "crosshair";
+      this.hoverX = y < this.layout().overviewTop ? x : null;
+      this.schedule();
       return;
     }
     if (g.kind === "overview") this.centreOverview(x);
