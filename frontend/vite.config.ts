@@ -9,13 +9,6 @@ export default defineConfig({
     emptyOutDir: true,
     chunkSizeWarningLimit: 900,
   },
-  server: {
-    proxy: {
-      "/api": "http://127.0.0.1:8000",
-      "/login": "http://127.0.0.1:8000",
-      "/logout": "http://127.0.0.1:8000",
-    },
-  },
   test: {
     include: ["tests/**/*.test.ts"],
     environment: "node",

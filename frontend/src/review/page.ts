@@ -3,7 +3,7 @@
 // the API straight away (saver.ts); undo/redo are edits too, so the audit log is complete.
 
 import { get, post } from "../api/client";
-import type { Capture, Cut, Label, Me, Project, Review, ReviewEvent, Signal, SignalResponse } from "../api/types";
+import type { Capture, Cut, Label, Me, Project, Review, ReviewEvent, Segment, Signal, SignalResponse } from "../api/types";
 import { advance, frameOf, nextSpeed, seek, togglePlay, type Playback } from "../player/clock";
 import { SkeletonView } from "../player/skeletonView";
 import { clear, dialog, h, toast } from "../ui/dom";
@@ -93,6 +93,7 @@ class ReviewPage {
   private raf = 0;
   private shownFrame = -1;
   private floorSet = false;
+  private panelSegment: Segment | undefined;
   private readonly saver: Saver;
   private readonly store: FrameStore;
   private readonly player: SkeletonView | null;
@@ -227,6 +228,7 @@ class ReviewPage {
 
   private renderSide(): void {
     const segment = segmentAt(this.review.segments, this.frame());
+    this.panelSegment = segment;
     renderLabels(this.el.labels, this.labels, segment?.label ?? null, this.locked() !== null, (name) => this.labelCurrent(name));
     renderSelection(this.el.selection, this.selectedCut(), segment, this.capture.fps);
     renderStats(this.el.stats, this.review);
@@ -405,6 +407,9 @@ class ReviewPage {
   private refreshPlayhead(frame: number): void {
     this.showFrame(frame);
     this.timeline.update({ ...this.timelineModel(), playhead: frame });
+    // The side panels describe the segment under the playhead: redraw when it changes.
+    const segment = segmentAt(this.review.segments, frame);
+    if (segment !== this.panelSegment) this.renderSide();
   }
 
   private timelineModel() {
