@@ -283,3 +283,48 @@ def test_it_lists_the_shortcuts_and_locks_the_review_once_submitted(live_server,
     expect(page.get_by_test_id("submit")).to_be_disabled()
     assert screen.review()["version"] == version
     assert page.errors == []
+
+
+def test_it_undoes_and_redoes_moves_inserts_and_deletes_on_the_server(live_server, new_page, ingested_capture, studio):
+    page = new_page("ann")
+    screen = ReviewScreen(page, live_server.url, ingested_capture)
+    screen.open()
+    start = screen.review()
+    c0, c1 = sorted(start["cuts"], key=lambda c: c["frame"])[:2]
+    as_left = {c["id"]: (c["fate"], c["frame"]) for c in start["cuts"]}
+
+    # Move c0 with the mouse, delete c1 with the keyboard, insert a cut between them.
+    page.mouse.move(screen.x(c0["frame"]), screen.signal_y())
+    page.mouse.down()
+    page.mouse.move(screen.x(c0["frame"]) + 12, screen.signal_y(), steps=4)
+    page.mouse.up()
+    screen.saved()
+    page.keyboard.press("Home")
+    page.keyboard.press("Shift+ArrowRight")
+    page.keyboard.press("Shift+ArrowRight")
+    page.keyboard.press("d")
+    screen.saved()
+    page.mouse.click(screen.x((c0["frame"] + c1["frame"]) // 2 + 40), screen.ruler_y())
+    page.keyboard.press("i")
+    screen.saved()
+    edited = screen.review()
+    assert cut_by_id(edited, c0["id"])["fate"] == "moved"
+    assert cut_by_id(edited, c1["id"])["fate"] == "deleted"
+    assert len([c for c in edited["cuts"] if c["origin"] == "inserted"]) == 1
+
+    # Three undos bring every cut back to how it was: the inserted one ends deleted.
+    for _ in range(3):
+        page.keyboard.press("z")
+        screen.saved()
+    undone = screen.review()
+    assert {c["id"]: (c["fate"], c["frame"]) for c in undone["cuts"] if c["origin"] == "candidate"} == as_left
+    assert [c["fate"] for c in undone["cuts"] if c["origin"] == "inserted"] == ["deleted"]
+
+    # Three redos bring the edits back, the inserted cut under its original id.
+    for _ in range(3):
+        page.keyboard.press("Shift+Z")
+        screen.saved()
+    redone = screen.review()
+    assert {c["id"]: (c["fate"], c["frame"]) for c in redone["cuts"]} == {c["id"]: (c["fate"], c["frame"]) for c in edited["cuts"]}
+    assert redone["segments"] == edited["segments"]
+    assert page.errors == []
