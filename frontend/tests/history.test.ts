@@ -96,6 +96,8 @@ describe("undo and redo", () => {
     expect(changeFor(r, { kind: "move", cutId: 1, frame: 230 }).title).toBe("move cut 200 → 230");
     expect(changeFor(r, { kind: "fate", cutId: 1, fate: "accepted" }).title).toBe("accept cut at 200");
     expect(changeFor(r, { kind: "label", start: 0, stop: 200, label: null }).title).toBe("clear label");
+    const deleted = applyEdit(r, { kind: "fate", cutId: 2, fate: "deleted" }, N);
+    expect(changeFor(deleted, { kind: "fate", cutId: 2, fate: "pending" }).title).toBe("restore cut at 500");
   });
 
   it("test_it_keeps_at_most_the_history_limit", () => {

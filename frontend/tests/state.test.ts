@@ -84,6 +84,12 @@ describe("applyEdit", () => {
     expect(next.segments.map((s) => s.label)).toEqual(["walk", "squat", "punch", null]);
   });
 
+  it("test_it_refuses_to_restore_a_deleted_cut_onto_a_kept_one", () => {
+    const r = review([cut(1, 500, "deleted"), { ...cut(2, 500, "accepted"), origin: "inserted" }]);
+    expect(() => applyEdit(r, { kind: "fate", cutId: 1, fate: "pending" }, N)).toThrow("Cannot restore the cut at frame 500: another cut is there now.");
+    expect(applyEdit(review([cut(1, 500, "deleted")]), { kind: "fate", cutId: 1, fate: "pending" }, N).segments).toHaveLength(2);
+  });
+
   it("test_it_names_the_unknown_cut", () => {
     expect(() => applyEdit(review(), { kind: "fate", cutId: 99, fate: "accepted" }, N)).toThrow("Cut 99 is not in this review.");
   });

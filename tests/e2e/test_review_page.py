@@ -272,7 +272,13 @@ def test_it_lists_the_shortcuts_and_locks_the_review_once_submitted(live_server,
     page.keyboard.press("l")
     expect(state).not_to_contain_text("loop")
 
+    # Submitting asks first, saying what is still open; cancelling changes nothing.
     page.get_by_test_id("submit").click()
+    expect(page.get_by_role("dialog")).to_contain_text("pending candidates")
+    page.get_by_test_id("confirm-cancel").click()
+    assert screen.review()["status"] == "in_progress"
+    page.get_by_test_id("submit").click()
+    page.get_by_test_id("confirm-ok").click()
     expect(page.get_by_test_id("readonly-banner")).to_contain_text("You submitted this review")
     assert screen.review()["status"] == "submitted"
     version = screen.review()["version"]
@@ -327,4 +333,11 @@ def test_it_undoes_and_redoes_moves_inserts_and_deletes_on_the_server(live_serve
     redone = screen.review()
     assert {c["id"]: (c["fate"], c["frame"]) for c in redone["cuts"]} == {c["id"]: (c["fate"], c["frame"]) for c in edited["cuts"]}
     assert redone["segments"] == edited["segments"]
+
+    # A deleted candidate stays on the ruler as a grey ×; clicking it restores the cut.
+    page.get_by_test_id("zoom-fit").click()
+    page.mouse.click(screen.x(c1["frame"]), screen.box()["y"] + 21)
+    screen.saved()
+    assert cut_by_id(screen.review(), c1["id"])["fate"] == "pending"
+    assert screen.events()[-1]["action"] == "reset"
     assert page.errors == []

@@ -47,7 +47,7 @@ export function changeFor(review: Review, edit: Edit): Change {
   if (edit.kind === "move") {
     return { kind: "cut", title: `move cut ${cut.frame} → ${edit.frame}`, cutId: cut.id, before, after: { fate: movedFate(cut), frame: edit.frame } };
   }
-  const verb = { accepted: "accept", deleted: "delete", pending: "reset" }[edit.fate];
+  const verb = { accepted: "accept", deleted: "delete", pending: cut.fate === "deleted" ? "restore" : "reset" }[edit.fate];
   return { kind: "cut", title: `${verb} cut at ${cut.frame}`, cutId: cut.id, before, after: { fate: edit.fate, frame: cut.frame } };
 }
 

@@ -87,6 +87,7 @@ export const HELP: [string, string][] = [
   ["+ / −, wheel", "zoom the timeline (Shift+wheel pans)"],
   ["Click a dashed cut", "accept it · drag any cut to move it"],
   ["Double-click", "insert a cut there"],
+  ["Click a grey × in the ruler", "restore that deleted candidate"],
   ["?", "show / hide this help"],
 ];
 

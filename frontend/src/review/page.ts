@@ -6,7 +6,7 @@ import { get, post } from "../api/client";
 import type { Capture, Cut, Label, Me, Project, Review, ReviewEvent, Segment, Signal, SignalResponse } from "../api/types";
 import { advance, frameOf, nextSpeed, seek, togglePlay, type Playback } from "../player/clock";
 import { SkeletonView } from "../player/skeletonView";
-import { clear, dialog, h, toast } from "../ui/dom";
+import { clear, confirmDialog, dialog, h, toast } from "../ui/dom";
 import { icon } from "../ui/icons";
 import { FrameStore, loadFrames } from "./frames";
 import { changeFor, emptyHistory, record, redo, undo, type Change, type History } from "./history";
@@ -139,6 +139,7 @@ class ReviewPage {
       acceptCut: (id) => this.perform({ kind: "fate", cutId: id, fate: "accepted" }),
       moveCut: (id, frame) => this.perform({ kind: "move", cutId: id, frame }),
       insertAt: (frame) => this.perform({ kind: "insert", frame, tempId: this.nextTempId-- }),
+      restoreCut: (id) => this.perform({ kind: "fate", cutId: id, fate: "pending" }),
       setLoop: (range) => {
         this.playback = range ? seek({ ...this.playback, loop: range }, range.start) : { ...this.playback, loop: null };
         this.refresh();
@@ -320,6 +321,13 @@ class ReviewPage {
 
   private async submit(): Promise<void> {
     if (this.locked() || this.saver.pending) return;
+    const pending = this.review.cuts.filter((c) => c.fate === "pending").length;
+    const unlabelled = this.review.segments.filter((s) => !s.label).length;
+    const ok = await confirmDialog("Submit this review?", [
+      h("p", {}, "A submitted review counts towards agreement and the library, and can no longer be edited."),
+      pending || unlabelled ? h("p", { class: "muted" }, `Still open: ${pending} pending candidate${pending === 1 ? "" : "s"}, ${unlabelled} unlabelled segment${unlabelled === 1 ? "" : "s"}.`) : null,
+    ], "Submit");
+    if (!ok) return;
     try {
       this.review = await post<Review>(`/api/captures/${this.capture.id}/review/submit/`, { version: this.saver.server.version });
       this.saver.server = this.review;

@@ -77,7 +77,7 @@ export function applyEdit(review: Review, edit: Edit, nFrames: number): Review {
   } else {
     const cut = cuts.find((c) => c.id === edit.cutId);
     if (!cut) throw new EditError(`Cut ${edit.cutId} is not in this review.`);
-    if (edit.kind === "fate") cut.fate = edit.fate;
+    if (edit.kind === "fate") restoreOrSetFate(cut, cuts, edit.fate);
     else moveCut(cut, cuts, edit.frame, nFrames);
   }
   const labels = labelsByStartCut(review);
@@ -91,6 +91,13 @@ function checkInsert(cuts: readonly Cut[], frame: number, nFrames: number): void
   if (cuts.some((c) => isKept(c) && c.frame === frame)) {
     throw new EditError(`There is already a cut at frame ${frame}.`);
   }
+}
+
+function restoreOrSetFate(cut: Cut, cuts: readonly Cut[], fate: Cut["fate"]): void {
+  if (cut.fate === "deleted" && fate !== "deleted" && cuts.some((c) => c.id !== cut.id && isKept(c) && c.frame === cut.frame)) {
+    throw new EditError(`Cannot restore the cut at frame ${cut.frame}: another cut is there now.`);
+  }
+  cut.fate = fate;
 }
 
 function moveCut(cut: Cut, cuts: readonly Cut[], frame: number, nFrames: number): void {

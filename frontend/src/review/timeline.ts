@@ -26,6 +26,7 @@ export interface TimelineHandlers {
   moveCut(id: number, frame: number): void;
   insertAt(frame: number): void;
   setLoop(range: { start: number; stop: number } | null): void;
+  restoreCut(id: number): void;
 }
 
 const RULER = 26;
@@ -58,6 +59,7 @@ export class Timeline {
   private gesture: Gesture | null = null;
   private loopPreview: { start: number; stop: number } | null = null;
   private hoverX: number | null = null;
+  private hoverY: number | null = null;
   private queued = false;
   private width = 1;
   onViewChange: (() => void) | null = null;
@@ -262,6 +264,7 @@ export class Timeline {
 
   private drawCuts(ctx: CanvasRenderingContext2D, m: TimelineModel, top: number, bottom: number): void {
     const drag = this.gesture?.kind === "drag" && this.gesture.moved ? this.gesture : null;
+    this.drawDeleted(ctx, m, top);
     for (const cut of m.cuts) {
       if (!isKept(cut)) continue;
       const frame = drag && drag.cut.id === cut.id ? drag.frame : cut.frame;
@@ -298,6 +301,24 @@ export class Timeline {
     }
   }
 
+  /** Deleted candidates stay findable: a small grey × each, which a click restores. */
+  private drawDeleted(ctx: CanvasRenderingContext2D, m: TimelineModel, top: number): void {
+    ctx.strokeStyle = "#6b7687";
+    ctx.lineWidth = 1.25;
+    ctx.beginPath();
+    for (const cut of m.cuts) {
+      if (cut.fate !== "deleted" || cut.origin !== "candidate") continue;
+      const x = Math.round(this.x(cut.frame)) + 0.5;
+      if (x < -4 || x > this.width + 4) continue;
+      ctx.moveTo(x - 3, top - 8);
+      ctx.lineTo(x + 3, top - 2);
+      ctx.moveTo(x + 3, top - 8);
+      ctx.lineTo(x - 3, top - 2);
+    }
+    ctx.stroke();
+    ctx.lineWidth = 1;
+  }
+
   /** Where a moved cut was proposed: a hollow marker in the ruler joined to the cut. */
   private drawGhost(ctx: CanvasRenderingContext2D, frame: number, cutX: number, top: number): void {
     const x = Math.round(this.x(frame)) + 0.5;
@@ -325,7 +346,8 @@ export class Timeline {
     ctx.moveTo(x, RULER);
     ctx.lineTo(x, bottom);
     ctx.stroke();
-    const text = `${frame} · ${formatTime(frame, m.fps)}`;
+    const deleted = this.hoverY === null ? null : this.hitDeleted(this.hoverX, this.hoverY);
+    const text = deleted ? `deleted cut at ${deleted.frame} · click to restore` : `${frame} · ${formatTime(frame, m.fps)}`;
     ctx.font = "11px ui-monospace, SFMono-Regular, Menlo, monospace";
     const w = ctx.measureText(text).width + 8;
     const left = Math.min(Math.max(x + 4, 0), this.width - w);
@@ -383,6 +405,20 @@ export class Timeline {
     return bestDistance <= HIT_PX ? best : null;
   }
 
+  /** A deleted candidate's marker (a small × at the foot of the ruler) under the pointer. */
+  private hitDeleted(x: number, y: number): Cut | null {
+    const m = this.model;
+    if (!m || y < RULER - 12 || y > RULER + 2) return null;
+    let best: Cut | null = null;
+    let bestDistance = HIT_PX + 1;
+    for (const cut of m.cuts) {
+      if (cut.fate !== "deleted" || cut.origin !== "candidate") continue;
+      const d = Math.abs(this.x(cut.frame) - x);
+      if (d < bestDistance) [best, bestDistance] = [cut, d];
+    }
+    return bestDistance <= HIT_PX ? best : null;
+  }
+
   private point(e: MouseEvent): [number, number] {
     const rect = this.canvas.getBoundingClientRect();
     return [e.clientX - rect.left, e.clientY - rect.top];
@@ -412,6 +448,11 @@ export class Timeline {
       this.gesture = { kind: "drag", cut, startX: x, moved: false, frame: cut.frame };
       return;
     }
+    const deleted = this.hitDeleted(x, y);
+    if (deleted && !this.model.readOnly) {
+      this.handlers.restoreCut(deleted.id);
+      return;
+    }
     this.gesture = { kind: "scrub" };
     this.handlers.seek(snapFrame(this.view, x));
   }
@@ -420,8 +461,9 @@ export class Timeline {
     const [x, y] = this.point(e);
     const g = this.gesture;
     if (!g) {
-      this.canvas.style.cursor = this.hitCut(x, y) ? (this.model?.readOnly ? "pointer" : "ew-resize") : "crosshair";
+      this.canvas.style.cursor = this.hitCut(x, y) ? (this.model?.readOnly ? "pointer" : "ew-resize") : this.hitDeleted(x, y) ? "pointer" : "crosshair";
       this.hoverX = y < this.layout().overviewTop ? x : null;
+      this.hoverY = y;
       this.schedule();
       return;
     }

@@ -60,6 +60,30 @@ export function dialog(title: string, body: Child[], button = "OK"): Promise<voi
   });
 }
 
+/** A modal asking to confirm an action that cannot be undone; resolves true on "ok". */
+export function confirmDialog(title: string, body: Child[], ok: string, cancel = "Cancel"): Promise<boolean> {
+  return new Promise((resolve) => {
+    const close = (answer: boolean) => {
+      backdrop.remove();
+      document.removeEventListener("keydown", onKey, true);
+      resolve(answer);
+    };
+    const onKey = (e: KeyboardEvent) => {
+      if (e.key === "Escape") close(false);
+    };
+    const yes = h("button", { class: "btn btn-primary", onclick: () => close(true), "data-testid": "confirm-ok" }, ok);
+    const no = h("button", { class: "btn", onclick: () => close(false), "data-testid": "confirm-cancel" }, cancel);
+    const backdrop = h(
+      "div",
+      { class: "modal-backdrop", role: "dialog", "aria-modal": "true", "aria-label": title },
+      h("div", { class: "modal" }, h("h2", {}, title), h("div", { class: "modal-body" }, ...body), h("div", { class: "modal-actions" }, no, yes)),
+    );
+    document.addEventListener("keydown", onKey, true);
+    document.body.append(backdrop);
+    yes.focus();
+  });
+}
+
 export function formatDuration(seconds: number): string {
   if (!Number.isFinite(seconds)) return "—";
   const m = Math.floor(seconds / 60);
