@@ -8,7 +8,7 @@ FRONT_STAMP := frontend/node_modules/.installed
 HOST ?= 127.0.0.1
 PORT ?= 8000
 
-.PHONY: up test install frontend browser lint pytest vitest bench clean
+.PHONY: up test install frontend browser lint pytest vitest bench screenshots clean
 
 up: install frontend
 	$(PY) scripts/up.py --host $(HOST) --port $(PORT)
@@ -57,6 +57,10 @@ bench: install
 	@command -v wrk >/dev/null || { apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq wrk; } \
 		|| echo "wrk not installed: the capture list benchmark uses its Python client"
 	$(PY) benchmarks/capture_list_load.py
+
+# The README's screenshots, taken by the browser tests.
+screenshots: install frontend browser
+	CUTROOM_SCREENSHOTS=1 $(PY) -m pytest tests/e2e -q -k "restores_the_review or gold_version"
 
 clean:
 	rm -rf .venv frontend/node_modules frontend/dist var

@@ -31,6 +31,18 @@ EXPECT_TIMEOUT_MS = 15_000
 os.environ.setdefault("DJANGO_ALLOW_ASYNC_UNSAFE", "true")
 
 
+@pytest.fixture
+def screenshots(tmp_path):
+    """Where the tests save their screenshots: the README's ``docs/screenshots`` when
+    ``CUTROOM_SCREENSHOTS=1`` (``make screenshots``), else a temporary folder, so a test
+    run leaves the working tree as it found it."""
+    if os.environ.get("CUTROOM_SCREENSHOTS") == "1":
+        folder = REPO / "docs" / "screenshots"
+        folder.mkdir(parents=True, exist_ok=True)
+        return folder
+    return tmp_path
+
+
 def pytest_collection_modifyitems(items):
     for item in items:
         if "tests/e2e/" in str(item.fspath).replace(os.sep, "/"):

@@ -3,13 +3,10 @@ a reviewer starts the gold version from one of them, relabels a segment, saves i
 gold version is in the database, the library prefers it and plays it in place, the
 dashboard counts the capture as adjudicated, and an annotator cannot open the view."""
 
-from pathlib import Path
 
 from playwright.sync_api import expect
 
 from tests.segmentation.test_library import submit_review
-
-SCREENSHOTS = Path(__file__).resolve().parents[2] / "docs" / "screenshots"
 
 
 def two_reviews(capture, studio):
@@ -19,7 +16,7 @@ def two_reviews(capture, studio):
     return ann, [c0, c1, c2]
 
 
-def test_it_makes_a_gold_version_from_two_annotators_reviews(live_server, new_page, ingested_capture, studio):
+def test_it_makes_a_gold_version_from_two_annotators_reviews(live_server, new_page, ingested_capture, studio, screenshots):
     from segmentation.models_library import Adjudication, LibrarySegment
 
     ann_review, cuts = two_reviews(ingested_capture, studio)
@@ -44,7 +41,7 @@ def test_it_makes_a_gold_version_from_two_annotators_reviews(live_server, new_pa
     expect(gold.get_by_test_id("track-gold-seg-2")).to_have_text("walk")
     page.get_by_test_id("save-gold").click()
     expect(page.get_by_test_id("gold-status")).to_have_text("Saved")
-    page.screenshot(path=str(SCREENSHOTS / "adjudication.png"))
+    page.screenshot(path=str(screenshots / "adjudication.png"))
 
     saved = Adjudication.objects.get(capture=ingested_capture)
     assert (saved.cuts, saved.labels) == (cuts, ["walk", "punch", "walk", "kick"])
@@ -71,7 +68,7 @@ def test_it_makes_a_gold_version_from_two_annotators_reviews(live_server, new_pa
     before = page.evaluate(snapshot)
     page.wait_for_timeout(400)
     assert page.evaluate(snapshot) != before
-    page.screenshot(path=str(SCREENSHOTS / "library.png"))
+    page.screenshot(path=str(screenshots / "library.png"))
     # "Similar" lists the other gold segments, nearest first, by motion distance.
     page.get_by_test_id(f"similar-{first.pk}").click()
     similar_rows = page.locator("[data-testid=segment-rows] tr[data-testid^=segment-]")
@@ -81,7 +78,7 @@ def test_it_makes_a_gold_version_from_two_annotators_reviews(live_server, new_pa
     page.goto(f"{live_server.url}/projects/{studio['project'].pk}/dashboard/")
     expect(page.get_by_test_id("state-adjudicated")).to_have_text("1")
     expect(page.get_by_test_id("dash-annotators")).to_contain_text("ann")
-    page.screenshot(path=str(SCREENSHOTS / "dashboard.png"))
+    page.screenshot(path=str(screenshots / "dashboard.png"))
 
     # A library row opens its capture's review page at the segment's first frame.
     page.goto(f"{live_server.url}/library/")

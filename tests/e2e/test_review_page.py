@@ -2,12 +2,9 @@
 every edit lands in the database, survives a reload and shows in the audit log; another
 annotator starts from an untouched review; a reviewer reads it without editing it."""
 
-from pathlib import Path
 
 import pytest
 from playwright.sync_api import expect
-
-SCREENSHOT = Path(__file__).resolve().parents[2] / "docs" / "screenshots" / "review.png"
 
 
 class ReviewScreen:
@@ -59,7 +56,7 @@ def cut_by_id(review, cut_id):
     return next(c for c in review["cuts"] if c["id"] == cut_id)
 
 
-def test_it_saves_every_edit_and_restores_the_review_exactly_after_reload(live_server, new_page, ingested_capture, studio):
+def test_it_saves_every_edit_and_restores_the_review_exactly_after_reload(live_server, new_page, ingested_capture, studio, screenshots):
     page = new_page("ann")
     # The capture list shows the capture; opening it goes to the review page.
     row = page.get_by_test_id(f"capture-{ingested_capture.pk}")
@@ -168,8 +165,7 @@ def test_it_saves_every_edit_and_restores_the_review_exactly_after_reload(live_s
     page.get_by_test_id("zoom-in").click()
     page.mouse.move(300, 300)
     page.wait_for_timeout(300)
-    SCREENSHOT.parent.mkdir(parents=True, exist_ok=True)
-    page.screenshot(path=str(SCREENSHOT))
+    page.screenshot(path=str(screenshots / "review.png"))
     assert page.errors == []
 
     # Another annotator gets an untouched review of their own.
