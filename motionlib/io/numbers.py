@@ -18,6 +18,7 @@ import numpy as np
 
 _POW10 = 10.0 ** np.arange(64)
 _DOT_SCALE = np.concatenate([[1.0], _POW10[:-1]])  # by dot position from the right: 10**(p-1)
+_INTEGER_SCALE = np.concatenate([[_POW10[-1]], _POW10[1:]])  # 10**p, and 10**63 for no dot
 _EXACT = 2.0**53  # integers below this are exact in float64
 _MAX_TOKEN = 32
 _MAX_POWER = 22  # 10**22 is the largest power of ten that float64 holds exactly
@@ -91,6 +92,8 @@ class _Walk:
         self.exp_negative = np.zeros(n, bool)
         self.count = np.zeros(n, np.uint8)    # dots + exponent markers + inner signs seen
         self.bad = np.zeros(n, bool)
+        self.digits = np.zeros(n, np.uint8)   # plain walk: digits seen
+        self.scratch = np.empty(n)            # plain walk: one pass's weighted digits
 
 
 def token_values(b: np.ndarray, starts: np.ndarray, ends: np.ndarray, *,
@@ -102,7 +105,7 @@ def token_values(b: np.ndarray, starts: np.ndarray, ends: np.ndarray, *,
     are summed with the weight of their byte position (10**(k-1) for the k-th byte from the
     right) so a pass multiplies by one scalar; the positions of the dot, the exponent marker
     and its sign are recorded and corrected for afterwards. Text without exponents (BVH as
-    written by most tools) takes a lighter walk validated by byte counts.
+    written by most tools) takes a lighter walk first, validated by counting digits.
 
     Parameters
     ----------
@@ -111,8 +114,8 @@ def token_values(b: np.ndarray, starts: np.ndarray, ends: np.ndarray, *,
     starts, ends : ndarray of int
         Byte bounds of the tokens to read (any subset of the tokens of ``b``).
     plain : bool, optional
-        Whether ``b`` holds nothing but these numbers, whitespace, digits, dots and signs
-        (checked when not given). Pass False for a subset of a text with other tokens.
+        True: the tokens have no exponents (decline otherwise); False: use the full walk
+        (exponents allowed); None (default): try the light walk, then the full one.
 
     Returns
     -------
@@ -128,9 +131,24 @@ def token_values(b: np.ndarray, starts: np.ndarray, ends: np.ndarray, *,
     order = np.argsort(length, kind="stable")[::-1]  # radix sort of small ints: cheap
     # at_least[k]: how many tokens have a k-th byte; they are the first ones in `order`.
     at_least = np.cumsum(np.bincount(length, minlength=longest + 2)[::-1])[::-1]
-    plain = _is_plain(b) if plain is None else plain
-    w = _Walk(starts.size)
-    pos = ends[order].astype(np.intp)
+    first = b[starts[order]]
+    found = None
+    if plain is not False:  # most text has no exponents: try the lighter walk first
+        w = _walk(b, ends[order], longest, at_least, plain=True)
+        found = _finish_plain(w, length[order], first)
+    if found is None and not plain:
+        w = _walk(b, ends[order], longest, at_least, plain=False)
+        found = _finish(w, length[order], first)
+    if found is None:
+        return None
+    return _unsort(found, order, b, starts, ends)
+
+
+def _walk(b, ends, longest: int, at_least, *, plain: bool) -> _Walk:
+    """One pass per byte position from the right; pass k covers the at_least[k] tokens (in
+    walking order, longest first) that have a k-th byte."""
+    w = _Walk(ends.size)
+    pos = ends.astype(np.intp)
     for k in range(1, longest + 1):
         m = int(at_least[k])
         p = pos[:m]
@@ -139,56 +157,44 @@ def token_values(b: np.ndarray, starts: np.ndarray, ends: np.ndarray, *,
             _plain_step(w, b[p], m, k)
         else:
             _step(w, b[p], m, int(at_least[k + 1]), k)
-    first = b[starts[order]]
-    if plain:
-        found = _finish_plain(w, length[order], b, first)
-    else:
-        found = _finish(w, length[order], first)
-    if found is None:
-        return None
-    return _unsort(found, order, b, starts, ends)
-
-
-def _is_plain(b: np.ndarray) -> bool:
-    """Only whitespace, digits, '.', '+' and '-' (no exponents, no text)."""
-    ok = (b - np.uint8(43)) < 15  # + , - . / and digits
-    ok &= b != 44
-    ok &= b != 47
-    ok |= b <= 32
-    return bool(ok.all())
+    return w
 
 
 def _plain_step(w: _Walk, c, m: int, k: int) -> None:
-    """Pass k without exponents: digits and dots only (validated by counts afterwards)."""
+    """Pass k for text without exponents: digits and dots (checked by counting afterwards)."""
     d = c - np.uint8(48)
-    d *= d < 10
-    w.total[:m] += d * _POW10[k - 1]
+    isdig = d < 10
+    d *= isdig
+    w.digits[:m] += isdig
+    np.multiply(d, _POW10[k - 1], out=w.scratch[:m])
+    w.total[:m] += w.scratch[:m]
     np.copyto(w.dot[:m], k, where=c == 46)
 
 
-def _finish_plain(w: _Walk, length, b, first):
-    """(values, inexact) after a plain walk, or None if a token is malformed."""
+def _finish_plain(w: _Walk, length, first):
+    """(values, inexact) after a plain walk, or None if a token is not a plain decimal.
+
+    A plain decimal is digits, at most one dot and a leading sign: its length is exactly its
+    digits + dot + sign, which any other byte (a second dot, an inner sign, a letter) breaks.
+    """
     has_sign = (first == 45) | (first == 43)
-    # Every sign byte must start a token and no token may hold two dots (whole-text counts).
-    if np.count_nonzero(b == 45) + np.count_nonzero(b == 43) != np.count_nonzero(has_sign):
-        return None
     has_dot = w.dot > 0
-    if np.count_nonzero(b == 46) != np.count_nonzero(has_dot):
+    if np.any(length != w.digits + has_dot + has_sign) or not np.all(w.digits):
         return None
-    if np.any(length <= has_dot + has_sign.view(np.uint8)):  # no digit at all
-        return None
-    # total = 10*I*P + F with P = 10**(dot-1), F the fraction digits and I the integer part,
-    # so the mantissa I*P + F is (total + 9*F) / 10, exact while below 2**53. Without a dot,
-    # P = 10**63 (index -1) makes F = total and the mantissa total itself.
-    fraction = _below(w.total, w.dot.astype(np.intp) - 1)
-    mantissa = fraction
-    mantissa *= 9
-    mantissa += w.total
-    inexact = mantissa >= _EXACT
-    mantissa /= 10
+    # With the dot at byte position p, total = I * 10**p + F (integer part I, fraction digits
+    # F < 10**(p-1), the dot weighing 0), while the mantissa is I * 10**(p-1) + F, that is
+    # total - 9 * I * 10**(p-1): exact integer arithmetic while total < 2**53. Without a dot,
+    # the scale 10**63 makes I = 0.
+    scale = _INTEGER_SCALE[w.dot]
+    integer = w.total / scale
+    np.floor(integer, out=integer)
+    integer *= scale
+    integer /= 10
+    integer *= 9
+    mantissa = w.total - integer
     mantissa /= _DOT_SCALE[w.dot]
     mantissa[first == 45] *= -1
-    return mantissa, inexact
+    return mantissa, w.total >= _EXACT
 
 
 def _below(total: np.ndarray, digits: np.ndarray) -> np.ndarray:
