@@ -28,6 +28,7 @@ from motionlib import agreement as metrics
 from motionlib import similarity
 from segmentation import agreement, storage
 from segmentation.models_library import Adjudication, LibrarySegment
+from segmentation.services.captures import read_take
 
 log = logging.getLogger(__name__)
 
@@ -47,15 +48,6 @@ class StaleGold(Exception):
             f"the gold version is at version {adjudication.version}; reload it and redo the change"
         )
         self.adjudication = adjudication
-
-
-def read_take(capture):
-    """The parsed take of a capture's stored original (BVH, or AMC with its ASF)."""
-    with storage.local_path(capture.original) as path:
-        if capture.asf:
-            with storage.local_path(capture.asf) as asf_path:
-                return motionlib.read(path, asf=asf_path)
-        return motionlib.read(path)
 
 
 def capture_joints(capture):

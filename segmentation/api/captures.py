@@ -14,6 +14,7 @@ from rest_framework.parsers import FormParser, JSONParser, MultiPartParser
 from rest_framework.response import Response
 
 from segmentation import services, storage
+from segmentation.api.params import int_param
 from segmentation.api.projects import project_for
 from segmentation.api.serializers import (
     CaptureSerializer,
@@ -29,20 +30,6 @@ class CapturePagination(PageNumberPagination):
     page_size = 50
     page_size_query_param = "page_size"
     max_page_size = 200
-
-
-def int_param(request, name, default, low=None, high=None):
-    """An integer query parameter; ValueError (a 400) names it and its value."""
-    raw = request.query_params.get(name)
-    if raw is None or raw == "":
-        return default
-    try:
-        value = int(raw)
-    except ValueError:
-        raise ValueError(f"{name}: must be an integer, got {raw!r}") from None
-    if low is not None and value < low or high is not None and value > high:
-        raise ValueError(f"{name}: must be between {low} and {high}, got {value}")
-    return value
 
 
 class CaptureViewSet(

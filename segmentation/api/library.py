@@ -22,7 +22,8 @@ from rest_framework.response import Response
 from rest_framework.views import APIView
 
 from segmentation import agreement, library
-from segmentation.api.captures import capture_for, int_param
+from segmentation.api.captures import capture_for
+from segmentation.api.params import bool_param, float_param, int_param
 from segmentation.api.projects import project_for
 from segmentation.models import Review
 from segmentation.models_library import Adjudication, LibrarySegment
@@ -61,30 +62,6 @@ class SegmentSerializer(serializers.ModelSerializer):
 
     def get_color(self, s) -> str:
         return s.label.color if s.label_id else "#888888"
-
-
-def float_param(request, name, low=None, high=None):
-    raw = request.query_params.get(name)
-    if raw is None or raw == "":
-        return None
-    try:
-        value = float(raw)
-    except ValueError:
-        raise ValueError(f"{name}: must be a number, got {raw!r}") from None
-    if low is not None and value < low or high is not None and value > high:
-        raise ValueError(f"{name}: must be between {low} and {high}, got {raw}")
-    return value
-
-
-def bool_param(request, name):
-    raw = request.query_params.get(name)
-    if raw is None or raw == "":
-        return None
-    if raw.lower() in ("true", "1", "yes"):
-        return True
-    if raw.lower() in ("false", "0", "no"):
-        return False
-    raise ValueError(f"{name}: must be true or false, got {raw!r}")
 
 
 def segment_query(request):

@@ -146,8 +146,8 @@ def _send(task, pk):
         log.exception("could not send %s(%s); the sweep will retry", task.name, pk)
 
 
-def _read(capture):
-    """The parsed take of a capture's stored original."""
+def read_take(capture):
+    """The parsed take of a capture's stored original (BVH, or AMC with its ASF)."""
     with storage.local_path(capture.original) as path:
         if capture.asf:
             with storage.local_path(capture.asf) as asf_path:
@@ -184,7 +184,7 @@ def ingest_capture(capture):
 
 
 def _ingest(capture):
-    take = _read(capture)
+    take = read_take(capture)
     positions = np.asarray(motionlib.forward_kinematics(take), dtype="<f4")
     height = float(motionlib.skeleton_height(take))
     storage.save_npy(capture.positions, "positions.npy", positions)
@@ -247,7 +247,7 @@ def detect_run(run):
 
 
 def _detect(run, take=None):
-    take = _read(run.capture) if take is None else take
+    take = read_take(run.capture) if take is None else take
     segmenter = get_segmenter(run.method)
     result = segmenter(**segmenter.validate_params(run.params)).fit_predict(take)
     candidates = [

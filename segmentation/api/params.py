@@ -1,0 +1,37 @@
+"""Query-string parameters. Each parser raises ``ValueError`` (a 400) whose message names
+the parameter and the value at fault."""
+
+
+def int_param(request, name, default, low=None, high=None):
+    """An integer query parameter between ``low`` and ``high``, or ``default`` if absent."""
+    return _number(request, name, default, int, "an integer", low, high)
+
+
+def float_param(request, name, low=None, high=None):
+    """A number query parameter between ``low`` and ``high``, or None if absent."""
+    return _number(request, name, None, float, "a number", low, high)
+
+
+def bool_param(request, name):
+    """true/1/yes or false/0/no, or None if absent."""
+    raw = request.query_params.get(name)
+    if raw is None or raw == "":
+        return None
+    if raw.lower() in ("true", "1", "yes"):
+        return True
+    if raw.lower() in ("false", "0", "no"):
+        return False
+    raise ValueError(f"{name}: must be true or false, got {raw!r}")
+
+
+def _number(request, name, default, convert, kind, low, high):
+    raw = request.query_params.get(name)
+    if raw is None or raw == "":
+        return default
+    try:
+        value = convert(raw)
+    except ValueError:
+        raise ValueError(f"{name}: must be {kind}, got {raw!r}") from None
+    if low is not None and value < low or high is not None and value > high:
+        raise ValueError(f"{name}: must be between {low} and {high}, got {raw}")
+    return value
