@@ -129,16 +129,17 @@ def token_values(b: np.ndarray, starts: np.ndarray, ends: np.ndarray, *,
         return None
     length = length.astype(np.uint8)
     order = np.argsort(length, kind="stable")[::-1]  # radix sort of small ints: cheap
+    walked = length[order]  # lengths, longest first
     # at_least[k]: how many tokens have a k-th byte; they are the first ones in `order`.
-    at_least = np.cumsum(np.bincount(length, minlength=longest + 2)[::-1])[::-1]
-    first = b[starts[order]]
+    at_least = np.searchsorted(-walked.astype(np.int16), -np.arange(longest + 2), side="right")
+    first = b[starts][order]
     found = None
     if plain is not False:  # most text has no exponents: try the lighter walk first
         w = _walk(b, ends[order], longest, at_least, plain=True)
-        found = _finish_plain(w, length[order], first)
+        found = _finish_plain(w, walked, first)
     if found is None and not plain:
         w = _walk(b, ends[order], longest, at_least, plain=False)
-        found = _finish(w, length[order], first)
+        found = _finish(w, walked, first)
     if found is None:
         return None
     return _unsort(found, order, b, starts, ends)
