@@ -152,3 +152,26 @@ def test_it_reproduces_matrices_close_to_gimbal_lock():
                        [10.0, 89.9999, -170.0]])
     R = euler_to_matrix(angles, "ZYX")
     assert_allclose(euler_to_matrix(matrix_to_euler_zyx(R), "ZYX"), R, atol=1e-9)
+
+
+def test_it_moves_every_joint_with_the_root_translation(bvh_13_29):
+    take = motionlib.read(bvh_13_29).slice(1, 200)
+    positions = motionlib.forward_kinematics(take)
+    shifted = take.channels.copy()
+    shifted[:, :3] += [10.0, -2.0, 3.5]  # Xposition Yposition Zposition of the root
+    moved = motionlib.forward_kinematics(take, shifted)
+    assert_allclose(moved - positions, np.broadcast_to([10.0, -2.0, 3.5], positions.shape),
+                    atol=1e-9)
+
+
+def test_it_turns_every_joint_about_the_root_with_the_outermost_root_rotation(bvh_13_29):
+    # The root's channels are Zrotation Yrotation Xrotation, R = Rz @ Ry @ Rx: adding an angle
+    # to Z turns the whole body about the world Z axis through the root.
+    take = motionlib.read(bvh_13_29).slice(1, 200)
+    assert take.skeleton.channels[0][3] == "Zrotation"
+    positions = motionlib.forward_kinematics(take)
+    turned = take.channels.copy()
+    turned[:, 3] += 90.0
+    rotated = motionlib.forward_kinematics(take, turned)
+    root = positions[:, :1]
+    assert_allclose(rotated, root + (positions - root) @ rot("Z", 90).T, atol=1e-9)
