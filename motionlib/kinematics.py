@@ -177,18 +177,61 @@ def _rotate(Gp, rots, channels, axes, j):
 
     Returns ``Gp`` itself (not a copy) when the joint never rotates; never modifies it.
     """
-    theta = np.deg2rad(np.ascontiguousarray(channels[:, [col for _, col in rots]].T))
-    moving = theta.any(axis=1)  # converters fill unused channels with zeros: skip them
+    degrees = np.ascontiguousarray(channels[:, [col for _, col in rots]].T)
+    moving = degrees.any(axis=1)  # converters fill unused channels with zeros: skip them
     if not moving.any():
         return Gp
     G = _times_constant(Gp, axes[j]) if axes is not None else Gp.copy()
-    cos, sin = np.cos(theta[moving]), np.sin(theta[moving])
+    sin, cos = sincos_degrees(degrees[moving])
     turns = [axis for (axis, _), m in zip(rots, moving, strict=True) if m]
     for k, axis in enumerate(turns):
         _turn(G, axis, cos[k], sin[k])
     if axes is not None:
         G = _times_constant(G, axes[j].T)
     return G
+
+
+_TABLE_STEP = 0.1  # degrees
+_TABLE_LIMIT = 720  # degrees either side of zero
+_table: tuple[np.ndarray, np.ndarray] | None = None
+
+
+def sincos_degrees(degrees: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(sin, cos)`` of angles in degrees, to a few ulp, about 3x faster than np.sin + np.cos.
+
+    float64 ``np.sin``/``np.cos`` run at ~9 ns a value here and were most of forward
+    kinematics. Instead: the nearest multiple of 0.1 degree from a table, then the angle-sum
+    formulas with short series for the remainder (below 0.05 degree the omitted terms are
+    under 1e-17). Angles beyond ±720 degrees go to numpy.
+
+    Parameters
+    ----------
+    degrees : ndarray
+
+    Returns
+    -------
+    sin, cos : ndarray, same shape
+    """
+    global _table
+    if degrees.size == 0 or np.abs(degrees).max() > _TABLE_LIMIT:
+        radians = np.deg2rad(degrees)
+        return np.sin(radians), np.cos(radians)
+    half = round(_TABLE_LIMIT / _TABLE_STEP)
+    if _table is None:
+        # k * step, computed exactly as for `fine` below, so table and remainder agree.
+        grid = np.deg2rad(np.arange(-half, half + 1) * _TABLE_STEP)
+        _table = (np.sin(grid), np.cos(grid))
+    steps = np.rint(degrees / _TABLE_STEP)
+    fine = degrees - steps * _TABLE_STEP
+    fine *= np.pi / 180
+    index = steps.astype(np.intp)
+    index += half
+    sin_coarse, cos_coarse = _table[0][index], _table[1][index]
+    fine2 = fine * fine
+    sin_fine = fine * (1 - fine2 / 6)
+    cos_fine = 1 - fine2 / 2 * (1 - fine2 / 12)
+    return (sin_coarse * cos_fine + cos_coarse * sin_fine,
+            cos_coarse * cos_fine - sin_coarse * sin_fine)
 
 
 def rest_positions(take) -> np.ndarray:

@@ -175,3 +175,15 @@ def test_it_turns_every_joint_about_the_root_with_the_outermost_root_rotation(bv
     rotated = motionlib.forward_kinematics(take, turned)
     root = positions[:, :1]
     assert_allclose(rotated, root + (positions - root) @ rot("Z", 90).T, atol=1e-9)
+
+
+def test_it_computes_sines_and_cosines_of_degrees_to_a_few_ulp():
+    from motionlib.kinematics import sincos_degrees
+
+    rng = np.random.default_rng(3)
+    degrees = np.concatenate([rng.uniform(-720, 720, 20000), np.arange(-720, 720.01, 0.05),
+                              [0.0, 90.0, -180.0, 719.99, 1e-9, -0.04999999],
+                              rng.uniform(-5000, 5000, 50)])  # beyond the table: numpy
+    sin, cos = sincos_degrees(degrees)
+    assert_allclose(sin, np.sin(np.deg2rad(degrees)), rtol=0, atol=4e-15)
+    assert_allclose(cos, np.cos(np.deg2rad(degrees)), rtol=0, atol=4e-15)
