@@ -70,7 +70,7 @@ def token_bounds(b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     Bytes up to 32 (space, tab, CR, LF and other controls) separate tokens.
     """
     if b.size == 0:
-        return np.zeros(0, np.int32), np.zeros(0, np.int32)
+        return np.zeros(0, np.intp), np.zeros(0, np.intp)
     tok = b > 32
     # Edge i lies between bytes i-1 and i; the text is padded with whitespace at both ends so
     # edges alternate start, end, start, end...
@@ -78,7 +78,7 @@ def token_bounds(b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     edge[0], edge[-1] = tok[0], tok[-1]
     np.not_equal(tok[1:], tok[:-1], out=edge[1:-1])
     edges = np.flatnonzero(edge)
-    return edges[0::2].astype(np.int32), edges[1::2].astype(np.int32)
+    return edges[0::2], edges[1::2]
 
 
 class _Walk:
@@ -149,7 +149,7 @@ def _walk(b, ends, longest: int, at_least, *, plain: bool) -> _Walk:
     """One pass per byte position from the right; pass k covers the at_least[k] tokens (in
     walking order, longest first) that have a k-th byte."""
     w = _Walk(ends.size)
-    pos = ends.astype(np.intp)
+    pos = ends.astype(np.intp, copy=False)  # a fresh gather: ours to change
     for k in range(1, longest + 1):
         m = int(at_least[k])
         p = pos[:m]
