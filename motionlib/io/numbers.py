@@ -19,6 +19,7 @@ import numpy as np
 _POW10 = 10.0 ** np.arange(64)
 _DOT_SCALE = np.concatenate([[1.0], _POW10[:-1]])  # by dot position from the right: 10**(p-1)
 _INTEGER_SCALE = np.concatenate([[_POW10[-1]], _POW10[1:]])  # 10**p, and 10**63 for no dot
+_NINE_TENTHS_SCALE = np.concatenate([[0.0], 9 * _POW10[:-1]])  # 9 * 10**(p-1), exact
 _EXACT = 2.0**53  # integers below this are exact in float64
 _MAX_TOKEN = 32
 _MAX_POWER = 22  # 10**22 is the largest power of ten that float64 holds exactly
@@ -186,15 +187,13 @@ def _finish_plain(w: _Walk, length, first):
     # F < 10**(p-1), the dot weighing 0), while the mantissa is I * 10**(p-1) + F, that is
     # total - 9 * I * 10**(p-1): exact integer arithmetic while total < 2**53. Without a dot,
     # the scale 10**63 makes I = 0.
-    scale = _INTEGER_SCALE[w.dot]
-    integer = w.total / scale
+    dot = w.dot.astype(np.intp)
+    integer = w.total / _INTEGER_SCALE.take(dot)
     np.floor(integer, out=integer)
-    integer *= scale
-    integer /= 10
-    integer *= 9
-    mantissa = w.total - integer
-    mantissa /= _DOT_SCALE[w.dot]
-    mantissa[first == 45] *= -1
+    integer *= _NINE_TENTHS_SCALE.take(dot)
+    mantissa = np.subtract(w.total, integer, out=integer)
+    mantissa /= _DOT_SCALE.take(dot)
+    np.negative(mantissa, out=mantissa, where=first == 45)
     return mantissa, w.total >= _EXACT
 
 
