@@ -1,9 +1,10 @@
 """BVH reading and writing.
 
 The HIERARCHY is parsed token by token (it is small); the MOTION block, which is nearly all of
-the file, is parsed in one vectorised pass (:mod:`motionlib.io.numbers`) and validated as a
-whole. Only when that validation fails does a line-by-line pass run, to find and name the bad
-line.
+the file, is parsed by vectorised passes over all its numbers at once
+(:mod:`motionlib.io.numbers`) and validated as a whole (values per line, number of lines). Only
+when that fails does a line-by-line pass run, to read what the fast parser declines (``nan``
+and friends are then rejected) and to find and name the bad line.
 """
 
 from __future__ import annotations
