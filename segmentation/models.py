@@ -139,6 +139,16 @@ class ClaimQuerySet(models.QuerySet):
         return self.filter(last_sent, status="queued")
 
 
+class JSONArrayLength(models.Func):
+    """Length of a JSON array column, counted by the database (SQLite and PostgreSQL)."""
+
+    function = "JSON_ARRAY_LENGTH"
+    output_field = models.IntegerField()
+
+    def as_postgresql(self, compiler, connection, **extra):
+        return self.as_sql(compiler, connection, function="JSONB_ARRAY_LENGTH", **extra)
+
+
 class Job(models.Model):
     """State shared by the two kinds of background work (ingest, detect)."""
 

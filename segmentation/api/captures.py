@@ -5,6 +5,7 @@ import math
 
 import numpy as np
 from django.conf import settings
+from django.db.models import Prefetch
 from drf_spectacular.utils import OpenApiParameter, extend_schema
 from rest_framework import mixins, viewsets
 from rest_framework.decorators import action
@@ -17,13 +18,14 @@ from segmentation import services, storage
 from segmentation.api.params import int_param
 from segmentation.api.projects import project_for
 from segmentation.api.serializers import (
+    CaptureListSerializer,
     CaptureSerializer,
     RunRequestSerializer,
     RunSerializer,
     UploadSerializer,
 )
 from segmentation.errors import NotReady, UploadTooLarge
-from segmentation.models import Capture
+from segmentation.models import Capture, DetectionRun, JSONArrayLength
 
 
 class CapturePagination(PageNumberPagination):
@@ -42,8 +44,18 @@ class CaptureViewSet(
     pagination_class = CapturePagination
     parser_classes = [MultiPartParser, FormParser, JSONParser]
 
+    def get_serializer_class(self):
+        return CaptureListSerializer if self.action == "list" else super().get_serializer_class()
+
     def get_queryset(self):
-        captures = Capture.objects.visible_to(self.request.user).prefetch_related("runs")
+        captures = Capture.objects.visible_to(self.request.user)
+        if self.action == "list":
+            runs = DetectionRun.objects.defer("candidates", "params", "timings").annotate(
+                n_candidates=JSONArrayLength("candidates")
+            )
+            captures = captures.defer("skeleton").prefetch_related(Prefetch("runs", runs))
+        else:
+            captures = captures.prefetch_related("runs")
         project = int_param(self.request, "project", None)
         if project is not None:
             captures = captures.filter(project_id=project)

@@ -77,6 +77,31 @@ class CaptureSerializer(serializers.ModelSerializer):
         return capture.skeleton if capture.status == "ready" else None
 
 
+class RunSummarySerializer(serializers.ModelSerializer):
+    """A run in a capture list row: its state and how many candidates, not the candidates."""
+
+    error = serializers.SerializerMethodField()
+    n_candidates = serializers.IntegerField(read_only=True)
+
+    class Meta:
+        model = DetectionRun
+        fields = ["id", "method", "status", "error", "created_at", "finished_at", "n_candidates"]
+
+    def get_error(self, run) -> str | None:
+        return run.error or None
+
+
+class CaptureListSerializer(CaptureSerializer):
+    """A capture list row: a capture without its skeleton, its latest run summarised.
+    Those two are most of a full capture's bytes and decoding time, and a list shows
+    neither; ``GET /api/captures/{id}/`` has them."""
+
+    latest_run = RunSummarySerializer(read_only=True, allow_null=True)
+
+    class Meta(CaptureSerializer.Meta):
+        fields = [f for f in CaptureSerializer.Meta.fields if f != "skeleton"]
+
+
 class UploadSerializer(serializers.Serializer):
     file = serializers.FileField(allow_empty_file=True)
     asf = serializers.FileField(required=False, allow_empty_file=True)

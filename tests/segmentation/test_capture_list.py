@@ -26,6 +26,13 @@ class CaptureListTestCase(BaseTestCase):
         self.assertEqual((body["count"], len(body["results"])), (2, 1))
         self.assertIn("page=2", body["next"])
 
+    def test_it_summarises_the_latest_run_in_list_rows(self):
+        rows = {c["name"]: c for c in self.client.get("/api/captures/").json()["results"]}
+        run = rows["walking.bvh"]["latest_run"]
+        self.assertEqual((run["status"], run["n_candidates"]), ("ready", 3))
+        self.assertNotIn("candidates", run)
+        self.assertNotIn("skeleton", rows["walking.bvh"])
+
     def test_it_shows_a_capture_with_its_latest_run_and_skeleton(self):
         body = self.client.get(f"/api/captures/{self.walk_take.pk}/").json()
         self.assertEqual(body["duration"], 400 / 120.0)

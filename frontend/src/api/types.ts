@@ -63,6 +63,21 @@ export interface Capture {
   duplicate?: boolean;
 }
 
+/** A row of the capture list: no skeleton, the latest run summarised. */
+export interface RunSummary {
+  id: number;
+  method: string;
+  status: string;
+  error: string | null;
+  created_at: string;
+  finished_at: string | null;
+  n_candidates: number;
+}
+
+export interface CaptureSummary extends Omit<Capture, "skeleton" | "latest_run"> {
+  latest_run: RunSummary | null;
+}
+
 export interface Page<T> {
   count: number;
   next: string | null;

@@ -2,7 +2,7 @@
 // them (with progress); rows still being processed refresh themselves.
 
 import { get } from "../api/client";
-import type { Capture, Me, Page, Project } from "../api/types";
+import type { CaptureSummary, Me, Page, Project } from "../api/types";
 import { clear, formatDuration, h, toast } from "../ui/dom";
 import { navigate } from "../router";
 import { pairFiles, upload, type UploadItem } from "./upload";
@@ -138,7 +138,7 @@ export async function renderCaptureList(root: HTMLElement): Promise<() => void> 
     clearTimeout(timer);
     const request = ++latest;
     const q = new URLSearchParams(queryOf(filters).slice(1));
-    const data = await get<Page<Capture>>(`/api/captures/?${q}`).catch((err: Error) => {
+    const data = await get<Page<CaptureSummary>>(`/api/captures/?${q}`).catch((err: Error) => {
       if (request !== latest || !mounted) return null;
       clear(rows, h("tr", {}, h("td", { colspan: 9, class: "error-text" }, `Could not load captures: ${err.message} (trying again)`)));
       timer = window.setTimeout(() => void load(), 4000);
@@ -174,10 +174,10 @@ export async function renderCaptureList(root: HTMLElement): Promise<() => void> 
   };
 }
 
-function row(c: Capture, project: string): HTMLElement {
+function row(c: CaptureSummary, project: string): HTMLElement {
   const open = () => navigate(`/captures/${c.id}/`);
   const status = h("span", { class: `badge badge-${c.status}`, title: c.error ?? "" }, c.status);
-  const cuts = c.latest_run?.candidates?.length;
+  const cuts = c.latest_run?.n_candidates;
   return h(
     "tr",
     { class: "capture-row", "data-testid": `capture-${c.id}`, tabindex: 0, onclick: open, onkeydown: (e: Event) => (e as KeyboardEvent).key === "Enter" && open() },
