@@ -8,7 +8,7 @@ client if it is missing) requests the list with a token for a fixed time per sce
 Queries and CPU time per request are measured in-process for the same URLs.
 
     .venv/bin/python benchmarks/capture_list_load.py [--captures 10000] [--seconds 10]
-        [--connections 8] [--postgres postgres://postgres@127.0.0.1:5432]
+        [--connections 4] [--workers 4] [--threads 1] [--postgres postgres://postgres@127.0.0.1:5432]
 
 Target: p95 <= 100 ms.
 """
@@ -52,8 +52,11 @@ def parse_args():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--captures", type=int, default=10_000)
     parser.add_argument("--seconds", type=float, default=10.0)
-    parser.add_argument("--connections", type=int, default=8)
+    parser.add_argument("--connections", type=int, default=4)
     parser.add_argument("--postgres", default="postgres://postgres@127.0.0.1:5432")
+    parser.add_argument("--workers", type=int, default=4, help="gunicorn worker processes")
+    parser.add_argument("--threads", type=int, default=1,
+                        help="threads per gunicorn worker (1: sync workers, as in production)")
     return parser.parse_args()
 
 
@@ -183,10 +186,10 @@ def free_port():
         return probe.getsockname()[1]
 
 
-def start_gunicorn(port, log):
+def start_gunicorn(port, log, workers, threads):
     proc = subprocess.Popen(
         [str(Path(sys.executable).with_name("gunicorn")), "cutroom.wsgi:application",
-         "--bind", f"127.0.0.1:{port}", "--workers", "2", "--threads", "4",
+         "--bind", f"127.0.0.1:{port}", "--workers", str(workers), "--threads", str(threads),
          "--access-logfile", "/dev/null", "--error-logfile", "-"],
         cwd=REPO, env=os.environ.copy(), stdout=log.open("w"), stderr=subprocess.STDOUT,
         start_new_session=True,
@@ -281,13 +284,13 @@ def main():
 
         connections.close_all()
         port = free_port()
-        server = start_gunicorn(port, var / "gunicorn.log")
+        server = start_gunicorn(port, var / "gunicorn.log", args.workers, args.threads)
         tool = "wrk" if shutil.which("wrk") else "python client"
         script = var / "report.lua"
         script.write_text(LUA)
         print(f"GET /api/captures/ on PostgreSQL, {args.captures} captures of the caller "
-              f"(+1000 of another user; seeded in {seeded:.1f} s), gunicorn 2 workers x 4 "
-              f"threads on loopback, {tool}, {args.connections} connections, "
+              f"(+1000 of another user; seeded in {seeded:.1f} s), gunicorn {args.workers} workers x "
+              f"{args.threads} threads on loopback, {tool}, {args.connections} connections, "
               f"{args.seconds:g} s per scenario, page size 50; machine: {os.cpu_count()} "
               f"cores, load average {os.getloadavg()[0]:.1f} at start")
         print(f"{'scenario':<20} {'queries':>7} {'CPU ms':>7} {'p50 ms':>8} {'p95 ms':>8} "
