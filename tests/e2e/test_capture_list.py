@@ -103,6 +103,32 @@ def test_it_uploads_dropped_files_and_shows_their_status_as_it_changes(live_serv
     assert page.errors == []
 
 
+def test_it_retries_a_failed_capture_from_its_stored_original(live_server, new_page, studio):
+    from django.core.files.uploadedfile import SimpleUploadedFile
+
+    from segmentation import services
+    from segmentation.models import Capture
+
+    content = synthetic_bvh(seed=4, duration=8.0)
+    capture, _ = services.do_upload_capture(studio["project"], studio["alice"], SimpleUploadedFile("lost_take.bvh", content))
+    # Not the file's fault: the worker holding it was lost too often.
+    Capture.objects.filter(pk=capture.pk).update(status="failed", error="the worker was lost 3 times")
+
+    page = open_list(new_page, "ann")
+    row = page.get_by_test_id(f"capture-{capture.pk}")
+    expect(row).to_contain_text("the worker was lost 3 times")
+    page.get_by_test_id(f"retry-{capture.pk}").click()
+    expect(row).to_contain_text("queued")
+    expect(page.get_by_test_id(f"retry-{capture.pk}")).to_have_count(0)
+    assert page.url.rstrip("/") == live_server.url, "the click retried without opening the capture"
+
+    run_worker_jobs()
+    expect(row).to_contain_text("ready", timeout=20_000)
+    with Capture.objects.get(pk=capture.pk).original.open("rb") as handle:
+        assert handle.read() == content
+    assert page.errors == []
+
+
 def test_it_lists_only_captures_of_projects_the_user_belongs_to(live_server, new_page, studio):
     from django.contrib.auth import get_user_model
     from django.core.files.uploadedfile import SimpleUploadedFile

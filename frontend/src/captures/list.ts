@@ -1,7 +1,7 @@
 // The capture list: filter by project, status and name; drop files anywhere to upload
 // them (with progress); rows still being processed refresh themselves.
 
-import { get } from "../api/client";
+import { get, post } from "../api/client";
 import type { CaptureSummary, Me, Page, Project } from "../api/types";
 import { clear, formatDuration, h, toast } from "../ui/dom";
 import { navigate } from "../router";
@@ -145,7 +145,7 @@ export async function renderCaptureList(root: HTMLElement): Promise<() => void> 
       return null;
     });
     if (!data || request !== latest || !mounted) return;
-    clear(rows, ...data.results.map((c) => row(c, projectName.get(c.project) ?? String(c.project))));
+    clear(rows, ...data.results.map((c) => row(c, projectName.get(c.project) ?? String(c.project), load)));
     if (!data.results.length) rows.append(h("tr", {}, h("td", { colspan: 9, class: "muted empty" }, "No captures match. Drop a file above to add one.")));
     clear(
       pager,
@@ -174,14 +174,28 @@ export async function renderCaptureList(root: HTMLElement): Promise<() => void> 
   };
 }
 
-function row(c: CaptureSummary, project: string): HTMLElement {
+/** Queue a failed capture's ingest again from its stored original, then refresh. */
+function retryButton(c: CaptureSummary, reload: () => Promise<void>): HTMLElement {
+  const retry = (e: Event) => {
+    e.stopPropagation();
+    post(`/api/captures/${c.id}/retry/`)
+      .then(() => {
+        toast(`${c.name}: queued again.`);
+        return reload();
+      })
+      .catch((err: Error) => toast(`${c.name}: ${err.message}`, "error"));
+  };
+  return h("button", { class: "btn btn-small", "data-testid": `retry-${c.id}`, title: "Read the stored original again", onclick: retry }, "Retry");
+}
+
+function row(c: CaptureSummary, project: string, reload: () => Promise<void>): HTMLElement {
   const open = () => navigate(`/captures/${c.id}/`);
   const status = h("span", { class: `badge badge-${c.status}`, title: c.error ?? "" }, c.status);
   const cuts = c.latest_run?.n_candidates;
   return h(
     "tr",
     { class: "capture-row", "data-testid": `capture-${c.id}`, tabindex: 0, onclick: open, onkeydown: (e: Event) => (e as KeyboardEvent).key === "Enter" && open() },
-    h("td", {}, h("a", { href: `/captures/${c.id}/`, onclick: (e: Event) => e.preventDefault() }, c.name), c.status === "failed" && c.error ? h("div", { class: "error-text small" }, c.error) : null),
+    h("td", {}, h("a", { href: `/captures/${c.id}/`, onclick: (e: Event) => e.preventDefault() }, c.name), c.status === "failed" && c.error ? h("div", { class: "error-text small" }, c.error) : null, c.status === "failed" ? retryButton(c, reload) : null),
     h("td", {}, project),
     h("td", {}, status),
     h("td", { class: "num" }, c.n_frames?.toLocaleString() ?? "—"),
