@@ -18,7 +18,6 @@ import os
 import random
 import re
 import shutil
-import signal
 import socket
 import subprocess
 import sys
@@ -29,8 +28,8 @@ import urllib.request
 from pathlib import Path
 
 import numpy as np
+from harness import REPO, drop_database, scratch_database, start_django, stop
 
-REPO = Path(__file__).resolve().parents[1]
 TARGET_MS = 100.0
 SCENARIOS = [
     ("first page", "/api/captures/"),
@@ -58,36 +57,6 @@ def parse_args():
     parser.add_argument("--threads", type=int, default=1,
                         help="threads per gunicorn worker (1: sync workers, as in production)")
     return parser.parse_args()
-
-
-def scratch_database(server, name):
-    """Create database ``name`` on ``server`` (dropping a leftover); returns its URL."""
-    import psycopg
-
-    with psycopg.connect(f"{server}/postgres", autocommit=True) as conn:
-        conn.execute(f'DROP DATABASE IF EXISTS "{name}" WITH (FORCE)')
-        conn.execute(f'CREATE DATABASE "{name}"')
-    return f"{server}/{name}"
-
-
-def drop_database(server, name):
-    import psycopg
-
-    with psycopg.connect(f"{server}/postgres", autocommit=True) as conn:
-        conn.execute(f'DROP DATABASE IF EXISTS "{name}" WITH (FORCE)')
-
-
-def django_on(url, var):
-    os.environ.update(DATABASE_URL=url, CUTROOM_VAR_DIR=str(var), DB_CONN_MAX_AGE="60",
-                      DJANGO_SETTINGS_MODULE="cutroom.settings")
-    os.environ.pop("CELERY_BROKER_URL", None)
-    sys.path.insert(0, str(REPO))
-    import django
-
-    django.setup()
-    from django.core.management import call_command
-
-    call_command("migrate", verbosity=0)
 
 
 def seed(n_captures):
@@ -206,15 +175,6 @@ def start_gunicorn(port, log, workers, threads):
     sys.exit(f"gunicorn did not start:\n{log.read_text()}")
 
 
-def stop(proc):
-    proc.send_signal(signal.SIGTERM)
-    try:
-        proc.wait(30)
-    except subprocess.TimeoutExpired:
-        os.killpg(proc.pid, signal.SIGKILL)
-        proc.wait(10)
-
-
 def run_wrk(url, token, seconds, connections, script):
     """(p50 ms, p95 ms, p99 ms, requests/s, errors) from wrk."""
     out = subprocess.run(
@@ -272,7 +232,8 @@ def main():
     server = None
     try:
         url = scratch_database(args.postgres, name)
-        django_on(url, var)
+        start_django(unset=("CELERY_BROKER_URL",), DATABASE_URL=url, CUTROOM_VAR_DIR=str(var),
+                     DB_CONN_MAX_AGE="60")
         started = time.perf_counter()
         token, project = seed(args.captures)
         seeded = time.perf_counter() - started

@@ -15,36 +15,12 @@ import argparse
 import os
 import re
 import statistics
-import sys
 import time
-from pathlib import Path
-from urllib.parse import urlparse, urlunparse
 
-import psycopg
-
-REPO = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(REPO))
+from harness import drop_database, scratch_database, start_django
 
 N_DESCRIBED = 20000
 LABELS = ["walk", "run", "jump", "punch", "kick", "squat", "wave", "turn", "sit", "idle"]
-
-
-def scratch_database(admin_url, name, create):
-    with psycopg.connect(admin_url, autocommit=True) as conn:
-        conn.execute(f'DROP DATABASE IF EXISTS "{name}"')
-        if create:
-            conn.execute(f'CREATE DATABASE "{name}"')
-
-
-def setup_django(database_url):
-    os.environ["DATABASE_URL"] = database_url
-    os.environ.setdefault("DJANGO_SETTINGS_MODULE", "cutroom.settings")
-    import django
-
-    django.setup()
-    from django.core.management import call_command
-
-    call_command("migrate", verbosity=0)
 
 
 def populate(n_segments, seed=6):
@@ -186,11 +162,10 @@ def main():
         "DATABASE_ADMIN_URL", "postgres://postgres@127.0.0.1:5432/postgres"))
     args = parser.parse_args()
     name = f"cutroom_bench_library_{os.getpid()}"
-    url = urlunparse(urlparse(args.admin_url)._replace(path=f"/{name}"))
-    scratch_database(args.admin_url, name, create=True)
+    url = scratch_database(args.admin_url, name)
     try:
         started = time.perf_counter()
-        setup_django(url)
+        start_django(DATABASE_URL=url)
         ctx = populate(args.segments)
         print(f"scratch database {name}: {args.segments:,} segments loaded in "
               f"{time.perf_counter() - started:.1f} s (PostgreSQL, {args.repeat} timed runs each)\n")
@@ -209,7 +184,7 @@ def main():
         from django.db import connections
 
         connections.close_all()
-        scratch_database(args.admin_url, name, create=False)
+        drop_database(args.admin_url, name)
         print(f"\nscratch database {name} dropped")
 
 

@@ -16,7 +16,6 @@ import argparse
 import io
 import os
 import shutil
-import signal
 import subprocess
 import sys
 import tempfile
@@ -24,8 +23,8 @@ import time
 from pathlib import Path
 
 import numpy as np
+from harness import REPO, start_django, stop
 
-REPO = Path(__file__).resolve().parents[1]
 TARGET_SECONDS = 2.0
 
 
@@ -43,16 +42,8 @@ def parse_args():
 
 def embedded_environment(var):
     """Environment of this process and the worker: everything under ``var``."""
-    for name in ("DATABASE_URL", "CELERY_BROKER_URL", "CUTROOM_MEDIA_ROOT", "CELERY_BROKER_DIR"):
-        os.environ.pop(name, None)
-    os.environ.update(CUTROOM_VAR_DIR=str(var), DJANGO_SETTINGS_MODULE="cutroom.settings")
-    sys.path.insert(0, str(REPO))
-    import django
-
-    django.setup()
-    from django.core.management import call_command
-
-    call_command("migrate", verbosity=0)
+    start_django(unset=("DATABASE_URL", "CELERY_BROKER_URL", "CUTROOM_MEDIA_ROOT", "CELERY_BROKER_DIR"),
+                 CUTROOM_VAR_DIR=str(var))
 
 
 def start_worker(var):
@@ -69,15 +60,6 @@ def start_worker(var):
             sys.exit(f"worker did not start:\n{(var / 'worker.log').read_text()}")
         time.sleep(0.1)
     return proc
-
-
-def stop_worker(proc):
-    proc.send_signal(signal.SIGTERM)
-    try:
-        proc.wait(30)
-    except subprocess.TimeoutExpired:
-        os.killpg(proc.pid, signal.SIGKILL)
-        proc.wait(10)
 
 
 def takes(repeats, minutes, fps, first_seed=100):
@@ -185,7 +167,7 @@ def main():
         report(rows, files[0][2], args)
     finally:
         if worker is not None:
-            stop_worker(worker)
+            stop(worker)
         shutil.rmtree(var, ignore_errors=True)
 
 

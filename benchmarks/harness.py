@@ -1,0 +1,61 @@
+"""What the service benchmarks share: a scratch PostgreSQL database, Django started on
+a chosen environment, and stopping a child process group."""
+
+import os
+import signal
+import subprocess
+import sys
+from pathlib import Path
+from urllib.parse import urlparse, urlunparse
+
+REPO = Path(__file__).resolve().parents[1]
+
+
+def database_url(server, name):
+    """``server`` (any PostgreSQL URL; its database part is ignored) pointed at ``name``."""
+    return urlunparse(urlparse(server)._replace(path=f"/{name}"))
+
+
+def scratch_database(server, name):
+    """Create database ``name`` (dropping a leftover of the same name); returns its URL."""
+    _admin(server, f'DROP DATABASE IF EXISTS "{name}" WITH (FORCE)', f'CREATE DATABASE "{name}"')
+    return database_url(server, name)
+
+
+def drop_database(server, name):
+    _admin(server, f'DROP DATABASE IF EXISTS "{name}" WITH (FORCE)')
+
+
+def _admin(server, *statements):
+    import psycopg
+
+    with psycopg.connect(database_url(server, "postgres"), autocommit=True) as conn:
+        for statement in statements:
+            conn.execute(statement)
+
+
+def start_django(unset=(), **env):
+    """Set up Django in this process on ``env`` (minus the ``unset`` variables) and
+    migrate its database."""
+    for name in unset:
+        os.environ.pop(name, None)
+    os.environ.update(env)
+    os.environ.setdefault("DJANGO_SETTINGS_MODULE", "cutroom.settings")
+    if str(REPO) not in sys.path:
+        sys.path.insert(0, str(REPO))
+    import django
+
+    django.setup()
+    from django.core.management import call_command
+
+    call_command("migrate", verbosity=0)
+
+
+def stop(proc):
+    """SIGTERM, then the whole process group killed if it is not gone within 30 s."""
+    proc.send_signal(signal.SIGTERM)
+    try:
+        proc.wait(30)
+    except subprocess.TimeoutExpired:
+        os.killpg(proc.pid, signal.SIGKILL)
+        proc.wait(10)
