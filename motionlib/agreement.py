@@ -22,7 +22,7 @@ from itertools import combinations
 
 import numpy as np
 
-from motionlib.metrics import match
+from motionlib.metrics import boundary_scores
 
 MISSING = -1
 
@@ -45,13 +45,8 @@ def boundary_agreement(cuts_a, cuts_b, *, fps: float, tolerance_s: float = 0.25)
         raise ValueError(f"fps: must be positive, got {fps}")
     if tolerance_s < 0:
         raise ValueError(f"tolerance_s: must be >= 0, got {tolerance_s}")
-    a = np.asarray(cuts_a, dtype=np.int64).reshape(-1)
-    b = np.asarray(cuts_b, dtype=np.int64).reshape(-1)
-    matched = len(match(a, b, tolerance=int(round(tolerance_s * fps)))[0]) if len(b) else 0
-    precision = matched / len(a) if len(a) else 1.0
-    recall = matched / len(b) if len(b) else 1.0
-    f1 = 2 * matched / (len(a) + len(b)) if len(a) + len(b) else 1.0
-    return {"precision": precision, "recall": recall, "f1": f1, "matched": matched}
+    # B's cuts play the truth: the same one-to-one matching and scores as a detector's.
+    return boundary_scores(cuts_a, cuts_b, fps=fps, tolerance_s=tolerance_s)
 
 
 def label_codes(segment_lists, n_frames: int) -> tuple[np.ndarray, list]:
