@@ -82,9 +82,9 @@ def do_upload_capture(project, user, upload, asf=None):
     digest = checksum(upload, asf)
     existing = Capture.objects.filter(project=project, checksum=digest).first()
     if existing:
-        if existing.status == "failed":
-            # Uploading a failed take again is the natural way to ask for another try.
-            do_retry_capture(existing)
+        # Uploading a failed take again is the natural way to ask for another try (if a
+        # concurrent retry queued it already, that is just as good).
+        if existing.status == "failed" and _requeue_failed(existing):
             existing.refresh_from_db()
         return existing, False
     capture = Capture(project=project, uploaded_by=user, name=upload.name, format=fmt)
@@ -108,13 +108,20 @@ def do_retry_capture(capture):
     For a failure that was not the file's fault (a worker lost too often, storage down,
     a parser bug since fixed); the error of the last try is cleared when it is queued.
     """
+    if not _requeue_failed(capture):
+        capture.refresh_from_db(fields=["status"])
+        raise NotReady(
+            f"capture {capture.pk} is {capture.status}; only a failed capture can be retried"
+        )
+
+
+def _requeue_failed(capture):
+    """Queue a failed capture's ingest again; False if it was not failed (any more)."""
     with transaction.atomic():
         if not Capture.objects.requeue_failed(capture.pk):
-            capture.refresh_from_db(fields=["status"])
-            raise NotReady(
-                f"capture {capture.pk} is {capture.status}; only a failed capture can be retried"
-            )
+            return False
         _enqueue("ingest", capture.pk)
+    return True
 
 
 def do_start_run(capture, user, method, params):
