@@ -329,10 +329,10 @@ def _amc_fast(data: bytes, offset: int, sk: Skeleton) -> np.ndarray | None:
             return None
     number_cols = np.setdiff1d(np.arange(width), name_cols)
     values = np.empty((n, number_cols.size))
-    for lo in range(0, n, _FRAMES_PER_BLOCK):  # blocks keep the parser's temporaries small
+    for lo in range(0, n, _FRAMES_PER_BLOCK):  # blocks keep the gathered bounds small
         block = slice(lo, lo + _FRAMES_PER_BLOCK)
         parsed = token_values(b, starts[block, number_cols].ravel(),
-                              ends[block, number_cols].ravel(), plain=False)
+                              ends[block, number_cols].ravel())
         if parsed is None:
             return None
         values[block] = parsed.reshape(-1, number_cols.size)

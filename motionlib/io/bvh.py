@@ -1,10 +1,10 @@
 """BVH reading and writing.
 
 The HIERARCHY is parsed token by token (it is small); the MOTION block, which is nearly all of
-the file, is parsed by vectorised passes over all its numbers at once
-(:mod:`motionlib.io.numbers`) and validated as a whole (values per line, number of lines). Only
-when that fails does a line-by-line pass run, to read what the fast parser declines (``nan``
-and friends are then rejected) and to find and name the bad line.
+the file, is read in one call to the compiled number reader (:mod:`motionlib.io.numbers`),
+which also checks its shape (values per line, number of lines). Only when that declines does a
+line-by-line pass run, to read what the fast reader declines (``nan`` and friends are then
+rejected) and to find and name the bad line.
 """
 
 from __future__ import annotations
@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from motionlib.errors import CaptureError
-from motionlib.io.numbers import parse_decimal_lines
+from motionlib.io.numbers import read_rows
 from motionlib.skeleton import CHANNEL_NAMES, ROTATION_CHANNELS, Skeleton
 from motionlib.take import Take, frame_range
 
@@ -187,13 +187,10 @@ def _motion_header(data: bytes, pos: int, line: int, path) -> tuple[int, float, 
 def _parse_motion(data: bytes, pos: int, line: int, n_frames: int, n_channels: int,
                   path) -> np.ndarray:
     """Frame values as (n_frames, n_channels); ``line`` is the line number of byte ``pos``."""
-    parsed = parse_decimal_lines(data, pos)
-    if parsed is not None:
-        values, per_line = parsed
-        per_line = per_line[per_line > 0]
-        if per_line.size == n_frames and np.all(per_line == n_channels):
-            return values.reshape(n_frames, n_channels)
-    # Slow path: exponents, nan, or something wrong that needs a line number.
+    values = read_rows(data, pos, n_frames, n_channels)
+    if values is not None:
+        return values
+    # Slow path: nan, no channels, or something wrong that needs a line number.
     return _parse_motion_lines(data[pos:].decode("utf-8", "replace"), line, n_frames,
                                n_channels, path)
 

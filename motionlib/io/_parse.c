@@ -1,0 +1,204 @@
+/* Exact, C-speed reading of whitespace-separated decimal numbers (motionlib.io._parse).
+ *
+ * A capture's MOTION section is hundreds of thousands of decimals such as "-17.2528" or
+ * "-2.51463e-014". Each one is read as an integer mantissa and a power of ten; when the
+ * mantissa has at most 2**53 and the power is within +-22, both are exact doubles and one
+ * multiplication or division gives the correctly rounded value (Clinger's fast path), so the
+ * result is bit for bit what Python's float() gives. Any other well-formed number goes
+ * through PyOS_string_to_double, Python's own correctly rounded conversion. Anything that is
+ * not such a number (nan, inf, "1,5", stray text) or is not finite makes the call decline
+ * (-1 or the token's index): the Python caller then re-reads the text line by line to say
+ * what is wrong and where. Only the buffer protocol is used, so building needs no numpy.
+ */
+#define PY_SSIZE_T_CLEAN
+#include <Python.h>
+#include <math.h>
+#include <stdint.h>
+
+static const double POW10[23] = {
+    1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,  1e8,  1e9,  1e10, 1e11,
+    1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
+
+#define MAX_TOKEN 511     /* longer tokens are declined (a %f double is at most ~320) */
+#define MAX_DIGITS 19     /* significant digits that always fit a uint64_t */
+
+/* Separators inside a line; '\n' ends it. str.split() agrees on these bytes. */
+static inline int is_blank(unsigned char c) {
+    return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f';
+}
+
+static inline int is_digit(unsigned char c) { return (unsigned char)(c - '0') < 10; }
+
+/* Python's conversion for what the fast path cannot do exactly; 0 on success. */
+static int slow_number(const char *p, const char *end, double *value) {
+    char buf[MAX_TOKEN + 1];
+    Py_ssize_t n = end - p;
+    char *stop;
+    if (n > MAX_TOKEN)
+        return -1;
+    memcpy(buf, p, (size_t)n);
+    buf[n] = '\0';
+    double v = PyOS_string_to_double(buf, &stop, NULL);
+    if (v == -1.0 && PyErr_Occurred()) {
+        PyErr_Clear();
+        return -1;
+    }
+    if (stop != buf + n || !isfinite(v))
+        return -1;
+    *value = v;
+    return 0;
+}
+
+/* Read [+-]digits[.digits][(e|E)[+-]digits] (or [+-].digits...) starting at p; return the
+ * byte after it, or NULL to decline. The caller checks that a separator follows. */
+static const char *scan_number(const char *p, const char *end, double *value) {
+    const char *start = p, *digits;
+    int negative = 0;
+    uint64_t mantissa = 0;
+    long power = 0;
+    Py_ssize_t significant;
+    if (p < end && (*p == '+' || *p == '-'))
+        negative = *p++ == '-';
+    while (p < end && *p == '0')  /* leading zeros are not significant */
+        p++;
+    int seen = p > start + (start < end && (*start == '+' || *start == '-'));
+    for (digits = p; p < end && is_digit(*p); p++)
+        mantissa = mantissa * 10 + (uint64_t)(*p - '0');
+    significant = p - digits;
+    seen |= significant > 0;
+    if (p < end && *p == '.') {
+        const char *fraction = ++p;
+        if (significant == 0)  /* 0.000123: zeros after the dot only scale */
+            while (p < end && *p == '0')
+                p++;
+        for (digits = p; p < end && is_digit(*p); p++)
+            mantissa = mantissa * 10 + (uint64_t)(*p - '0');
+        significant += p - digits;
+        power -= p - fraction;
+        seen |= p > fraction;
+    }
+    if (!seen)
+        return NULL;
+    if (p < end && (*p == 'e' || *p == 'E')) {
+        int exp_negative = 0;
+        long exponent = 0;
+        p++;
+        if (p < end && (*p == '+' || *p == '-'))
+            exp_negative = *p++ == '-';
+        if (p == end || !is_digit(*p))
+            return NULL;
+        for (; p < end && is_digit(*p); p++)
+            if (exponent < 100000)
+                exponent = exponent * 10 + (*p - '0');
+        power += exp_negative ? -exponent : exponent;
+    }
+    if (significant > MAX_DIGITS || mantissa > ((uint64_t)1 << 53) || power > 22 ||
+        power < -22) {
+        if (significant == 0)
+            *value = negative ? -0.0 : 0.0;
+        else if (slow_number(start, p, value))
+            return NULL;
+        return p;
+    }
+    double v = (double)mantissa;
+    v = power < 0 ? v / POW10[-power] : v * POW10[power];
+    *value = negative ? -v : v;
+    return p;
+}
+
+PyDoc_STRVAR(read_rows_doc,
+"read_rows(data, offset, out, row_length) -> int\n\n"
+"Read the lines of ``data[offset:]`` into ``out`` (a writable float64 buffer), each\n"
+"non-blank line holding exactly ``row_length`` numbers. Returns the number of rows read,\n"
+"or -1 when a line has another count, a token is not a finite decimal, or there are more\n"
+"rows than ``out`` holds.");
+
+static PyObject *read_rows(PyObject *self, PyObject *args) {
+    (void)self;
+    Py_buffer data, out;
+    Py_ssize_t offset, row_length, rows = 0;
+    if (!PyArg_ParseTuple(args, "y*nw*n", &data, &offset, &out, &row_length))
+        return NULL;
+    Py_ssize_t result = -1;
+    if (offset < 0 || offset > data.len || row_length <= 0 || out.len % sizeof(double)) {
+        PyErr_SetString(PyExc_ValueError, "read_rows: bad offset, row length or buffer");
+        goto done;
+    }
+    const char *p = (const char *)data.buf + offset, *end = (const char *)data.buf + data.len;
+    double *dst = (double *)out.buf;
+    Py_ssize_t capacity = (Py_ssize_t)(out.len / sizeof(double)) / row_length;
+    while (p < end) {
+        Py_ssize_t count = 0;
+        for (;;) {
+            while (p < end && is_blank((unsigned char)*p))
+                p++;
+            if (p == end || *p == '\n')
+                break;
+            if (count == row_length || rows == capacity)
+                goto done;
+            p = scan_number(p, end, dst + rows * row_length + count);
+            if (!p || (p < end && *p != '\n' && !is_blank((unsigned char)*p)))
+                goto done;
+            count++;
+        }
+        if (count) {
+            if (count != row_length)
+                goto done;
+            rows++;
+        }
+        p++;  /* past the '\n' (or the end) */
+    }
+    result = rows;
+done:
+    PyBuffer_Release(&data);
+    PyBuffer_Release(&out);
+    return PyErr_Occurred() ? NULL : PyLong_FromSsize_t(result);
+}
+
+PyDoc_STRVAR(read_tokens_doc,
+"read_tokens(data, starts, ends, out) -> int\n\n"
+"Read the tokens ``data[starts[i]:ends[i]]`` (starts, ends: intp buffers) into ``out``\n"
+"(float64). Returns -1 when all are finite decimals, else the index of the first that\n"
+"is not.");
+
+static PyObject *read_tokens(PyObject *self, PyObject *args) {
+    (void)self;
+    Py_buffer data, starts, ends, out;
+    if (!PyArg_ParseTuple(args, "y*y*y*w*", &data, &starts, &ends, &out))
+        return NULL;
+    Py_ssize_t n = starts.len / (Py_ssize_t)sizeof(Py_ssize_t), result = -1;
+    if (starts.len != ends.len || out.len != n * (Py_ssize_t)sizeof(double)) {
+        PyErr_SetString(PyExc_ValueError, "read_tokens: buffers of different lengths");
+        goto done;
+    }
+    const char *text = (const char *)data.buf;
+    const Py_ssize_t *lo = (const Py_ssize_t *)starts.buf, *hi = (const Py_ssize_t *)ends.buf;
+    double *dst = (double *)out.buf;
+    for (Py_ssize_t i = 0; i < n; i++) {
+        if (lo[i] < 0 || hi[i] < lo[i] || hi[i] > data.len ||
+            scan_number(text + lo[i], text + hi[i], dst + i) != text + hi[i]) {
+            result = i;
+            break;
+        }
+    }
+done:
+    PyBuffer_Release(&data);
+    PyBuffer_Release(&starts);
+    PyBuffer_Release(&ends);
+    PyBuffer_Release(&out);
+    return PyErr_Occurred() ? NULL : PyLong_FromSsize_t(result);
+}
+
+static PyMethodDef methods[] = {
+    {"read_rows", read_rows, METH_VARARGS, read_rows_doc},
+    {"read_tokens", read_tokens, METH_VARARGS, read_tokens_doc},
+    {NULL, NULL, 0, NULL},
+};
+
+static struct PyModuleDef module = {
+    PyModuleDef_HEAD_INIT, "_parse",
+    "Exact, C-speed reading of whitespace-separated decimal numbers.", -1, methods, NULL, NULL,
+    NULL, NULL,
+};
+
+PyMODINIT_FUNC PyInit__parse(void) { return PyModule_Create(&module); }

@@ -1,0 +1,9 @@
+"""The compiled part of motionlib (everything else about the package is in pyproject.toml):
+its number reader, C with only the buffer protocol, so building needs a C compiler and
+Python's headers and nothing else."""
+
+from setuptools import Extension, setup
+
+setup(ext_modules=[
+    Extension("motionlib.io._parse", ["motionlib/io/_parse.c"]),
+])
