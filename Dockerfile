@@ -21,8 +21,12 @@ RUN useradd --create-home --uid 1000 cutroom \
     && mkdir -p /data/var /data/media && chown -R cutroom:cutroom /data
 WORKDIR /app
 COPY --chown=cutroom:cutroom . .
-# Editable, so the code, its templates and migrations stay where settings expect them.
-RUN pip install -e . && rm -rf frontend/node_modules
+# Editable, so the code, its templates and migrations stay where settings expect them. The
+# compiler builds motionlib's C parts (number reader, forward kinematics) and is removed after.
+RUN apt-get update && apt-get install -y --no-install-recommends gcc libc6-dev \
+    && pip install -e . \
+    && apt-get purge -y --auto-remove gcc libc6-dev && rm -rf /var/lib/apt/lists/* \
+    && rm -rf frontend/node_modules build
 COPY --from=frontend --chown=cutroom:cutroom /app/frontend/dist frontend/dist
 USER cutroom
 EXPOSE 8000

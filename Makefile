@@ -17,7 +17,7 @@ test: install frontend browser lint vitest pytest
 
 install: $(STAMP)
 
-$(STAMP): pyproject.toml setup.py motionlib/io/_parse.c
+$(STAMP): pyproject.toml setup.py motionlib/io/_parse.c motionlib/_kinematics.c
 	test -x $(PY) || python3 -m venv .venv
 	$(PIP) install -q --upgrade pip
 	$(PIP) install -q -e ".[dev,bench]"

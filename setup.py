@@ -1,9 +1,10 @@
-"""The compiled part of motionlib (everything else about the package is in pyproject.toml):
-its number reader, C with only the buffer protocol, so building needs a C compiler and
-Python's headers and nothing else."""
+"""The compiled parts of motionlib (everything else about the package is in pyproject.toml):
+its number reader and its forward kinematics, C with only the buffer protocol, so building
+needs a C compiler and Python's headers and nothing else."""
 
 from setuptools import Extension, setup
 
 setup(ext_modules=[
     Extension("motionlib.io._parse", ["motionlib/io/_parse.c"]),
+    Extension("motionlib._kinematics", ["motionlib/_kinematics.c"]),
 ])

@@ -177,13 +177,31 @@ def test_it_turns_every_joint_about_the_root_with_the_outermost_root_rotation(bv
     assert_allclose(rotated, root + (positions - root) @ rot("Z", 90).T, atol=1e-9)
 
 
-def test_it_computes_sines_and_cosines_of_degrees_to_a_few_ulp():
-    from motionlib.kinematics import sincos_degrees
-
+def test_it_turns_by_any_angle_to_a_few_ulp():
+    # One frame per angle: joint a turned about Z puts the child at (cos, sin, 0).
     rng = np.random.default_rng(3)
     degrees = np.concatenate([rng.uniform(-720, 720, 20000), np.arange(-720, 720.01, 0.05),
-                              [0.0, 90.0, -180.0, 719.99, 1e-9, -0.04999999],
-                              rng.uniform(-5000, 5000, 50)])  # beyond the table: numpy
-    sin, cos = sincos_degrees(degrees)
-    assert_allclose(sin, np.sin(np.deg2rad(degrees)), rtol=0, atol=4e-15)
-    assert_allclose(cos, np.cos(np.deg2rad(degrees)), rtol=0, atol=4e-15)
+                              [90.0, -180.0, 719.99, 1e-9, -0.04999999, 0.5, -0.5, 359.5],
+                              rng.uniform(-1e6, 1e6, 200), [1e14 + 0.25, -3e15, 1e300]])
+    values = np.zeros((degrees.size, 9))
+    values[:, 6] = degrees
+    positions = motionlib.forward_kinematics(chain(values))
+    radians = np.deg2rad(np.fmod(degrees, 360))  # exact: large angles stay accurate
+    assert_allclose(positions[:, 2, 0] - 1, np.cos(radians), rtol=0, atol=4e-15)
+    assert_allclose(positions[:, 2, 1], np.sin(radians), rtol=0, atol=4e-15)
+
+
+def test_it_gives_nan_positions_for_nan_angles_rather_than_failing():
+    positions = motionlib.forward_kinematics(chain([0, 0, 0, 0, 0, 0, np.nan, 0, 0]))
+    assert np.isnan(positions[0, 2]).all() and not np.isnan(positions[0, :2]).any()
+
+
+def test_it_refuses_channels_of_the_wrong_shape():
+    take = chain([0] * 9)
+    with pytest.raises(ValueError, match=r"shape \(n_frames, 9\)"):
+        motionlib.forward_kinematics(take, np.zeros((3, 8)))
+
+
+def test_it_handles_a_take_without_frames():
+    take = chain(np.zeros((0, 9)))
+    assert motionlib.forward_kinematics(take).shape == (0, 3, 3)
