@@ -43,6 +43,22 @@ def test_it_matches_float_bit_for_bit_on_well_formed_rows(rows, sep, newline):
     assert bits(values.ravel()) == bits(float(t) for row in rows for t in row)
 
 
+short = st.builds(lambda sign, whole, frac: sign + whole + frac, st.sampled_from(["", "-", "+"]),
+                  st.text("0123456789", min_size=1, max_size=9),
+                  st.one_of(st.just(""), st.text("0123456789", max_size=9).map(lambda d: "." + d)))
+
+
+@deterministic
+@given(st.lists(short, min_size=12, max_size=12), st.sampled_from([" ", "\t", " \r"]))
+def test_it_matches_float_on_short_decimals_read_a_word_at_a_time(tokens, sep):
+    # Up to 7 digits either side of the dot take a word-wide path when 17 bytes follow; 8 or
+    # 9 digits, an empty side and the last tokens of the text take the byte loop.
+    text = sep.join(tokens[:6]) + "\n" + sep.join(tokens[6:]) + "\n"
+    values = read_rows(text.encode(), 0, 2, 6)
+    assert values is not None
+    assert bits(values.ravel()) == bits(float(t) for t in tokens)
+
+
 @deterministic
 @given(st.floats(allow_nan=False, allow_infinity=False))
 def test_it_round_trips_every_double_through_repr(x):
