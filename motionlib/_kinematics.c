@@ -78,39 +78,50 @@ typedef struct {
     double *out;                /* (n_frames, n_joints, 3) */
 } Layout;
 
-/* One frame; G holds 9 doubles per joint (global rotations), SC 2 per rotation slot. */
-static void frame_positions(const Layout *L, const double *values, double *G, double *SC,
-                            double *out) {
+/* Per-call scratch: global rotations, sines and cosines, and which rotation each joint uses. */
+typedef struct {
+    double *G;               /* 9 per joint: rotations computed this frame */
+    double *SC;              /* 2 per rotation slot: sine, cosine */
+    const double **global;   /* per joint: its global rotation (G + 9j or an ancestor's) */
+    unsigned char *parent;   /* per joint: 1 if some joint is its child */
+} Work;
+
+/* One frame of positions into out (n_joints x 3). */
+static void frame_positions(const Layout *L, const double *values, Work *W, double *out) {
     static const double identity[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
     /* Every sine and cosine first: independent of each other, so they overlap in the CPU,
      * where inside the walk each one would wait for its parent's rotation. */
     for (Py_ssize_t slot = 0; slot < L->n_joints * MAX_ROTATIONS; slot++)
-        if (L->rotation[2 * slot] >= 0)
-            sincos_degrees(values[L->rotation[2 * slot + 1]], SC + 2 * slot, SC + 2 * slot + 1);
+        if (L->rotation[2 * slot] >= 0 && W->parent[slot / MAX_ROTATIONS])
+            sincos_degrees(values[L->rotation[2 * slot + 1]], W->SC + 2 * slot,
+                           W->SC + 2 * slot + 1);
     for (Py_ssize_t j = 0; j < L->n_joints; j++) {
-        double t[3], *here = out + 3 * j, *Gj = G + 9 * j;
+        double t[3], *here = out + 3 * j;
         for (int a = 0; a < 3; a++) {
             Py_ssize_t col = L->position[3 * j + a];
             t[a] = col >= 0 ? values[col] : L->offsets[3 * j + a];
         }
         Py_ssize_t p = L->parents[j];
-        const double *Gp = p < 0 ? identity : G + 9 * p;
+        const double *Gp = p < 0 ? identity : W->global[p];
         for (int r = 0; r < 3; r++)
             here[r] = (p < 0 ? 0 : out[3 * p + r]) +
                       (p < 0 ? t[r] : Gp[3 * r] * t[0] + Gp[3 * r + 1] * t[1] + Gp[3 * r + 2] * t[2]);
+        if (!W->parent[j])
+            continue; /* a leaf's rotation moves no joint */
         const Py_ssize_t *rot = L->rotation + 2 * MAX_ROTATIONS * j;
         int moving = 0;
         for (int k = 0; k < MAX_ROTATIONS && rot[2 * k] >= 0; k++)
             moving |= values[rot[2 * k + 1]] != 0;
-        if (!moving) { /* zero angles are the identity: skip the work, exactly */
-            memcpy(Gj, Gp, sizeof(double) * 9);
+        if (!moving) { /* zero angles are the identity: share the parent's, exactly */
+            W->global[j] = Gp;
             continue;
         }
+        double *Gj = W->G + 9 * j;
         if (L->axes)
             matmul(Gp, L->axes + 9 * j, Gj, 0);
         else
             memcpy(Gj, Gp, sizeof(double) * 9);
-        const double *sc = SC + 2 * MAX_ROTATIONS * j;
+        const double *sc = W->SC + 2 * MAX_ROTATIONS * j;
         for (int k = 0; k < MAX_ROTATIONS && rot[2 * k] >= 0; k++)
             if (values[rot[2 * k + 1]] != 0)
                 turn(Gj, (int)rot[2 * k], sc[2 * k + 1], sc[2 * k]);
@@ -119,6 +130,7 @@ static void frame_positions(const Layout *L, const double *values, double *G, do
             matmul(Gj, L->axes + 9 * j, tmp, 1);
             memcpy(Gj, tmp, sizeof(tmp));
         }
+        W->global[j] = Gj;
     }
 }
 
@@ -157,7 +169,7 @@ static PyObject *positions(PyObject *self, PyObject *args) {
                           &position, &rotation, &axes_obj, &out))
         return NULL;
     int ok = 0;
-    double *G = NULL;
+    Work W = {0};
     if (axes_obj != Py_None && PyObject_GetBuffer(axes_obj, &axes, PyBUF_SIMPLE) < 0)
         goto done;
     L.n_joints = parents.len / (Py_ssize_t)sizeof(Py_ssize_t);
@@ -182,18 +194,27 @@ static PyObject *positions(PyObject *self, PyObject *args) {
         PyErr_SetString(PyExc_ValueError, "positions: joint layout out of range");
         goto done;
     }
-    G = PyMem_Malloc(sizeof(double) * (9 + 2 * MAX_ROTATIONS) * (size_t)(J > 0 ? J : 1));
-    if (!G) {
+    size_t n = (size_t)(J > 0 ? J : 1);
+    W.G = PyMem_Malloc(sizeof(double) * (9 + 2 * MAX_ROTATIONS) * n);
+    W.global = PyMem_Malloc(sizeof(double *) * n);
+    W.parent = PyMem_Calloc(n, 1);
+    if (!W.G || !W.global || !W.parent) {
         PyErr_NoMemory();
         goto done;
     }
+    W.SC = W.G + 9 * J;
+    for (Py_ssize_t j = 0; j < J; j++)
+        if (L.parents[j] >= 0)
+            W.parent[L.parents[j]] = 1;
     Py_BEGIN_ALLOW_THREADS
     for (Py_ssize_t f = 0; f < F; f++)
-        frame_positions(&L, L.channels + f * L.n_channels, G, G + 9 * J, L.out + f * J * 3);
+        frame_positions(&L, L.channels + f * L.n_channels, &W, L.out + f * J * 3);
     Py_END_ALLOW_THREADS
     ok = 1;
 done:
-    PyMem_Free(G);
+    PyMem_Free(W.G);
+    PyMem_Free(W.global);
+    PyMem_Free(W.parent);
     PyBuffer_Release(&ch);
     PyBuffer_Release(&parents);
     PyBuffer_Release(&offsets);

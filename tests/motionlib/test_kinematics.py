@@ -82,6 +82,21 @@ def test_it_agrees_with_the_oracle_with_asf_axis_frames(seed):
     assert_allclose(motionlib.forward_kinematics(take), oracle(take), atol=1e-9)
 
 
+@pytest.mark.parametrize("with_axes", [False, True])
+def test_it_agrees_with_the_oracle_when_some_angles_are_exactly_zero(with_axes):
+    # Zero angles are skipped and a joint that does not turn shares its parent's rotation.
+    rng = np.random.default_rng(7)
+    take = random_take(rng, n_frames=40, n_joints=12, with_axes=with_axes)
+    take.channels[rng.random(take.channels.shape) < 0.4] = 0.0
+    take.channels[::3, :] = 0.0  # whole frames at rest too
+    assert_allclose(motionlib.forward_kinematics(take), oracle(take), atol=1e-9)
+
+
+def test_it_agrees_with_the_oracle_on_a_real_take(bvh_13_29):
+    take = motionlib.read(bvh_13_29).slice(0, 60)  # frame 0 is all zeros but the root
+    assert_allclose(motionlib.forward_kinematics(take), oracle(take), atol=1e-9)
+
+
 def chain(channel_values, offsets=((0, 0, 0), (1, 0, 0), (1, 0, 0))):
     sk = Skeleton(names=["root", "a", "b"], parents=[-1, 0, 1], offsets=offsets,
                   channels=[("Xposition", "Yposition", "Zposition", "Zrotation", "Yrotation",
