@@ -222,43 +222,104 @@ done:
     return PyErr_Occurred() ? NULL : PyLong_FromSsize_t(result);
 }
 
-PyDoc_STRVAR(read_tokens_doc,
-"read_tokens(data, starts, ends, out) -> int\n\n"
-"Read the tokens ``data[starts[i]:ends[i]]`` (starts, ends: intp buffers) into ``out``\n"
-"(float64). Returns -1 when all are finite decimals, else the index of the first that\n"
-"is not.");
+/* Skip blanks and line ends; the start of the next token or end. */
+static inline const char *next_token(const char *p, const char *end) {
+    while (p < end && (*p == '\n' || is_blank((unsigned char)*p)))
+        p++;
+    return p;
+}
 
-static PyObject *read_tokens(PyObject *self, PyObject *args) {
+static inline const char *token_end(const char *p, const char *end) {
+    while (p < end && *p != '\n' && !is_blank((unsigned char)*p))
+        p++;
+    return p;
+}
+
+/* Whether the token at p is the decimal integer `expected`; the byte after it in *after. */
+static int is_frame_number(const char *p, const char *end, Py_ssize_t expected,
+                           const char **after) {
+    const char *stop = token_end(p, end);
+    Py_ssize_t value = 0;
+    *after = stop;
+    if (stop == p || stop - p > 18)
+        return 0;
+    for (; p < stop; p++) {
+        if (!is_digit(*p))
+            return 0;
+        value = value * 10 + (*p - '0');
+    }
+    return value == expected;
+}
+
+PyDoc_STRVAR(read_frames_doc,
+"read_frames(data, offset, names, counts, out) -> int\n\n"
+"Read AMC frames from ``data[offset:]``: each is its frame number (1, 2, ... in turn), then\n"
+"every bone of ``names`` (a sequence of bytes) in that order, each followed by\n"
+"``counts[i]`` numbers (counts: intp buffer). The numbers of a frame go to one row of\n"
+"``out`` (float64, rows of sum(counts)). Returns the number of frames, or -1 when the text\n"
+"departs from that pattern, a number is not a finite decimal, or ``out`` is too small.");
+
+static PyObject *read_frames(PyObject *self, PyObject *args) {
     (void)self;
-    Py_buffer data, starts, ends, out;
-    if (!PyArg_ParseTuple(args, "y*y*y*w*", &data, &starts, &ends, &out))
+    Py_buffer data, counts, out;
+    Py_ssize_t offset, rows = 0, result = -1, width = 0;
+    PyObject *names, *seq = NULL;
+    if (!PyArg_ParseTuple(args, "y*nOy*w*", &data, &offset, &names, &counts, &out))
         return NULL;
-    Py_ssize_t n = starts.len / (Py_ssize_t)sizeof(Py_ssize_t), result = -1;
-    if (starts.len != ends.len || out.len != n * (Py_ssize_t)sizeof(double)) {
-        PyErr_SetString(PyExc_ValueError, "read_tokens: buffers of different lengths");
+    Py_ssize_t n_bones = counts.len / (Py_ssize_t)sizeof(Py_ssize_t);
+    const Py_ssize_t *count = counts.buf;
+    seq = PySequence_Fast(names, "read_frames: names must be a sequence of bytes");
+    if (!seq)
+        goto done;
+    if (PySequence_Fast_GET_SIZE(seq) != n_bones || offset < 0 || offset > data.len) {
+        PyErr_SetString(PyExc_ValueError, "read_frames: names and counts differ in length");
         goto done;
     }
-    const char *text = (const char *)data.buf;
-    const Py_ssize_t *lo = (const Py_ssize_t *)starts.buf, *hi = (const Py_ssize_t *)ends.buf;
-    double *dst = (double *)out.buf;
-    for (Py_ssize_t i = 0; i < n; i++) {
-        if (lo[i] < 0 || hi[i] < lo[i] || hi[i] > data.len ||
-            scan_number(text + lo[i], text + hi[i], dst + i) != text + hi[i]) {
-            result = i;
-            break;
+    for (Py_ssize_t k = 0; k < n_bones; k++) {
+        if (!PyBytes_Check(PySequence_Fast_GET_ITEM(seq, k)) || count[k] < 0) {
+            PyErr_SetString(PyExc_ValueError, "read_frames: names must be bytes, counts >= 0");
+            goto done;
         }
+        width += count[k];
     }
+    if (width == 0 || out.len % ((Py_ssize_t)sizeof(double) * width)) {
+        PyErr_SetString(PyExc_ValueError, "read_frames: out is not rows of sum(counts)");
+        goto done;
+    }
+    Py_ssize_t capacity = out.len / (Py_ssize_t)sizeof(double) / width;
+    const char *p = (const char *)data.buf + offset, *end = (const char *)data.buf + data.len;
+    double *dst = out.buf;
+    for (p = next_token(p, end); p < end; p = next_token(p, end)) {
+        if (rows == capacity || !is_frame_number(p, end, rows + 1, &p))
+            goto done;
+        for (Py_ssize_t k = 0; k < n_bones; k++) {
+            PyObject *name = PySequence_Fast_GET_ITEM(seq, k);
+            Py_ssize_t length = PyBytes_GET_SIZE(name);
+            p = next_token(p, end);
+            if (token_end(p, end) - p != length || memcmp(p, PyBytes_AS_STRING(name), length))
+                goto done;
+            p += length;
+            for (Py_ssize_t i = 0; i < count[k]; i++) {
+                p = next_token(p, end);
+                if (p == end || !(p = scan_number(p, end, dst++)) ||
+                    (p < end && *p != '\n' && !is_blank((unsigned char)*p)))
+                    goto done;
+            }
+        }
+        rows++;
+    }
+    result = rows;
 done:
+    Py_XDECREF(seq);
     PyBuffer_Release(&data);
-    PyBuffer_Release(&starts);
-    PyBuffer_Release(&ends);
+    PyBuffer_Release(&counts);
     PyBuffer_Release(&out);
     return PyErr_Occurred() ? NULL : PyLong_FromSsize_t(result);
 }
 
 static PyMethodDef methods[] = {
     {"read_rows", read_rows, METH_VARARGS, read_rows_doc},
-    {"read_tokens", read_tokens, METH_VARARGS, read_tokens_doc},
+    {"read_frames", read_frames, METH_VARARGS, read_frames_doc},
     {NULL, NULL, 0, NULL},
 };
 

@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from motionlib.errors import CaptureError
-from motionlib.io.numbers import token_bounds, token_values
+from motionlib.io import _parse
 from motionlib.kinematics import euler_to_matrix
 from motionlib.skeleton import Skeleton
 from motionlib.take import Take
@@ -266,7 +266,6 @@ def read_amc(path: str | os.PathLike, asf: str | os.PathLike | Asf) -> Take:
 
 
 AMC_FPS = 120.0
-_FRAMES_PER_BLOCK = 512
 
 
 def _amc_body(data: bytes, path) -> tuple[int, int]:
@@ -284,8 +283,8 @@ def _amc_body(data: bytes, path) -> tuple[int, int]:
     raise CaptureError("no frames after the header", path=path, line=line - 1)
 
 
-def _first_frame_layout(data: bytes, offset: int, sk: Skeleton):
-    """Bones of the first frame as [(name, token index)] and the tokens per frame, or None."""
+def _first_frame_layout(data: bytes, offset: int, sk: Skeleton) -> list[str] | None:
+    """Bones of the first frame in their order, or None."""
     dof = {name: len(ch) for name, ch in zip(sk.names, sk.channels, strict=True)}
     size = 4096
     while True:
@@ -293,68 +292,42 @@ def _first_frame_layout(data: bytes, offset: int, sk: Skeleton):
         complete = offset + size >= len(data)
         if not complete:
             tokens = tokens[:-1]  # the last one may be cut in half
-        layout, i = [], 1
+        names, i = [], 1
         while i < len(tokens) and tokens[i] in dof:
-            layout.append((tokens[i], i))
+            names.append(tokens[i])
             i += 1 + dof[tokens[i]]
         if i < len(tokens) or complete:
             break
         size *= 4
-    names = [name for name, _ in layout]
-    if not layout or len(set(names)) < len(names) or (i < len(tokens) and
-                                                       not tokens[i].isdigit()):
+    if not names or len(set(names)) < len(names) or (i < len(tokens) and
+                                                     not tokens[i].isdigit()):
         return None
-    return layout, i
+    return names
 
 
 def _amc_fast(data: bytes, offset: int, sk: Skeleton) -> np.ndarray | None:
-    """Vectorised parse when every frame lists the same bones in the same order, else None.
-
-    Every frame then has the same token pattern (number, name, values, name, values, …):
-    names are checked byte by byte per column and all numbers parsed at once.
-    """
-    found = _first_frame_layout(data, offset, sk)
-    if found is None:
+    """One pass of the compiled reader when every frame lists the same bones in the same order
+    as the first one (as CMU writes them), else None."""
+    layout = _first_frame_layout(data, offset, sk)
+    if layout is None:
         return None
-    layout, width = found
-    b = np.frombuffer(data, dtype=np.uint8, offset=offset)
-    starts, ends = token_bounds(b)
-    if starts.size % width:
+    joints = [sk.names.index(name) for name in layout]
+    counts = np.array([len(sk.channels[j]) for j in joints], np.intp)
+    if not counts.sum():
         return None
-    n = starts.size // width
-    starts, ends = starts.reshape(n, width), ends.reshape(n, width)
-    name_cols = [col for _, col in layout]
-    for name, col in layout:
-        if not _column_is(b, starts[:, col], ends[:, col], name.encode()):
-            return None
-    number_cols = np.setdiff1d(np.arange(width), name_cols)
-    values = np.empty((n, number_cols.size))
-    for lo in range(0, n, _FRAMES_PER_BLOCK):  # blocks keep the gathered bounds small
-        block = slice(lo, lo + _FRAMES_PER_BLOCK)
-        parsed = token_values(b, starts[block, number_cols].ravel(),
-                              ends[block, number_cols].ravel())
-        if parsed is None:
-            return None
-        values[block] = parsed.reshape(-1, number_cols.size)
-    if not np.array_equal(values[:, 0], np.arange(1, n + 1)):
+    # A frame takes one line per bone plus its number: an upper bound on the frames.
+    capacity = data.count(b"\n", offset) // (len(layout) + 1) + 1
+    values = np.empty((capacity, int(counts.sum())))
+    n = _parse.read_frames(data, offset, [name.encode() for name in layout], counts, values)
+    if n < 0:
         return None
     channels = np.zeros((n, sk.n_channels))
-    where = {col: k for k, col in enumerate(number_cols)}
-    for name, col in layout:
-        j = sk.names.index(name)
-        count = len(sk.channels[j])
-        first = where[col + 1] if count else 0
-        channels[:, sk.channel_starts[j]:sk.channel_starts[j] + count] = \
-            values[:, first:first + count]
+    first = 0
+    for j, count in zip(joints, counts, strict=True):
+        start = sk.channel_starts[j]
+        channels[:, start:start + count] = values[:n, first:first + count]
+        first += count
     return channels
-
-
-def _column_is(b, starts, ends, name: bytes) -> bool:
-    """Whether every token starting at ``starts`` (and ending at ``ends``) spells ``name``."""
-    if not np.all(ends - starts == len(name)):
-        return False
-    spelled = b[starts[:, None] + np.arange(len(name))]
-    return bool(np.all(spelled == np.frombuffer(name, dtype=np.uint8)))
 
 
 def _amc_lines(body: str, first_line: int, asf: Asf, path) -> np.ndarray:

@@ -128,3 +128,26 @@ def test_it_reads_every_cmu_motion_beside_the_repository(amc_13_29):
         take = motionlib.read(motion, asf=cmu / "asf" / f"{subject}.asf")
         assert take.n_frames > 500 and np.all(np.isfinite(take.channels))
         assert set(motionlib.canonical_indices(take)) == set(motionlib.CANONICAL_PARTS)
+
+
+def test_its_compiled_reader_gives_what_the_line_by_line_reader_gives(amc_13_29):
+    from motionlib.io.asf_amc import _amc_body, _amc_fast, _amc_lines
+
+    amc, asf_path = amc_13_29
+    asf = read_asf(asf_path)
+    data = amc.read_bytes()
+    offset, first_line = _amc_body(data, amc)
+    fast = _amc_fast(data, offset, asf.skeleton)
+    slow = _amc_lines(data[offset:].decode(), first_line, asf, amc)
+    assert fast is not None and fast.shape == (4592, asf.skeleton.n_channels)
+    assert_array_equal(fast, slow)
+
+
+def test_its_compiled_reader_declines_a_frame_that_departs_from_the_first(tmp_path):
+    from motionlib.io.asf_amc import _amc_body, _amc_fast
+
+    shuffled = FRAMES.replace("lowerback 5 -10 15\nupperback 14 -20\n",
+                              "upperback 14 -20\nlowerback 5 -10 15\n", 1)
+    amc, asf = write(tmp_path, frames=shuffled)
+    data = amc.read_bytes()
+    assert _amc_fast(data, _amc_body(data, amc)[0], read_asf(asf).skeleton) is None
