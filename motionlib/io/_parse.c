@@ -229,6 +229,13 @@ static inline const char *next_token(const char *p, const char *end) {
     return p;
 }
 
+/* Past the blanks at p, which must end the line: the '\n' (or end), else NULL. */
+static inline const char *line_end(const char *p, const char *end) {
+    while (p < end && is_blank((unsigned char)*p))
+        p++;
+    return p == end || *p == '\n' ? p : NULL;
+}
+
 static inline const char *token_end(const char *p, const char *end) {
     while (p < end && *p != '\n' && !is_blank((unsigned char)*p))
         p++;
@@ -253,11 +260,12 @@ static int is_frame_number(const char *p, const char *end, Py_ssize_t expected,
 
 PyDoc_STRVAR(read_frames_doc,
 "read_frames(data, offset, names, counts, out) -> int\n\n"
-"Read AMC frames from ``data[offset:]``: each is its frame number (1, 2, ... in turn), then\n"
-"every bone of ``names`` (a sequence of bytes) in that order, each followed by\n"
-"``counts[i]`` numbers (counts: intp buffer). The numbers of a frame go to one row of\n"
-"``out`` (float64, rows of sum(counts)). Returns the number of frames, or -1 when the text\n"
-"departs from that pattern, a number is not a finite decimal, or ``out`` is too small.");
+"Read AMC frames from ``data[offset:]``: each is a line with its frame number (1, 2, ...\n"
+"in turn), then a line per bone of ``names`` (a sequence of bytes) in that order, holding\n"
+"the name and ``counts[i]`` numbers (counts: intp buffer); blank lines are skipped. A\n"
+"frame's numbers go to one row of ``out`` (float64, rows of sum(counts)). Returns the\n"
+"number of frames, or -1 when the text departs from that pattern, a number is not a\n"
+"finite decimal, or ``out`` is too small.");
 
 static PyObject *read_frames(PyObject *self, PyObject *args) {
     (void)self;
@@ -290,7 +298,7 @@ static PyObject *read_frames(PyObject *self, PyObject *args) {
     const char *p = (const char *)data.buf + offset, *end = (const char *)data.buf + data.len;
     double *dst = out.buf;
     for (p = next_token(p, end); p < end; p = next_token(p, end)) {
-        if (rows == capacity || !is_frame_number(p, end, rows + 1, &p))
+        if (rows == capacity || !is_frame_number(p, end, rows + 1, &p) || !line_end(p, end))
             goto done;
         for (Py_ssize_t k = 0; k < n_bones; k++) {
             PyObject *name = PySequence_Fast_GET_ITEM(seq, k);
@@ -300,11 +308,14 @@ static PyObject *read_frames(PyObject *self, PyObject *args) {
                 goto done;
             p += length;
             for (Py_ssize_t i = 0; i < count[k]; i++) {
-                p = next_token(p, end);
-                if (p == end || !(p = scan_number(p, end, dst++)) ||
+                while (p < end && is_blank((unsigned char)*p))
+                    p++;
+                if (p == end || *p == '\n' || !(p = scan_number(p, end, dst++)) ||
                     (p < end && *p != '\n' && !is_blank((unsigned char)*p)))
                     goto done;
             }
+            if (!(p = line_end(p, end)))
+                goto done;
         }
         rows++;
     }

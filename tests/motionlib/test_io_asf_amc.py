@@ -4,6 +4,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from numpy.testing import assert_allclose, assert_array_equal
 
 import motionlib
@@ -151,3 +153,31 @@ def test_its_compiled_reader_declines_a_frame_that_departs_from_the_first(tmp_pa
     amc, asf = write(tmp_path, frames=shuffled)
     data = amc.read_bytes()
     assert _amc_fast(data, _amc_body(data, amc)[0], read_asf(asf).skeleton) is None
+
+
+@settings(derandomize=True, max_examples=300, deadline=None)
+@given(st.lists(st.sampled_from(["6\n", "7\n", "root 1 2 3 10 20 30\n", "lowerback 5 -10 15\n",
+                                 "upperback 1 2\n", "6", "root", "upperback", "5", "-10.5", "1e3",
+                                 "nan", "x", "#", " ", "\n", "\t", "\r\n"]), max_size=40))
+def test_its_compiled_reader_agrees_with_the_line_by_line_reader_or_declines(tmp_path_factory,
+                                                                              pieces):
+    from motionlib.io.asf_amc import _amc_body, _amc_fast, _amc_lines
+
+    amc, asf_path = write(tmp_path_factory.mktemp("amc"), frames=FRAMES + "".join(pieces))
+    asf = read_asf(asf_path)
+    data = amc.read_bytes()
+    offset, first_line = _amc_body(data, amc)
+    fast = _amc_fast(data, offset, asf.skeleton)
+    if fast is not None:  # what it accepts, the careful reader reads the same
+        assert_array_equal(fast, _amc_lines(data[offset:].decode(), first_line, asf, amc))
+
+
+def test_its_compiled_reader_declines_a_frame_written_on_one_line(tmp_path):
+    from motionlib.io.asf_amc import _amc_body, _amc_fast
+
+    one_line = FRAMES + "6 root 1 2 3 10 20 30 lowerback 5 -10 15 upperback 1 2\n"
+    amc, asf = write(tmp_path, frames=one_line)
+    data = amc.read_bytes()
+    assert _amc_fast(data, _amc_body(data, amc)[0], read_asf(asf).skeleton) is None
+    with pytest.raises(motionlib.CaptureError):
+        motionlib.read(amc, asf=asf)
