@@ -19,6 +19,7 @@ import numpy as np
 
 from motionlib.errors import CaptureError
 from motionlib.io import _parse
+from motionlib.io.numbers import finite_value
 from motionlib.kinematics import euler_to_matrix
 from motionlib.skeleton import Skeleton
 from motionlib.take import Take
@@ -365,18 +366,7 @@ def _amc_lines(body: str, first_line: int, asf: Asf, path) -> np.ndarray:
         if len(tokens) - 1 != count:
             raise CaptureError(f"bone {name!r} needs {count} values, found {len(tokens) - 1}",
                                path=path, line=n)
+        bone = f" of bone {name!r}"
         frames[-1][starts[j]:starts[j] + count] = [
-            _amc_value(tok, name, path, n) for tok in tokens[1:]]
+            finite_value(tok, "value ", bone, path, n) for tok in tokens[1:]]
     return np.array(frames).reshape(len(frames), sk.n_channels)
-
-
-def _amc_value(tok: str, name: str, path, line: int) -> float:
-    try:
-        value = float(tok)
-    except ValueError:
-        raise CaptureError(f"value {tok[:30]!r} of bone {name!r} is not a number",
-                           path=path, line=line) from None
-    if not math.isfinite(value):
-        raise CaptureError(f"value {tok!r} of bone {name!r} is not a finite number",
-                           path=path, line=line)
-    return value

@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from motionlib.errors import CaptureError
-from motionlib.io.numbers import read_rows
+from motionlib.io.numbers import finite_value, read_rows
 from motionlib.skeleton import CHANNEL_NAMES, ROTATION_CHANNELS, Skeleton
 from motionlib.take import Take, frame_range
 
@@ -210,23 +210,12 @@ def _parse_motion_lines(text: str, first_line: int, n_frames: int, n_channels: i
         if len(tokens) != n_channels:
             raise CaptureError(f"frame {len(rows)}: expected {n_channels} values, found "
                                f"{len(tokens)}", path=path, line=last)
-        rows.append([_finite(tok, k, len(rows), path, last) for k, tok in enumerate(tokens)])
+        rows.append([finite_value(tok, f"frame {len(rows)}, value {k + 1}: ", "", path, last)
+                     for k, tok in enumerate(tokens)])
     if len(rows) < n_frames:
         raise CaptureError(f"truncated MOTION section: 'Frames: {n_frames}' but the file ends "
                            f"after {len(rows)} frame lines", path=path, line=last)
     return np.array(rows, dtype=np.float64).reshape(n_frames, n_channels)
-
-
-def _finite(tok: str, k: int, frame: int, path, line: int) -> float:
-    try:
-        value = float(tok)
-    except ValueError:
-        raise CaptureError(f"frame {frame}, value {k + 1}: {tok[:30]!r} is not a number",
-                           path=path, line=line) from None
-    if not math.isfinite(value):
-        raise CaptureError(f"frame {frame}, value {k + 1}: {tok!r} is not a finite number",
-                           path=path, line=line)
-    return value
 
 
 def detect_rest_pose(skeleton: Skeleton, channels: np.ndarray) -> int | None:

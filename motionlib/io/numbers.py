@@ -10,8 +10,11 @@ caller can fall back to a careful line-by-line parse that says what is wrong and
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
+from motionlib.errors import CaptureError
 from motionlib.io import _parse
 
 
@@ -37,3 +40,20 @@ def read_rows(data: bytes, offset: int, n_rows: int, row_length: int) -> np.ndar
         return None
     out = np.empty((n_rows, row_length))
     return out if _parse.read_rows(data, offset, out, row_length) == n_rows else None
+
+
+def finite_value(token: str, before: str, after: str, path, line: int) -> float:
+    """``float(token)`` for the careful line-by-line readers, or a CaptureError at path:line.
+
+    The message names the token as ``before + repr(token) + after`` (e.g. ``"frame 3, value
+    2: "`` and ``""``, or ``"value "`` and ``" of bone 'root'"``), then says what is wrong.
+    """
+    try:
+        value = float(token)
+    except ValueError:
+        raise CaptureError(f"{before}{token[:30]!r}{after} is not a number", path=path,
+                           line=line) from None
+    if not math.isfinite(value):
+        raise CaptureError(f"{before}{token!r}{after} is not a finite number", path=path,
+                           line=line)
+    return value
