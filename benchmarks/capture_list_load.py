@@ -63,8 +63,8 @@ def seed(n_captures):
     """Users, projects and ``n_captures`` ready captures with a finished run; returns
     (token key, id of the first project)."""
     from django.contrib.auth import get_user_model
-    from rest_framework.authtoken.models import Token
 
+    from cutroom.accounts.models import ApiToken
     from segmentation import services
 
     users = get_user_model().objects
@@ -81,7 +81,7 @@ def seed(n_captures):
     with connection.cursor() as cursor:
         # What autovacuum does soon after a bulk load: planner statistics, visibility map.
         cursor.execute("VACUUM ANALYZE")
-    return Token.objects.create(user=owner).key, projects[0].pk
+    return ApiToken.objects.issue(owner)[1], projects[0].pk
 
 
 def _captures(project, user, count, rng):

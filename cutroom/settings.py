@@ -59,13 +59,15 @@ INSTALLED_APPS = [
     "whitenoise.runserver_nostatic",
     "django.contrib.staticfiles",
     "rest_framework",
-    "rest_framework.authtoken",
     "drf_spectacular",
+    "drf_spectacular_sidecar",  # Swagger UI served from /static/, not a CDN
+    "cutroom.accounts",
     "segmentation",
 ]
 
 MIDDLEWARE = [
     "django.middleware.security.SecurityMiddleware",
+    "cutroom.security.ContentSecurityPolicyMiddleware",
     "whitenoise.middleware.WhiteNoiseMiddleware",
     "django.contrib.sessions.middleware.SessionMiddleware",
     "django.middleware.common.CommonMiddleware",
@@ -120,6 +122,34 @@ AUTH_PASSWORD_VALIDATORS = [
 if envbool("BEHIND_TLS_PROXY", False):
     SECURE_PROXY_SSL_HEADER = ("HTTP_X_FORWARDED_PROTO", "https")
 SESSION_COOKIE_SECURE = CSRF_COOKIE_SECURE = envbool("SECURE_COOKIES", False)
+
+# Sign-in throttling (/login/, /admin/login/, /api/auth/token/): within a sliding window
+# of CUTROOM_LOGIN_WINDOW seconds, a username with this many failed sign-ins, or an
+# address with that many, is refused (429, Retry-After) until the oldest leaves the window.
+CUTROOM_LOGIN_WINDOW = envint("CUTROOM_LOGIN_WINDOW", 15 * 60)
+CUTROOM_LOGIN_FAILURES_PER_USER = envint("CUTROOM_LOGIN_FAILURES_PER_USER", 10)
+CUTROOM_LOGIN_FAILURES_PER_ADDRESS = envint("CUTROOM_LOGIN_FAILURES_PER_ADDRESS", 30)
+# How many reverse proxies append to X-Forwarded-For in front of the web server (0: the
+# client address is REMOTE_ADDR; a header clients can forge is never trusted by default).
+CUTROOM_TRUSTED_PROXIES = envint("CUTROOM_TRUSTED_PROXIES", 0)
+# An API token works for this many days after it was issued.
+CUTROOM_TOKEN_DAYS = envint("CUTROOM_TOKEN_DAYS", 30)
+
+# Scripts only from our own files; inline styles are allowed (label colours are style
+# attributes; so are parts of the admin and of Swagger UI), inline scripts are not.
+CONTENT_SECURITY_POLICY = os.environ.get("CONTENT_SECURITY_POLICY") or "; ".join([
+    "default-src 'self'",
+    "script-src 'self'",
+    "style-src 'self' 'unsafe-inline'",
+    "img-src 'self' data: blob:",
+    "font-src 'self' data:",
+    "connect-src 'self'",
+    "worker-src 'self' blob:",
+    "object-src 'none'",
+    "base-uri 'self'",
+    "form-action 'self'",
+    "frame-ancestors 'none'",
+])
 
 LOGIN_URL = "/login/"
 LOGIN_REDIRECT_URL = "/"
@@ -199,8 +229,9 @@ CELERY_BEAT_SCHEDULE = {
 
 REST_FRAMEWORK = {
     "DEFAULT_AUTHENTICATION_CLASSES": [
+        # First, so an anonymous call gets 401 with "WWW-Authenticate: Token", not 403.
+        "cutroom.accounts.authentication.ExpiringTokenAuthentication",
         "rest_framework.authentication.SessionAuthentication",
-        "rest_framework.authentication.TokenAuthentication",
     ],
     "DEFAULT_PERMISSION_CLASSES": ["rest_framework.permissions.IsAuthenticated"],
     "DEFAULT_SCHEMA_CLASS": "drf_spectacular.openapi.AutoSchema",
@@ -212,6 +243,9 @@ SPECTACULAR_SETTINGS = {
     "DESCRIPTION": "Motion-capture takes, candidate cuts, reviews. See docs/api.md.",
     "VERSION": "1",
     "SERVE_INCLUDE_SCHEMA": False,
+    "SWAGGER_UI_DIST": "SIDECAR",
+    "SWAGGER_UI_FAVICON_HREF": "SIDECAR",
+    "REDOC_DIST": "SIDECAR",
     "ENUM_NAME_OVERRIDES": {
         "JobStatusEnum": "segmentation.models.JOB_STATUSES",
         "ReviewStatusEnum": "segmentation.models.Review.STATUSES",

@@ -6,7 +6,7 @@ from django.contrib.auth.decorators import login_required
 from django.http import HttpResponse
 from django.shortcuts import redirect, render
 from django.views.decorators.csrf import ensure_csrf_cookie
-from django.views.decorators.http import require_http_methods
+from django.views.decorators.http import require_POST
 
 
 @login_required
@@ -20,8 +20,9 @@ def app(request, path=""):
     return HttpResponse(index.read_text(encoding="utf-8"))
 
 
-@require_http_methods(["GET", "POST"])
+@require_POST
 def logout_view(request):
-    # Logging out by link is what people expect from a small internal tool.
+    # POST only (with the CSRF token, checked by the middleware): a link or an image on
+    # another page must not be able to sign anyone out.
     logout(request)
     return redirect(settings.LOGOUT_REDIRECT_URL)

@@ -1,8 +1,8 @@
 from django.urls import path
-from drf_spectacular.views import SpectacularAPIView, SpectacularSwaggerView
-from rest_framework.authtoken.views import obtain_auth_token
+from drf_spectacular.views import SpectacularAPIView, SpectacularSwaggerSplitView
 from rest_framework.routers import SimpleRouter
 
+from cutroom.accounts import api as accounts_api
 from segmentation.api import library, reviews
 from segmentation.api.captures import CaptureViewSet
 from segmentation.api.projects import MethodsView, MeView, ProjectViewSet
@@ -13,11 +13,12 @@ router.register("captures", CaptureViewSet, basename="capture")
 
 review = "captures/<int:pk>/review/"
 urlpatterns = [
-    path("auth/token/", obtain_auth_token, name="api-token"),
+    *accounts_api.urlpatterns,
     path("me/", MeView.as_view(), name="api-me"),
     path("methods/", MethodsView.as_view(), name="api-methods"),
     path("schema/", SpectacularAPIView.as_view(), name="api-schema"),
-    path("docs/", SpectacularSwaggerView.as_view(url_name="api-schema"), name="api-docs"),
+    # The split view serves its start-up script as a file, which the CSP allows.
+    path("docs/", SpectacularSwaggerSplitView.as_view(url_name="api-schema"), name="api-docs"),
     path(review, reviews.ReviewView.as_view(), name="api-review"),
     path(review + "cuts/", reviews.CutsView.as_view(), name="api-review-cuts"),
     path(review + "cuts/<int:cut_id>/", reviews.CutView.as_view(), name="api-review-cut"),

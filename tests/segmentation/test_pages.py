@@ -34,9 +34,9 @@ class PagesTestCase(BaseTestCase):
 
     def test_logout_ends_the_session(self):
         self.client.force_login(self.bob)
-        r = self.client.get("/logout/")
+        r = self.client.post("/logout/")
         self.assertEqual(r["Location"], "/login/")
-        self.assertEqual(self.client.get("/api/me/").status_code, 403)
+        self.assertEqual(self.client.get("/api/me/").status_code, 401)
 
     def test_the_api_schema_and_docs_are_served(self):
         self.client.force_login(self.bob)

@@ -4,6 +4,7 @@
 import { get, post } from "../api/client";
 import type { CaptureSummary, Me, Page, Project } from "../api/types";
 import { clear, formatDuration, h, toast } from "../ui/dom";
+import { logoutButton } from "../ui/logout";
 import { navigate } from "../router";
 import { pairFiles, upload, type UploadItem } from "./upload";
 
@@ -96,7 +97,7 @@ export async function renderCaptureList(root: HTMLElement): Promise<() => void> 
   const page = h(
     "div",
     { class: "list-page" },
-    h("header", { class: "topbar" }, h("a", { class: "brand", href: "/" }, "Cutroom"), h("nav", { class: "crumbs" }, h("strong", {}, "Captures")), h("span", { class: "spacer" }), h("a", { class: "btn btn-ghost", href: "/library/", "data-testid": "nav-library" }, "Library"), h("span", { class: "user" }, me.username), h("a", { class: "btn btn-ghost", href: "/logout/" }, "Log out")),
+    h("header", { class: "topbar" }, h("a", { class: "brand", href: "/" }, "Cutroom"), h("nav", { class: "crumbs" }, h("strong", {}, "Captures")), h("span", { class: "spacer" }), h("a", { class: "btn btn-ghost", href: "/library/", "data-testid": "nav-library" }, "Library"), h("span", { class: "user" }, me.username), logoutButton()),
     h(
       "main",
       { class: "list-main" },

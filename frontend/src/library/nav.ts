@@ -3,6 +3,7 @@ import "./library.css";
 // project, its dashboard.
 
 import { h } from "../ui/dom";
+import { logoutButton } from "../ui/logout";
 
 export function topbar(crumbs: [string, string | null][], project?: number): HTMLElement {
   return h(
@@ -17,6 +18,6 @@ export function topbar(crumbs: [string, string | null][], project?: number): HTM
     h("span", { class: "spacer" }),
     h("a", { class: "btn btn-ghost", href: "/library/", "data-testid": "nav-library" }, "Library"),
     project ? h("a", { class: "btn btn-ghost", href: `/projects/${project}/dashboard/`, "data-testid": "nav-dashboard" }, "Dashboard") : null,
-    h("a", { class: "btn btn-ghost", href: "/logout/" }, "Log out"),
+    logoutButton(),
   );
 }

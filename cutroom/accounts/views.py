@@ -1,0 +1,32 @@
+"""Sign-in pages: Django's login views behind the sign-in throttle."""
+
+import math
+from functools import wraps
+
+from django.shortcuts import render
+
+from cutroom.accounts import throttle
+
+
+def throttled_sign_in(view):
+    """Refuse a sign-in POST with 429 while its username or address is throttled.
+
+    The password is not checked then; failures are counted by ``signals.count_failure``.
+    """
+
+    @wraps(view)
+    def wrapper(request, *args, **kwargs):
+        if request.method == "POST":
+            wait = throttle.wait_seconds(request, throttle.username_of(request.POST))
+            if wait:
+                return too_many_attempts(request, wait)
+        return view(request, *args, **kwargs)
+
+    return wrapper
+
+
+def too_many_attempts(request, wait):
+    context = {"minutes": math.ceil(wait / 60), "back": request.get_full_path()}
+    response = render(request, "registration/throttled.html", context, status=429)
+    response["Retry-After"] = str(wait)
+    return response
