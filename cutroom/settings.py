@@ -134,6 +134,8 @@ CUTROOM_LOGIN_FAILURES_PER_ADDRESS = envint("CUTROOM_LOGIN_FAILURES_PER_ADDRESS"
 CUTROOM_TRUSTED_PROXIES = envint("CUTROOM_TRUSTED_PROXIES", 0)
 # An API token works for this many days after it was issued.
 CUTROOM_TOKEN_DAYS = envint("CUTROOM_TOKEN_DAYS", 30)
+# An invitation to join a project can be accepted for this many days.
+CUTROOM_INVITATION_DAYS = envint("CUTROOM_INVITATION_DAYS", 14)
 
 # Scripts only from our own files; inline styles are allowed (label colours are style
 # attributes; so are parts of the admin and of Swagger UI), inline scripts are not.
@@ -249,6 +251,7 @@ SPECTACULAR_SETTINGS = {
     "ENUM_NAME_OVERRIDES": {
         "JobStatusEnum": "segmentation.models.JOB_STATUSES",
         "ReviewStatusEnum": "segmentation.models.Review.STATUSES",
+        "RoleEnum": "segmentation.models.ROLES",
     },
 }
 

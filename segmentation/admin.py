@@ -4,6 +4,7 @@ from segmentation.models import (
     Capture,
     Cut,
     DetectionRun,
+    Invitation,
     Label,
     Membership,
     Project,
@@ -34,6 +35,24 @@ class ProjectAdmin(admin.ModelAdmin):
 class MembershipAdmin(admin.ModelAdmin):
     list_display = ("project", "user", "role")
     list_filter = ("role",)
+
+
+@admin.register(Invitation)
+class InvitationAdmin(admin.ModelAdmin):
+    """The record of who invited whom, and what became of it; read-only."""
+
+    list_display = ("username", "project", "role", "status", "invited_by", "created_at", "answered_at")
+    list_filter = ("status", "role")
+    search_fields = ("username", "project__name")
+
+    def has_add_permission(self, request):
+        return False
+
+    def has_change_permission(self, request, obj=None):
+        return False
+
+    def has_delete_permission(self, request, obj=None):
+        return False
 
 
 @admin.register(Label)

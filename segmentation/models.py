@@ -398,8 +398,9 @@ class ReviewEvent(models.Model):
         return f"{self.action} by {self.user}"
 
 
-# The clip library and agreement records live in their own module (same app, same
-# migrations); importing them here registers them with the app.
+# The clip library and agreement records, and invitations, live in their own modules
+# (same app, same migrations); importing them here registers them with the app.
+from segmentation.models_invitations import Invitation  # noqa: E402, F401
 from segmentation.models_library import (  # noqa: E402, F401
     Adjudication,
     CaptureAgreement,

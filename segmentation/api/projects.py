@@ -10,8 +10,9 @@ from rest_framework.views import APIView
 
 from motionlib.segmenters import list_segmenters
 from segmentation import services
+from segmentation.api.invitations import InvitationSerializer, invited_response
 from segmentation.api.serializers import LabelSerializer, MemberSerializer, ProjectSerializer
-from segmentation.models import Project
+from segmentation.models import Membership, Project
 
 
 class ProjectViewSet(
@@ -22,7 +23,7 @@ class ProjectViewSet(
     viewsets.GenericViewSet,
 ):
     serializer_class = ProjectSerializer
-    http_method_names = ["get", "post", "patch", "head", "options"]
+    http_method_names = ["get", "post", "patch", "delete", "head", "options"]
 
     def get_queryset(self):
         return Project.objects.for_user(self.request.user).prefetch_related("labels").order_by("id")
@@ -61,8 +62,30 @@ class ProjectViewSet(
         serializer = MemberSerializer(data=request.data)
         serializer.is_valid(raise_exception=True)
         data = serializer.validated_data
-        member = services.do_set_member(project, data["user"]["username"], data["role"])
-        return Response(MemberSerializer(member).data, status=201)
+        added = services.do_add_member(project, request.user, data["user"]["username"], data["role"])
+        if isinstance(added, Membership):
+            return Response(MemberSerializer(added).data)
+        # Anyone not yet a member is invited; the answer is the same whether or not an
+        # account has that name, so a project cannot be used to find out.
+        return invited_response(added)
+
+    @extend_schema(responses=InvitationSerializer(many=True))
+    @action(detail=True, methods=["get"])
+    def invitations(self, request, pk=None):
+        """Pending invitations (expired and answered ones are left out)."""
+        project = self._admin_project()
+        if not project.can_manage(request.user):
+            raise PermissionDenied("Only the project's admins see its invitations.")
+        invitations = project.invitations.pending().select_related("invited_by")
+        return Response(InvitationSerializer(invitations, many=True).data)
+
+    @extend_schema(request=None, responses={204: None})
+    @action(detail=True, methods=["delete"], url_path=r"invitations/(?P<invitation_id>\d+)")
+    def cancel_invitation(self, request, pk=None, invitation_id=None):
+        project = self._admin_project()
+        invitation = get_object_or_404(project.invitations.pending(), pk=invitation_id)
+        services.do_cancel_invitation(invitation, request.user)
+        return Response(status=204)
 
 
 class MeView(APIView):

@@ -3,7 +3,7 @@ from drf_spectacular.views import SpectacularAPIView, SpectacularSwaggerSplitVie
 from rest_framework.routers import SimpleRouter
 
 from cutroom.accounts import api as accounts_api
-from segmentation.api import library, reviews
+from segmentation.api import invitations, library, reviews
 from segmentation.api.captures import CaptureViewSet
 from segmentation.api.projects import MethodsView, MeView, ProjectViewSet
 
@@ -27,5 +27,6 @@ urlpatterns = [
     path(review + "events/", reviews.EventsView.as_view(), name="api-review-events"),
     path("captures/<int:pk>/reviews/", reviews.AllReviewsView.as_view(), name="api-reviews"),
     *library.urlpatterns,
+    *invitations.urlpatterns,
     *router.urls,
 ]

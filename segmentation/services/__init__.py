@@ -13,6 +13,12 @@ from segmentation.services.captures import (
     ingest_capture,
     sweep_stale_claims,
 )
+from segmentation.services.invitations import (
+    do_accept_invitation,
+    do_add_member,
+    do_cancel_invitation,
+    do_decline_invitation,
+)
 from segmentation.services.projects import (
     do_add_label,
     do_create_project,
@@ -30,9 +36,13 @@ from segmentation.services.reviews import (
 __all__ = [
     "default_method",
     "detect_run",
+    "do_accept_invitation",
     "do_add_label",
+    "do_add_member",
+    "do_cancel_invitation",
     "do_change_cut",
     "do_create_project",
+    "do_decline_invitation",
     "do_insert_cut",
     "do_label_segment",
     "do_retry_capture",

@@ -1,0 +1,90 @@
+"""Adding people to projects: by invitation, which the person accepts or declines.
+
+A project admin's "add member" must neither reveal whether an account exists (anyone can
+create a project, so it would enumerate usernames) nor put someone into a stranger's
+project. So it changes the role of someone already a member (the admin sees the members
+anyway) and otherwise invites the username, whether or not an account has it; only a
+site admin (who may see accounts) is told that no account has that name.
+"""
+
+from datetime import timedelta
+
+from django.conf import settings
+from django.contrib.auth import get_user_model
+from django.db import transaction
+from django.utils import timezone
+
+from segmentation.models import Invitation
+from segmentation.services.projects import do_set_member
+
+USERNAME_MAX = 150  # Django's own limit on usernames
+
+
+def can_see_accounts(user):
+    """Site admins, who may list accounts in the admin anyway, learn whether one exists."""
+    return user.has_perm("auth.view_user")
+
+
+def do_add_member(project, actor, username, role):
+    """A member's new role (a ``Membership``), or an ``Invitation`` for anyone else.
+
+    The invitation is made the same way whether or not an account named ``username``
+    exists, so nothing the caller sees differs (unless ``can_see_accounts(actor)``).
+    Inviting a username again replaces its pending invitation.
+    """
+    if not username or len(username) > USERNAME_MAX:
+        raise ValueError(f"username: must be 1 to {USERNAME_MAX} characters, got {len(username)}")
+    with transaction.atomic():
+        if project.memberships.filter(user__username=username).exists():
+            return do_set_member(project, username, role)
+        users = get_user_model().objects
+        if can_see_accounts(actor) and not users.filter(username=username).exists():
+            raise ValueError(f"username: no user named {username!r}")
+        now = timezone.now()
+        invitation, _ = Invitation.objects.update_or_create(
+            project=project, username=username, status="pending",
+            defaults={"role": role, "invited_by": actor, "created_at": now,
+                      "expires_at": now + timedelta(days=settings.CUTROOM_INVITATION_DAYS)},
+        )
+    return invitation
+
+
+def do_accept_invitation(invitation, user):
+    """Join the project with the invited role; the invitation records who and when."""
+    with transaction.atomic():
+        invitation = _still_pending(invitation, user)
+        membership = do_set_member(invitation.project, user.get_username(), invitation.role)
+        _answer(invitation, user, "accepted")
+    return membership
+
+
+def do_decline_invitation(invitation, user):
+    with transaction.atomic():
+        invitation = _still_pending(invitation, user)
+        _answer(invitation, user, "declined")
+    return invitation
+
+
+def do_cancel_invitation(invitation, admin):
+    """A project admin withdraws a pending invitation (it stays on record, cancelled)."""
+    with transaction.atomic():
+        invitation = Invitation.objects.select_for_update().get(pk=invitation.pk)
+        if invitation.status != "pending":
+            raise ValueError(f"status: the invitation is already {invitation.status}")
+        _answer(invitation, admin, "cancelled")
+    return invitation
+
+
+def _still_pending(invitation, user):
+    """The invitation re-read under a row lock, if it is still the user's to answer."""
+    locked = Invitation.objects.select_for_update().for_user(user).filter(pk=invitation.pk).first()
+    if locked is None:
+        raise ValueError("status: this invitation was already answered, cancelled or has expired")
+    return locked
+
+
+def _answer(invitation, user, status):
+    invitation.status = status
+    invitation.answered_by = user
+    invitation.answered_at = timezone.now()
+    invitation.save(update_fields=["status", "answered_by", "answered_at"])
