@@ -5,6 +5,7 @@ import { get, post } from "../api/client";
 import type { CaptureSummary, Me, Page, Project } from "../api/types";
 import { clear, formatDuration, h, toast } from "../ui/dom";
 import { logoutButton } from "../ui/logout";
+import { invitationsBox } from "./invitations";
 import { navigate } from "../router";
 import { pairFiles, upload, type UploadItem } from "./upload";
 
@@ -101,6 +102,7 @@ export async function renderCaptureList(root: HTMLElement): Promise<() => void> 
     h(
       "main",
       { class: "list-main" },
+      invitationsBox(() => location.reload()),
       h(
         "div",
         { class: "filters" },
