@@ -5,7 +5,7 @@
 import { get, post } from "../api/client";
 import type { Capture, Cut, Label, Me, Project, Review, ReviewEvent, Segment, Signal, SignalResponse } from "../api/types";
 import { advance, frameOf, nextSpeed, seek, togglePlay, type Playback } from "../player/clock";
-import { SkeletonView } from "../player/skeletonView";
+import { MAX_JOINTS, SkeletonView, TooManyJoints } from "../player/skeletonView";
 import { clear, confirmDialog, dialog, h, toast } from "../ui/dom";
 import { icon } from "../ui/icons";
 import { FrameStore, loadFrames } from "./frames";
@@ -51,9 +51,15 @@ class FrameFeed {
   onChunk: () => void = () => {};
 
   constructor(capture: Capture) {
-    this.store = new FrameStore(capture.n_frames, capture.n_joints || capture.skeleton!.joints.length);
-    this.done = loadFrames(capture.id, this.store, frameFromUrl(capture.n_frames), () => this.onChunk(), this.abort.signal);
+    // Poses the player will not draw are not fetched (nor memory set aside for them).
+    const drawable = jointCount(capture) <= MAX_JOINTS;
+    this.store = new FrameStore(capture.n_frames, drawable ? jointCount(capture) : 0);
+    this.done = drawable ? loadFrames(capture.id, this.store, frameFromUrl(capture.n_frames), () => this.onChunk(), this.abort.signal) : Promise.resolve();
   }
+}
+
+function jointCount(capture: Capture): number {
+  return Math.max(capture.n_joints ?? 0, capture.skeleton?.joints.length ?? 0);
 }
 
 /** The frame asked for by `?frame=N` (the library links a segment's start this way), else 0. */
@@ -166,6 +172,13 @@ class ReviewPage {
   // ---- layout --------------------------------------------------------------------------
 
   private makePlayer(): SkeletonView | null {
+    const joints = jointCount(this.capture);
+    if (joints > MAX_JOINTS) {
+      const text = `No 3D view: this capture has ${new TooManyJoints(joints).message}. The timeline still works.`;
+      this.el.viewport.append(h("div", { class: "no-webgl", "data-testid": "too-many-joints" }, text));
+      this.el.loading.hidden = true;
+      return null;
+    }
     try {
       return new SkeletonView(this.el.viewport, this.capture.skeleton!);
     } catch (err) {
