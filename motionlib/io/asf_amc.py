@@ -63,13 +63,13 @@ class _AsfLines:
         try:
             values = [float(t) for t in tokens[:count]]
         except ValueError:
-            raise self.error(f"{what} must be numbers, found {' '.join(tokens[:count])!r}",
+            raise self.error(f"{what} must be numbers, found {shorten(' '.join(tokens[:count]))}",
                              line) from None
         if not all(math.isfinite(v) for v in values):
-            raise self.error(f"{what} must be finite, found {' '.join(tokens[:count])!r}", line)
+            raise self.error(f"{what} must be finite, found {shorten(' '.join(tokens[:count]))}", line)
         bound = self.limits.max_length
         if any(abs(v) > bound for v in values):
-            raise self.error(f"{what} is {' '.join(tokens[:count])!r}, beyond the limit of "
+            raise self.error(f"{what} is {shorten(' '.join(tokens[:count]))}, beyond the limit of "
                              f"±{bound:g}", line)
         return values
 
@@ -94,7 +94,7 @@ def _angle_scale(asf: _AsfLines, units) -> float:
         if tokens[0].lower() == "angle" and len(tokens) > 1:
             unit = tokens[1].lower()
             if unit not in ("deg", "rad"):
-                raise asf.error(f"angle unit must be deg or rad, found {tokens[1]!r}", n)
+                raise asf.error(f"angle unit must be deg or rad, found {shorten(tokens[1])}", n)
             return 1.0 if unit == "deg" else 180.0 / math.pi
     return 1.0  # the Acclaim default is degrees
 
@@ -107,7 +107,7 @@ def _parse_bones(asf: _AsfLines, lines, to_deg: float) -> dict[str, _Bone]:
         if key == "begin":
             bone = _Bone(name="", line=n)
         elif bone is None:
-            raise asf.error(f"{tokens[0]!r} outside a begin ... end bone block", n)
+            raise asf.error(f"{shorten(tokens[0])} outside a begin ... end bone block", n)
         elif key == "end":
             _add_bone(asf, bones, bone)
             bone = None
@@ -168,7 +168,7 @@ def _parse_root(asf: _AsfLines, lines, to_deg: float) -> _Bone:
         if key == "order":
             if any(t.lower() not in _DOF for t in tokens[1:]):
                 raise asf.error(f"root order must use TX TY TZ RX RY RZ, found "
-                                f"{' '.join(tokens[1:])!r}", n)
+                                f"{shorten(' '.join(tokens[1:]))}", n)
             root.dof = tuple(_DOF[t.lower()] for t in tokens[1:])
         elif key == "axis" and len(tokens) > 1:
             root.order = _axis_order(asf, tokens[1], n)

@@ -203,15 +203,20 @@ def _guarded(job, what, work, **fail_fields):
     try:
         work()
     except ValueError as exc:
-        job.fail(str(exc), **fail_fields)
+        job.fail(_bounded(str(exc), 2000), **fail_fields)
     except Exception as exc:
         log.exception("%s failed", what)
-        detail = str(exc) if len(str(exc)) <= 300 else str(exc)[:300] + "..."
         job.fail(
-            f"{what} failed with an internal error ({type(exc).__name__}: {detail}). "
+            f"{what} failed with an internal error ({type(exc).__name__}: "
+            f"{_bounded(str(exc), 300)}). "
             "The original upload is kept; report this to the service's administrators.",
             **fail_fields,
         )
+
+
+def _bounded(text, limit):
+    """An error text for a job's row, cut to about ``limit`` characters."""
+    return text if len(text) <= limit else text[:limit] + "..."
 
 
 def ingest_capture(capture):

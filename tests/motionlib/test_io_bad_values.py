@@ -155,3 +155,19 @@ def test_its_limits_leave_a_normal_take_alone(tmp_path):
     text = HEADER + "Frames: 3\nFrame Time: 0.0083333\n" + FRAME * 3
     take = motionlib.read(write(tmp_path, text))
     assert take.channels.shape == (3, 9) and np.isfinite(take.channels).all()
+
+
+def test_it_does_not_echo_a_huge_number(tmp_path):
+    text = HEADER + "Frames: 1\nFrame Time: 0.01\n" + FRAME.replace("8\n", "9" * 1_000_000 + "\n")
+    with pytest.raises(CaptureError, match=r"bad\.bvh:19: frame 0, value 9: '9999.*\(1000000 "
+                                           r"characters\) is not a finite number") as caught:
+        motionlib.read(write(tmp_path, text))
+    assert len(str(caught.value)) < 300
+
+
+def test_it_does_not_echo_a_huge_asf_unit(tmp_path):
+    amc, asf = amc_pair(tmp_path, AMC_FRAME.format(n=1),
+                        ASF.replace("angle deg", "angle " + "d" * 1_000_000))
+    with pytest.raises(CaptureError, match=r"bad\.asf:6: angle unit must be deg or rad") as caught:
+        motionlib.read(amc, asf=asf)
+    assert len(str(caught.value)) < 300
