@@ -124,3 +124,15 @@ def test_stored_names_are_safe_file_names():
     long = stored_name("ü" * 150 + ".bvh")
     assert len(long.encode()) <= 104 and long.endswith(".bvh")
     assert re.fullmatch(r"[\w-]+\.bvh", stored_name("a b\x00c.bvh"))
+
+
+def test_the_import_command_checks_files_under_the_same_limits(tmp_path):
+    import pytest
+
+    from motionlib import CaptureError
+    from segmentation.importing import check_readable
+
+    path = tmp_path / "empty.bvh"
+    path.write_bytes(two_joint_bvh(n_frames=0))
+    with pytest.raises(CaptureError, match=r"empty\.bvh:17: the take has 0 frames"):
+        check_readable(path)
