@@ -98,3 +98,12 @@ def test_it_refuses_to_draw_more_joints_than_the_service_admits(live_server, new
     page.keyboard.press("End")
     expect(page.get_by_test_id("hud-frame")).to_have_text(f"Frame {last} / {last}", timeout=PROMPT_MS)
     assert page.errors == []
+
+
+def test_it_refuses_to_draw_what_the_service_is_set_to_refuse(live_server, new_page, crowded_capture, settings):
+    settings.CUTROOM_MAX_JOINTS = 500
+    page = new_page("ann")
+    page.goto(f"{live_server.url}/captures/{crowded_capture.pk}/")
+    expect(page.get_by_test_id("too-many-joints")).to_contain_text(
+        "1,000 joints; the player draws at most 500")
+    assert page.errors == []

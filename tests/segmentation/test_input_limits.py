@@ -89,6 +89,14 @@ class IngestLimitsTestCase(BaseTestCase):
         self.assertEqual((body["start"], body["stop"], body["n_frames"]), (5, 15, 10))
 
 
+class AdmittedLimitsTestCase(BaseTestCase):
+    def test_it_tells_the_pages_how_many_joints_it_admits(self):
+        self.login(self.bob)
+        self.assertEqual(self.client.get("/api/me/").json()["limits"], {"max_joints": 1000})
+        with override_settings(CUTROOM_MAX_JOINTS=40):
+            self.assertEqual(self.client.get("/api/me/").json()["limits"], {"max_joints": 40})
+
+
 class OutOfRangeNumbersTestCase(BaseTestCase):
     def setUp(self):
         super().setUp()

@@ -18,7 +18,7 @@ const CMU_LIMBS = "(clavicle|humerus|radius|wrist|hand|fingers|thumb|hipjoint|fe
 const LEFT_LIMB = new RegExp(`^l${CMU_LIMBS}`, "i");
 const RIGHT_LIMB = new RegExp(`^r${CMU_LIMBS}`, "i");
 
-/** The most joints the service admits (CUTROOM_MAX_JOINTS' default): more are not drawn. */
+/** The most joints the service admits by default (CUTROOM_MAX_JOINTS); /api/me/ says the actual limit. */
 export const MAX_JOINTS = 1000;
 /** Above this many joints, spheres and cylinders get fewer faces. */
 const DETAILED_JOINTS = 64;
@@ -53,8 +53,9 @@ export class SkeletonView {
   constructor(
     private readonly container: HTMLElement,
     private readonly skeleton: Skeleton,
+    maxJoints = MAX_JOINTS,
   ) {
-    if (skeleton.joints.length > MAX_JOINTS) throw new TooManyJoints(skeleton.joints.length);
+    if (skeleton.joints.length > maxJoints) throw new TooManyJoints(skeleton.joints.length, maxJoints);
     this.renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
     this.renderer.setPixelRatio(Math.min(window.devicePixelRatio, 2));
     this.canvas = this.renderer.domElement;
@@ -187,8 +188,11 @@ export class SkeletonView {
 
 /** A skeleton the player will not draw: more joints than the service admits. */
 export class TooManyJoints extends Error {
-  constructor(readonly count: number) {
-    super(`${count.toLocaleString("en-US")} joints; the player draws at most ${MAX_JOINTS.toLocaleString("en-US")}, as many as the service admits`);
+  constructor(
+    readonly count: number,
+    readonly limit: number,
+  ) {
+    super(`${count.toLocaleString("en-US")} joints; the player draws at most ${limit.toLocaleString("en-US")}, as many as the service admits`);
   }
 }
 

@@ -28,7 +28,7 @@ export async function renderReview(root: HTMLElement, captureId: number): Promis
   const project = listOf(projects).find((p) => p.id === capture.project);
   if (capture.status !== "ready" || !capture.skeleton) return renderNotReady(root, capture);
   // Poses start streaming now, in parallel with the review and the signal.
-  const frames = new FrameFeed(capture);
+  const frames = new FrameFeed(capture, maxJoints(me));
   try {
     const [review, signal] = await Promise.all([
       post<Review>(`/api/captures/${captureId}/review/`),
@@ -50,9 +50,9 @@ class FrameFeed {
   readonly done: Promise<void>;
   onChunk: () => void = () => {};
 
-  constructor(capture: Capture) {
+  constructor(capture: Capture, maxJoints: number) {
     // Poses the player will not draw are not fetched (nor memory set aside for them).
-    const drawable = jointCount(capture) <= MAX_JOINTS;
+    const drawable = jointCount(capture) <= maxJoints;
     this.store = new FrameStore(capture.n_frames, drawable ? jointCount(capture) : 0);
     this.done = drawable ? loadFrames(capture.id, this.store, frameFromUrl(capture.n_frames), () => this.onChunk(), this.abort.signal) : Promise.resolve();
   }
@@ -60,6 +60,10 @@ class FrameFeed {
 
 function jointCount(capture: Capture): number {
   return Math.max(capture.n_joints ?? 0, capture.skeleton?.joints.length ?? 0);
+}
+
+function maxJoints(me: Me): number {
+  return me.limits?.max_joints ?? MAX_JOINTS;
 }
 
 /** The frame asked for by `?frame=N` (the library links a segment's start this way), else 0. */
@@ -173,14 +177,15 @@ class ReviewPage {
 
   private makePlayer(): SkeletonView | null {
     const joints = jointCount(this.capture);
-    if (joints > MAX_JOINTS) {
-      const text = `No 3D view: this capture has ${new TooManyJoints(joints).message}. The timeline still works.`;
+    const limit = maxJoints(this.me);
+    if (joints > limit) {
+      const text = `No 3D view: this capture has ${new TooManyJoints(joints, limit).message}. The timeline still works.`;
       this.el.viewport.append(h("div", { class: "no-webgl", "data-testid": "too-many-joints" }, text));
       this.el.loading.hidden = true;
       return null;
     }
     try {
-      return new SkeletonView(this.el.viewport, this.capture.skeleton!);
+      return new SkeletonView(this.el.viewport, this.capture.skeleton!, limit);
     } catch (err) {
       this.el.viewport.append(h("div", { class: "no-webgl" }, `3D view unavailable (${err instanceof Error ? err.message : "no WebGL"}); the timeline still works.`));
       return null;
