@@ -126,6 +126,10 @@ def _add_bone(asf: _AsfLines, bones: dict[str, _Bone], bone: _Bone) -> None:
     if bone.name in bones or bone.name == "root":
         raise asf.error(f"bone {bone.name!r} is defined twice (or is named like the root)",
                         bone.line)
+    if np.abs(bone.direction * bone.length).max() > limits.max_length:
+        raise asf.error(f"bone {bone.name} is {np.linalg.norm(bone.direction) * bone.length:g} "
+                        f"long (direction x length), beyond the limit of {limits.max_length:g}",
+                        bone.line)
     if len(bones) + 1 >= limits.max_joints:  # the root is a joint too
         raise asf.error(f"more than {limits.max_joints} joints (the limit); bone "
                         f"{bone.name} is one too many", bone.line)

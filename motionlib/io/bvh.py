@@ -211,9 +211,12 @@ def _motion_header(data: bytes, pos: int, line: int, path,
     if not m:
         raise CaptureError(f"expected 'Frames: <count>' after MOTION, found {text[:40]!r}",
                            path=path, line=line)
-    if not re.fullmatch(r"[0-9]{1,18}", m.group(1)):
+    if not re.fullmatch(r"[0-9]+", m.group(1)):
         raise CaptureError(f"frame count must be a whole number, found {_short(m.group(1))}",
                            path=path, line=line)
+    if len(m.group(1)) > 18:  # int() of a megabyte of digits is slow (and far past any limit)
+        raise CaptureError(f"frame count {_short(m.group(1))} is more than the limit of "
+                           f"{limits.max_frames}", path=path, line=line)
     n_frames, frames_line = int(m.group(1)), line
     text, line, pos = _next_line(data, pos, line + 1)
     m = re.fullmatch(r"Frame\s+Time:\s*(\S+)", text, re.IGNORECASE)

@@ -171,3 +171,18 @@ def test_it_does_not_echo_a_huge_asf_unit(tmp_path):
     with pytest.raises(CaptureError, match=r"bad\.asf:6: angle unit must be deg or rad") as caught:
         motionlib.read(amc, asf=asf)
     assert len(str(caught.value)) < 300
+
+
+def test_it_refuses_an_asf_bone_whose_direction_times_length_is_beyond_the_limit(tmp_path):
+    asf = ASF.replace("direction 0 1 0", "direction 0 1000 0").replace("length 2", "length 1e4")
+    amc, asf = amc_pair(tmp_path, AMC_FRAME.format(n=1), asf)
+    with pytest.raises(CaptureError, match=r"bad\.asf:13: bone lowerback is 1e\+07 long "
+                                           r"\(direction x length\), beyond the limit"):
+        motionlib.read(amc, asf=asf)
+
+
+def test_it_refuses_a_frame_count_of_a_hundred_digits_as_beyond_the_limit(tmp_path):
+    text = HEADER + "Frames: " + "9" * 100 + "\nFrame Time: 0.01\n" + FRAME
+    with pytest.raises(CaptureError, match=r"bad\.bvh:17: frame count '9999.* is more than the "
+                                           r"limit of 2000000"):
+        motionlib.read(write(tmp_path, text))
