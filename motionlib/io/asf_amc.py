@@ -304,11 +304,12 @@ def read_amc(path: str | os.PathLike, asf: str | os.PathLike | Asf, *,
     data = read_lines_bytes(path)
     offset, first_line = _amc_body(data, path)
     sk = asf.skeleton
+    positions = [sk.channel_starts[j] + k for j, names in enumerate(sk.channels)
+                 for k, name in enumerate(names) if name.endswith("position")]
     bounds = np.full(sk.n_channels, np.inf)
-    bounds[[sk.channel_starts[j] + k for j, names in enumerate(sk.channels)
-            for k, name in enumerate(names) if name.endswith("position")]] = limits.max_length
+    bounds[positions] = limits.max_length
     channels = _amc_fast(data, offset, sk, limits)
-    if channels is None or (np.abs(channels) > bounds).any():
+    if channels is None or (np.abs(channels[:, positions]) > limits.max_length).any():
         body = data[offset:].decode("utf-8", "replace")
         channels = _amc_lines(body, first_line, asf, path, bounds,
                               max_frames_for(sk.n_joints, sk.n_channels, len(data), limits))

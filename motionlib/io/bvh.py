@@ -248,10 +248,12 @@ def _parse_motion(data: bytes, pos: int, line: int, n_frames: int, skeleton: Ske
                   path, limits: Limits) -> np.ndarray:
     """Frame values as (n_frames, n_channels); ``line`` is the line number of byte ``pos``."""
     n_channels = skeleton.n_channels
+    positions = _position_columns(skeleton)
     bounds = np.full(n_channels, np.inf)
-    bounds[_position_columns(skeleton)] = limits.max_length
+    bounds[positions] = limits.max_length
     values = read_rows(data, pos, n_frames, n_channels)
-    if values is not None and not (np.abs(values) > bounds).any():
+    # Only the few position columns are copied for the check (not the whole take).
+    if values is not None and not (np.abs(values[:, positions]) > limits.max_length).any():
         return values
     # Slow path: nan, no channels, a position out of bounds, or something wrong that needs
     # a line number.
