@@ -194,6 +194,15 @@ CUTROOM_CLAIM_TIMEOUT = envint("CUTROOM_CLAIM_TIMEOUT", 15 * 60)
 # After this many claims a job that keeps killing its worker is marked failed.
 CUTROOM_MAX_ATTEMPTS = envint("CUTROOM_MAX_ATTEMPTS", 3)
 CUTROOM_FRAMES_PER_REQUEST = 5000
+# What one capture may hold, checked before its frames are allocated (motionlib.take.Limits;
+# unset means motionlib's default, given in .env.example).
+CUTROOM_MAX_JOINTS = envint("CUTROOM_MAX_JOINTS", None)
+CUTROOM_MAX_FRAMES = envint("CUTROOM_MAX_FRAMES", None)
+CUTROOM_MAX_FRAME_VALUES = envint("CUTROOM_MAX_FRAME_VALUES", None)
+CUTROOM_MAX_JOINT_FRAMES = envint("CUTROOM_MAX_JOINT_FRAMES", None)
+CUTROOM_MAX_EXPANSION = envint("CUTROOM_MAX_EXPANSION", None)
+# One /frames/ answer carries at most this many joint positions (frames × joints).
+CUTROOM_JOINT_FRAMES_PER_REQUEST = 250_000
 
 # Celery. No result backend: a job's state is its row (status, error, timings).
 # (the host part only keeps kombu from warning that none was given)

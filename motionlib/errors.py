@@ -8,6 +8,15 @@ from __future__ import annotations
 
 import os
 
+MAX_MESSAGE = 1000
+
+
+def shorten(value, limit: int = 40) -> str:
+    """``repr(value)`` cut to about ``limit`` characters, for naming a value in a message
+    (a 1 MB joint name must not be echoed back whole)."""
+    text = str(value)
+    return repr(text) if len(text) <= limit else repr(text[:limit]) + f"... ({len(text)} characters)"
+
 
 class CaptureError(ValueError):
     """A capture file (or a take built from one) cannot be used as it is.
@@ -24,7 +33,8 @@ class CaptureError(ValueError):
 
     def __init__(self, message: str, *, path: str | os.PathLike | None = None,
                  line: int | None = None):
-        self.reason = message
+        # Values are shortened where they are named; this is the net under all of them.
+        self.reason = message if len(message) <= MAX_MESSAGE else message[:MAX_MESSAGE] + "..."
         self.path = None if path is None else os.fspath(path)
         self.line = line
         super().__init__(self._format())

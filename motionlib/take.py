@@ -6,6 +6,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from motionlib.errors import CaptureError
 from motionlib.skeleton import Skeleton
 
 
@@ -70,3 +71,89 @@ def frame_range(n_frames: int, start: int | None, stop: int | None) -> tuple[int
         raise ValueError(f"frame range [{start}, {stop}) is empty or outside the take's "
                          f"{n_frames} frames")
     return start, stop
+
+
+@dataclass(frozen=True)
+class Limits:
+    """What a capture file may hold and expand to; readers check these before allocating.
+
+    The defaults admit an hour of a CMU take at 120 fps (432,000 frames × 31 joints) and
+    refuse files built to exhaust memory: ``Frames: 1000000000000``, 80,000 joints, or a
+    small file of channel-less joints whose positions would be thousands of times its size.
+
+    Attributes
+    ----------
+    max_joints : int
+        Joints (BVH joints, ASF bones) in one skeleton.
+    max_frames : int
+        Frames in one take.
+    max_values : int
+        ``n_frames × n_channels``: the channel array, 8 bytes each.
+    max_joint_frames : int
+        ``n_frames × n_joints``: the world positions (3 float32, 12 bytes each).
+    max_expansion : int
+        The positions (12 bytes per joint per frame) may be at most this many times the
+        size of the file, or :data:`EXPANSION_FLOOR_BYTES` when that is more.
+    min_frames : int
+        Frames a take needs (0: an empty take can be read and written back).
+    min_frame_time, max_frame_time : float
+        Seconds per frame (10 kHz to one frame every 10 s).
+    max_length : float
+        Largest absolute offset or position value, in the file's length unit.
+    max_name_length : int
+        Characters in a joint name.
+    """
+
+    max_joints: int = 1000
+    max_frames: int = 2_000_000
+    max_values: int = 60_000_000
+    max_joint_frames: int = 20_000_000
+    max_expansion: int = 16
+    min_frames: int = 0
+    min_frame_time: float = 1e-4
+    max_frame_time: float = 10.0
+    max_length: float = 1e6
+    max_name_length: int = 200
+
+
+DEFAULT_LIMITS = Limits()
+EXPANSION_FLOOR_BYTES = 16 * 2**20
+POSITION_BYTES = 12  # one joint in one frame: x, y, z as float32
+
+
+def max_frames_for(n_joints: int, n_channels: int, file_bytes: int, limits: Limits) -> int:
+    """The most frames a take of this shape, read from a file of ``file_bytes``, may have."""
+    budget = max(limits.max_expansion * file_bytes, EXPANSION_FLOOR_BYTES) // POSITION_BYTES
+    return min(limits.max_frames, limits.max_values // max(n_channels, 1),
+               limits.max_joint_frames // max(n_joints, 1), budget // max(n_joints, 1))
+
+
+def check_size(n_frames: int, n_joints: int, n_channels: int, file_bytes: int,
+               limits: Limits, path=None, line: int | None = None) -> None:
+    """Refuse a take whose arrays would exceed ``limits``, before they are allocated.
+
+    Raises
+    ------
+    CaptureError
+        Naming the count at fault, the limit and (when given) the file and line.
+    """
+    if limits.min_frames <= n_frames <= max_frames_for(n_joints, n_channels, file_bytes, limits):
+        return
+    budget = max(limits.max_expansion * file_bytes, EXPANSION_FLOOR_BYTES) // POSITION_BYTES
+    joint_frames = n_frames * n_joints
+    if n_frames < limits.min_frames:
+        message = (f"the take has {n_frames} frame{'' if n_frames == 1 else 's'}; a capture "
+                   f"needs at least {limits.min_frames}")
+    elif n_frames > limits.max_frames:
+        message = f"{n_frames} frames is more than the limit of {limits.max_frames}"
+    elif n_frames * n_channels > limits.max_values:
+        message = (f"{n_frames} frames × {n_channels} channels = {n_frames * n_channels} "
+                   f"values is more than the limit of {limits.max_values}")
+    elif joint_frames > limits.max_joint_frames:
+        message = (f"{n_frames} frames × {n_joints} joints = {joint_frames} joint positions "
+                   f"is more than the limit of {limits.max_joint_frames}")
+    else:
+        message = (f"{n_frames} frames × {n_joints} joints = {joint_frames} joint positions "
+                   f"is too many for a {file_bytes}-byte file: their positions may take at "
+                   f"most {limits.max_expansion} times its size ({budget} joint positions)")
+    raise CaptureError(message, path=path, line=line)

@@ -95,8 +95,9 @@ def find_asf(amc, asf=None):
 
 
 def check_readable(path, asf=None):
-    """Parse the file with motionlib; CaptureError names the file, line and value at fault."""
-    motionlib.read(path, asf=asf)
+    """Parse the file with motionlib under the service's input limits; CaptureError names
+    the file, line and value at fault."""
+    motionlib.read(path, asf=asf, limits=services.captures.input_limits())
 
 
 def import_file(project, user, path, asf=None, check=True):

@@ -8,12 +8,13 @@ from pathlib import Path
 from motionlib.errors import CaptureError
 from motionlib.io.asf_amc import read_amc, read_asf
 from motionlib.io.bvh import read_bvh, write_bvh
-from motionlib.take import Take
+from motionlib.take import DEFAULT_LIMITS, Limits, Take
 
 __all__ = ["read", "read_amc", "read_asf", "read_bvh", "write_bvh"]
 
 
-def read(path: str | os.PathLike, *, asf: str | os.PathLike | None = None) -> Take:
+def read(path: str | os.PathLike, *, asf: str | os.PathLike | None = None,
+         limits: Limits = DEFAULT_LIMITS) -> Take:
     """Read a capture: BVH by its ``.bvh`` extension, CMU ``.amc`` with its ``asf`` skeleton.
 
     Parameters
@@ -21,6 +22,8 @@ def read(path: str | os.PathLike, *, asf: str | os.PathLike | None = None) -> Ta
     path : str or PathLike
     asf : str or PathLike, optional
         Required for ``.amc``.
+    limits : Limits, optional
+        What the file may hold and expand to (joints, frames, sizes, physical values).
 
     Returns
     -------
@@ -41,7 +44,7 @@ def read(path: str | os.PathLike, *, asf: str | os.PathLike | None = None) -> Ta
         if p is not None and not Path(p).is_file():
             raise CaptureError("no such file", path=p)
     if suffix == ".bvh":
-        return read_bvh(path)
+        return read_bvh(path, limits=limits)
     if asf is None:
         raise CaptureError("an .amc motion needs its .asf skeleton (pass the .asf file too)", path=path)
-    return read_amc(path, asf)
+    return read_amc(path, asf, limits=limits)

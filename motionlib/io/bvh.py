@@ -16,50 +16,67 @@ from pathlib import Path
 
 import numpy as np
 
-from motionlib.errors import CaptureError
+from motionlib.errors import CaptureError, shorten
 from motionlib.io.numbers import finite_value, read_rows
+from motionlib.io.text import read_lines_bytes
 from motionlib.skeleton import CHANNEL_NAMES, ROTATION_CHANNELS, Skeleton
-from motionlib.take import Take, frame_range
+from motionlib.take import DEFAULT_LIMITS, Limits, Take, check_size, frame_range
 
 _CHANNEL_BY_LOWER = {c.lower(): c for c in CHANNEL_NAMES}
 _MOTION = re.compile(rb"^[ \t]*MOTION\b", re.MULTILINE | re.IGNORECASE)
 
 
+_TOKEN = re.compile(r"\n|[{}]|[^\s{}]+")
+
+
 def _short(token: str) -> str:
     """A token for an error message: quoted, and cut if it is binary junk or very long."""
-    return repr(token if len(token) <= 40 else token[:40] + "...")
+    return shorten(token)
+
+
+def _scan(text: str):
+    """(token, line number) pairs, braces split off, produced as they are asked for."""
+    line = 1
+    for m in _TOKEN.finditer(text):
+        token = m.group()
+        if token == "\n":
+            line += 1
+        else:
+            yield token, line
 
 
 class _Tokens:
-    """The HIERARCHY as a stream of (token, line number), braces split off."""
+    """The HIERARCHY as a stream of (token, line number) with one token of lookahead.
+
+    Tokens are made one at a time, so a limit reached early stops the reading early.
+    """
 
     def __init__(self, text: str, path):
-        self.items = [(tok, n) for n, line in enumerate(text.splitlines(), 1)
-                      for tok in line.replace("{", " { ").replace("}", " } ").split()]
+        self._items = _scan(text)
+        self._ahead = next(self._items, None)
         self.path = path
-        self.pos = 0
         self.last_line = max(1, text.count("\n") + 1)
 
     def error(self, message: str, line: int | None = None) -> CaptureError:
         if line is None:
-            line = self.items[self.pos][1] if self.pos < len(self.items) else self.last_line
+            line = self._ahead[1] if self._ahead is not None else self.last_line
         return CaptureError(message, path=self.path, line=line)
 
     def peek(self) -> str | None:
-        return self.items[self.pos][0] if self.pos < len(self.items) else None
+        return self._ahead[0] if self._ahead is not None else None
 
     def next(self, what: str) -> tuple[str, int]:
-        if self.pos >= len(self.items):
+        if self._ahead is None:
             raise self.error(f"unexpected end of HIERARCHY, expected {what}")
-        self.pos += 1
-        return self.items[self.pos - 1]
+        item, self._ahead = self._ahead, next(self._items, None)
+        return item
 
     def expect(self, keyword: str) -> None:
         tok, line = self.next(repr(keyword))
         if tok.upper() != keyword.upper():
             raise self.error(f"expected {keyword!r}, found {_short(tok)}", line)
 
-    def number(self, what: str) -> float:
+    def number(self, what: str, bound: float) -> float:
         tok, line = self.next(what)
         try:
             value = float(tok)
@@ -67,44 +84,65 @@ class _Tokens:
             raise self.error(f"{what} must be a number, found {_short(tok)}", line) from None
         if not math.isfinite(value):
             raise self.error(f"{what} must be finite, found {_short(tok)}", line)
+        if abs(value) > bound:
+            raise self.error(f"{what} is {_short(tok)}, beyond the limit of ±{bound:g}", line)
         return value
 
 
 class _Builder:
-    def __init__(self):
+    def __init__(self, limits: Limits):
         self.names, self.parents, self.offsets, self.channels = [], [], [], []
+        self.seen: set[str] = set()
         self.end_sites: dict[int, np.ndarray] = {}
+        self.limits = limits
 
 
-def _parse_joint(tokens: _Tokens, b: _Builder, parent: int) -> None:
+def _parse_joints(tokens: _Tokens, b: _Builder) -> None:
+    """The root joint and everything nested in it, with a stack instead of recursion (a
+    hierarchy nested thousands deep is read like a flat one)."""
+    open_joints = [_open_joint(tokens, b, -1)]
+    while open_joints:
+        j = open_joints[-1]
+        tok, line = tokens.next(f"JOINT, End Site or '}}' closing {b.names[j]}")
+        if tok == "}":
+            open_joints.pop()
+        elif tok.upper() == "JOINT":
+            open_joints.append(_open_joint(tokens, b, j))
+        elif tok.upper() == "END":
+            _parse_end_site(tokens, b, j)
+        else:
+            raise tokens.error(f"unexpected {_short(tok)} in joint {b.names[j]}", line)
+
+
+def _open_joint(tokens: _Tokens, b: _Builder, parent: int) -> int:
+    """Read a joint's name, OFFSET and CHANNELS; return its index."""
     name, line = tokens.next("a joint name")
+    limits = b.limits
     if name in ("{", "}"):
         raise tokens.error(f"missing joint name before {name!r}", line)
-    if name in b.names:
+    if len(name) > limits.max_name_length:
+        raise tokens.error(f"joint name {_short(name)} is longer than the limit of "
+                           f"{limits.max_name_length} characters", line)
+    if name in b.seen:
         raise tokens.error(f"duplicate joint name {name!r}", line)
+    if len(b.names) == limits.max_joints:
+        raise tokens.error(f"more than {limits.max_joints} joints (the limit); joint {name} "
+                           "is one too many", line)
     j = len(b.names)
+    b.seen.add(name)
     b.names.append(name)
     b.parents.append(parent)
     tokens.expect("{")
     tokens.expect("OFFSET")
-    b.offsets.append([tokens.number(f"OFFSET of {name}") for _ in range(3)])
+    b.offsets.append([tokens.number(f"OFFSET of {name}", limits.max_length) for _ in range(3)])
     b.channels.append(_parse_channels(tokens, name) if tokens.peek() == "CHANNELS" else ())
-    while True:
-        tok, line = tokens.next(f"JOINT, End Site or '}}' closing {name}")
-        if tok == "}":
-            return
-        if tok.upper() == "JOINT":
-            _parse_joint(tokens, b, j)
-        elif tok.upper() == "END":
-            _parse_end_site(tokens, b, j)
-        else:
-            raise tokens.error(f"unexpected {_short(tok)} in joint {name}", line)
+    return j
 
 
 def _parse_channels(tokens: _Tokens, name: str) -> tuple[str, ...]:
     tokens.next("CHANNELS")
     tok, line = tokens.next("a channel count")
-    if not tok.isdigit() or int(tok) > 6:
+    if tok not in ("0", "1", "2", "3", "4", "5", "6"):
         raise tokens.error(f"channel count of {name} must be 0 to 6, found {_short(tok)}", line)
     channels = []
     for _ in range(int(tok)):
@@ -122,20 +160,24 @@ def _parse_end_site(tokens: _Tokens, b: _Builder, j: int) -> None:
     tokens.expect("Site")
     tokens.expect("{")
     tokens.expect("OFFSET")
-    b.end_sites[j] = np.array([tokens.number(f"End Site OFFSET of {b.names[j]}")
-                               for _ in range(3)])
+    b.end_sites[j] = np.array([tokens.number(f"End Site OFFSET of {b.names[j]}",
+                                             b.limits.max_length) for _ in range(3)])
     tokens.expect("}")
 
 
-def parse_hierarchy(text: str, path=None) -> Skeleton:
-    """Skeleton from the HIERARCHY section of a BVH file (everything before ``MOTION``)."""
+def parse_hierarchy(text: str, path=None, *, limits: Limits = DEFAULT_LIMITS) -> Skeleton:
+    """Skeleton from the HIERARCHY section of a BVH file (everything before ``MOTION``).
+
+    Linear in the size of the text; joints beyond ``limits.max_joints``, names longer than
+    ``limits.max_name_length`` and offsets beyond ``limits.max_length`` are refused.
+    """
     tokens = _Tokens(text, path)
-    if not tokens.items:
+    if tokens.peek() is None:
         raise tokens.error("empty HIERARCHY")
     tokens.expect("HIERARCHY")
     tokens.expect("ROOT")
-    b = _Builder()
-    _parse_joint(tokens, b, -1)
+    b = _Builder(limits)
+    _parse_joints(tokens, b)
     if tokens.peek() is not None:
         tok, line = tokens.next("")
         what = "a second ROOT (only one skeleton per file is supported)" if tok.upper() == "ROOT" \
@@ -158,17 +200,24 @@ def _next_line(data: bytes, pos: int, line: int) -> tuple[str, int, int]:
     return "", line, pos
 
 
-def _motion_header(data: bytes, pos: int, line: int, path) -> tuple[int, float, int, int]:
-    """Parse ``Frames:`` and ``Frame Time:``; return (n_frames, frame_time, body byte, body line)."""
+def _motion_header(data: bytes, pos: int, line: int, path,
+                   limits: Limits) -> tuple[int, float, int, int, int]:
+    """Parse ``Frames:`` and ``Frame Time:``.
+
+    Returns (n_frames, frame_time, body byte, body line, line of ``Frames:``).
+    """
     text, line, pos = _next_line(data, pos, line)
     m = re.fullmatch(r"Frames:\s*(\S+)", text, re.IGNORECASE)
     if not m:
         raise CaptureError(f"expected 'Frames: <count>' after MOTION, found {text[:40]!r}",
                            path=path, line=line)
-    if not m.group(1).isdigit():
-        raise CaptureError(f"frame count must be a whole number, found {m.group(1)!r}",
+    if not re.fullmatch(r"[0-9]+", m.group(1)):
+        raise CaptureError(f"frame count must be a whole number, found {_short(m.group(1))}",
                            path=path, line=line)
-    n_frames = int(m.group(1))
+    if len(m.group(1)) > 18:  # int() of a megabyte of digits is slow (and far past any limit)
+        raise CaptureError(f"frame count {_short(m.group(1))} is more than the limit of "
+                           f"{limits.max_frames}", path=path, line=line)
+    n_frames, frames_line = int(m.group(1)), line
     text, line, pos = _next_line(data, pos, line + 1)
     m = re.fullmatch(r"Frame\s+Time:\s*(\S+)", text, re.IGNORECASE)
     if not m:
@@ -180,23 +229,40 @@ def _motion_header(data: bytes, pos: int, line: int, path) -> tuple[int, float, 
         frame_time = math.nan
     if not (math.isfinite(frame_time) and frame_time > 0):
         raise CaptureError(f"frame time must be a positive number of seconds, found "
-                           f"{m.group(1)!r}", path=path, line=line)
-    return n_frames, frame_time, pos, line + 1
+                           f"{_short(m.group(1))}", path=path, line=line)
+    if not limits.min_frame_time <= frame_time <= limits.max_frame_time:
+        raise CaptureError(f"frame time {_short(m.group(1))} is outside "
+                           f"{limits.min_frame_time:g} to {limits.max_frame_time:g} seconds",
+                           path=path, line=line)
+    return n_frames, frame_time, pos, line + 1, frames_line
 
 
-def _parse_motion(data: bytes, pos: int, line: int, n_frames: int, n_channels: int,
-                  path) -> np.ndarray:
+def _position_columns(skeleton: Skeleton) -> np.ndarray:
+    """Columns of the position channels, shape (k,)."""
+    starts = skeleton.channel_starts
+    return np.array([starts[j] + k for j, names in enumerate(skeleton.channels)
+                     for k, name in enumerate(names) if name.endswith("position")], np.intp)
+
+
+def _parse_motion(data: bytes, pos: int, line: int, n_frames: int, skeleton: Skeleton,
+                  path, limits: Limits) -> np.ndarray:
     """Frame values as (n_frames, n_channels); ``line`` is the line number of byte ``pos``."""
+    n_channels = skeleton.n_channels
+    positions = _position_columns(skeleton)
+    bounds = np.full(n_channels, np.inf)
+    bounds[positions] = limits.max_length
     values = read_rows(data, pos, n_frames, n_channels)
-    if values is not None:
+    # Only the few position columns are copied for the check (not the whole take).
+    if values is not None and not (np.abs(values[:, positions]) > limits.max_length).any():
         return values
-    # Slow path: nan, no channels, or something wrong that needs a line number.
+    # Slow path: nan, no channels, a position out of bounds, or something wrong that needs
+    # a line number.
     return _parse_motion_lines(data[pos:].decode("utf-8", "replace"), line, n_frames,
-                               n_channels, path)
+                               n_channels, path, bounds)
 
 
 def _parse_motion_lines(text: str, first_line: int, n_frames: int, n_channels: int,
-                        path) -> np.ndarray:
+                        path, bounds: np.ndarray) -> np.ndarray:
     rows = []
     last = first_line
     for i, raw in enumerate(text.splitlines()):
@@ -210,8 +276,15 @@ def _parse_motion_lines(text: str, first_line: int, n_frames: int, n_channels: i
         if len(tokens) != n_channels:
             raise CaptureError(f"frame {len(rows)}: expected {n_channels} values, found "
                                f"{len(tokens)}", path=path, line=last)
-        rows.append([finite_value(tok, f"frame {len(rows)}, value {k + 1}: ", "", path, last)
-                     for k, tok in enumerate(tokens)])
+        row = [finite_value(tok, f"frame {len(rows)}, value {k + 1}: ", "", path, last)
+               for k, tok in enumerate(tokens)]
+        beyond = np.flatnonzero(np.abs(row) > bounds)
+        if beyond.size:
+            k = int(beyond[0])
+            raise CaptureError(f"frame {len(rows)}, value {k + 1}: {_short(tokens[k])} is a "
+                               f"position beyond the limit of ±{bounds[k]:g}", path=path,
+                               line=last)
+        rows.append(row)
     if len(rows) < n_frames:
         raise CaptureError(f"truncated MOTION section: 'Frames: {n_frames}' but the file ends "
                            f"after {len(rows)} frame lines", path=path, line=last)
@@ -244,12 +317,14 @@ def _snap_fps(frame_time: float) -> float:
     return float(whole) if whole > 0 and abs(fps - whole) <= 1e-3 * fps else fps
 
 
-def read_bvh(path: str | os.PathLike) -> Take:
+def read_bvh(path: str | os.PathLike, *, limits: Limits = DEFAULT_LIMITS) -> Take:
     """Read a BVH file.
 
     Parameters
     ----------
     path : str or PathLike
+    limits : Limits, optional
+        Joints, frames and sizes to refuse; checked before the frames are allocated.
 
     Returns
     -------
@@ -262,18 +337,21 @@ def read_bvh(path: str | os.PathLike) -> Take:
         Naming the file, the line and what was wrong.
     """
     path = os.fspath(path)
-    data = Path(path).read_bytes()
+    data = read_lines_bytes(path)
     if not data.strip():
         raise CaptureError("empty file", path=path, line=1)
     m = _MOTION.search(data)
     header = data[:m.start()] if m else data
-    skeleton = parse_hierarchy(header.decode("utf-8-sig", "replace"), path)
+    skeleton = parse_hierarchy(header.decode("utf-8-sig", "replace"), path, limits=limits)
     if m is None:
         raise CaptureError("no MOTION section after the HIERARCHY", path=path,
                            line=header.count(b"\n") + 1)
     motion_line = header.count(b"\n") + 1
-    n_frames, frame_time, pos, line = _motion_header(data, m.end(), motion_line, path)
-    channels = _parse_motion(data, pos, line, n_frames, skeleton.n_channels, path)
+    n_frames, frame_time, pos, line, frames_line = _motion_header(data, m.end(), motion_line,
+                                                                  path, limits)
+    check_size(n_frames, skeleton.n_joints, skeleton.n_channels, len(data), limits,
+               path=path, line=frames_line)
+    channels = _parse_motion(data, pos, line, n_frames, skeleton, path, limits)
     del data
     return Take(name=Path(path).stem, format="bvh", fps=_snap_fps(frame_time),
                 frame_time=frame_time, channels=channels, skeleton=skeleton,
@@ -327,18 +405,28 @@ def _fmt(values) -> str:
     return " ".join(f"{v:.6f}" for v in values)
 
 
-def _hierarchy_lines(sk: Skeleton, j: int, depth: int) -> list[str]:
-    pad = "\t" * depth
-    keyword = "ROOT" if j == 0 else "JOINT"
-    lines = [f"{pad}{keyword} {sk.names[j]}", f"{pad}{{", f"{pad}\tOFFSET {_fmt(sk.offsets[j])}"]
-    if sk.channels[j] or j == 0:
-        lines.append(f"{pad}\tCHANNELS {len(sk.channels[j])} {' '.join(sk.channels[j])}".rstrip())
-    for child in sk.children(j):
-        lines += _hierarchy_lines(sk, child, depth + 1)
-    if j in sk.end_sites:
-        lines += [f"{pad}\tEnd Site", f"{pad}\t{{",
-                  f"{pad}\t\tOFFSET {_fmt(sk.end_sites[j])}", f"{pad}\t}}"]
-    lines.append(f"{pad}}}")
+def _hierarchy_lines(sk: Skeleton) -> list[str]:
+    """The HIERARCHY's joint blocks, written with a stack (a chain of 1,000 joints is fine)."""
+    children = sk.children_lists()
+    lines: list[str] = []
+    stack: list[tuple[int, int, bool]] = [(0, 0, False)]  # (joint, depth, closing)
+    while stack:
+        j, depth, closing = stack.pop()
+        pad = "\t" * depth
+        if closing:
+            if j in sk.end_sites:
+                lines += [f"{pad}\tEnd Site", f"{pad}\t{{",
+                          f"{pad}\t\tOFFSET {_fmt(sk.end_sites[j])}", f"{pad}\t}}"]
+            lines.append(f"{pad}}}")
+            continue
+        keyword = "ROOT" if j == 0 else "JOINT"
+        lines += [f"{pad}{keyword} {sk.names[j]}", f"{pad}{{",
+                  f"{pad}\tOFFSET {_fmt(sk.offsets[j])}"]
+        if sk.channels[j] or j == 0:
+            lines.append(f"{pad}\tCHANNELS {len(sk.channels[j])} "
+                         f"{' '.join(sk.channels[j])}".rstrip())
+        stack.append((j, depth, True))
+        stack += [(c, depth + 1, False) for c in reversed(children[j])]
     return lines
 
 
@@ -358,7 +446,7 @@ def write_bvh(take: Take, path_or_textfile, *, start: int | None = None,
     """
     start, stop = frame_range(take.n_frames, start, stop) if take.n_frames else (0, 0)
     skeleton, channels = bvh_layout(take)
-    head = ["HIERARCHY", *_hierarchy_lines(skeleton, 0, 0), "MOTION",
+    head = ["HIERARCHY", *_hierarchy_lines(skeleton), "MOTION",
             f"Frames: {stop - start}", f"Frame Time: {take.frame_time:.10g}"]
     body = "\n".join(_fmt(row) for row in channels[start:stop])
     text = "\n".join(head) + "\n" + body + ("\n" if body else "")

@@ -14,7 +14,7 @@ import math
 
 import numpy as np
 
-from motionlib.errors import CaptureError
+from motionlib.errors import CaptureError, shorten
 from motionlib.io import _parse
 
 
@@ -51,9 +51,9 @@ def finite_value(token: str, before: str, after: str, path, line: int) -> float:
     try:
         value = float(token)
     except ValueError:
-        raise CaptureError(f"{before}{token[:30]!r}{after} is not a number", path=path,
+        raise CaptureError(f"{before}{shorten(token)}{after} is not a number", path=path,
                            line=line) from None
     if not math.isfinite(value):
-        raise CaptureError(f"{before}{token!r}{after} is not a finite number", path=path,
+        raise CaptureError(f"{before}{shorten(token)}{after} is not a finite number", path=path,
                            line=line)
     return value

@@ -108,8 +108,11 @@ class CaptureViewSet(
         start = int_param(request, "start", 0, 0, n - 1)
         step = int_param(request, "step", 1, 1, n)
         stop = int_param(request, "stop", n, start + 1, n)
-        # At most CUTROOM_FRAMES_PER_REQUEST frames; the client continues from "stop".
-        stop = min(stop, start + settings.CUTROOM_FRAMES_PER_REQUEST * step)
+        # At most CUTROOM_FRAMES_PER_REQUEST frames, and fewer for a skeleton of many joints
+        # (an answer stays a few MB); the client continues from "stop".
+        per_request = min(settings.CUTROOM_FRAMES_PER_REQUEST,
+                          settings.CUTROOM_JOINT_FRAMES_PER_REQUEST // max(capture.n_joints, 1))
+        stop = min(stop, start + max(per_request, 1) * step)
         block = np.ascontiguousarray(storage.load_npy(capture.positions)[start:stop:step], "<f4")
         return Response({
             "start": start, "stop": stop, "step": step,

@@ -95,7 +95,10 @@ class MeView(APIView):
             {"id": m.project_id, "name": m.project.name, "role": m.role}
             for m in request.user.memberships.select_related("project").order_by("project_id")
         ]
-        return Response({"id": request.user.pk, "username": request.user.username, "projects": projects})
+        # What the service admits, so the pages refuse the same (e.g. a skeleton too big to draw).
+        limits = {"max_joints": services.captures.input_limits().max_joints}
+        return Response({"id": request.user.pk, "username": request.user.username, "projects": projects,
+                         "limits": limits})
 
 
 class MethodsView(APIView):

@@ -105,7 +105,7 @@ class CaptureListSerializer(CaptureSerializer):
 class UploadSerializer(serializers.Serializer):
     file = serializers.FileField(allow_empty_file=True)
     asf = serializers.FileField(required=False, allow_empty_file=True)
-    project = serializers.IntegerField()
+    project = serializers.IntegerField(min_value=1, max_value=2**63 - 1)
 
 
 class CutSerializer(serializers.Serializer):

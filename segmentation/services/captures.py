@@ -3,6 +3,7 @@
 import hashlib
 import logging
 import os
+import re
 import uuid
 
 import numpy as np
@@ -11,7 +12,9 @@ from django.db import IntegrityError, transaction
 from django.utils import timezone
 
 import motionlib
+from motionlib.errors import shorten
 from motionlib.segmenters import ParamError, get_segmenter, list_segmenters
+from motionlib.take import Limits
 from segmentation import storage
 from segmentation.errors import NotReady, UploadError, UploadTooLarge
 from segmentation.models import Capture, DetectionRun
@@ -19,6 +22,10 @@ from segmentation.models import Capture, DetectionRun
 log = logging.getLogger(__name__)
 
 FORMATS = {".bvh": "bvh", ".amc": "amc"}
+# Stored file names keep word characters only and stay well under the 255 bytes a file
+# system allows per name (the capture's name keeps what the user uploaded; Django has cut
+# it to 255 characters, which may be up to 1,020 bytes).
+MAX_STORED_STEM_BYTES = 100
 
 
 def default_method():
@@ -42,7 +49,7 @@ def check_upload(upload, asf=None):
     extension = os.path.splitext(upload.name)[1].lower()
     if extension not in FORMATS:
         raise UploadError(
-            f"file: {upload.name!r} has extension {extension or '(none)'!r}; "
+            f"file: {shorten(upload.name)} has extension {shorten(extension or '(none)')}; "
             "upload a .bvh file, or an .amc file with its .asf skeleton"
         )
     for field, item in (("file", upload), ("asf", asf)):
@@ -89,9 +96,9 @@ def do_upload_capture(project, user, upload, asf=None):
         return existing, False
     capture = Capture(project=project, uploaded_by=user, name=upload.name, format=fmt)
     capture.checksum = digest
-    capture.original.save(os.path.basename(upload.name), upload, save=False)
+    capture.original.save(stored_name(upload.name), upload, save=False)
     if asf is not None:
-        capture.asf.save(os.path.basename(asf.name), asf, save=False)
+        capture.asf.save(stored_name(asf.name), asf, save=False)
     try:
         with transaction.atomic():
             capture.save()
@@ -100,6 +107,16 @@ def do_upload_capture(project, user, upload, asf=None):
         # The same file arrived twice at once; the other request stored it.
         return Capture.objects.get(project=project, checksum=digest), False
     return capture, True
+
+
+def stored_name(name):
+    """A file name for storing an upload: its stem's word characters (cut to
+    MAX_STORED_STEM_BYTES of UTF-8, or ``capture`` when none are left) and its extension."""
+    stem, extension = os.path.splitext(os.path.basename(name))
+    stem = re.sub(r"[^\w-]", "", stem.replace(" ", "_"))
+    while len(stem.encode()) > MAX_STORED_STEM_BYTES:
+        stem = stem[:-1]
+    return f"{stem or 'capture'}{extension.lower()}"
 
 
 def do_retry_capture(capture):
@@ -153,13 +170,27 @@ def _send(task, pk):
         log.exception("could not send %s(%s); the sweep will retry", task.name, pk)
 
 
+def input_limits():
+    """motionlib's limits on what a capture may hold, with those set in the settings, and
+    at least two frames (one pose has no motion to segment or review)."""
+    overrides = {
+        "max_joints": settings.CUTROOM_MAX_JOINTS,
+        "max_frames": settings.CUTROOM_MAX_FRAMES,
+        "max_values": settings.CUTROOM_MAX_FRAME_VALUES,
+        "max_joint_frames": settings.CUTROOM_MAX_JOINT_FRAMES,
+        "max_expansion": settings.CUTROOM_MAX_EXPANSION,
+    }
+    return Limits(min_frames=2, **{k: v for k, v in overrides.items() if v is not None})
+
+
 def read_take(capture):
     """The parsed take of a capture's stored original (BVH, or AMC with its ASF)."""
+    limits = input_limits()
     with storage.local_path(capture.original) as path:
         if capture.asf:
             with storage.local_path(capture.asf) as asf_path:
-                return motionlib.read(path, asf=asf_path)
-        return motionlib.read(path)
+                return motionlib.read(path, asf=asf_path, limits=limits)
+        return motionlib.read(path, limits=limits)
 
 
 def _guarded(job, what, work, **fail_fields):
@@ -172,14 +203,20 @@ def _guarded(job, what, work, **fail_fields):
     try:
         work()
     except ValueError as exc:
-        job.fail(str(exc), **fail_fields)
+        job.fail(_bounded(str(exc), 2000), **fail_fields)
     except Exception as exc:
         log.exception("%s failed", what)
         job.fail(
-            f"{what} failed with an internal error ({type(exc).__name__}: {exc}). "
+            f"{what} failed with an internal error ({type(exc).__name__}: "
+            f"{_bounded(str(exc), 300)}). "
             "The original upload is kept; report this to the service's administrators.",
             **fail_fields,
         )
+
+
+def _bounded(text, limit):
+    """An error text for a job's row, cut to about ``limit`` characters."""
+    return text if len(text) <= limit else text[:limit] + "..."
 
 
 def ingest_capture(capture):

@@ -22,6 +22,8 @@ export interface Me {
   id: number;
   username: string;
   projects: { id: number; name: string; role: Role }[];
+  /** What the service admits (CUTROOM_MAX_JOINTS…). */
+  limits?: { max_joints: number };
 }
 
 export interface Skeleton {

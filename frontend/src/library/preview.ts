@@ -3,9 +3,12 @@
 
 import { get } from "../api/client";
 import type { Capture, FramesResponse } from "../api/types";
-import { SkeletonView } from "../player/skeletonView";
+import { SkeletonView, TooManyJoints } from "../player/skeletonView";
 import { decodeFloat32 } from "../review/frames";
 import { clear, h, toast } from "../ui/dom";
+
+/** One answer of /frames/ carries at most this many joint positions (CUTROOM_JOINT_FRAMES_PER_REQUEST). */
+const JOINT_FRAMES_PER_ANSWER = 250_000;
 
 /** Playback step so a clip preview downloads at most `maxFrames` poses. */
 export function previewStep(frames: number, maxFrames = 1500): number {
@@ -23,7 +26,8 @@ export class ClipPreview {
     if (!this.captures.has(captureId)) this.captures.set(captureId, get<Capture>(`/api/captures/${captureId}/`));
     const capture = await this.captures.get(captureId)!;
     if (!capture.skeleton) return toast("This capture has no skeleton yet.", "error");
-    const step = previewStep(stop - start);
+    // One answer holds the whole clip: fewer poses for a skeleton of many joints.
+    const step = previewStep(stop - start, Math.min(1500, Math.floor(JOINT_FRAMES_PER_ANSWER / Math.max(capture.skeleton.joints.length, 1))));
     const frames = await get<FramesResponse>(`/api/captures/${captureId}/frames/?start=${start}&stop=${stop}&step=${step}`);
     const poses = decodeFloat32(frames.data);
     const size = frames.n_joints * 3;
@@ -32,8 +36,9 @@ export class ClipPreview {
     let view: SkeletonView | null = null;
     try {
       view = new SkeletonView(stage, capture.skeleton);
-    } catch {
-      stage.append(h("p", { class: "muted" }, "WebGL is not available to draw the skeleton."));
+    } catch (err) {
+      const why = err instanceof TooManyJoints ? `No 3D view: ${err.message}.` : "WebGL is not available to draw the skeleton.";
+      stage.append(h("p", { class: "muted" }, why));
     }
     this.box.setAttribute("data-playing", id);
     let raf = 0;

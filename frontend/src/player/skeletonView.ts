@@ -1,6 +1,10 @@
 // The 3D skeleton: joints as spheres, bones as cylinders (instanced, so one draw call
 // each), a floor grid and an orbit camera that can follow the root. It renders on demand
 // only, which keeps an idle review page from burning a CPU core.
+//
+// A skeleton of many joints (markers, fingers, props) is drawn with coarser spheres and
+// cylinders so a pose costs about the same to draw whatever the joint count, and posing
+// allocates nothing per joint. Beyond MAX_JOINTS, what the service refuses, nothing is drawn.
 
 import * as THREE from "three";
 import { OrbitControls } from "three/examples/jsm/controls/OrbitControls.js";
@@ -11,6 +15,13 @@ const RIGHT = new THREE.Color("#ffb74d");
 const CENTRE = new THREE.Color("#e0e6ef");
 
 const CMU_LIMBS = "(clavicle|humerus|radius|wrist|hand|fingers|thumb|hipjoint|femur|tibia|foot|toes)";
+const LEFT_LIMB = new RegExp(`^l${CMU_LIMBS}`, "i");
+const RIGHT_LIMB = new RegExp(`^r${CMU_LIMBS}`, "i");
+
+/** The most joints the service admits by default (CUTROOM_MAX_JOINTS); /api/me/ says the actual limit. */
+export const MAX_JOINTS = 1000;
+/** Above this many joints, spheres and cylinders get fewer faces. */
+const DETAILED_JOINTS = 64;
 
 /** Which side of the body a joint is on: CMU "lfemur", BVH "LeftUpLeg"/"LHipJoint", "mixamorig:RightArm". */
 export function sideOf(name: string): "left" | "right" | "centre" {
@@ -18,8 +29,8 @@ export function sideOf(name: string): "left" | "right" | "centre" {
   // Case-sensitive for the single-letter prefix, so "Root" or "LowerBack" stay central.
   const letter = /^L[A-Z_]/.test(bare) ? "left" : /^R[A-Z_]/.test(bare) ? "right" : null;
   if (letter) return letter;
-  if (/^left/i.test(bare) || new RegExp(`^l${CMU_LIMBS}`, "i").test(bare) || /[._]l$/i.test(bare)) return "left";
-  if (/^right/i.test(bare) || new RegExp(`^r${CMU_LIMBS}`, "i").test(bare) || /[._]r$/i.test(bare)) return "right";
+  if (/^left/i.test(bare) || LEFT_LIMB.test(bare) || /[._]l$/i.test(bare)) return "left";
+  if (/^right/i.test(bare) || RIGHT_LIMB.test(bare) || /[._]r$/i.test(bare)) return "right";
   return "centre";
 }
 
@@ -42,7 +53,9 @@ export class SkeletonView {
   constructor(
     private readonly container: HTMLElement,
     private readonly skeleton: Skeleton,
+    maxJoints = MAX_JOINTS,
   ) {
+    if (skeleton.joints.length > maxJoints) throw new TooManyJoints(skeleton.joints.length, maxJoints);
     this.renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
     this.renderer.setPixelRatio(Math.min(window.devicePixelRatio, 2));
     this.canvas = this.renderer.domElement;
@@ -62,8 +75,11 @@ export class SkeletonView {
     this.floor = floor(height);
     this.scene.add(this.floor);
     this.boneList = skeleton.parents.flatMap((p, j) => (p >= 0 ? [[p, j] as [number, number]] : []));
-    this.joints = this.instanced(new THREE.SphereGeometry(1, 14, 10), skeleton.joints.length, (i) => skeleton.joints[i]);
-    this.bones = this.instanced(new THREE.CylinderGeometry(1, 1, 1, 10), this.boneList.length, (i) => skeleton.joints[this.boneList[i][1]]);
+    const detailed = skeleton.joints.length <= DETAILED_JOINTS;
+    const sphere = detailed ? new THREE.SphereGeometry(1, 14, 10) : new THREE.SphereGeometry(1, 6, 4);
+    const cylinder = new THREE.CylinderGeometry(1, 1, 1, detailed ? 10 : 4, 1, !detailed);
+    this.joints = this.instanced(sphere, skeleton.joints.length, (i) => skeleton.joints[i]);
+    this.bones = this.instanced(cylinder, this.boneList.length, (i) => skeleton.joints[this.boneList[i][1]]);
     this.camera.position.set(height * 0.95, height * 0.8, height * 2.0);
     this.controls = new OrbitControls(this.camera, this.canvas);
     this.controls.target.set(0, height * 0.45, 0);
@@ -88,26 +104,23 @@ export class SkeletonView {
 
   /** Show one pose: `pose` is (n_joints, 3) flattened, in the capture's units, Y up. */
   setPose(pose: Float32Array): void {
-    const m = new THREE.Matrix4();
-    const q = new THREE.Quaternion();
-    const a = new THREE.Vector3();
-    const b = new THREE.Vector3();
-    const up = new THREE.Vector3(0, 1, 0);
+    const { m, q, a, b, mid, scale } = SCRATCH;
     const r = this.radius;
     for (let j = 0; j < this.skeleton.joints.length; j++) {
       a.fromArray(pose, j * 3);
       m.compose(a, q.identity(), b.set(r * 1.25, r * 1.25, r * 1.25));
       this.joints.setMatrixAt(j, m);
     }
-    this.boneList.forEach(([p, c], i) => {
+    for (let i = 0; i < this.boneList.length; i++) {
+      const [p, c] = this.boneList[i];
       a.fromArray(pose, p * 3);
       b.fromArray(pose, c * 3);
       const length = a.distanceTo(b);
-      const mid = a.clone().add(b).multiplyScalar(0.5);
-      q.setFromUnitVectors(up, length > 1e-9 ? b.sub(a).divideScalar(length) : up);
-      m.compose(mid, q, new THREE.Vector3(length > 1e-9 ? r * 0.8 : 0, length, r * 0.8));
+      mid.copy(a).add(b).multiplyScalar(0.5);
+      q.setFromUnitVectors(UP, length > 1e-9 ? b.sub(a).divideScalar(length) : UP);
+      m.compose(mid, q, scale.set(length > 1e-9 ? r * 0.8 : 0, length, r * 0.8));
       this.bones.setMatrixAt(i, m);
-    });
+    }
     this.joints.instanceMatrix.needsUpdate = true;
     this.bones.instanceMatrix.needsUpdate = true;
     this.followRoot(new THREE.Vector3().fromArray(pose, 0));
@@ -172,6 +185,27 @@ export class SkeletonView {
     this.canvas.remove();
   }
 }
+
+/** A skeleton the player will not draw: more joints than the service admits. */
+export class TooManyJoints extends Error {
+  constructor(
+    readonly count: number,
+    readonly limit: number,
+  ) {
+    super(`${count.toLocaleString("en-US")} joints; the player draws at most ${limit.toLocaleString("en-US")}, as many as the service admits`);
+  }
+}
+
+const UP = new THREE.Vector3(0, 1, 0);
+// Reused by every setPose: posing a frame allocates nothing per joint.
+const SCRATCH = {
+  m: new THREE.Matrix4(),
+  q: new THREE.Quaternion(),
+  a: new THREE.Vector3(),
+  b: new THREE.Vector3(),
+  mid: new THREE.Vector3(),
+  scale: new THREE.Vector3(),
+};
 
 /**
  * A floor with grid lines drawn in the fragment shader: a line primitive crossing the

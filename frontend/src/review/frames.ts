@@ -1,5 +1,5 @@
 // Joint positions for playback, fetched in chunks (the API serves at most 5,000 frames
-// per request) into one Float32Array so a 72,000-frame take never builds JS objects
+// per request, fewer for many joints, continuing from its "stop") into one Float32Array so a 72,000-frame take never builds JS objects
 // per frame. The chunk under the playhead comes first; the rest stream in after it.
 
 import { get } from "../api/client";
@@ -118,6 +118,8 @@ export async function loadFrames(captureId: number, store: FrameStore, firstFram
       const response = await get<FramesResponse>(`/api/captures/${captureId}/frames/?start=${range.start}&stop=${range.stop}&step=1`);
       if (signal?.aborted) return;
       store.put(response);
+      // The server sends fewer frames per answer for a skeleton of many joints: ask for the rest next.
+      if (response.stop > range.start && response.stop < range.stop) queue.unshift({ start: response.stop, stop: range.stop });
       onChunk();
     }
   };

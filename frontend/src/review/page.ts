@@ -5,7 +5,7 @@
 import { get, post } from "../api/client";
 import type { Capture, Cut, Label, Me, Project, Review, ReviewEvent, Segment, Signal, SignalResponse } from "../api/types";
 import { advance, frameOf, nextSpeed, seek, togglePlay, type Playback } from "../player/clock";
-import { SkeletonView } from "../player/skeletonView";
+import { MAX_JOINTS, SkeletonView, TooManyJoints } from "../player/skeletonView";
 import { clear, confirmDialog, dialog, h, toast } from "../ui/dom";
 import { icon } from "../ui/icons";
 import { FrameStore, loadFrames } from "./frames";
@@ -28,7 +28,7 @@ export async function renderReview(root: HTMLElement, captureId: number): Promis
   const project = listOf(projects).find((p) => p.id === capture.project);
   if (capture.status !== "ready" || !capture.skeleton) return renderNotReady(root, capture);
   // Poses start streaming now, in parallel with the review and the signal.
-  const frames = new FrameFeed(capture);
+  const frames = new FrameFeed(capture, maxJoints(me));
   try {
     const [review, signal] = await Promise.all([
       post<Review>(`/api/captures/${captureId}/review/`),
@@ -50,10 +50,20 @@ class FrameFeed {
   readonly done: Promise<void>;
   onChunk: () => void = () => {};
 
-  constructor(capture: Capture) {
-    this.store = new FrameStore(capture.n_frames, capture.n_joints || capture.skeleton!.joints.length);
-    this.done = loadFrames(capture.id, this.store, frameFromUrl(capture.n_frames), () => this.onChunk(), this.abort.signal);
+  constructor(capture: Capture, maxJoints: number) {
+    // Poses the player will not draw are not fetched (nor memory set aside for them).
+    const drawable = jointCount(capture) <= maxJoints;
+    this.store = new FrameStore(capture.n_frames, drawable ? jointCount(capture) : 0);
+    this.done = drawable ? loadFrames(capture.id, this.store, frameFromUrl(capture.n_frames), () => this.onChunk(), this.abort.signal) : Promise.resolve();
   }
+}
+
+function jointCount(capture: Capture): number {
+  return Math.max(capture.n_joints ?? 0, capture.skeleton?.joints.length ?? 0);
+}
+
+function maxJoints(me: Me): number {
+  return me.limits?.max_joints ?? MAX_JOINTS;
 }
 
 /** The frame asked for by `?frame=N` (the library links a segment's start this way), else 0. */
@@ -166,8 +176,16 @@ class ReviewPage {
   // ---- layout --------------------------------------------------------------------------
 
   private makePlayer(): SkeletonView | null {
+    const joints = jointCount(this.capture);
+    const limit = maxJoints(this.me);
+    if (joints > limit) {
+      const text = `No 3D view: this capture has ${new TooManyJoints(joints, limit).message}. The timeline still works.`;
+      this.el.viewport.append(h("div", { class: "no-webgl", "data-testid": "too-many-joints" }, text));
+      this.el.loading.hidden = true;
+      return null;
+    }
     try {
-      return new SkeletonView(this.el.viewport, this.capture.skeleton!);
+      return new SkeletonView(this.el.viewport, this.capture.skeleton!, limit);
     } catch (err) {
       this.el.viewport.append(h("div", { class: "no-webgl" }, `3D view unavailable (${err instanceof Error ? err.message : "no WebGL"}); the timeline still works.`));
       return null;

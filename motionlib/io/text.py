@@ -1,0 +1,21 @@
+"""Reading capture files as bytes with their line ends made uniform."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+_LONE_CR = re.compile(rb"\r(?!\n)")
+
+
+def read_lines_bytes(path) -> bytes:
+    """The bytes of ``path``, with classic Mac line ends (a CR alone) turned into LF.
+
+    Every reader counts lines by LF; a file saved with CR alone would otherwise be one long
+    line, and its error messages would point at the wrong place for the wrong reason.
+    CRLF is left as it is (the CR is whitespace to the readers).
+    """
+    data = Path(path).read_bytes()
+    if b"\r" in data and data.count(b"\r") != data.count(b"\r\n"):
+        data = _LONE_CR.sub(b"\n", data)
+    return data
