@@ -160,17 +160,20 @@ def fit_cut_model(examples: Sequence[tuple[object, Sequence[int]]]) -> CutModel:
     if shortest is not None:  # only ever shorter: a longer one would hide short activities
         p["min_segment_s"] = float(np.clip(MIN_SEGMENT_FACTOR * shortest, MIN_SEGMENT_S,
                                            p["min_segment_s"]))
-    prepared = []
+    # One pass over the takes, keeping only peaks and placement offsets: a project's
+    # examples need not all be held in memory with their pose streams.
+    peaks, residuals = [], {name: [] for name in PLACEMENTS}
     for take, cuts in checked:
         analysis = Default.analyse(take, p)
         if analysis is None:
             raise ExampleError(f"{_where(take)}: too short to learn from "
                                f"({take.n_frames} frames)")
-        prepared.append((take, cuts, analysis))
-    p["prominence"] = _count(prepared, p)
-    placement, offset = _placement(prepared, p)
-    return CutModel(n_takes=len(prepared), n_cuts=int(sum(len(c) for _, c, _ in prepared)),
-                    threshold=p["threshold"], prominence=p["prominence"],
+        peaks.append(_all_peaks(take, cuts, analysis, p))
+        _add_residuals(residuals, take, cuts, analysis, p)
+    prominence = _count(peaks, p["prominence"])
+    placement, offset = _placement(residuals, "onset" if p["onset"] else "pause")
+    return CutModel(n_takes=len(checked), n_cuts=int(sum(len(c) for _, c in checked)),
+                    threshold=p["threshold"], prominence=prominence,
                     min_segment_s=p["min_segment_s"], placement=placement, offset_s=offset)
 
 
@@ -204,15 +207,15 @@ def matched_count(candidates: np.ndarray, truth: np.ndarray, tolerance: int) -> 
     return matched
 
 
-def _count(prepared, p: dict) -> float:
+def _all_peaks(take, cuts, analysis, p: dict) -> tuple:
+    """Every novelty peak of one example (frames, prominences) with its cuts and tolerance."""
+    peaks, prominence = Default._peaks(analysis.novelty, analysis.rate, {**p, "prominence": 0.0})
+    frames = analysis.peak_frames(peaks) + analysis.first
+    return frames, prominence, np.sort(cuts), int(round(MATCH_S * take.fps))
+
+
+def _count(per_take, zero: float) -> float:
     """The prominence of PROMINENCE_GRID whose peaks fit the example cuts best."""
-    per_take = []
-    for take, cuts, analysis in prepared:
-        peaks, prominence = Default._peaks(analysis.novelty, analysis.rate,
-                                           {**p, "prominence": 0.0})
-        frames = analysis.peak_frames(peaks) + analysis.first
-        per_take.append((frames, prominence, np.sort(cuts), int(round(MATCH_S * take.fps))))
-    zero = p["prominence"]
     best, best_score = zero, -math.inf
     for prominence in PROMINENCE_GRID:
         score = -PROMINENCE_PRIOR * abs(math.log(prominence / zero))
@@ -225,18 +228,20 @@ def _count(prepared, p: dict) -> float:
     return best
 
 
-def _placement(prepared, p: dict) -> tuple[str, float]:
-    """The placement step and shift (s) that follow the human cuts most steadily."""
-    residuals = {name: [] for name in PLACEMENTS}
-    for take, cuts, analysis in prepared:
-        peaks, _ = Default._peaks(analysis.novelty, analysis.rate, p)
-        stages, _ = place_stages(analysis.x, analysis.peak_frames(peaks), analysis.fps,
-                                 analysis.gamma, p)
-        for name, placed in stages.items():
-            placed = placed + analysis.first
-            ci, ti = metrics.match(placed, cuts, tolerance=int(round(MATCH_S * take.fps)))
-            residuals[name].extend(((cuts[ti] - placed[ci]) / take.fps).tolist())
-    zero_shot = "onset" if p["onset"] else "pause"
+def _add_residuals(residuals: dict, take, cuts, analysis, p: dict) -> None:
+    """Signed (human - placed) offsets in seconds of each placement step's cuts that match
+    a human cut within 1 s; the cuts are the zero-shot ones."""
+    peaks, _ = Default._peaks(analysis.novelty, analysis.rate, p)
+    stages, _ = place_stages(analysis.x, analysis.peak_frames(peaks), analysis.fps,
+                             analysis.gamma, p)
+    for name, placed in stages.items():
+        placed = placed + analysis.first
+        ci, ti = metrics.match(placed, cuts, tolerance=int(round(MATCH_S * take.fps)))
+        residuals[name].extend(((cuts[ti] - placed[ci]) / take.fps).tolist())
+
+
+def _placement(residuals: dict, zero_shot: str) -> tuple[str, float]:
+    """The placement step and shift (s) that follow the human cuts best, if clearly so."""
     r = np.asarray(residuals[zero_shot])
     if len(r) < PLACEMENT_MIN_CUTS:
         return zero_shot, 0.0

@@ -148,25 +148,43 @@ def mmd_novelty(x: np.ndarray, w: int, gamma: float) -> np.ndarray:
     -------
     (n,) biased MMD² estimate at each split t (0 where a window would leave the take).
     """
+    return multi_mmd_novelty(x, [w], gamma)[0]
+
+
+def multi_mmd_novelty(x: np.ndarray, widths, gamma: float) -> list[np.ndarray]:
+    """``mmd_novelty`` for several window lengths, sharing the kernel at each lag.
+
+    Returns
+    -------
+    list of (n,) arrays, one per width in ``widths``.
+    """
     n = len(x)
-    out = np.zeros(n)
-    if n < 2 * w or w < 1:
-        return out
-    t = np.arange(w, n - w + 1)
-    within = np.zeros(len(t))
-    cross = np.zeros(len(t))
-    for lag in range(0, 2 * w):
+    acc = {}
+    for w in widths:
+        if w >= 1 and n >= 2 * w:
+            t = np.arange(w, n - w + 1)
+            acc[w] = (t, np.zeros(len(t)), np.zeros(len(t)))
+    for lag in range(0, 2 * max(acc, default=0)):
         k = np.exp(-gamma * ((x[lag:] - x[: n - lag]) ** 2).sum(axis=1))
         c = np.concatenate([[0.0], np.cumsum(k)])  # c[i] = sum of k[:i]
-        if lag < w:  # pairs (i, i + lag) inside the past and inside the future window
-            mult = 1.0 if lag == 0 else 2.0
-            within += mult * (c[t - lag] - c[t - w] + c[t + w - lag] - c[t])
-        if lag >= 1:  # pairs with i in the past window and i + lag in the future one
-            lo = np.maximum(t - w, t - lag)
-            hi = np.minimum(t, t + w - lag)
-            cross += np.where(hi > lo, c[np.maximum(hi, lo)] - c[lo], 0.0)
-    out[t] = (within - 2 * cross) / (w * w)
-    return np.maximum(out, 0.0)
+        for w, (t, within, cross) in acc.items():
+            if lag >= 2 * w:
+                continue
+            if lag < w:  # pairs (i, i + lag) inside the past and inside the future window
+                mult = 1.0 if lag == 0 else 2.0
+                within += mult * (c[t - lag] - c[t - w] + c[t + w - lag] - c[t])
+            if lag >= 1:  # pairs with i in the past window and i + lag in the future one
+                lo = np.maximum(t - w, t - lag)
+                hi = np.minimum(t, t + w - lag)
+                cross += np.where(hi > lo, c[np.maximum(hi, lo)] - c[lo], 0.0)
+    out = []
+    for w in widths:
+        curve = np.zeros(n)
+        if w in acc:
+            t, within, cross = acc[w]
+            curve[t] = np.maximum((within - 2 * cross) / (w * w), 0.0)
+        out.append(curve)
+    return out
 
 
 def mirrored_novelty(x: np.ndarray, w: int, gamma: float) -> np.ndarray:
@@ -176,11 +194,19 @@ def mirrored_novelty(x: np.ndarray, w: int, gamma: float) -> np.ndarray:
     again, so an activity shorter than a window at the very start or end still
     produces a peak at its boundary.
     """
-    w = min(w, len(x) - 1)
-    if w < 1:
-        return np.zeros(len(x))
-    padded = np.concatenate([x[w:0:-1], x, x[-2 : -w - 2 : -1]])
-    return mmd_novelty(padded, w, gamma)[w : w + len(x)]
+    return mirrored_novelties(x, [w], gamma)[0]
+
+
+def mirrored_novelties(x: np.ndarray, widths, gamma: float) -> list[np.ndarray]:
+    """``mirrored_novelty`` for several widths at once (one mirror, shared kernels)."""
+    widths = [min(w, len(x) - 1) for w in widths]
+    pad = max(widths, default=0)
+    if pad < 1:
+        return [np.zeros(len(x)) for _ in widths]
+    padded = np.concatenate([x[pad:0:-1], x, x[-2 : -pad - 2 : -1]])
+    curves = multi_mmd_novelty(padded, widths, gamma)
+    return [c[pad : pad + len(x)] if w >= 1 else np.zeros(len(x))
+            for c, w in zip(curves, widths, strict=True)]
 
 
 # A pause is a slowest frame at most this fraction of the typical speed around it.
@@ -486,7 +512,7 @@ class Default(Segmenter):
             return np.zeros(len(x))
         scales = np.linspace(p["scale_min_s"], p["scale_max_s"], 3)
         widths = sorted({max(1, int(round(s * rate))) for s in scales})
-        return np.mean([mirrored_novelty(x, w, gamma) for w in widths], axis=0)
+        return np.mean(mirrored_novelties(x, widths, gamma), axis=0)
 
     @staticmethod
     def _peaks(novelty: np.ndarray, rate: float, p: dict) -> tuple[np.ndarray, np.ndarray]:
