@@ -49,6 +49,7 @@ import csv
 import json
 import math
 import os
+import time
 from collections.abc import Sequence
 from dataclasses import asdict, dataclass
 from pathlib import Path
@@ -322,10 +323,12 @@ def detect(take, model: CutModel | None = None, **params) -> Segmentation:
     if model is None:
         return Default(**params).fit_predict(take)
     p = {**Default.validate_params(params), **model.params()}
+    start = time.perf_counter()
     analysis = Default.analyse(take, p)
-    if analysis is None:
-        return empty_segmentation(take)
-    return _segment(analysis, p, model.placement, model.offset_s)
+    result = empty_segmentation(take) if analysis is None else \
+        _segment(analysis, p, model.placement, model.offset_s)
+    result.timings["total"] = time.perf_counter() - start
+    return result
 
 
 # --- examples CSV -----------------------------------------------------------------------
