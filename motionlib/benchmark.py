@@ -1,8 +1,10 @@
 """The segmentation benchmark: every method, default parameters, every labelled take.
 
-Rows are the registered segmenters plus two peers from the change-point literature,
-run on the same heading-invariant pose stream the default detector uses (10 joints in
-the body frame plus root height; ``segmenters.default.pose_features``):
+Takes are found by ``benchdata.discover`` (every labelled take in the ``shared/data``
+layout, whatever its name; four-channel takes run only the methods that need no
+skeleton). Rows are the registered segmenters plus two peers from the change-point
+literature, run on the same heading-invariant pose stream the default detector uses (10
+joints in the body frame plus root height; ``segmenters.default.take_features``):
 
 - ``ruptures_kernel``: ruptures ``KernelCPD`` with the RBF kernel (median-heuristic
   bandwidth), on the pose averaged to 10 Hz, minimum segment 2 s, one fixed penalty
@@ -11,6 +13,13 @@ the body frame plus root height; ``segmenters.default.pose_features``):
   learned), on the pose averaged to 30 Hz.
 
 Both are imported only here, and only when the bench runs.
+
+With ``--loo`` three rows are scored leave-one-take-out (``LOO_ROWS``): the default's
+settings chosen from ``tuning.GRID`` without the take scored, the default adapted to the
+other takes of the same label source (``motionlib.adapt``), and ruptures with its
+penalty chosen without the take; the out-of-sample score of every option of every
+setting, and a short-activity check on synthetic takes, follow the tables. Each take is
+scored separately and the means are given per kind of take and over all.
 """
 
 from __future__ import annotations
@@ -144,7 +153,11 @@ def loo_rows(cache: list[tuning.TakeCache], selection: tuning.Selection) -> dict
     for c, (params, _) in zip(cache, chosen, strict=True):
         out["default/loo"].append(_timed_row(lambda t, p=params: Default(**p).fit_predict(t).cuts,
                                              c.take, c.labelled.truth))
-        model = adapt.fit_cut_model(_examples(cache, c))
+        examples = _examples(cache, c)
+        if not examples:  # the only take of its label source: nothing to learn from
+            out["adapted/loo"].append({key: float("nan") for _, key in COLUMNS})
+            continue
+        model = adapt.fit_cut_model(examples)
         out["adapted/loo"].append(_timed_row(lambda t, m=model: adapt.detect(t, m).cuts,
                                              c.take, c.labelled.truth))
     out["ruptures/loo"] = _ruptures_loo(cache)

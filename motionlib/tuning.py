@@ -98,7 +98,10 @@ class Selection:
     rows: list[list[dict]]
 
     def best(self, keep: Sequence[bool]) -> int:
-        """Index of the best choice on the takes where ``keep`` is true."""
+        """Index of the best choice on the takes where ``keep`` is true (the first
+        choice when there is no such take: nothing to choose on)."""
+        if not any(keep):
+            return 0
         scores = [objective([r for r, k in zip(rows, keep, strict=True) if k])
                   for rows in self.rows]
         return max(range(len(scores)), key=lambda i: scores[i])
