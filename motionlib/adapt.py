@@ -197,8 +197,8 @@ def fit_cut_model(examples: Sequence[tuple[object, Sequence[int]]]) -> CutModel:
         if analysis is None:
             raise ExampleError(f"{_where(take)}: too short to learn from "
                                f"({take.n_frames} frames)")
-        for windows in options:
-            other = analysis if windows == zero_windows else analysis.with_windows(*windows)
+        others = analysis.with_windows(*options[1:]) if len(options) > 1 else []
+        for windows, other in zip(options, [analysis, *others], strict=True):
             peaks[windows].append(_all_peaks(take, cuts, other, p))
         _add_residuals(residuals, take, cuts, analysis, p)
     scored = [(_count(peaks[w], p["prominence"]), w) for w in options]

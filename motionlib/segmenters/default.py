@@ -408,6 +408,12 @@ def place_stages(x: np.ndarray, peaks: np.ndarray, fps: float, gamma: float, p: 
     return {k: np.asarray(v, dtype=np.int64) for k, v in stages.items()}, speed
 
 
+def window_widths(scale_min_s: float, scale_max_s: float, rate: float) -> list[int]:
+    """Three window lengths evenly spread between the two scales, in samples at ``rate``."""
+    scales = np.linspace(scale_min_s, scale_max_s, 3)
+    return sorted({max(1, int(round(s * rate))) for s in scales})
+
+
 @dataclass
 class Analysis:
     """What the default detector computes before choosing cuts.
@@ -429,11 +435,18 @@ class Analysis:
         """Novelty samples per second."""
         return self.fps / self.step
 
-    def with_windows(self, scale_min_s: float, scale_max_s: float) -> Analysis:
-        """The same pose stream and kernel with the novelty at other window lengths."""
-        p = {"scale_min_s": scale_min_s, "scale_max_s": scale_max_s}
-        novelty = Default._novelty(block_mean(self.x, self.step), self.rate, self.gamma, p)
-        return replace(self, novelty=novelty)
+    def with_windows(self, *windows: tuple[float, float]) -> list[Analysis]:
+        """The same pose stream and kernel with the novelty at other window lengths.
+
+        ``windows`` are ``(scale_min_s, scale_max_s)`` pairs; all their window lengths
+        share one pass over the lags (``mirrored_novelties``).
+        """
+        widths = [window_widths(lo, hi, self.rate) for lo, hi in windows]
+        union = sorted({w for ws in widths for w in ws})
+        blocks = block_mean(self.x, self.step)
+        curves = dict(zip(union, mirrored_novelties(blocks, union, self.gamma), strict=True))
+        return [replace(self, novelty=np.mean([curves[w] for w in ws], axis=0))
+                for ws in widths]
 
     def peak_frames(self, peaks: np.ndarray) -> np.ndarray:
         """Novelty sample indices -> frames of ``x`` (block centres)."""
@@ -556,8 +569,7 @@ class Default(Segmenter):
         """Mean MMD² over window lengths evenly spread between the two scales."""
         if len(x) < 4:
             return np.zeros(len(x))
-        scales = np.linspace(p["scale_min_s"], p["scale_max_s"], 3)
-        widths = sorted({max(1, int(round(s * rate))) for s in scales})
+        widths = window_widths(p["scale_min_s"], p["scale_max_s"], rate)
         return np.mean(mirrored_novelties(x, widths, gamma), axis=0)
 
     @staticmethod
