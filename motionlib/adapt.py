@@ -197,10 +197,11 @@ def fit_cut_model(examples: Sequence[tuple[object, Sequence[int]]]) -> CutModel:
         if analysis is None:
             raise ExampleError(f"{_where(take)}: too short to learn from "
                                f"({take.n_frames} frames)")
+        placed = _add_residuals(residuals, take, cuts, analysis, p)
         others = analysis.with_windows(*options[1:]) if len(options) > 1 else []
         for windows, other in zip(options, [analysis, *others], strict=True):
-            peaks[windows].append(_all_peaks(take, cuts, other, p))
-        _add_residuals(residuals, take, cuts, analysis, p)
+            peaks[windows].append(_all_peaks(take, cuts, other, p,
+                                             placed if other is analysis else {}))
     scored = [(_count(peaks[w], p["prominence"]), w) for w in options]
     (score, prominence), windows = max(
         ((s - (WINDOW_PRIOR if w != zero_windows else 0.0), pr), w) for (s, pr), w in scored)
@@ -245,11 +246,19 @@ def matched_count(candidates: np.ndarray, truth: np.ndarray, tolerance: int) -> 
     return matched
 
 
-def _all_peaks(take, cuts, analysis, p: dict) -> tuple:
-    """Every novelty peak of one example (frames, prominences) with its cuts and tolerance."""
+def _all_peaks(take, cuts, analysis, p: dict, placed: dict) -> tuple:
+    """Every novelty peak of one example (frames, prominences) with its cuts and tolerance.
+
+    A peak the zero-shot detector keeps is counted where it places it (``placed``: peak
+    index -> take frame), since its placement can move it by more than the tolerance
+    (the onset after a pause); any other peak at its own frame.
+    """
     peaks, prominence = Default._peaks(analysis.novelty, analysis.rate, {**p, "prominence": 0.0})
     frames = analysis.peak_frames(peaks) + analysis.first
-    return frames, prominence, np.sort(cuts), int(round(MATCH_S * take.fps))
+    frames = np.asarray([placed.get(int(k), f) for k, f in zip(peaks, frames, strict=True)],
+                        dtype=np.int64)
+    order = np.argsort(frames, kind="stable")
+    return frames[order], prominence[order], np.sort(cuts), int(round(MATCH_S * take.fps))
 
 
 def _count(per_take, zero: float) -> tuple[float, float]:
@@ -269,9 +278,14 @@ def _count(per_take, zero: float) -> tuple[float, float]:
     return best_score, best
 
 
-def _add_residuals(residuals: dict, take, cuts, analysis, p: dict) -> None:
-    """Signed (human - placed) offsets in seconds of each placement step's cuts that match
-    a human cut within 1 s; the cuts are the zero-shot ones."""
+def _add_residuals(residuals: dict, take, cuts, analysis, p: dict) -> dict[int, int]:
+    """Add each placement step's signed (human - placed) offsets in seconds, over the
+    zero-shot cuts that match a human cut within 1 s.
+
+    Returns
+    -------
+    novelty peak index -> take frame where the zero-shot detector places that peak.
+    """
     peaks, _ = Default._peaks(analysis.novelty, analysis.rate, p)
     stages, _ = place_stages(analysis.x, analysis.peak_frames(peaks), analysis.fps,
                              analysis.gamma, p)
@@ -279,6 +293,8 @@ def _add_residuals(residuals: dict, take, cuts, analysis, p: dict) -> None:
         placed = placed + analysis.first
         ci, ti = metrics.match(placed, cuts, tolerance=int(round(MATCH_S * take.fps)))
         residuals[name].extend(((cuts[ti] - placed[ci]) / take.fps).tolist())
+    zero_shot = stages["onset" if p["onset"] else "pause"] + analysis.first
+    return dict(zip(peaks.tolist(), zero_shot.tolist(), strict=True))
 
 
 def _placement(residuals: dict, zero_shot: str) -> tuple[str, float]:
