@@ -33,7 +33,7 @@ kept), so a project's examples can be read one at a time.
 
 Scored on the 11 labelled takes under ``shared/data`` with the other takes of the same
 label source as examples (``python -m motionlib bench --loo``, row ``adapted/loo``):
-mean F1@1 s 0.947 and 0.40 edits per true cut, against 0.957 and 0.41 for the zero-shot
+mean F1@1 s 0.947 and 0.41 edits per true cut, against 0.957 and 0.41 for the zero-shot
 default chosen without the take: on these takes the zero-shot settings already are what
 the examples would teach (mocap6 13_29 and 13_30 teach each other nothing new; the
 subject-86 takes teach a slightly higher prominence, which loses one cut of 86_14). On
@@ -91,7 +91,8 @@ class CutModel:
     prominence : novelty peak prominence (MMD²) for a cut.
     min_segment_s : minimum time between two cuts (s).
     scale_min_s, scale_max_s : shortest and longest novelty window (s).
-    placement : the placement step the cut is taken from ("split", "turn" or "pause").
+    placement : the placement step the cut is taken from (``segmenters.default.PLACEMENTS``:
+        "split", "turn", "pause" or "onset").
     offset_s : signed shift added to every placed cut (s); positive moves cuts later.
     """
 
@@ -168,7 +169,13 @@ def fit_cut_model(examples: Sequence[tuple[object, Sequence[int]]]) -> CutModel:
     Parameters
     ----------
     examples : sequence of (take, cuts); cuts are 0-based take frames where a new segment
-        starts (a take with no cut is a valid example: one activity throughout).
+        starts (a take with no cut is a valid example: one activity throughout). A take
+        is a ``motionlib.Take`` (or anything ``segmenters.default.take_features`` reads);
+        each is analysed once, in order, and not kept.
+
+    Returns
+    -------
+    CutModel; one example is enough, more make each step surer.
 
     Raises
     ------
@@ -203,7 +210,7 @@ def fit_cut_model(examples: Sequence[tuple[object, Sequence[int]]]) -> CutModel:
             peaks[windows].append(_all_peaks(take, cuts, other, p,
                                              placed if other is analysis else {}))
     scored = [(_count(peaks[w], p["prominence"]), w) for w in options]
-    (score, prominence), windows = max(
+    (_, prominence), windows = max(
         ((s - (WINDOW_PRIOR if w != zero_windows else 0.0), pr), w) for (s, pr), w in scored)
     placement, offset = _placement(residuals, "onset" if p["onset"] else "pause")
     return CutModel(n_takes=len(checked), n_cuts=int(sum(len(c) for _, c in checked)),
@@ -253,7 +260,8 @@ def _all_peaks(take, cuts, analysis, p: dict, placed: dict) -> tuple:
     index -> take frame), since its placement can move it by more than the tolerance
     (the onset after a pause); any other peak at its own frame.
     """
-    peaks, prominence = Default._peaks(analysis.novelty, analysis.rate, {**p, "prominence": 0.0})
+    peaks, prominence = Default.select_peaks(analysis.novelty, analysis.rate,
+                                             {**p, "prominence": 0.0})
     frames = analysis.peak_frames(peaks) + analysis.first
     frames = np.asarray([placed.get(int(k), f) for k, f in zip(peaks, frames, strict=True)],
                         dtype=np.int64)
@@ -286,7 +294,7 @@ def _add_residuals(residuals: dict, take, cuts, analysis, p: dict) -> dict[int, 
     -------
     novelty peak index -> take frame where the zero-shot detector places that peak.
     """
-    peaks, _ = Default._peaks(analysis.novelty, analysis.rate, p)
+    peaks, _ = Default.select_peaks(analysis.novelty, analysis.rate, p)
     stages, _ = place_stages(analysis.x, analysis.peak_frames(peaks), analysis.fps,
                              analysis.gamma, p)
     for name, placed in stages.items():
@@ -317,7 +325,7 @@ def _placement(residuals: dict, zero_shot: str) -> tuple[str, float]:
 
 
 def _segment(analysis, p: dict, placement: str, offset_s: float) -> Segmentation:
-    peaks, strength = Default._peaks(analysis.novelty, analysis.rate, p)
+    peaks, strength = Default.select_peaks(analysis.novelty, analysis.rate, p)
     stages, speed = place_stages(analysis.x, analysis.peak_frames(peaks), analysis.fps,
                                  analysis.gamma, p)
     cuts = stages[placement] + int(round(offset_s * analysis.fps))
@@ -329,8 +337,9 @@ def detect(take, model: CutModel | None = None, **params) -> Segmentation:
     """Candidate cuts of ``take``; ``model=None`` is the zero-shot default detector.
 
     ``params`` are the ``default`` segmenter's parameters (validated with its schema);
-    with a model, its learnt ``threshold``, ``prominence`` and ``min_segment_s`` replace
-    those, and each cut is taken from its ``placement`` step and moved by its ``offset_s``.
+    with a model, its learnt ``threshold``, ``prominence``, ``min_segment_s`` and windows
+    (``scale_min_s``, ``scale_max_s``) replace those, and each cut is taken from its
+    ``placement`` step and moved by its ``offset_s``.
 
     Returns
     -------

@@ -71,7 +71,7 @@ class TakeCache:
         a = self.analysis(p)
         if a is None:
             return np.zeros(0, dtype=np.int64)
-        peaks, _ = Default._peaks(a.novelty, a.rate, p)
+        peaks, _ = Default.select_peaks(a.novelty, a.rate, p)
         key = (id(a), p["refine_s"], tuple(peaks))
         if key not in self.placed:
             self.placed[key] = place_stages(a.x, a.peak_frames(peaks), a.fps, a.gamma, p)[0]

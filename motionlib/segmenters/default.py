@@ -522,7 +522,7 @@ class Default(Segmenter):
         if analysis is None:
             return empty_segmentation(take)
         t0 = time.perf_counter()
-        peaks, strength = self._peaks(analysis.novelty, analysis.rate, p)
+        peaks, strength = self.select_peaks(analysis.novelty, analysis.rate, p)
         cuts, speed = self._place(analysis.x, analysis.peak_frames(peaks), analysis.fps,
                                   analysis.gamma, p)
         result = analysis.segmentation(cuts, confidence(strength, p), speed)
@@ -573,7 +573,7 @@ class Default(Segmenter):
         return np.mean(mirrored_novelties(x, widths, gamma), axis=0)
 
     @staticmethod
-    def _peaks(novelty: np.ndarray, rate: float, p: dict) -> tuple[np.ndarray, np.ndarray]:
+    def select_peaks(novelty: np.ndarray, rate: float, p: dict) -> tuple[np.ndarray, np.ndarray]:
         """Novelty peaks that become cuts, and each one's evidence (its prominence).
 
         A peak must reach ``threshold``, stand ``prominence`` above the higher of the
