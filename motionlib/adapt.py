@@ -67,6 +67,9 @@ from motionlib.segmenters.default import (
 )
 
 FORMAT = 1
+# Fields added to format 1 after its first models were stored, with the value that keeps
+# those models detecting as they did (no prominence test).
+OPTIONAL_FIELDS = {"prominence": 0.0}
 MIN_SEGMENT_S = 0.5
 MIN_SEGMENT_FACTOR = 0.75
 # A placement other than the zero-shot one needs this many matched example cuts and must
@@ -133,7 +136,7 @@ class CutModel:
                            ("prominence", float), ("min_segment_s", float),
                            ("scale_min_s", float), ("scale_max_s", float),
                            ("offset_s", float)):
-            value = data.get(name)
+            value = data.get(name, OPTIONAL_FIELDS.get(name))
             ok = isinstance(value, int | float) and not isinstance(value, bool)
             if not ok or not math.isfinite(value) or (kind is int and value != int(value)):
                 raise ValueError(f"cut model: {name} must be a finite "

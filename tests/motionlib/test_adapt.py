@@ -78,6 +78,12 @@ def test_it_refuses_a_stored_model_it_cannot_read(text, fault):
         CutModel.from_json(text)
 
 
+def test_it_reads_a_stored_model_from_before_the_prominence_test_as_it_was():
+    text = ('{"format": 1, "n_takes": 1, "n_cuts": 4, "threshold": 0.3, "min_segment_s": 2, '
+            '"scale_min_s": 3, "scale_max_s": 6, "offset_s": 0, "placement": "pause"}')
+    assert CutModel.from_json(text).prominence == 0.0
+
+
 def test_it_refuses_a_cut_outside_the_example_take():
     take, _ = _take(1, duration=20.0)
     with pytest.raises(ExampleError, match=f"cut {take.n_frames + 5} is outside"):
