@@ -90,6 +90,12 @@ def test_it_refuses_a_cut_outside_the_example_take():
         fit_cut_model([(take, [100, take.n_frames + 5])])
 
 
+def test_it_names_an_example_take_too_short_to_learn_from():
+    take, _ = _take(1, duration=20.0)
+    with pytest.raises(ExampleError, match=r"synth-1: too short to learn from \(3 frames\)"):
+        fit_cut_model([(_take(2)[0], []), (take.slice(0, 3), [1])])
+
+
 def test_it_refuses_an_empty_example_list():
     with pytest.raises(ExampleError, match="no example takes"):
         fit_cut_model([])
