@@ -196,10 +196,7 @@ def fit_cut_model(examples: Sequence[tuple[object, Sequence[int]]]) -> CutModel:
     # One pass over the takes, keeping only peaks and placement offsets: a project's
     # examples need not all be held in memory with their pose streams.
     zero_windows = (p["scale_min_s"], p["scale_max_s"])
-    # Shorter windows are tried only when an example activity is shorter than the
-    # shortest window: otherwise they only add cuts inside activities (out of sample).
-    options = [zero_windows] + ([w for w in WINDOW_OPTIONS if w != zero_windows]
-                                if shortest is not None and shortest < zero_windows[0] else [])
+    options = _window_options(zero_windows, shortest)
     peaks = {w: [] for w in options}
     residuals = {name: [] for name in PLACEMENTS}
     for take, cuts in checked:
@@ -220,6 +217,18 @@ def fit_cut_model(examples: Sequence[tuple[object, Sequence[int]]]) -> CutModel:
                     threshold=p["threshold"], prominence=prominence,
                     min_segment_s=p["min_segment_s"], scale_min_s=windows[0],
                     scale_max_s=windows[1], placement=placement, offset_s=offset)
+
+
+def _window_options(zero_windows: tuple[float, float],
+                    shortest: float | None) -> list[tuple[float, float]]:
+    """The novelty windows to score, zero-shot first.
+
+    Shorter windows are tried only when an example activity is shorter than the shortest
+    zero-shot window: otherwise they only add cuts inside activities (out of sample).
+    """
+    if shortest is None or shortest >= zero_windows[0]:
+        return [zero_windows]
+    return [zero_windows, *[w for w in WINDOW_OPTIONS if w != zero_windows]]
 
 
 def _shortest_segment(checked) -> float | None:
