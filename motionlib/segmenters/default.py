@@ -77,8 +77,7 @@ onset          off 0.957/0.41, **on 0.957/0.39** (few of these takes pause
 The prominence is the sensitive setting: on the three full-skeleton takes 0.1 to 0.13
 all score F1@1 s 1.0, while 0.07 loses a cut of 13_29 (0.83-0.91) and 0.15 one of 13_30
 (0.86); the four-channel takes prefer 0.1 or lower. 0.1 sits at the low edge of the
-full-skeleton plateau, so a new take is likelier to get an extra candidate than to miss
-one, the cheaper error for a reviewer who deletes faster than they insert.
+full-skeleton plateau: on a new take an extra candidate is likelier than a missed one.
 
 Placement (step 5), median |cut - human cut| over matched cuts: 0.09 s on the three
 full-skeleton takes, 0.39 s on the four-channel ones, whose transition windows' middles
