@@ -197,7 +197,7 @@ def fit_cut_model(examples: Sequence[tuple[object, Sequence[int]]]) -> CutModel:
     # examples need not all be held in memory with their pose streams.
     zero_windows = (p["scale_min_s"], p["scale_max_s"])
     options = _window_options(zero_windows, shortest)
-    peaks = {w: [] for w in options}
+    peaks = {w: [] for w in [*options, "placed"]}
     residuals = {name: [] for name in PLACEMENTS}
     for take, cuts in checked:
         analysis = Default.analyse(take, p)
@@ -205,13 +205,20 @@ def fit_cut_model(examples: Sequence[tuple[object, Sequence[int]]]) -> CutModel:
             raise ExampleError(f"{_where(take)}: too short to learn from "
                                f"({take.n_frames} frames)")
         placed = _add_residuals(residuals, take, cuts, analysis, p)
+        peaks["placed"].append(_all_peaks(take, cuts, analysis, p, placed))
         others = analysis.with_windows(*options[1:]) if len(options) > 1 else []
-        for windows, other in zip(options, [analysis, *others], strict=True):
-            peaks[windows].append(_all_peaks(take, cuts, other, p,
-                                             placed if other is analysis else {}))
-    scored = [(_count(peaks[w], p["prominence"]), w) for w in options]
-    (_, prominence), windows = max(
-        ((s - (WINDOW_PRIOR if w != zero_windows else 0.0), pr), w) for (s, pr), w in scored)
+        for windows, other in zip(options[1:], others, strict=True):
+            peaks[windows].append(_all_peaks(take, cuts, other, p, {}))
+    windows = zero_windows
+    if len(options) > 1:
+        # Windows compete on unplaced peaks (placing them all would cost a detection each);
+        # the count is then chosen where the chosen windows' cuts really land.
+        peaks[zero_windows] = [_unplaced(take_peaks) for take_peaks in peaks["placed"]]
+        scores = {w: _count(peaks[w], p["prominence"])[0] - (w != zero_windows) * WINDOW_PRIOR
+                  for w in options}
+        windows = max(options, key=lambda w: scores[w])
+    _, prominence = _count(peaks["placed"] if windows == zero_windows else peaks[windows],
+                           p["prominence"])
     placement, offset = _placement(residuals, "onset" if p["onset"] else "pause")
     return CutModel(n_takes=len(checked), n_cuts=int(sum(len(c) for _, c in checked)),
                     threshold=p["threshold"], prominence=prominence,
@@ -274,11 +281,19 @@ def _all_peaks(take, cuts, analysis, p: dict, placed: dict) -> tuple:
     """
     peaks, prominence = Default.select_peaks(analysis.novelty, analysis.rate,
                                              {**p, "prominence": 0.0})
-    frames = analysis.peak_frames(peaks) + analysis.first
-    frames = np.asarray([placed.get(int(k), f) for k, f in zip(peaks, frames, strict=True)],
+    raw = analysis.peak_frames(peaks) + analysis.first
+    frames = np.asarray([placed.get(int(k), f) for k, f in zip(peaks, raw, strict=True)],
                         dtype=np.int64)
     order = np.argsort(frames, kind="stable")
-    return frames[order], prominence[order], np.sort(cuts), int(round(MATCH_S * take.fps))
+    return (frames[order], prominence[order], np.sort(cuts), int(round(MATCH_S * take.fps)),
+            raw[order])
+
+
+def _unplaced(take_peaks: tuple) -> tuple:
+    """``_all_peaks`` output with every peak back at its own frame (raw_frames order)."""
+    _, prominence, cuts, tol, raw = take_peaks
+    order = np.argsort(raw, kind="stable")
+    return raw[order], prominence[order], cuts, tol, raw[order]
 
 
 def _count(per_take, zero: float) -> tuple[float, float]:
@@ -289,7 +304,7 @@ def _count(per_take, zero: float) -> tuple[float, float]:
     best, best_score = zero, -math.inf
     for prominence in PROMINENCE_GRID:
         score = -PROMINENCE_PRIOR * abs(math.log(prominence / zero))
-        for frames, prom, cuts, tol in per_take:
+        for frames, prom, cuts, tol, _ in per_take:
             kept = frames[prom >= prominence]
             total = len(kept) + len(cuts)
             score += 2 * matched_count(kept, cuts, tol) / total if total else 1.0
