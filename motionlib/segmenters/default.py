@@ -8,23 +8,28 @@ repeats every second or so; a boundary is where that distribution changes. So:
 1. Each frame becomes a pose vector that ignores where the performer stands and which
    way they face (joint positions relative to the root, heading removed, plus the root
    height, which separates squatting and jumping from standing), optionally with joint
-   velocities so that holding a pose differs from moving through it.
+   velocities so that holding a pose differs from moving through it. A take known only
+   by a few angle channels (the subject-86 four-channel extracts) uses those angles.
 2. The pose stream is averaged into short blocks (``rate_hz``) for speed.
 3. At each instant the poses of the past window and the future window are compared
    with the maximum mean discrepancy (MMD) under a Gaussian kernel whose bandwidth is
    set by the median heuristic, at three window lengths from ``scale_min_s`` to
-   ``scale_max_s`` (3 to 6 s: a window must span several repetitions of a periodic
-   activity, about 1 Hz for most exercises, so that the poses inside one activity look
-   alike from window to window; shorter windows also fire on brief changes inside an
-   activity that annotators do not cut). MMD² is 0 for identical distributions and
-   approaches 2 for disjoint ones, whatever the capture's units.
-4. Peaks of the mean novelty curve higher than ``threshold`` and at least
-   ``min_segment_s`` apart become cuts; confidence ``s / (s + threshold)`` grows with
-   the peak height s (0.5 at the threshold), so candidates rank by evidence.
+   ``scale_max_s`` (a window must span several repetitions of a periodic activity,
+   about 1 Hz for most exercises, so that the poses inside one activity look alike from
+   window to window; shorter windows also fire on brief changes inside an activity that
+   annotators do not cut). MMD² is 0 for identical distributions and approaches 2 for
+   disjoint ones, whatever the capture's units.
+4. How many cuts. Peaks of the mean novelty curve at least ``threshold`` high, standing
+   at least ``prominence`` above the higher of the valleys beside them, and at least
+   ``min_segment_s`` from a higher peak become cuts; confidence ``q / (q + prominence)``
+   grows with the peak's prominence q (0.5 at the setting), so candidates rank by
+   evidence. Prominence, not height, is what tells a boundary from a wobble on the
+   shoulder of a broad peak: most false peaks have a prominence near 0.
 5. Placement, coarse to fine. The novelty peak locates a change only to within a
    block and a window; an annotator cuts at "the moment the motion changes": the end
-   of the last movement of the old activity, where the body is momentarily still.
-   So each cut is re-estimated in three steps, all at most ``refine_s`` from the
+   of the last movement of the old activity, where the body is momentarily still, or,
+   after a pause, where the next activity sets off. So each cut is re-estimated in
+   four steps (``place_stages``), the first three at most ``refine_s`` from the
    previous estimate:
 
    a. *Split.* Over ``±scale_min_s`` around the peak (never past half-way to a
@@ -35,24 +40,61 @@ repeats every second or so; a boundary is where that distribution changes. So:
       (poses low-passed at 3 Hz, native frame rate): the split locates the change to
       within a movement cycle, and between two cycles the body turns.
    c. *Pause.* If the performer really stops nearby (the 1 Hz speed falls below half
-      its typical value around the cut), the cut moves to that pause, where
-      annotators cut too (``settle_frame``).
+      its typical value around the cut), the cut moves to that pause (``settle_frame``).
+   d. *Onset* (``onset``). If the cut then lies in a pause of at most 3 s after which
+      the next activity moves at its typical speed, it moves to the end of the pause,
+      the onset of the next activity, which is where annotators of the mocap6 and
+      subject-86 labels cut (``onset_frame``); a long still stretch, or one followed by
+      slow motion (idling), is an activity of its own and keeps its cut.
 
-   Tried on the three labelled CMU takes (mean of the per-take median cut errors; it
-   was 0.23 s with the peak moved only to a pause) and on synthetic takes, choosing
-   only between these principled settings, with no per-take or per-count knowledge:
-   the split alone (a) places synthetic cuts within 0.05 s (their truth is the
-   middle of a cross-fade, a statistical midpoint) but real ones 0.24 s off, because
-   annotators cut between movements, not at the midpoint of the statistics; (a)+(b)
-   takes the real error to 0.09 s; (c) then fixes one more real cut (fewer edits,
-   same median). On synthetic takes (10 seeds at 120, 60 and 30 fps) F1 is unchanged
-   and the median error stays about where it was (0.22 -> 0.24 s): there the turning
-   point lies up to a quarter cycle from the cross-fade's middle. Not kept: the
-   turning point with the best split statistic instead of the nearest (0.19 s),
-   joint velocities in the split statistic (no gain), a linear (mean-pose) cost
-   instead of the kernel (0.54 s: periodic activities share a mean pose), a context
-   of ``scale_max_s`` instead of ``scale_min_s`` (same or worse), and the native
-   frame rate for the split (same result, several times the time).
+How the settings were chosen, and how each choice scores out of sample
+----------------------------------------------------------------------
+Every setting of ``tuning.GRID`` (windows, threshold, prominence, minimum segment,
+onset; 320 combinations of principled options) was scored on all 11 labelled takes
+under ``shared/data`` (13_29 BVH, 13_30 and 86_01 AMC, and the eight subject-86
+four-channel takes, 86_01's counted as the same take as its AMC), and the defaults are
+the combination with the best mean F1 at 1 s (ties: fewer edits per true cut). Scored
+leave-one-take-out, i.e. each take with the combination chosen without it
+(``python -m motionlib bench --loo``), that choice gets mean F1@1 s 0.957 and 0.41
+edits per true cut (the earlier defaults, threshold 0.25 and no prominence test: 0.862
+and 0.60, chosen on 3 takes). Each option with the others still chosen without the take
+scored, mean F1@1 s / edits per true cut:
+
+=============  ==========================================================
+windows        1.5-3 s 0.863/0.69, 1.5-6 s 0.839/0.73, 2-4 s 0.898/0.55,
+               **3-6 s 0.957/0.41**
+threshold      **0.1** and 0.15 0.957/0.41, 0.2 0.918/0.46, 0.25 0.882/0.53,
+               0.3 0.795/0.73
+prominence     0 (off) 0.862/0.60, 0.05 0.909/0.49, **0.1 0.957/0.41**,
+               0.15 0.916/0.47
+min_segment_s  **1.5** and 2 s alike (0.957/0.41); 1.5 s kept so that activities
+               of 1.5 s can be cut at both ends
+onset          off 0.957/0.41, **on 0.957/0.39** (few of these takes pause
+               between activities; on synthetic takes with a pause it puts
+               the cut within 0.1 s of the onset, off leaves it 0.3-1 s early)
+=============  ==========================================================
+
+The prominence is the sensitive setting: on the three full-skeleton takes 0.1 to 0.13
+all score F1@1 s 1.0, while 0.07 loses a cut of 13_29 (0.83-0.91) and 0.15 one of 13_30
+(0.86); the four-channel takes prefer 0.1 or lower. 0.1 sits at the low edge of the
+full-skeleton plateau: on a new take an extra candidate is likelier than a missed one.
+
+Placement (step 5), median |cut - human cut| over matched cuts: 0.09 s on the three
+full-skeleton takes, 0.39 s on the four-channel ones, whose transition windows' middles
+are rough estimates and whose four angles say little about the moment of a change. The
+steps a-c were chosen earlier on the three full-skeleton takes (split alone 0.24 s,
++turning point 0.09 s, +pause one more cut fixed); not kept then: the turning point
+with the best split statistic instead of the nearest, joint velocities in the split
+statistic, a linear (mean-pose) cost instead of the kernel (0.54 s: periodic activities
+share a mean pose), a context of ``scale_max_s`` and the native frame rate for the
+split.
+
+Known limit: windows of 3-6 s see an activity shorter than about 2.5 s between two long
+ones as one broad peak, so one of its two boundaries is often lost (synthetic takes with
+1.5-6 s activities: 60 % of the boundaries beside a short activity found within 1 s).
+Shorter windows find them (93 % with 1.5-6 s windows) but cut inside real activities
+(table above), so the zero-shot detector keeps 3-6 s and ``motionlib.adapt`` switches
+to shorter windows when a studio's own examples hold such activities (91 %).
 
 All durations are in seconds, so the same defaults work at any frame rate.
 """
@@ -60,6 +102,7 @@ All durations are in seconds, so the same defaults work at any frame rate.
 from __future__ import annotations
 
 import time
+from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy.signal import find_peaks
@@ -102,6 +145,23 @@ def pose_features(
     return x
 
 
+def take_features(take, *, velocity_s: float = 0.0) -> tuple[np.ndarray, int]:
+    """The detector's per-frame feature vectors of a take.
+
+    A take with a skeleton gives ``pose_features``; a take known only by a few angle
+    channels (``benchdata.ChannelTake``, no ``skeleton``) gives those angles in radians:
+    the kernel's width follows the data (median heuristic), so any unit works.
+
+    Returns
+    -------
+    x : (n_used, n_features); first : take frame of ``x[0]`` (after a rest pose).
+    """
+    if getattr(take, "skeleton", None) is None:
+        return np.radians(np.asarray(take.channels, dtype=float)), 0
+    positions, joints, first = take_positions(take)
+    return pose_features(positions, joints, fps=float(take.fps), velocity_s=velocity_s), first
+
+
 def block_mean(x: np.ndarray, step: int) -> np.ndarray:
     """Average consecutive blocks of ``step`` frames: (n, d) -> (n // step, d)."""
     n = len(x) // step
@@ -130,25 +190,43 @@ def mmd_novelty(x: np.ndarray, w: int, gamma: float) -> np.ndarray:
     -------
     (n,) biased MMD² estimate at each split t (0 where a window would leave the take).
     """
+    return multi_mmd_novelty(x, [w], gamma)[0]
+
+
+def multi_mmd_novelty(x: np.ndarray, widths, gamma: float) -> list[np.ndarray]:
+    """``mmd_novelty`` for several window lengths, sharing the kernel at each lag.
+
+    Returns
+    -------
+    list of (n,) arrays, one per width in ``widths``.
+    """
     n = len(x)
-    out = np.zeros(n)
-    if n < 2 * w or w < 1:
-        return out
-    t = np.arange(w, n - w + 1)
-    within = np.zeros(len(t))
-    cross = np.zeros(len(t))
-    for lag in range(0, 2 * w):
+    acc = {}
+    for w in widths:
+        if w >= 1 and n >= 2 * w:
+            t = np.arange(w, n - w + 1)
+            acc[w] = (t, np.zeros(len(t)), np.zeros(len(t)))
+    for lag in range(0, 2 * max(acc, default=0)):
         k = np.exp(-gamma * ((x[lag:] - x[: n - lag]) ** 2).sum(axis=1))
         c = np.concatenate([[0.0], np.cumsum(k)])  # c[i] = sum of k[:i]
-        if lag < w:  # pairs (i, i + lag) inside the past and inside the future window
-            mult = 1.0 if lag == 0 else 2.0
-            within += mult * (c[t - lag] - c[t - w] + c[t + w - lag] - c[t])
-        if lag >= 1:  # pairs with i in the past window and i + lag in the future one
-            lo = np.maximum(t - w, t - lag)
-            hi = np.minimum(t, t + w - lag)
-            cross += np.where(hi > lo, c[np.maximum(hi, lo)] - c[lo], 0.0)
-    out[t] = (within - 2 * cross) / (w * w)
-    return np.maximum(out, 0.0)
+        for w, (t, within, cross) in acc.items():
+            if lag >= 2 * w:
+                continue
+            if lag < w:  # pairs (i, i + lag) inside the past and inside the future window
+                mult = 1.0 if lag == 0 else 2.0
+                within += mult * (c[t - lag] - c[t - w] + c[t + w - lag] - c[t])
+            if lag >= 1:  # pairs with i in the past window and i + lag in the future one
+                lo = np.maximum(t - w, t - lag)
+                hi = np.minimum(t, t + w - lag)
+                cross += np.where(hi > lo, c[np.maximum(hi, lo)] - c[lo], 0.0)
+    out = []
+    for w in widths:
+        curve = np.zeros(n)
+        if w in acc:
+            t, within, cross = acc[w]
+            curve[t] = np.maximum((within - 2 * cross) / (w * w), 0.0)
+        out.append(curve)
+    return out
 
 
 def mirrored_novelty(x: np.ndarray, w: int, gamma: float) -> np.ndarray:
@@ -158,11 +236,19 @@ def mirrored_novelty(x: np.ndarray, w: int, gamma: float) -> np.ndarray:
     again, so an activity shorter than a window at the very start or end still
     produces a peak at its boundary.
     """
-    w = min(w, len(x) - 1)
-    if w < 1:
-        return np.zeros(len(x))
-    padded = np.concatenate([x[w:0:-1], x, x[-2 : -w - 2 : -1]])
-    return mmd_novelty(padded, w, gamma)[w : w + len(x)]
+    return mirrored_novelties(x, [w], gamma)[0]
+
+
+def mirrored_novelties(x: np.ndarray, widths, gamma: float) -> list[np.ndarray]:
+    """``mirrored_novelty`` for several widths at once (one mirror, shared kernels)."""
+    widths = [min(w, len(x) - 1) for w in widths]
+    pad = max(widths, default=0)
+    if pad < 1:
+        return [np.zeros(len(x)) for _ in widths]
+    padded = np.concatenate([x[pad:0:-1], x, x[-2 : -pad - 2 : -1]])
+    curves = multi_mmd_novelty(padded, widths, gamma)
+    return [c[pad : pad + len(x)] if w >= 1 else np.zeros(len(x))
+            for c, w in zip(curves, widths, strict=True)]
 
 
 # A pause is a slowest frame at most this fraction of the typical speed around it.
@@ -183,6 +269,38 @@ def settle_frame(speed: np.ndarray, cut: int, radius: int, context: int) -> int:
     slowest = a + int(np.argmin(speed[a:b]))
     typical = np.median(speed[max(0, cut - context) : cut + context])
     return slowest if speed[slowest] < PAUSE_RATIO * typical else cut
+
+
+# How far (s) the onset of the next activity may lie after a pause.
+ONSET_MAX_S = 3.0
+
+
+def onset_frame(speed: np.ndarray, cut: int, stop: int, context: int) -> int:
+    """The end of the pause ``cut`` lies in: where the next activity sets off.
+
+    When the speed at ``cut`` is below ``PAUSE_RATIO`` of the median speed over
+    ``±context`` frames, the performer may be standing between two activities, and
+    annotators who cut at the onset of the next one cut where the speed rises past that
+    level again. Only a pause that ends by frame ``stop``, lasts at most ``stop - cut``
+    frames in all and is followed by ``context`` frames at the typical speed (and at
+    least half the speed of the ``context`` frames before) counts: a
+    longer slow stretch, or one followed by slow motion, is an activity of its own
+    (standing, idling), not a pause between two. Elsewhere ``cut`` is returned unchanged.
+    """
+    level = PAUSE_RATIO * np.median(speed[max(0, cut - context) : cut + context])
+    if not speed[cut] < level or stop <= cut:
+        return cut
+    above = np.flatnonzero(speed[cut : stop + 1] >= level)
+    if not len(above):
+        return cut
+    end = cut + int(above[0])
+    before = np.flatnonzero(speed[max(0, end - (stop - cut)) : cut] >= level)
+    # The next activity must then move at least at the typical speed and at half the
+    # previous one's: a slow one (idling, swaying) is not set off by a rise of a moment.
+    after = np.median(speed[end : end + context])
+    moving = after >= max(level / PAUSE_RATIO,
+                          PAUSE_RATIO * np.median(speed[max(0, cut - context) : cut]))
+    return end if len(before) and moving else cut
 
 
 def split_gains(x: np.ndarray, gamma: float) -> np.ndarray:
@@ -230,18 +348,21 @@ def best_split(x: np.ndarray, cut: int, lo: int, hi: int, *, step: int, radius: 
     return int(frames[near][np.argmax(gains[near])])
 
 
-def turning_points(x: np.ndarray, *, fps: float) -> np.ndarray:
-    """Frames where the pose momentarily slows down (local minima of its speed).
+def fine_speed(x: np.ndarray, *, fps: float) -> np.ndarray:
+    """Pose speed per frame with the poses low-passed at 3 Hz first, as for the
+    velocities, so that capture jitter makes no turning points or onsets of its own."""
+    smooth = features.lowpass(x, fps=fps, cutoff_hz=min(3.0, 0.45 * fps))
+    return features.frame_speed(smooth, fps=fps)
 
-    The poses are low-passed at 3 Hz first, as for the velocities, so that capture
-    jitter does not make turning points of its own.
+
+def turning_points(x: np.ndarray, *, fps: float) -> np.ndarray:
+    """Frames where the pose momentarily slows down (local minima of ``fine_speed``).
 
     Returns
     -------
     (n_points,) int frames, increasing.
     """
-    smooth = features.lowpass(x, fps=fps, cutoff_hz=min(3.0, 0.45 * fps))
-    frames, is_max = features.local_extrema(features.frame_speed(smooth, fps=fps))
+    frames, is_max = features.local_extrema(fine_speed(x, fps=fps))
     return frames[~is_max]
 
 
@@ -251,6 +372,109 @@ def nearest(points: np.ndarray, target: int, radius: int) -> int:
         return target
     best = points[np.argmin(np.abs(points - target))]
     return int(best) if abs(best - target) <= radius else target
+
+
+PLACEMENTS = ("split", "turn", "pause", "onset")
+
+
+def place_stages(x: np.ndarray, peaks: np.ndarray, fps: float, gamma: float, p: dict):
+    """Each placement step's estimate of every cut (see the module docstring, step 5).
+
+    Returns
+    -------
+    stages : {"split", "turn", "pause", "onset"} -> (n_cuts,) int frames of ``x``, each
+        step starting from the previous one's result.
+    speed : (n,) the 1 Hz pose speed.
+    """
+    speed = features.lowpass(features.frame_speed(x, fps=fps), fps=fps, cutoff_hz=1.0)
+    step = max(1, int(round(fps / SPLIT_RATE_HZ)))
+    fine = fine_speed(x, fps=fps)
+    frames, is_max = features.local_extrema(fine)
+    turns = frames[~is_max]
+    radius = int(round(p["refine_s"] * fps))
+    context = int(round(p["scale_min_s"] * fps))
+    onset_radius = int(round(ONSET_MAX_S * fps))
+    stages = {name: [] for name in PLACEMENTS}
+    for i, cut in enumerate(int(c) for c in peaks):
+        # Never look past half-way to a neighbouring cut: that stretch is theirs.
+        lo = max(0, cut - context, (int(peaks[i - 1]) + cut) // 2 if i else 0)
+        hi = min(len(x), cut + context)
+        if i + 1 < len(peaks):
+            hi = min(hi, (cut + int(peaks[i + 1])) // 2)
+        split = best_split(x, cut, lo, hi, step=step, radius=radius, gamma=gamma)
+        turn = nearest(turns, split, radius)
+        pause = settle_frame(speed, turn, radius, context)
+        stages["split"].append(split)
+        stages["turn"].append(turn)
+        stages["pause"].append(pause)
+        limit = (cut + int(peaks[i + 1])) // 2 if i + 1 < len(peaks) else len(x) - 1
+        stages["onset"].append(onset_frame(fine, pause, min(limit, pause + onset_radius),
+                                           context))
+    return {k: np.asarray(v, dtype=np.int64) for k, v in stages.items()}, speed
+
+
+def window_widths(scale_min_s: float, scale_max_s: float, rate: float) -> list[int]:
+    """Three window lengths evenly spread between the two scales, in samples at ``rate``."""
+    scales = np.linspace(scale_min_s, scale_max_s, 3)
+    return sorted({max(1, int(round(s * rate))) for s in scales})
+
+
+@dataclass
+class Analysis:
+    """What the default detector computes before choosing cuts.
+
+    x : (n, d) pose features of frames ``first ..`` at ``fps``; step : frames per novelty
+    block; gamma : kernel 1 / bandwidth²; novelty : (n // step,) mean MMD² per block.
+    """
+
+    x: np.ndarray
+    fps: float
+    step: int
+    first: int
+    gamma: float
+    novelty: np.ndarray
+    timings: dict[str, float]
+
+    @property
+    def rate(self) -> float:
+        """Novelty samples per second."""
+        return self.fps / self.step
+
+    def with_windows(self, *windows: tuple[float, float]) -> list[Analysis]:
+        """The same pose stream and kernel with the novelty at other window lengths.
+
+        ``windows`` are ``(scale_min_s, scale_max_s)`` pairs; all their window lengths
+        share one pass over the lags (``mirrored_novelties``).
+        """
+        widths = [window_widths(lo, hi, self.rate) for lo, hi in windows]
+        union = sorted({w for ws in widths for w in ws})
+        blocks = block_mean(self.x, self.step)
+        curves = dict(zip(union, mirrored_novelties(blocks, union, self.gamma), strict=True))
+        return [replace(self, novelty=np.mean([curves[w] for w in ws], axis=0))
+                for ws in widths]
+
+    def peak_frames(self, peaks: np.ndarray) -> np.ndarray:
+        """Novelty sample indices -> frames of ``x`` (block centres)."""
+        return np.asarray(peaks, dtype=np.int64) * self.step + self.step // 2
+
+    def segmentation(self, cuts: np.ndarray, confidence: np.ndarray,
+                     speed: np.ndarray) -> Segmentation:
+        """The result for cuts given in frames of ``x``."""
+        centres = np.arange(len(self.novelty)) * self.step + self.step / 2
+        curve = np.interp(np.arange(len(self.x)), centres, self.novelty)
+        return Segmentation(
+            cuts=np.asarray(cuts, dtype=np.int64) + self.first,
+            confidence=confidence,
+            signals={"novelty": full_length(curve, self.first),
+                     "speed": full_length(speed, self.first)},
+            timings=dict(self.timings),
+        )
+
+
+def empty_segmentation(take) -> Segmentation:
+    """No cuts, for a take too short to compare anything."""
+    return Segmentation(np.zeros(0, np.int64), np.zeros(0),
+                        {"novelty": np.zeros(take.n_frames)})
 
 
 # The split is searched on block means at this rate: finer than the 0.1 s that
@@ -269,10 +493,10 @@ class Default(Segmenter):
     )
     params = {
         "threshold": Param(
-            "float", 0.25, 0.0, 2.0,
+            "float", 0.1, 0.0, 2.0,
             "Minimum mean MMD² (0 = same poses, 2 = disjoint) for a peak to become a cut.",
         ),
-        "min_segment_s": Param("float", 2.0, 0.1, 60.0, "Minimum time between two cuts (s)."),
+        "min_segment_s": Param("float", 1.5, 0.1, 60.0, "Minimum time between two cuts (s)."),
         "scale_min_s": Param("float", 3.0, 0.2, 30.0, "Shortest comparison window (s)."),
         "scale_max_s": Param("float", 6.0, 0.2, 60.0, "Longest comparison window (s)."),
         "bandwidth": Param(
@@ -288,9 +512,34 @@ class Default(Segmenter):
             "How far (s) each placement step (best split, turning point, pause) may move a cut.",
         ),
         "rate_hz": Param("float", 10.0, 1.0, 60.0, "Pose rate (Hz) for the novelty curve."),
+        "prominence": Param(
+            "float", 0.1, 0.0, 2.0,
+            "Minimum rise of a peak above the higher of the two valleys beside it (MMD²).",
+        ),
+        "onset": Param(
+            "bool", True, 0, 1,
+            "Move a cut that falls in a pause to its end, the onset of the next activity.",
+        ),
     }
 
     def _segment(self, take, **p) -> Segmentation:
+        analysis = self.analyse(take, p)
+        if analysis is None:
+            return empty_segmentation(take)
+        t0 = time.perf_counter()
+        peaks, strength = self.select_peaks(analysis.novelty, analysis.rate, p)
+        cuts, speed = self._place(analysis.x, analysis.peak_frames(peaks), analysis.fps,
+                                  analysis.gamma, p)
+        result = analysis.segmentation(cuts, confidence(strength, p), speed)
+        result.timings["cuts"] = time.perf_counter() - t0
+        return result
+
+    @classmethod
+    def analyse(cls, take, p: dict) -> Analysis | None:
+        """Pose stream, kernel and novelty curve of ``take`` (None if it is too short).
+
+        ``p`` are validated parameters; a scale error raises ParamError.
+        """
         if p["scale_max_s"] < p["scale_min_s"]:
             raise ParamError(
                 f"scale_max_s: must be at least scale_min_s ({p['scale_min_s']:g}), "
@@ -298,29 +547,18 @@ class Default(Segmenter):
             )
         fps = float(take.fps)
         t0 = time.perf_counter()
-        positions, joints, first = take_positions(take)
+        x, first = take_features(take, velocity_s=p["velocity_s"])
         t1 = time.perf_counter()
-        x = pose_features(positions, joints, fps=fps, velocity_s=p["velocity_s"])
         step = max(1, int(round(fps / p["rate_hz"])))
         if len(x) < 2 * step:  # too short to compare anything: no cuts
-            flat = full_length(np.zeros(len(x)), first)
-            return Segmentation(np.zeros(0, np.int64), np.zeros(0), {"novelty": flat})
+            return None
         blocks = block_mean(x, step)
         # One kernel for detection and placement, its width from the median heuristic.
         gamma = 1.0 / max(p["bandwidth"] * median_sq_distance(blocks), 1e-12)
-        novelty = self._novelty(blocks, fps / step, gamma, p)
+        novelty = cls._novelty(blocks, fps / step, gamma, p)
         t2 = time.perf_counter()
-        peaks, strength = self._peaks(novelty, fps / step, p)
-        cuts, speed = self._place(x, peaks * step + step // 2, fps, gamma, p)
-        t3 = time.perf_counter()
-        centres = np.arange(len(novelty)) * step + step / 2
-        curve = np.interp(np.arange(len(x)), centres, novelty)
-        return Segmentation(
-            cuts=cuts + first,
-            confidence=strength / (strength + p["threshold"] + 1e-12),
-            signals={"novelty": full_length(curve, first), "speed": full_length(speed, first)},
-            timings={"kinematics": t1 - t0, "novelty": t2 - t1, "cuts": t3 - t2},
-        )
+        return Analysis(x=x, fps=fps, step=step, first=first, gamma=gamma, novelty=novelty,
+                        timings={"kinematics": t1 - t0, "novelty": t2 - t1})
 
     @staticmethod
     def _place(x: np.ndarray, peaks: np.ndarray, fps: float, gamma: float, p: dict):
@@ -328,41 +566,38 @@ class Default(Segmenter):
 
         Returns the placed cuts (frames of ``x``) and the 1 Hz pose speed.
         """
-        speed = features.lowpass(features.frame_speed(x, fps=fps), fps=fps, cutoff_hz=1.0)
-        step = max(1, int(round(fps / SPLIT_RATE_HZ)))
-        turns = turning_points(x, fps=fps)
-        radius = int(round(p["refine_s"] * fps))
-        context = int(round(p["scale_min_s"] * fps))
-        placed = []
-        for i, cut in enumerate(int(c) for c in peaks):
-            # Never look past half-way to a neighbouring cut: that stretch is theirs.
-            lo = max(0, cut - context, (int(peaks[i - 1]) + cut) // 2 if i else 0)
-            hi = min(len(x), cut + context)
-            if i + 1 < len(peaks):
-                hi = min(hi, (cut + int(peaks[i + 1])) // 2)
-            split = best_split(x, cut, lo, hi, step=step, radius=radius, gamma=gamma)
-            turn = nearest(turns, split, radius)
-            placed.append(settle_frame(speed, turn, radius, context))
-        return np.asarray(placed, dtype=np.int64), speed
+        stages, speed = place_stages(x, peaks, fps, gamma, p)
+        return stages["onset" if p["onset"] else "pause"], speed
 
     @staticmethod
     def _novelty(x: np.ndarray, rate: float, gamma: float, p: dict) -> np.ndarray:
         """Mean MMD² over window lengths evenly spread between the two scales."""
         if len(x) < 4:
             return np.zeros(len(x))
-        scales = np.linspace(p["scale_min_s"], p["scale_max_s"], 3)
-        widths = sorted({max(1, int(round(s * rate))) for s in scales})
-        return np.mean([mirrored_novelty(x, w, gamma) for w in widths], axis=0)
+        widths = window_widths(p["scale_min_s"], p["scale_max_s"], rate)
+        return np.mean(mirrored_novelties(x, widths, gamma), axis=0)
 
     @staticmethod
-    def _peaks(novelty: np.ndarray, rate: float, p: dict) -> tuple[np.ndarray, np.ndarray]:
+    def select_peaks(novelty: np.ndarray, rate: float, p: dict) -> tuple[np.ndarray, np.ndarray]:
+        """Novelty peaks that become cuts, and each one's evidence (its prominence).
+
+        A peak must reach ``threshold``, stand ``prominence`` above the higher of the
+        valleys beside it, and lie ``min_segment_s`` from a higher peak.
+        """
         # Zero guards let a peak sit on the first or last sample.
         padded = np.concatenate([[0.0], novelty, [0.0]])
         distance = max(1, int(round(p["min_segment_s"] * rate)))
-        peaks, _ = find_peaks(padded, height=max(p["threshold"], 1e-12), distance=distance)
-        peaks = peaks - 1
+        peaks, props = find_peaks(padded, height=max(p["threshold"], 1e-12),
+                                  distance=distance, prominence=p["prominence"])
+        peaks, prominence = peaks - 1, props["prominences"]
         # The first and last segment may be shorter than the others, but not absurdly:
         # at least half the minimum segment.
         edge = p["min_segment_s"] * rate / 2
-        peaks = peaks[(peaks + 0.5 >= edge) & (len(novelty) - peaks - 0.5 >= edge)]
-        return peaks, novelty[peaks]
+        keep = (peaks + 0.5 >= edge) & (len(novelty) - peaks - 0.5 >= edge)
+        return peaks[keep], prominence[keep]
+
+
+def confidence(evidence: np.ndarray, p: dict) -> np.ndarray:
+    """Peak prominence -> confidence in [0, 1): 0.5 at the ``prominence`` setting."""
+    half = p["prominence"] if p["prominence"] > 0 else p["threshold"]
+    return evidence / (evidence + max(half, 1e-12))

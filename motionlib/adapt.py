@@ -1,0 +1,452 @@
+"""Adapting the default detector to a studio's own cuts.
+
+A studio's annotators have a convention: what counts as a boundary, how many there are,
+where exactly the cut goes. Given example takes with their human cuts,
+:func:`fit_cut_model` learns that convention as a :class:`CutModel`, and :func:`detect`
+runs the default detector with it.
+
+What is learnt, step by step (each from all examples together, never per take); every
+step starts from the zero-shot setting and leaves it only when the examples clearly say
+so, because one or two reviewed takes are all a new project has:
+
+1. *Minimum segment.* The shortest human segment bounds how close two cuts may be:
+   ``min_segment_s`` becomes 0.75 x the shortest example segment when that is shorter
+   than the zero-shot 1.5 s (never below 0.5 s, never longer than zero-shot).
+2. *How many cuts, and at which scale.* The novelty peaks of every example are computed
+   once, each zero-shot cut counted where the detector places it; the ``prominence`` from
+   :data:`PROMINENCE_GRID` whose peaks match the human cuts best (summed F1 at 1 s,
+   one-to-one within 1 s), less a prior cost of moving away from the zero-shot
+   prominence, is kept. Prominence, not height, is what separated true from false peaks
+   out of sample (``segmenters.default``). When an example activity is shorter than the
+   zero-shot shortest window (3 s), the shorter windows of :data:`WINDOW_OPTIONS` are
+   scored the same way (all windows on unplaced peaks) and kept if they beat the
+   zero-shot windows by :data:`WINDOW_PRIOR`.
+3. *Where.* Each placement step of the detector (best split, turning point, pause,
+   onset; see ``segmenters.default``) is an anchor; for each, the signed offsets from the
+   zero-shot cut to the human cut it matches within 1 s, and their median as a shift. The
+   anchor and shift with the smallest median error replace the zero-shot placement only
+   when at least 6 example cuts matched and the error drops by 20 % and 0.03 s
+   (annotators who mark the onset of the next activity cut a steady time after the
+   statistical change; a handful of cuts cannot show that).
+
+Each example take is analysed once and then dropped (only its peaks and offsets are
+kept), so a project's examples can be read one at a time.
+
+Scored on the 11 labelled takes under ``shared/data`` with the other takes of the same
+label source as examples (``python -m motionlib bench --loo``, row ``adapted/loo``):
+mean F1@1 s 0.947 and 0.40 edits per true cut, against 0.957 and 0.41 for the zero-shot
+default chosen without the take: on these takes the zero-shot settings already are what
+the examples would teach (mocap6 13_29 and 13_30 teach each other nothing new; the
+subject-86 takes teach a slightly higher prominence, which loses one cut of 86_14). On
+synthetic takes whose annotators cut 0.6 s after the change, or that hold activities of
+1.5-2.5 s, the adapted model follows them where the zero-shot one cannot (tests).
+
+Pure numpy/scipy, no Django; the service stores ``CutModel.to_json()``.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+import os
+import time
+from collections.abc import Sequence
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+import numpy as np
+
+from motionlib import metrics
+from motionlib.segmenters.base import Segmentation, _checked
+from motionlib.segmenters.default import (
+    PLACEMENTS,
+    Default,
+    confidence,
+    empty_segmentation,
+    place_stages,
+)
+
+FORMAT = 1
+# Fields added to format 1 after its first models were stored, with the value that keeps
+# those models detecting as they did (no prominence test).
+OPTIONAL_FIELDS = {"prominence": 0.0}
+MIN_SEGMENT_S = 0.5
+MIN_SEGMENT_FACTOR = 0.75
+# A placement other than the zero-shot one needs this many matched example cuts and must
+# cut the median placement error by this fraction and this many seconds: few cuts or a
+# small gain are noise, and a wrong shift moves every cut.
+PLACEMENT_MIN_CUTS = 6
+PLACEMENT_GAIN = (0.2, 0.03)
+MATCH_S = 1.0
+
+
+class ExampleError(ValueError):
+    """An example take or its cuts cannot be learnt from; the message names it."""
+
+
+@dataclass(frozen=True)
+class CutModel:
+    """What the default detector learnt from example takes with human cuts.
+
+    n_takes : example takes it learnt from.
+    n_cuts : human cuts it learnt from.
+    threshold : novelty peak height (mean MMD²) for a cut.
+    prominence : novelty peak prominence (MMD²) for a cut.
+    min_segment_s : minimum time between two cuts (s).
+    scale_min_s, scale_max_s : shortest and longest novelty window (s).
+    placement : the placement step the cut is taken from (``segmenters.default.PLACEMENTS``:
+        "split", "turn", "pause" or "onset").
+    offset_s : signed shift added to every placed cut (s); positive moves cuts later.
+    """
+
+    n_takes: int
+    n_cuts: int
+    threshold: float
+    prominence: float
+    min_segment_s: float
+    scale_min_s: float
+    scale_max_s: float
+    placement: str
+    offset_s: float
+
+    def params(self) -> dict[str, float]:
+        """The default segmenter's parameters this model sets."""
+        return {"threshold": self.threshold, "prominence": self.prominence,
+                "min_segment_s": self.min_segment_s, "scale_min_s": self.scale_min_s,
+                "scale_max_s": self.scale_max_s}
+
+    def to_json(self) -> str:
+        """Stable JSON text (sorted keys) with ``"format": 1``."""
+        return json.dumps({"format": FORMAT, **asdict(self)}, sort_keys=True)
+
+    @classmethod
+    def from_json(cls, text: str) -> CutModel:
+        """Parse ``to_json`` output; ValueError naming what is wrong."""
+        try:
+            data = json.loads(text)
+        except (TypeError, json.JSONDecodeError) as exc:
+            raise ValueError(f"cut model: not JSON: {exc}") from None
+        if not isinstance(data, dict):
+            raise ValueError(f"cut model: expected a JSON object, got {type(data).__name__}")
+        if data.get("format") != FORMAT:
+            raise ValueError(f"cut model: unsupported format {data.get('format')!r} "
+                             f"(expected {FORMAT})")
+        values = {}
+        for name, kind in (("n_takes", int), ("n_cuts", int), ("threshold", float),
+                           ("prominence", float), ("min_segment_s", float),
+                           ("scale_min_s", float), ("scale_max_s", float),
+                           ("offset_s", float)):
+            value = data.get(name, OPTIONAL_FIELDS.get(name))
+            ok = isinstance(value, int | float) and not isinstance(value, bool)
+            if not ok or not math.isfinite(value) or (kind is int and value != int(value)):
+                raise ValueError(f"cut model: {name} must be a finite "
+                                 f"{'integer' if kind is int else 'number'}, got {value!r}")
+            values[name] = kind(value)
+        if data.get("placement") not in PLACEMENTS:
+            raise ValueError(f"cut model: placement must be one of {', '.join(PLACEMENTS)}, "
+                             f"got {data.get('placement')!r}")
+        return cls(**values, placement=data["placement"])
+
+
+def _where(take) -> str:
+    return os.path.basename(take.path) if getattr(take, "path", None) else take.name
+
+
+def _checked_cuts(take, cuts) -> np.ndarray:
+    """Cuts as sorted unique int frames inside the take; ExampleError naming a bad one."""
+    out = []
+    for value in cuts:
+        number = float(value)
+        if not math.isfinite(number) or number != int(number):
+            raise ExampleError(f"{_where(take)}: cut {value!r} is not a whole frame")
+        if not 0 < int(number) < take.n_frames:
+            raise ExampleError(f"{_where(take)}: cut {int(number)} is outside the take "
+                               f"(frames 1 to {take.n_frames - 1} can start a segment)")
+        out.append(int(number))
+    return np.unique(np.asarray(out, dtype=np.int64))
+
+
+def fit_cut_model(examples: Sequence[tuple[object, Sequence[int]]]) -> CutModel:
+    """Adapt the default detector to example takes with human cuts.
+
+    Parameters
+    ----------
+    examples : sequence of (take, cuts); cuts are 0-based take frames where a new segment
+        starts (a take with no cut is a valid example: one activity throughout). A take
+        is a ``motionlib.Take`` (or anything ``segmenters.default.take_features`` reads);
+        each is analysed once, in order, and not kept.
+
+    Returns
+    -------
+    CutModel; one example is enough, more make each step surer.
+
+    Raises
+    ------
+    ExampleError (a ValueError) naming the take and the value: an empty example list, a cut
+    outside the take, a take too short to analyse.
+    """
+    if len(examples) == 0:
+        raise ExampleError("no example takes to learn from")
+    p = Default.validate_params({})
+    checked = [(take, _checked_cuts(take, cuts)) for take, cuts in examples]
+    shortest = _shortest_segment(checked)
+    if shortest is not None:  # only ever shorter: a longer one would hide short activities
+        p["min_segment_s"] = float(np.clip(MIN_SEGMENT_FACTOR * shortest, MIN_SEGMENT_S,
+                                           p["min_segment_s"]))
+    # One pass over the takes, keeping only peaks and placement offsets: a project's
+    # examples need not all be held in memory with their pose streams.
+    zero_windows = (p["scale_min_s"], p["scale_max_s"])
+    options = _window_options(zero_windows, shortest)
+    peaks = {w: [] for w in [*options, "placed"]}
+    residuals = {name: [] for name in PLACEMENTS}
+    for take, cuts in checked:
+        analysis = Default.analyse(take, p)
+        if analysis is None:
+            raise ExampleError(f"{_where(take)}: too short to learn from "
+                               f"({take.n_frames} frames)")
+        placed = _add_residuals(residuals, take, cuts, analysis, p)
+        peaks["placed"].append(_all_peaks(take, cuts, analysis, p, placed))
+        others = analysis.with_windows(*options[1:]) if len(options) > 1 else []
+        for windows, other in zip(options[1:], others, strict=True):
+            peaks[windows].append(_all_peaks(take, cuts, other, p, {}))
+    windows = zero_windows
+    if len(options) > 1:
+        # Windows compete on unplaced peaks (placing them all would cost a detection each);
+        # the count is then chosen where the chosen windows' cuts really land.
+        peaks[zero_windows] = [_unplaced(take_peaks) for take_peaks in peaks["placed"]]
+        scores = {w: _count(peaks[w], p["prominence"])[0] - (w != zero_windows) * WINDOW_PRIOR
+                  for w in options}
+        windows = max(options, key=lambda w: scores[w])
+    _, prominence = _count(peaks["placed"] if windows == zero_windows else peaks[windows],
+                           p["prominence"])
+    placement, offset = _placement(residuals, "onset" if p["onset"] else "pause")
+    return CutModel(n_takes=len(checked), n_cuts=int(sum(len(c) for _, c in checked)),
+                    threshold=p["threshold"], prominence=prominence,
+                    min_segment_s=p["min_segment_s"], scale_min_s=windows[0],
+                    scale_max_s=windows[1], placement=placement, offset_s=offset)
+
+
+def _window_options(zero_windows: tuple[float, float],
+                    shortest: float | None) -> list[tuple[float, float]]:
+    """The novelty windows to score, zero-shot first.
+
+    Shorter windows are tried only when an example activity is shorter than the shortest
+    zero-shot window: otherwise they only add cuts inside activities (out of sample).
+    """
+    if shortest is None or shortest >= zero_windows[0]:
+        return [zero_windows]
+    return [zero_windows, *[w for w in WINDOW_OPTIONS if w != zero_windows]]
+
+
+def _shortest_segment(checked) -> float | None:
+    """The shortest inner human segment (s) over the examples; None without one."""
+    shortest = [np.diff(cuts).min() / take.fps for take, cuts in checked if len(cuts) > 1]
+    return min(shortest) if shortest else None
+
+
+# The prominences (MMD², see segmenters.default) the count is chosen from, and the summed
+# example F1 that moving a factor e from the zero-shot prominence must buy: a prior that
+# keeps one or two examples from pulling the count to wherever they happen to score best.
+PROMINENCE_GRID = tuple(sorted({*np.round(np.geomspace(0.02, 2.0, 41), 4),
+                                Default.params["prominence"].default}))
+PROMINENCE_PRIOR = 0.05
+# Shorter novelty windows (s) the examples may choose when they hold activities shorter
+# than the zero-shot shortest window, and the summed example F1 such a choice must buy.
+WINDOW_OPTIONS = ((2.0, 4.0), (1.5, 3.0))
+WINDOW_PRIOR = 0.1
+
+
+def matched_count(candidates: np.ndarray, truth: np.ndarray, tolerance: int) -> int:
+    """Size of the largest one-to-one matching within ``tolerance`` frames.
+
+    On a line with one tolerance for all, matching each true cut in order to the earliest
+    free candidate in reach is optimal, and much faster than the assignment solver.
+    """
+    matched, j = 0, 0
+    for t in truth:
+        while j < len(candidates) and candidates[j] < t - tolerance:
+            j += 1
+        if j < len(candidates) and candidates[j] <= t + tolerance:
+            matched += 1
+            j += 1
+    return matched
+
+
+def _all_peaks(take, cuts, analysis, p: dict, placed: dict) -> tuple:
+    """Every novelty peak of one example (frames, prominences) with its cuts and tolerance.
+
+    A peak the zero-shot detector keeps is counted where it places it (``placed``: peak
+    index -> take frame), since its placement can move it by more than the tolerance
+    (the onset after a pause); any other peak at its own frame.
+    """
+    peaks, prominence = Default.select_peaks(analysis.novelty, analysis.rate,
+                                             {**p, "prominence": 0.0})
+    raw = analysis.peak_frames(peaks) + analysis.first
+    frames = np.asarray([placed.get(int(k), f) for k, f in zip(peaks, raw, strict=True)],
+                        dtype=np.int64)
+    order = np.argsort(frames, kind="stable")
+    return (frames[order], prominence[order], np.sort(cuts), int(round(MATCH_S * take.fps)),
+            raw[order])
+
+
+def _unplaced(take_peaks: tuple) -> tuple:
+    """``_all_peaks`` output with every peak back at its own frame (raw_frames order)."""
+    _, prominence, cuts, tol, raw = take_peaks
+    order = np.argsort(raw, kind="stable")
+    return raw[order], prominence[order], cuts, tol, raw[order]
+
+
+def _count(per_take, zero: float) -> tuple[float, float]:
+    """The prominence of PROMINENCE_GRID whose peaks fit the example cuts best.
+
+    Returns (score, prominence): the summed F1 less the prior, and the prominence.
+    """
+    best, best_score = zero, -math.inf
+    for prominence in PROMINENCE_GRID:
+        score = -PROMINENCE_PRIOR * abs(math.log(prominence / zero))
+        for frames, prom, cuts, tol, _ in per_take:
+            kept = frames[prom >= prominence]
+            total = len(kept) + len(cuts)
+            score += 2 * matched_count(kept, cuts, tol) / total if total else 1.0
+        if score > best_score + 1e-9:
+            best, best_score = float(prominence), score
+    return best_score, best
+
+
+def _add_residuals(residuals: dict, take, cuts, analysis, p: dict) -> dict[int, int]:
+    """Add each placement step's signed (human - placed) offsets in seconds, over the
+    zero-shot cuts that match a human cut within 1 s.
+
+    Returns
+    -------
+    novelty peak index -> take frame where the zero-shot detector places that peak.
+    """
+    peaks, _ = Default.select_peaks(analysis.novelty, analysis.rate, p)
+    stages, _ = place_stages(analysis.x, analysis.peak_frames(peaks), analysis.fps,
+                             analysis.gamma, p)
+    for name, placed in stages.items():
+        placed = placed + analysis.first
+        ci, ti = metrics.match(placed, cuts, tolerance=int(round(MATCH_S * take.fps)))
+        residuals[name].extend(((cuts[ti] - placed[ci]) / take.fps).tolist())
+    zero_shot = stages["onset" if p["onset"] else "pause"] + analysis.first
+    return dict(zip(peaks.tolist(), zero_shot.tolist(), strict=True))
+
+
+def _placement(residuals: dict, zero_shot: str) -> tuple[str, float]:
+    """The placement step and shift (s) that follow the human cuts best, if clearly so."""
+    r = np.asarray(residuals[zero_shot])
+    if len(r) < PLACEMENT_MIN_CUTS:
+        return zero_shot, 0.0
+    base = float(np.median(np.abs(r)))
+    best, best_error = (zero_shot, 0.0), base
+    for name in PLACEMENTS:
+        r = np.asarray(residuals[name])
+        offset = float(np.median(r))
+        error = float(np.median(np.abs(r - offset)))
+        if error < best_error:
+            best, best_error = (name, offset), error
+    ratio, seconds = PLACEMENT_GAIN
+    if best_error > min((1 - ratio) * base, base - seconds):
+        return zero_shot, 0.0
+    return best
+
+
+def _segment(analysis, p: dict, placement: str, offset_s: float) -> Segmentation:
+    peaks, strength = Default.select_peaks(analysis.novelty, analysis.rate, p)
+    stages, speed = place_stages(analysis.x, analysis.peak_frames(peaks), analysis.fps,
+                                 analysis.gamma, p)
+    cuts = stages[placement] + int(round(offset_s * analysis.fps))
+    result = analysis.segmentation(cuts, confidence(strength, p), speed)
+    return _checked(result, len(analysis.x) + analysis.first)
+
+
+def detect(take, model: CutModel | None = None, **params) -> Segmentation:
+    """Candidate cuts of ``take``; ``model=None`` is the zero-shot default detector.
+
+    ``params`` are the ``default`` segmenter's parameters (validated with its schema);
+    with a model, its learnt ``threshold``, ``prominence``, ``min_segment_s`` and windows
+    (``scale_min_s``, ``scale_max_s``) replace those, and each cut is taken from its
+    ``placement`` step and moved by its ``offset_s``.
+
+    Returns
+    -------
+    Segmentation, as ``Default(**params).fit_predict(take)``.
+    """
+    if model is None:
+        return Default(**params).fit_predict(take)
+    p = {**Default.validate_params(params), **model.params()}
+    start = time.perf_counter()
+    analysis = Default.analyse(take, p)
+    result = empty_segmentation(take) if analysis is None else \
+        _segment(analysis, p, model.placement, model.offset_s)
+    result.timings["total"] = time.perf_counter() - start
+    return result
+
+
+# --- examples CSV -----------------------------------------------------------------------
+
+EXAMPLE_COLUMNS = ("file", "asf", "cuts")
+
+
+def read_examples(path) -> list[tuple[object, np.ndarray]]:
+    """Example takes and their human cuts from a CSV with the header ``file,asf,cuts``.
+
+    ``file`` is a BVH or AMC path (relative paths from the CSV's folder), ``asf`` the ASF of
+    an AMC (empty for BVH), ``cuts`` 0-based take frames separated by spaces.
+
+    Raises
+    ------
+    ExampleError naming the CSV, the line and the value for a malformed row, an unreadable
+    take or a cut outside its take.
+    """
+    import motionlib
+
+    path = Path(path)
+    try:
+        with open(path, newline="", encoding="utf-8") as fh:
+            rows = list(csv.reader(fh))
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ExampleError(f"{path}: cannot read examples: {exc}") from None
+    header = [c.strip() for c in rows[0]] if rows else []
+    if tuple(header) != EXAMPLE_COLUMNS:
+        raise ExampleError(f"{path}:1: expected the header {','.join(EXAMPLE_COLUMNS)}, "
+                           f"got {','.join(header) or 'nothing'!r}")
+    examples = []
+    for line, row in enumerate(rows[1:], start=2):
+        if not any(cell.strip() for cell in row):
+            continue
+        if len(row) != 3:
+            raise ExampleError(f"{path}:{line}: expected 3 fields (file,asf,cuts), "
+                               f"got {len(row)}: {','.join(row)!r}")
+        file, asf, text = (cell.strip() for cell in row)
+        cuts = _parse_cuts(path, line, text)
+        if not file:
+            raise ExampleError(f"{path}:{line}: file is empty")
+        take_path = path.parent / file
+        asf_path = path.parent / asf if asf else None
+        try:
+            take = motionlib.read(take_path, asf=asf_path)
+        except (ValueError, OSError) as exc:
+            first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+            raise ExampleError(f"{path}:{line}: cannot read {file}: {first}") from None
+        for cut in cuts:
+            if not 0 < cut < take.n_frames:
+                raise ExampleError(f"{path}:{line}: cut {cut} is outside {file} "
+                                   f"({take.n_frames} frames; 1 to {take.n_frames - 1} can "
+                                   f"start a segment)")
+        examples.append((take, np.asarray(cuts, dtype=np.int64)))
+    if not examples:
+        raise ExampleError(f"{path}: no example takes")
+    return examples
+
+
+def _parse_cuts(path: Path, line: int, text: str) -> list[int]:
+    cuts = []
+    for word in text.split():
+        try:
+            cuts.append(int(word))
+        except ValueError:
+            raise ExampleError(f"{path}:{line}: cut {word!r} is not a whole frame "
+                               f"number") from None
+    return cuts
