@@ -162,6 +162,9 @@ CUTROOM_CLAIM_TIMEOUT = envint("CUTROOM_CLAIM_TIMEOUT", 15 * 60)
 # After this many claims a job that keeps killing its worker is marked failed.
 CUTROOM_MAX_ATTEMPTS = envint("CUTROOM_MAX_ATTEMPTS", 3)
 CUTROOM_FRAMES_PER_REQUEST = 5000
+# A project's model retrains this many seconds after a review submit or gold save;
+# submits made meanwhile join the same training.
+CUTROOM_RETRAIN_DELAY = envint("CUTROOM_RETRAIN_DELAY", 10)
 
 # Celery. No result backend: a job's state is its row (status, error, timings).
 # (the host part only keeps kombu from warning that none was given)
