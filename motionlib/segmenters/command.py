@@ -18,17 +18,33 @@ def add_segment(subparsers) -> None:
                    help="method parameter, repeatable")
     p.add_argument("--json", action="store_true", help="print JSON instead of a table")
     p.add_argument("--plot", metavar="OUT.png", help="also draw the signal with the cuts")
+    p.add_argument("--examples", metavar="EXAMPLES.csv",
+                   help="adapt the default method to these example takes with human cuts "
+                        "first (CSV header file,asf,cuts; cuts are 0-based frames separated "
+                        "by spaces)")
     p.set_defaults(handler=run_segment)
 
 
 def run_segment(args) -> int:
     from motionlib.io import read
-    from motionlib.segmenters import get_segmenter, parse_param_args
+    from motionlib.segmenters import ParamError, get_segmenter, parse_param_args
 
     cls = get_segmenter(args.method)
     params = cls.validate_params(parse_param_args(args.param))  # before the slow read
+    if args.examples and cls.name != "default":
+        raise ParamError(f"--examples: only the default method adapts, not {cls.name!r}")
+    model = None
+    if args.examples:
+        from motionlib.adapt import fit_cut_model, read_examples
+
+        model = fit_cut_model(read_examples(args.examples))
     take = read(args.file, asf=args.asf)
-    result = cls(**params).fit_predict(take)
+    if model is not None:
+        from motionlib.adapt import detect
+
+        result = detect(take, model, **parse_param_args(args.param))
+    else:
+        result = cls(**params).fit_predict(take)
     if args.plot:
         from motionlib.segmenters.plot import plot_segmentation
 
@@ -37,11 +53,15 @@ def run_segment(args) -> int:
     cuts = [{"frame": int(c), "confidence": round(float(p), 4)}
             for c, p in zip(result.cuts, result.confidence, strict=True)]
     if args.json:
-        print(json.dumps({"fps": take.fps, "n_frames": take.n_frames, "method": cls.name,
-                          "cuts": cuts}))
+        out = {"fps": take.fps, "n_frames": take.n_frames, "method": cls.name, "cuts": cuts}
+        if model is not None:
+            out["adapted_from"] = {"takes": model.n_takes, "cuts": model.n_cuts}
+        print(json.dumps(out))
         return 0
+    adapted = "" if model is None else \
+        f", adapted from {model.n_takes} example takes with {model.n_cuts} cuts"
     print(f"{args.file}: {len(cuts)} cuts by {cls.name} "
-          f"({take.n_frames} frames at {take.fps:g} fps)")
+          f"({take.n_frames} frames at {take.fps:g} fps{adapted})")
     print(f"{'frame':>8} {'time s':>9} {'confidence':>10}")
     for cut in cuts:
         print(f"{cut['frame']:>8} {cut['frame'] / take.fps:>9.3f} {cut['confidence']:>10.3f}")

@@ -60,6 +60,7 @@ All durations are in seconds, so the same defaults work at any frame rate.
 from __future__ import annotations
 
 import time
+from dataclasses import dataclass
 
 import numpy as np
 from scipy.signal import find_peaks
@@ -253,6 +254,83 @@ def nearest(points: np.ndarray, target: int, radius: int) -> int:
     return int(best) if abs(best - target) <= radius else target
 
 
+PLACEMENTS = ("split", "turn", "pause")
+
+
+def place_stages(x: np.ndarray, peaks: np.ndarray, fps: float, gamma: float, p: dict):
+    """Each placement step's estimate of every cut (see the module docstring, step 5).
+
+    Returns
+    -------
+    stages : {"split", "turn", "pause"} -> (n_cuts,) int frames of ``x``, each step
+        starting from the previous one's result.
+    speed : (n,) the 1 Hz pose speed.
+    """
+    speed = features.lowpass(features.frame_speed(x, fps=fps), fps=fps, cutoff_hz=1.0)
+    step = max(1, int(round(fps / SPLIT_RATE_HZ)))
+    turns = turning_points(x, fps=fps)
+    radius = int(round(p["refine_s"] * fps))
+    context = int(round(p["scale_min_s"] * fps))
+    stages = {name: [] for name in PLACEMENTS}
+    for i, cut in enumerate(int(c) for c in peaks):
+        # Never look past half-way to a neighbouring cut: that stretch is theirs.
+        lo = max(0, cut - context, (int(peaks[i - 1]) + cut) // 2 if i else 0)
+        hi = min(len(x), cut + context)
+        if i + 1 < len(peaks):
+            hi = min(hi, (cut + int(peaks[i + 1])) // 2)
+        split = best_split(x, cut, lo, hi, step=step, radius=radius, gamma=gamma)
+        turn = nearest(turns, split, radius)
+        stages["split"].append(split)
+        stages["turn"].append(turn)
+        stages["pause"].append(settle_frame(speed, turn, radius, context))
+    return {k: np.asarray(v, dtype=np.int64) for k, v in stages.items()}, speed
+
+
+@dataclass
+class Analysis:
+    """What the default detector computes before choosing cuts.
+
+    x : (n, d) pose features of frames ``first ..`` at ``fps``; step : frames per novelty
+    block; gamma : kernel 1 / bandwidth²; novelty : (n // step,) mean MMD² per block.
+    """
+
+    x: np.ndarray
+    fps: float
+    step: int
+    first: int
+    gamma: float
+    novelty: np.ndarray
+    timings: dict[str, float]
+
+    @property
+    def rate(self) -> float:
+        """Novelty samples per second."""
+        return self.fps / self.step
+
+    def peak_frames(self, peaks: np.ndarray) -> np.ndarray:
+        """Novelty sample indices -> frames of ``x`` (block centres)."""
+        return np.asarray(peaks, dtype=np.int64) * self.step + self.step // 2
+
+    def segmentation(self, cuts: np.ndarray, confidence: np.ndarray,
+                     speed: np.ndarray) -> Segmentation:
+        """The result for cuts given in frames of ``x``."""
+        centres = np.arange(len(self.novelty)) * self.step + self.step / 2
+        curve = np.interp(np.arange(len(self.x)), centres, self.novelty)
+        return Segmentation(
+            cuts=np.asarray(cuts, dtype=np.int64) + self.first,
+            confidence=confidence,
+            signals={"novelty": full_length(curve, self.first),
+                     "speed": full_length(speed, self.first)},
+            timings=dict(self.timings),
+        )
+
+
+def empty_segmentation(take) -> Segmentation:
+    """No cuts, for a take too short to compare anything."""
+    return Segmentation(np.zeros(0, np.int64), np.zeros(0),
+                        {"novelty": np.zeros(take.n_frames)})
+
+
 # The split is searched on block means at this rate: finer than the 0.1 s that
 # annotators label at, and the cut then moves to a turning point at the native rate.
 SPLIT_RATE_HZ = 30.0
@@ -291,6 +369,24 @@ class Default(Segmenter):
     }
 
     def _segment(self, take, **p) -> Segmentation:
+        analysis = self.analyse(take, p)
+        if analysis is None:
+            return empty_segmentation(take)
+        t0 = time.perf_counter()
+        peaks, strength = self._peaks(analysis.novelty, analysis.rate, p)
+        cuts, speed = self._place(analysis.x, analysis.peak_frames(peaks), analysis.fps,
+                                  analysis.gamma, p)
+        result = analysis.segmentation(cuts, strength / (strength + p["threshold"] + 1e-12),
+                                       speed)
+        result.timings["cuts"] = time.perf_counter() - t0
+        return result
+
+    @classmethod
+    def analyse(cls, take, p: dict) -> Analysis | None:
+        """Pose stream, kernel and novelty curve of ``take`` (None if it is too short).
+
+        ``p`` are validated parameters; a scale error raises ParamError.
+        """
         if p["scale_max_s"] < p["scale_min_s"]:
             raise ParamError(
                 f"scale_max_s: must be at least scale_min_s ({p['scale_min_s']:g}), "
@@ -303,24 +399,14 @@ class Default(Segmenter):
         x = pose_features(positions, joints, fps=fps, velocity_s=p["velocity_s"])
         step = max(1, int(round(fps / p["rate_hz"])))
         if len(x) < 2 * step:  # too short to compare anything: no cuts
-            flat = full_length(np.zeros(len(x)), first)
-            return Segmentation(np.zeros(0, np.int64), np.zeros(0), {"novelty": flat})
+            return None
         blocks = block_mean(x, step)
         # One kernel for detection and placement, its width from the median heuristic.
         gamma = 1.0 / max(p["bandwidth"] * median_sq_distance(blocks), 1e-12)
-        novelty = self._novelty(blocks, fps / step, gamma, p)
+        novelty = cls._novelty(blocks, fps / step, gamma, p)
         t2 = time.perf_counter()
-        peaks, strength = self._peaks(novelty, fps / step, p)
-        cuts, speed = self._place(x, peaks * step + step // 2, fps, gamma, p)
-        t3 = time.perf_counter()
-        centres = np.arange(len(novelty)) * step + step / 2
-        curve = np.interp(np.arange(len(x)), centres, novelty)
-        return Segmentation(
-            cuts=cuts + first,
-            confidence=strength / (strength + p["threshold"] + 1e-12),
-            signals={"novelty": full_length(curve, first), "speed": full_length(speed, first)},
-            timings={"kinematics": t1 - t0, "novelty": t2 - t1, "cuts": t3 - t2},
-        )
+        return Analysis(x=x, fps=fps, step=step, first=first, gamma=gamma, novelty=novelty,
+                        timings={"kinematics": t1 - t0, "novelty": t2 - t1})
 
     @staticmethod
     def _place(x: np.ndarray, peaks: np.ndarray, fps: float, gamma: float, p: dict):
@@ -328,22 +414,8 @@ class Default(Segmenter):
 
         Returns the placed cuts (frames of ``x``) and the 1 Hz pose speed.
         """
-        speed = features.lowpass(features.frame_speed(x, fps=fps), fps=fps, cutoff_hz=1.0)
-        step = max(1, int(round(fps / SPLIT_RATE_HZ)))
-        turns = turning_points(x, fps=fps)
-        radius = int(round(p["refine_s"] * fps))
-        context = int(round(p["scale_min_s"] * fps))
-        placed = []
-        for i, cut in enumerate(int(c) for c in peaks):
-            # Never look past half-way to a neighbouring cut: that stretch is theirs.
-            lo = max(0, cut - context, (int(peaks[i - 1]) + cut) // 2 if i else 0)
-            hi = min(len(x), cut + context)
-            if i + 1 < len(peaks):
-                hi = min(hi, (cut + int(peaks[i + 1])) // 2)
-            split = best_split(x, cut, lo, hi, step=step, radius=radius, gamma=gamma)
-            turn = nearest(turns, split, radius)
-            placed.append(settle_frame(speed, turn, radius, context))
-        return np.asarray(placed, dtype=np.int64), speed
+        stages, speed = place_stages(x, peaks, fps, gamma, p)
+        return stages["pause"], speed
 
     @staticmethod
     def _novelty(x: np.ndarray, rate: float, gamma: float, p: dict) -> np.ndarray:

@@ -1,0 +1,91 @@
+"""Adapting the default detector to example takes with human cuts (motionlib.adapt)."""
+
+import numpy as np
+import pytest
+
+from motionlib import metrics, synth
+from motionlib.adapt import CutModel, ExampleError, detect, fit_cut_model
+
+FPS = 60.0
+
+
+def _take(seed, **kw):
+    take, segments = synth.generate(seed=seed, fps=FPS, duration=kw.pop("duration", 50.0), **kw)
+    return take, np.asarray([start for start, _, _ in segments[1:]], dtype=np.int64)
+
+
+def _signed_errors(cuts, truth, fps):
+    ci, ti = metrics.match(cuts, truth, tolerance=int(fps))
+    return (np.asarray(truth)[ti] - np.asarray(cuts)[ci]) / fps
+
+
+def test_it_moves_placement_to_where_the_annotators_cut():
+    # These annotators mark the onset of the next activity, 0.6 s after the cross-fade.
+    late = int(0.6 * FPS)
+    examples = [(take, cuts + late) for take, cuts in (_take(1), _take(2))]
+    model = fit_cut_model(examples)
+    take, cuts = _take(3)
+    zero_shot = np.median(_signed_errors(detect(take).cuts, cuts + late, FPS))
+    adapted = np.median(_signed_errors(detect(take, model).cuts, cuts + late, FPS))
+    assert zero_shot > 0.3
+    assert abs(adapted) < 0.15
+
+
+def test_it_learns_that_a_studio_cuts_nothing_in_such_takes():
+    model = fit_cut_model([(_take(4)[0], []), (_take(5)[0], [])])
+    assert len(detect(_take(6)[0], model).cuts) == 0
+
+
+def test_it_learns_the_shortest_activity_from_the_examples():
+    short = dict(segment_seconds=(1.5, 2.5), duration=30.0)
+    model = fit_cut_model([_take(7, **short), _take(8, **short)])
+    assert model.min_segment_s < 1.5
+    take, cuts = _take(9, **short)
+    found = metrics.boundary_scores(detect(take, model).cuts, cuts, fps=FPS, tolerance_s=0.5)
+    zero_shot = metrics.boundary_scores(detect(take).cuts, cuts, fps=FPS, tolerance_s=0.5)
+    assert found["recall"] > zero_shot["recall"]
+
+
+def test_it_counts_the_examples_it_learnt_from():
+    model = fit_cut_model([_take(1), _take(2)])
+    assert (model.n_takes, model.n_cuts) == (2, len(_take(1)[1]) + len(_take(2)[1]))
+
+
+def test_it_round_trips_a_model_through_json():
+    model = CutModel(n_takes=2, n_cuts=9, threshold=0.2, min_segment_s=1.5,
+                     scale_min_s=1.5, scale_max_s=3.0,
+                     placement="split", offset_s=-0.1)
+    text = model.to_json()
+    assert '"format": 1' in text
+    assert CutModel.from_json(text) == model
+
+
+@pytest.mark.parametrize("text, fault", [
+    ("{", "not JSON"),
+    ('{"format": 2}', "format 2"),
+    ('{"format": 1, "n_takes": 1, "n_cuts": 1, "threshold": "x", "min_segment_s": 1, '
+     '"scale_min_s": 1, "scale_max_s": 2, "offset_s": 0, "placement": "pause"}', "threshold"),
+    ('{"format": 1, "n_takes": 1, "n_cuts": 1, "threshold": 1, "min_segment_s": 1, '
+     '"scale_min_s": 1, "scale_max_s": 2, "offset_s": 0, "placement": "middle"}', "placement"),
+])
+def test_it_refuses_a_stored_model_it_cannot_read(text, fault):
+    with pytest.raises(ValueError, match=fault):
+        CutModel.from_json(text)
+
+
+def test_it_refuses_a_cut_outside_the_example_take():
+    take, _ = _take(1, duration=20.0)
+    with pytest.raises(ExampleError, match=f"cut {take.n_frames + 5} is outside"):
+        fit_cut_model([(take, [100, take.n_frames + 5])])
+
+
+def test_it_refuses_an_empty_example_list():
+    with pytest.raises(ExampleError, match="no example takes"):
+        fit_cut_model([])
+
+
+def test_it_detects_zero_shot_exactly_as_the_default_segmenter():
+    from motionlib.segmenters.default import Default
+
+    take, _ = _take(1, duration=20.0)
+    assert detect(take).cuts.tolist() == Default().fit_predict(take).cuts.tolist()
