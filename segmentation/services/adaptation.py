@@ -104,7 +104,9 @@ def example_take(capture):
         take = read_take(capture)
     except (ValueError, OSError) as exc:
         raise ValueError(f"reviewed capture {capture.pk} ({capture.name!r}) cannot be read: {exc}") from exc
-    return dataclasses.replace(take, name=f"{capture.name} (capture {capture.pk})")
+    # motionlib names a take by its path when it has one: the stored file's name is a
+    # random folder away from what the studio knows, so name the capture instead.
+    return dataclasses.replace(take, name=f"capture {capture.pk} ({capture.name})", path=None)
 
 
 def train_project_model(job):
