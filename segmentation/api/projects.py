@@ -10,7 +10,12 @@ from rest_framework.views import APIView
 
 from motionlib.segmenters import list_segmenters
 from segmentation import services
-from segmentation.api.serializers import LabelSerializer, MemberSerializer, ProjectSerializer
+from segmentation.api.serializers import (
+    CutModelSerializer,
+    LabelSerializer,
+    MemberSerializer,
+    ProjectSerializer,
+)
 from segmentation.models import Project
 
 
@@ -63,6 +68,14 @@ class ProjectViewSet(
         data = serializer.validated_data
         member = services.do_set_member(project, data["user"]["username"], data["role"])
         return Response(MemberSerializer(member).data, status=201)
+
+
+    @extend_schema(responses=CutModelSerializer(many=True))
+    @action(detail=True, url_path="cut-models")
+    def cut_models(self, request, pk=None):
+        """The project's trainings, newest first: versions learnt from its reviews, and
+        failed trainings with their reason (detection keeps the newest version)."""
+        return Response(CutModelSerializer(self.get_object().cut_models.all()[:50], many=True).data)
 
 
 class MeView(APIView):

@@ -3,7 +3,15 @@ check the request's shape, and the services check its meaning."""
 
 from rest_framework import serializers
 
-from segmentation.models import ROLES, Capture, DetectionRun, Label, Review, ReviewEvent
+from segmentation.models import (
+    ROLES,
+    Capture,
+    DetectionRun,
+    Label,
+    ProjectCutModel,
+    Review,
+    ReviewEvent,
+)
 
 
 class LabelSerializer(serializers.ModelSerializer):
@@ -47,6 +55,22 @@ class RunSerializer(serializers.ModelSerializer):
 
     def get_error(self, run) -> str | None:
         return run.error or None
+
+
+class CutModelSerializer(serializers.ModelSerializer):
+    """One training of a project's cut model: a version, or why it failed."""
+
+    error = serializers.SerializerMethodField()
+
+    class Meta:
+        model = ProjectCutModel
+        fields = [
+            "id", "version", "status", "error", "n_takes", "n_cuts", "seconds", "created_at",
+            "finished_at",
+        ]
+
+    def get_error(self, job) -> str | None:
+        return job.error or None
 
 
 class RunRequestSerializer(serializers.Serializer):

@@ -210,3 +210,26 @@ class StaleTrainingTestCase(AdaptationTestCase):
         self.assertEqual(ProjectCutModel.objects.get(pk=waiting.pk).status, "queued")
         self.assertEqual(len(sends), 1)
 
+
+
+class CutModelsEndpointTestCase(AdaptationTestCase):
+    def test_members_see_the_projects_trainings_newest_first_with_failures_explained(self):
+        self.trained(1)
+        ProjectCutModel.objects.create(project=self.project, status="failed", error="training: x")
+        self.login(self.bob)
+        rows = self.client.get(f"/api/projects/{self.project.pk}/cut-models/").json()
+        self.assertEqual([(r["version"], r["status"], r["error"]) for r in rows],
+                         [(None, "failed", "training: x"), (1, "ready", None)])
+
+    def test_an_outsider_gets_404(self):
+        self.login(self.charlie)
+        self.assertEqual(self.client.get(f"/api/projects/{self.project.pk}/cut-models/").status_code, 404)
+
+    def test_the_admin_lists_and_shows_trainings(self):
+        from django.contrib.auth import get_user_model
+
+        job = self.trained(1)
+        self.client.force_login(get_user_model().objects.create_superuser("root", password="root-pw"))
+        self.assertEqual(self.client.get("/admin/segmentation/projectcutmodel/").status_code, 200)
+        page = self.client.get(f"/admin/segmentation/projectcutmodel/{job.pk}/change/")
+        self.assertEqual(page.status_code, 200)
