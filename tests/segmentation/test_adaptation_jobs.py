@@ -233,3 +233,19 @@ class CutModelsEndpointTestCase(AdaptationTestCase):
         self.assertEqual(self.client.get("/admin/segmentation/projectcutmodel/").status_code, 200)
         page = self.client.get(f"/admin/segmentation/projectcutmodel/{job.pk}/change/")
         self.assertEqual(page.status_code, 200)
+
+
+class SweepCommandTestCase(AdaptationTestCase):
+    def test_the_command_requeues_a_training_whose_worker_vanished(self):
+        from io import StringIO
+
+        from django.core.management import call_command
+
+        job = adaptation.request_training(self.project.pk)
+        ProjectCutModel.objects.filter(pk=job.pk).update(
+            status="processing", claim_token="dead", attempts=1,
+            claimed_at=timezone.now() - timezone.timedelta(hours=2))
+        out = StringIO()
+        call_command("sweep_claims", stdout=out)
+        self.assertEqual(out.getvalue().strip(), "1 stale job(s) requeued or failed")
+        self.assertEqual(ProjectCutModel.objects.get(pk=job.pk).status, "queued")
