@@ -14,6 +14,7 @@ Target: total <= 10 s on one core.
 
 import argparse
 import os
+import shutil
 import statistics
 import sys
 import tempfile
@@ -97,6 +98,13 @@ def time_parts(project):
 def main():
     args = parse_args()
     var = Path(tempfile.mkdtemp(prefix="cutroom-retrain-"))
+    try:
+        run(args, var)
+    finally:
+        shutil.rmtree(var, ignore_errors=True)
+
+
+def run(args, var):
     start_django(unset=("DATABASE_URL", "CELERY_BROKER_URL", "CUTROOM_MEDIA_ROOT", "CELERY_BROKER_DIR"),
                  CUTROOM_VAR_DIR=str(var))
     built = time.perf_counter()

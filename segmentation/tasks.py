@@ -12,7 +12,7 @@ from celery import shared_task
 from celery.signals import worker_ready
 
 from segmentation import services
-from segmentation.models import Capture, DetectionRun, ProjectCutModel
+from segmentation.models import Capture, DetectionRun
 from segmentation.services import adaptation
 from segmentation.services.captures import exhausted, give_up
 
@@ -50,7 +50,7 @@ def retrain(self, model_id):
     """Train a project's cut model from its reviewed takes (one at a time per project:
     the claim fails while another training of the project runs, which starts this one
     when it ends)."""
-    job = _claim(ProjectCutModel, model_id, self)
+    job = adaptation.claim_training(model_id, self.request.id or uuid.uuid4().hex)
     if job is not None:
         adaptation.train_project_model(job)
 

@@ -109,6 +109,29 @@ def example_take(capture):
     return dataclasses.replace(take, name=f"capture {capture.pk} ({capture.name})", path=None)
 
 
+def claim_training(pk, token):
+    """The claimed training row, or None when it is not its turn (another training of
+    the project runs), another worker has it, or it is done. A training that was
+    started too often without finishing (it keeps killing its worker) fails instead."""
+    if not ProjectCutModel.objects.claim(pk, token):
+        return None
+    job = ProjectCutModel.objects.get(pk=pk)
+    if job.attempts > settings.CUTROOM_MAX_ATTEMPTS:
+        _give_up(job)
+        return None
+    return job
+
+
+def _give_up(job):
+    failed = job.fail(
+        f"training started {job.attempts} times and never finished (the worker was killed or "
+        "lost); the project keeps its previous model",
+        finished_at=timezone.now(),
+    )
+    _start_waiting(job.project_id)
+    return failed
+
+
 def train_project_model(job):
     """Train a claimed ProjectCutModel row from the project's current examples, store it
     as the next version (or the reason it failed), then start the training that waited."""
@@ -166,12 +189,7 @@ def sweep_stale_trainings():
     for job in ProjectCutModel.objects.stale():
         waiting = ProjectCutModel.objects.filter(project_id=job.project_id, status="queued")
         if job.attempts >= settings.CUTROOM_MAX_ATTEMPTS or waiting.exists():
-            count += job.fail(
-                f"training started {job.attempts} times and never finished (the worker was "
-                "killed or lost); the project keeps its previous model",
-                finished_at=timezone.now(),
-            )
-            _start_waiting(job.project_id)
+            count += _give_up(job)
             continue
         try:
             with transaction.atomic():

@@ -249,3 +249,19 @@ class SweepCommandTestCase(AdaptationTestCase):
         call_command("sweep_claims", stdout=out)
         self.assertEqual(out.getvalue().strip(), "1 stale job(s) requeued or failed")
         self.assertEqual(ProjectCutModel.objects.get(pk=job.pk).status, "queued")
+
+
+class ExhaustedTrainingTestCase(AdaptationTestCase):
+    @override_settings(CUTROOM_MAX_ATTEMPTS=2)
+    def test_a_training_that_keeps_killing_its_worker_fails_and_the_next_one_is_sent(self):
+        job = adaptation.request_training(self.project.pk)
+        ProjectCutModel.objects.filter(pk=job.pk).update(status="processing", attempts=2, claim_token="x")
+        waiting = ProjectCutModel.objects.create(project=self.project)
+        with self.captureOnCommitCallbacks() as sends:
+            tasks.retrain.apply(args=[job.pk], task_id="x")
+        job.refresh_from_db()
+        self.assertEqual(job.status, "failed")
+        self.assertIn("started 3 times and never finished", job.error)
+        self.assertIn("keeps its previous model", job.error)
+        self.assertEqual(len(sends), 1)
+        self.assertEqual(ProjectCutModel.objects.get(pk=waiting.pk).status, "queued")
