@@ -9,7 +9,7 @@ has claimed the row) is timed end to end, then its two parts apart: reading the 
 
     .venv/bin/python benchmarks/retrain.py [--takes 50] [--minutes 5] [--repeats 3]
 
-Target: total <= 10 s on one core.
+Target: training <= 10 s on one core (CPU seconds of the job; wall time printed too).
 """
 
 import argparse
@@ -73,30 +73,33 @@ def time_training(project):
     job = ProjectCutModel.objects.create(project=project)
     assert ProjectCutModel.objects.claim(job.pk, f"bench-{job.pk}")
     job.refresh_from_db()
-    started = time.perf_counter()
+    started, cpu = time.perf_counter(), time.process_time()
     adaptation.train_project_model(job)
-    total = time.perf_counter() - started
+    total, cpu = time.perf_counter() - started, time.process_time() - cpu
     job.refresh_from_db()
     if job.status != "ready":
         sys.exit(f"training failed: {job.error}")
-    return total, job
+    return total, cpu, job
 
 
 def time_parts(project):
     from motionlib import adapt
     from segmentation.services import adaptation
 
-    started = time.perf_counter()
+    started = time.process_time()
     examples = adaptation.project_examples(project.pk)
     takes = [(adaptation.example_take(capture), cuts) for capture, cuts in examples]
-    read = time.perf_counter() - started
-    started = time.perf_counter()
+    read = time.process_time() - started
+    started = time.process_time()
     adapt.fit_cut_model(takes)
-    return read, time.perf_counter() - started
+    return read, time.process_time() - started
 
 
 def main():
     args = parse_args()
+    # "On one core": numpy (imported with Django below) must not fan out to other cores.
+    for name in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+        os.environ.setdefault(name, "1")
     var = Path(tempfile.mkdtemp(prefix="cutroom-retrain-"))
     try:
         run(args, var)
@@ -115,19 +118,25 @@ def run(args, var):
           f"{os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f}")
     rows = []
     for repeat in range(args.repeats):
-        total, job = time_training(project)
+        total, cpu, job = time_training(project)
         read, fit = time_parts(project)
-        rows.append((total, read, fit))
-        print(f"  repeat {repeat + 1}: training {total:.2f} s (model v{job.version}, "
-              f"{job.n_takes} takes, {job.n_cuts} cuts); read {read:.2f} s, fit {fit:.2f} s")
+        rows.append((total, cpu, read, fit))
+        print(f"  repeat {repeat + 1}: training {total:.2f} s wall, {cpu:.2f} s CPU (model "
+              f"v{job.version}, {job.n_takes} takes, {job.n_cuts} cuts); then apart: read "
+              f"{read:.2f} s CPU, fit {fit:.2f} s CPU")
     print()
-    print(f"{'':24}{'median':>10}{'min':>10}{'max':>10}")
-    for name, column in (("training job (s)", 0), ("  reading takes (s)", 1), ("  fitting (s)", 2)):
+    print(f"{'':30}{'median':>10}{'min':>10}{'max':>10}")
+    names = ("training job, wall (s)", "training job, CPU (s)", "  reading takes, CPU (s)",
+             "  fitting, CPU (s)")
+    for column, name in enumerate(names):
         values = [row[column] for row in rows]
-        print(f"{name:24}{statistics.median(values):>10.2f}{min(values):>10.2f}{max(values):>10.2f}")
-    median = statistics.median(row[0] for row in rows)
+        print(f"{name:30}{statistics.median(values):>10.2f}{min(values):>10.2f}{max(values):>10.2f}")
+    # CPU seconds of this single-threaded process: what the job costs one core, even when
+    # the machine is shared (its wall time then also counts the other processes).
+    median = statistics.median(row[1] for row in rows)
     verdict = "meets" if median <= TARGET_SECONDS else "MISSES"
-    print(f"\ntarget: training <= {TARGET_SECONDS:g} s -> median {median:.2f} s {verdict} it")
+    print(f"\ntarget: training <= {TARGET_SECONDS:g} s on one core -> median {median:.2f} s CPU "
+          f"{verdict} it")
 
 
 if __name__ == "__main__":
