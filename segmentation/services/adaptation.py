@@ -38,7 +38,9 @@ def on_examples_changed(project_id):
     new example; a training already running read the examples before it and is followed
     by the one queued here.
     """
-    transaction.on_commit(lambda: request_training(project_id))
+    # robust: the submit is committed by then; a failure here is logged (the next submit
+    # asks again) instead of turning the submit's answer into an error.
+    transaction.on_commit(lambda: request_training(project_id), robust=True)
 
 
 def request_training(project_id):
