@@ -7,18 +7,21 @@ runs the default detector with it.
 
 What is learnt, step by step (each from all examples together, never per take):
 
-1. *Minimum segment and windows.* The shortest human segment bounds how close two cuts
-   may be: ``min_segment_s`` is 0.75 x the shortest example segment, within [0.5, 4] s;
-   and the novelty windows must fit into it to see it: the shortest window is the shortest
-   segment (at most the zero-shot 3 s, at least 1 s), the longest twice that.
-2. *How many cuts.* The novelty threshold that scores the best F1 at 1 s between the
-   novelty peaks and the human cuts, summed over the examples (ties: the threshold nearest
-   the zero-shot default).
-3. *Where.* Each placement step of the detector (best split, turning point, pause; see
-   ``segmenters.default``) is an anchor; for each, the signed offsets from the detected
-   cut to the human cut it matches within 1 s. The anchor whose offsets vary least (median
-   absolute deviation) is kept with their median as a shift: annotators who mark the onset
-   of the next activity cut a steady time after the statistical change.
+1. *Minimum segment.* The shortest human segment bounds how close two cuts may be:
+   ``min_segment_s`` becomes 0.75 x the shortest example segment when that is shorter
+   than the zero-shot 1.5 s (never below 0.5 s, never longer than zero-shot).
+2. *How many cuts.* The novelty peaks of every example are computed once (zero-shot
+   windows and height threshold); the ``prominence`` from :data:`PROMINENCE_GRID` whose
+   peaks match the human cuts best (summed F1 at 1 s, one-to-one within 1 s), less a
+   prior cost of moving away from the zero-shot prominence, is kept. Prominence, not
+   height, is what separated true from false peaks out of sample (``segmenters.default``).
+3. *Where.* Each placement step of the detector (best split, turning point, pause,
+   onset; see ``segmenters.default``) is an anchor; for each, the signed offsets from the
+   detected cut to the human cut it matches within 1 s, and their median as a shift. The
+   anchor and shift with the smallest median error replace the zero-shot placement only
+   when at least 6 example cuts matched and the error drops by 20 % and 0.03 s
+   (annotators who mark the onset of the next activity cut a steady time after the
+   statistical change; a handful of cuts cannot show that).
 
 Pure numpy/scipy, no Django; the service stores ``CutModel.to_json()``.
 """
@@ -37,11 +40,22 @@ import numpy as np
 
 from motionlib import metrics
 from motionlib.segmenters.base import Segmentation, _checked
-from motionlib.segmenters.default import PLACEMENTS, Default, empty_segmentation, place_stages
+from motionlib.segmenters.default import (
+    PLACEMENTS,
+    Default,
+    confidence,
+    empty_segmentation,
+    place_stages,
+)
 
 FORMAT = 1
-MIN_SEGMENT_RANGE_S = (0.5, 4.0)
+MIN_SEGMENT_S = 0.5
 MIN_SEGMENT_FACTOR = 0.75
+# A placement other than the zero-shot one needs this many matched example cuts and must
+# cut the median placement error by this fraction and this many seconds: few cuts or a
+# small gain are noise, and a wrong shift moves every cut.
+PLACEMENT_MIN_CUTS = 6
+PLACEMENT_GAIN = (0.2, 0.03)
 MATCH_S = 1.0
 
 
@@ -56,8 +70,8 @@ class CutModel:
     n_takes : example takes it learnt from.
     n_cuts : human cuts it learnt from.
     threshold : novelty peak height (mean MMD²) for a cut.
+    prominence : novelty peak prominence (MMD²) for a cut.
     min_segment_s : minimum time between two cuts (s).
-    scale_min_s, scale_max_s : shortest and longest novelty window (s).
     placement : the placement step the cut is taken from ("split", "turn" or "pause").
     offset_s : signed shift added to every placed cut (s); positive moves cuts later.
     """
@@ -65,16 +79,15 @@ class CutModel:
     n_takes: int
     n_cuts: int
     threshold: float
+    prominence: float
     min_segment_s: float
-    scale_min_s: float
-    scale_max_s: float
     placement: str
     offset_s: float
 
     def params(self) -> dict[str, float]:
         """The default segmenter's parameters this model sets."""
-        return {"threshold": self.threshold, "min_segment_s": self.min_segment_s,
-                "scale_min_s": self.scale_min_s, "scale_max_s": self.scale_max_s}
+        return {"threshold": self.threshold, "prominence": self.prominence,
+                "min_segment_s": self.min_segment_s}
 
     def to_json(self) -> str:
         """Stable JSON text (sorted keys) with ``"format": 1``."""
@@ -94,8 +107,8 @@ class CutModel:
                              f"(expected {FORMAT})")
         values = {}
         for name, kind in (("n_takes", int), ("n_cuts", int), ("threshold", float),
-                           ("min_segment_s", float), ("scale_min_s", float),
-                           ("scale_max_s", float), ("offset_s", float)):
+                           ("prominence", float), ("min_segment_s", float),
+                           ("offset_s", float)):
             value = data.get(name)
             ok = isinstance(value, int | float) and not isinstance(value, bool)
             if not ok or not math.isfinite(value) or (kind is int and value != int(value)):
@@ -142,92 +155,116 @@ def fit_cut_model(examples: Sequence[tuple[object, Sequence[int]]]) -> CutModel:
     if len(examples) == 0:
         raise ExampleError("no example takes to learn from")
     p = Default.validate_params({})
-    prepared = []
-    for take, cuts in examples:
-        cuts = _checked_cuts(take, cuts)
+    checked = [(take, _checked_cuts(take, cuts)) for take, cuts in examples]
+    shortest = _shortest_segment(checked)
+    if shortest is not None:  # only ever shorter: a longer one would hide short activities
+        p["min_segment_s"] = float(np.clip(MIN_SEGMENT_FACTOR * shortest, MIN_SEGMENT_S,
+                                           p["min_segment_s"]))
+    # One pass over the takes, keeping only peaks and placement offsets: a project's
+    # examples need not all be held in memory with their pose streams.
+    peaks, residuals = [], {name: [] for name in PLACEMENTS}
+    for take, cuts in checked:
         analysis = Default.analyse(take, p)
         if analysis is None:
             raise ExampleError(f"{_where(take)}: too short to learn from "
                                f"({take.n_frames} frames)")
-        prepared.append((take, cuts, analysis))
-    shortest = _shortest_segment(prepared)
-    if shortest is not None:
-        lo, hi = MIN_SEGMENT_RANGE_S
-        scale = float(np.clip(shortest, 1.0, p["scale_min_s"]))
-        p = {**p, "min_segment_s": float(np.clip(MIN_SEGMENT_FACTOR * shortest, lo, hi)),
-             "scale_min_s": scale, "scale_max_s": 2 * scale}
-        if scale != Default.params["scale_min_s"].default:
-            prepared = [(take, cuts, Default.analyse(take, p)) for take, cuts, _ in prepared]
-    threshold = _threshold(prepared, p)
-    p = {**p, "threshold": threshold}
-    placement, offset = _placement(prepared, p)
-    return CutModel(n_takes=len(prepared), n_cuts=int(sum(len(c) for _, c, _ in prepared)),
-                    threshold=threshold, min_segment_s=p["min_segment_s"],
-                    scale_min_s=p["scale_min_s"], scale_max_s=p["scale_max_s"],
-                    placement=placement,
-                    offset_s=offset)
+        peaks.append(_all_peaks(take, cuts, analysis, p))
+        _add_residuals(residuals, take, cuts, analysis, p)
+    prominence = _count(peaks, p["prominence"])
+    placement, offset = _placement(residuals, "onset" if p["onset"] else "pause")
+    return CutModel(n_takes=len(checked), n_cuts=int(sum(len(c) for _, c in checked)),
+                    threshold=p["threshold"], prominence=prominence,
+                    min_segment_s=p["min_segment_s"], placement=placement, offset_s=offset)
 
 
-def _shortest_segment(prepared) -> float | None:
+def _shortest_segment(checked) -> float | None:
     """The shortest inner human segment (s) over the examples; None without one."""
-    shortest = [np.diff(cuts).min() / take.fps for take, cuts, _ in prepared if len(cuts) > 1]
+    shortest = [np.diff(cuts).min() / take.fps for take, cuts in checked if len(cuts) > 1]
     return min(shortest) if shortest else None
 
 
-def _threshold(prepared, p: dict) -> float:
-    """The novelty threshold with the best summed F1@1 s of raw peaks over the examples."""
-    candidates = []
-    per_take = []
-    for take, cuts, analysis in prepared:
-        peaks, strength = Default._peaks(analysis.novelty, analysis.rate,
-                                         {**p, "threshold": 1e-9})
-        frames = analysis.peak_frames(peaks) + analysis.first
-        per_take.append((take, cuts, frames, strength))
-        candidates.extend(strength.tolist())
-    # Thresholds just below each observed peak height, plus the default.
-    grid = np.unique(np.concatenate([np.asarray(candidates) * (1 - 1e-6), [p["threshold"]]]))
-    best, best_key = p["threshold"], None
-    for threshold in grid:
-        score = 0.0
-        for take, cuts, frames, strength in per_take:
-            kept = frames[strength >= threshold]
-            score += metrics.boundary_scores(kept, cuts, fps=take.fps, tolerance_s=MATCH_S)["f1"]
-        key = (round(score, 9), -abs(math.log(threshold / p["threshold"])))
-        if best_key is None or key > best_key:
-            best, best_key = float(threshold), key
+# The prominences (MMD², see segmenters.default) the count is chosen from, and the summed
+# example F1 that moving a factor e from the zero-shot prominence must buy: a prior that
+# keeps one or two examples from pulling the count to wherever they happen to score best.
+PROMINENCE_GRID = tuple(sorted({*np.round(np.geomspace(0.02, 2.0, 41), 4),
+                                Default.params["prominence"].default}))
+PROMINENCE_PRIOR = 0.05
+
+
+def matched_count(candidates: np.ndarray, truth: np.ndarray, tolerance: int) -> int:
+    """Size of the largest one-to-one matching within ``tolerance`` frames.
+
+    On a line with one tolerance for all, matching each true cut in order to the earliest
+    free candidate in reach is optimal, and much faster than the assignment solver.
+    """
+    matched, j = 0, 0
+    for t in truth:
+        while j < len(candidates) and candidates[j] < t - tolerance:
+            j += 1
+        if j < len(candidates) and candidates[j] <= t + tolerance:
+            matched += 1
+            j += 1
+    return matched
+
+
+def _all_peaks(take, cuts, analysis, p: dict) -> tuple:
+    """Every novelty peak of one example (frames, prominences) with its cuts and tolerance."""
+    peaks, prominence = Default._peaks(analysis.novelty, analysis.rate, {**p, "prominence": 0.0})
+    frames = analysis.peak_frames(peaks) + analysis.first
+    return frames, prominence, np.sort(cuts), int(round(MATCH_S * take.fps))
+
+
+def _count(per_take, zero: float) -> float:
+    """The prominence of PROMINENCE_GRID whose peaks fit the example cuts best."""
+    best, best_score = zero, -math.inf
+    for prominence in PROMINENCE_GRID:
+        score = -PROMINENCE_PRIOR * abs(math.log(prominence / zero))
+        for frames, prom, cuts, tol in per_take:
+            kept = frames[prom >= prominence]
+            total = len(kept) + len(cuts)
+            score += 2 * matched_count(kept, cuts, tol) / total if total else 1.0
+        if score > best_score + 1e-9:
+            best, best_score = float(prominence), score
     return best
 
 
-def _placement(prepared, p: dict) -> tuple[str, float]:
-    """The placement step and shift (s) that follow the human cuts most steadily."""
-    residuals = {name: [] for name in PLACEMENTS}
-    for take, cuts, analysis in prepared:
-        peaks, _ = Default._peaks(analysis.novelty, analysis.rate, p)
-        stages, _ = place_stages(analysis.x, analysis.peak_frames(peaks), analysis.fps,
-                                 analysis.gamma, p)
-        for name, placed in stages.items():
-            placed = placed + analysis.first
-            ci, ti = metrics.match(placed, cuts, tolerance=int(round(MATCH_S * take.fps)))
-            residuals[name].extend(((cuts[ti] - placed[ci]) / take.fps).tolist())
-    best = ("pause", 0.0)
-    best_spread = math.inf
-    for name in ("pause", "turn", "split"):  # ties keep the zero-shot step
+def _add_residuals(residuals: dict, take, cuts, analysis, p: dict) -> None:
+    """Signed (human - placed) offsets in seconds of each placement step's cuts that match
+    a human cut within 1 s; the cuts are the zero-shot ones."""
+    peaks, _ = Default._peaks(analysis.novelty, analysis.rate, p)
+    stages, _ = place_stages(analysis.x, analysis.peak_frames(peaks), analysis.fps,
+                             analysis.gamma, p)
+    for name, placed in stages.items():
+        placed = placed + analysis.first
+        ci, ti = metrics.match(placed, cuts, tolerance=int(round(MATCH_S * take.fps)))
+        residuals[name].extend(((cuts[ti] - placed[ci]) / take.fps).tolist())
+
+
+def _placement(residuals: dict, zero_shot: str) -> tuple[str, float]:
+    """The placement step and shift (s) that follow the human cuts best, if clearly so."""
+    r = np.asarray(residuals[zero_shot])
+    if len(r) < PLACEMENT_MIN_CUTS:
+        return zero_shot, 0.0
+    base = float(np.median(np.abs(r)))
+    best, best_error = (zero_shot, 0.0), base
+    for name in PLACEMENTS:
         r = np.asarray(residuals[name])
-        if len(r) == 0:
-            continue
         offset = float(np.median(r))
-        spread = float(np.median(np.abs(r - offset)))
-        if spread < best_spread - 1e-9:
-            best, best_spread = (name, offset), spread
+        error = float(np.median(np.abs(r - offset)))
+        if error < best_error:
+            best, best_error = (name, offset), error
+    ratio, seconds = PLACEMENT_GAIN
+    if best_error > min((1 - ratio) * base, base - seconds):
+        return zero_shot, 0.0
     return best
 
 
-def _segment(analysis, p: dict, placement: str = "pause", offset_s: float = 0.0) -> Segmentation:
+def _segment(analysis, p: dict, placement: str, offset_s: float) -> Segmentation:
     peaks, strength = Default._peaks(analysis.novelty, analysis.rate, p)
     stages, speed = place_stages(analysis.x, analysis.peak_frames(peaks), analysis.fps,
                                  analysis.gamma, p)
     cuts = stages[placement] + int(round(offset_s * analysis.fps))
-    result = analysis.segmentation(cuts, strength / (strength + p["threshold"] + 1e-12), speed)
+    result = analysis.segmentation(cuts, confidence(strength, p), speed)
     return _checked(result, len(analysis.x) + analysis.first)
 
 
@@ -235,8 +272,8 @@ def detect(take, model: CutModel | None = None, **params) -> Segmentation:
     """Candidate cuts of ``take``; ``model=None`` is the zero-shot default detector.
 
     ``params`` are the ``default`` segmenter's parameters (validated with its schema);
-    with a model, its learnt ``threshold`` and ``min_segment_s`` replace those two, and
-    each cut is taken from its ``placement`` step and moved by its ``offset_s``.
+    with a model, its learnt ``threshold``, ``prominence`` and ``min_segment_s`` replace
+    those, and each cut is taken from its ``placement`` step and moved by its ``offset_s``.
 
     Returns
     -------

@@ -1,10 +1,16 @@
-"""Benchmarks that print tables: ``python -m motionlib.bench io``.
+"""Benchmarks that print tables: ``python -m motionlib.bench io|adapt``.
 
 ``io``: read + forward kinematics of the CMU take 13_29 as BVH and as AMC + ASF, against the
 PyPI ``bvh`` package's parse of the same BVH (median of several interleaved runs, one process,
 same files; the machine's load average is printed since other work skews wall times),
 and peak traced memory of read + FK against the file size; plus the time to synthesise a
 five-minute take.
+
+``adapt``: the adapted default detector's speed on five-minute 120 fps synthetic takes:
+detection with an adapted model (median of several runs), and fitting a model on 50 such
+takes (10 distinct takes, each given five times, so the examples fit in memory; fitting
+visits every example in full either way), with wall and CPU time of this process and the
+load average (run it with ``OMP_NUM_THREADS=1`` for one core).
 """
 
 from __future__ import annotations
@@ -118,6 +124,44 @@ def _print_table(rows) -> None:
           f"{TARGET_MEMORY:.0f}x): {'ok' if ratio < TARGET_MEMORY else 'MISSED'}")
 
 
+TARGET_DETECT_S, TARGET_FIT_S = 0.5, 10.0
+
+
+def _timed(fn) -> tuple[float, float, object]:
+    wall, cpu = time.perf_counter(), time.process_time()
+    result = fn()
+    return time.perf_counter() - wall, time.process_time() - cpu, result
+
+
+def run_adapt(args) -> int:
+    import numpy as np
+
+    from motionlib import adapt, synth
+
+    minutes, distinct = args.minutes, 10
+    takes = []
+    for seed in range(distinct):
+        take, segments = synth.generate(seed=seed, fps=120.0, duration=60.0 * minutes)
+        takes.append((take, np.asarray([s[0] for s in segments[1:]])))
+    examples = [takes[i % distinct] for i in range(args.takes)]
+    fit_wall, fit_cpu, model = _timed(lambda: adapt.fit_cut_model(examples))
+    target, _ = synth.generate(seed=99, fps=120.0, duration=60.0 * minutes)
+    adapt.detect(target, model)  # warm up
+    runs = [_timed(lambda: adapt.detect(target, model))[:2] for _ in range(args.runs)]
+    detect_wall = statistics.median(r[0] for r in runs)
+    detect_cpu = statistics.median(r[1] for r in runs)
+    print(f"{'case':<48}{'wall s':>9}{'cpu s':>9}{'target s':>10}")
+    print(f"{f'detect, adapted model, {minutes:g}-min 120 fps take':<48}{detect_wall:>9.3f}"
+          f"{detect_cpu:>9.3f}{TARGET_DETECT_S:>10.1f}  "
+          f"{'ok' if detect_wall <= TARGET_DETECT_S else 'MISSED'} (median of {args.runs})")
+    print(f"{f'fit on {args.takes} {minutes:g}-min 120 fps takes':<48}{fit_wall:>9.3f}"
+          f"{fit_cpu:>9.3f}{TARGET_FIT_S:>10.1f}  "
+          f"{'ok' if fit_wall <= TARGET_FIT_S else 'MISSED'} ({model.n_cuts} cuts)")
+    print(f"threads: OMP_NUM_THREADS={os.environ.get('OMP_NUM_THREADS', 'unset')}; "
+          f"load average during the run: {' '.join(f'{x:.2f}' for x in os.getloadavg())}")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="python -m motionlib.bench",
                                      description="motionlib benchmarks (print tables).")
@@ -126,6 +170,11 @@ def build_parser() -> argparse.ArgumentParser:
     io.add_argument("--runs", type=int, default=21, help="timed runs per motionlib case")
     io.add_argument("--data", default=str(DATA), help="the shared data folder")
     io.set_defaults(handler=run_io)
+    ad = sub.add_parser("adapt", help="adapted detection and fitting speed, 5-min takes")
+    ad.add_argument("--takes", type=int, default=50, help="example takes to fit on")
+    ad.add_argument("--minutes", type=float, default=5.0, help="length of each take")
+    ad.add_argument("--runs", type=int, default=5, help="timed detection runs")
+    ad.set_defaults(handler=run_adapt)
     return parser
 
 

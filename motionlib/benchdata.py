@@ -1,9 +1,17 @@
 """The labelled real CMU takes used by the segmentation benchmark and tests.
 
-The data lives in the ``shared/data`` folder beside the repository (see its README):
-mocap6 labels for 13_29 and 13_30 (runs of 10 fps blocks, AMC frames 1-based), and the
-Krüger et al. 2017 transition windows for subject 86. Every loader returns true cuts
-as ``(n, 3)`` windows ``(lo, mid, hi)`` of 0-based *take* frames (``motionlib.metrics``).
+The data lives in the ``shared/data`` folder beside the repository (see its README), and
+every labelled take in that layout is found, whatever its name:
+
+- ``labels/mocap6/segments/<take>.csv`` (runs of 10 fps blocks, AMC frames 1-based) and
+  ``labels/cmu86_kruger2017/<take>.csv`` (Krüger et al. 2017 transition windows);
+- their motion: ``cmu/bvh/<take>.bvh`` where present (label frames shifted by the BVH's
+  extra T-pose lines), else ``cmu/amc/<take>.amc`` with ``cmu/asf/<subject>.asf``, else
+  ``cmu/channels4d/<take>.4d.txt`` (four AMC channels per frame: a *four-channel take*,
+  :class:`ChannelTake`, for whatever does not need the full skeleton).
+
+Every loader returns true cuts as ``(n, 3)`` windows ``(lo, mid, hi)`` of 0-based *take*
+frames (``motionlib.metrics``).
 """
 
 from __future__ import annotations
@@ -27,17 +35,66 @@ def data_dir() -> Path:
     return Path(os.environ.get("CUTROOM_BENCH_DATA", DEFAULT_DATA_DIR)).resolve()
 
 
+@dataclass(eq=False)
+class ChannelTake:
+    """A take known only by a few channels per frame (no skeleton).
+
+    channels : (n_frames, n_channels) float, here the AMC angles in degrees.
+    """
+
+    name: str
+    fps: float
+    channels: np.ndarray
+    path: str | None = None
+    rest_pose_frame: None = None
+
+    @property
+    def n_frames(self) -> int:
+        return int(self.channels.shape[0])
+
+
+# The CMU capture rate: AMC and its four-channel extracts store no rate.
+CMU_FPS = 120.0
+
+
+def read_channels(path: Path) -> ChannelTake:
+    """A ``cmu/channels4d/<take>.4d.txt`` file: one row of numbers per AMC frame."""
+    path = Path(path)
+    rows = []
+    with open(path, encoding="utf-8") as fh:
+        for line, text in enumerate(fh, start=1):
+            try:
+                rows.append([float(v) for v in text.split()])
+            except ValueError:
+                raise LabelError(f"{path}: line {line}: not numbers: {text.strip()[:40]!r}") \
+                    from None
+            if len(rows[-1]) != len(rows[0]) or not np.isfinite(rows[-1]).all():
+                raise LabelError(f"{path}: line {line}: expected {len(rows[0])} finite "
+                                 f"numbers, got {text.strip()[:40]!r}")
+    if not rows:
+        raise LabelError(f"{path}: no frames")
+    return ChannelTake(name=path.name.split(".")[0], fps=CMU_FPS,
+                       channels=np.asarray(rows, dtype=float), path=str(path))
+
+
 @dataclass(frozen=True)
 class LabelledTake:
-    """One capture with human cuts: ``truth`` is ``(n, 3)`` windows in take frames."""
+    """One capture with human cuts: ``truth`` is ``(n, 3)`` windows in take frames.
+
+    ``kind`` is ``"skeleton"`` (a BVH, or an AMC with ``asf``) or ``"channels"`` (a
+    four-channel take, read as a :class:`ChannelTake`); ``source`` names the label set.
+    """
 
     name: str
     path: Path
     asf: Path | None
     truth: np.ndarray
     source: str
+    kind: str = "skeleton"
 
     def read(self):
+        if self.kind == "channels":
+            return read_channels(self.path)
         import motionlib
 
         return motionlib.read(self.path, asf=self.asf)
@@ -93,35 +150,105 @@ def kruger_truth(path: Path) -> np.ndarray:
     return np.sort(np.asarray(rows[:-1], dtype=np.int64).reshape(-1, 3), axis=1)
 
 
-def labelled_takes(root: Path | None = None, *, bvh: bool = True) -> list[LabelledTake]:
-    """The benchmark's labelled takes, in a fixed order.
+LABEL_SOURCES = (("mocap6", "mocap6/segments"), ("kruger2017", "cmu86_kruger2017"))
 
-    13_29 is read from the cgspeed BVH when ``bvh`` is true (label frames shifted by its
-    T-pose line), else from the AMC; 13_30 and 86_01 from the AMC.
+
+def bvh_frames(path: Path) -> int:
+    """The ``Frames:`` count in a BVH header (without reading the motion)."""
+    with open(path, "rb") as fh:
+        for line in fh:
+            if line.strip().lower().startswith(b"frames:"):
+                return int(line.split(b":", 1)[1])
+    raise LabelError(f"{path}: no Frames: line")
+
+
+def _mocap6(path: Path, cmu: Path) -> tuple[Path, Path | None, np.ndarray] | None:
+    """Motion and truth of a mocap6 take: its BVH where present, else its AMC."""
+    name, subject = path.stem, path.stem.split("_")[0]
+    bvh, amc, asf = cmu / "bvh" / f"{name}.bvh", cmu / "amc" / f"{name}.amc", \
+        cmu / "asf" / f"{subject}.asf"
+    if bvh.is_file():
+        # The label's last end_frame is the AMC's length; a converted BVH may add lines
+        # before it (cgspeed: one T-pose line).
+        rows = _rows(path, ("end_frame",))
+        n_amc = _int(path, *rows[-1], "end_frame") if rows else 0
+        return bvh, None, mocap6_truth(path, frame_offset=max(0, bvh_frames(bvh) - n_amc))
+    if amc.is_file() and asf.is_file():
+        return amc, asf, mocap6_truth(path)
+    return None
+
+
+def _kruger(path: Path, cmu: Path) -> tuple[Path, Path | None, np.ndarray, str] | None:
+    """Motion and truth of a subject-86 take: its AMC, else its four channels."""
+    name, subject = path.stem, path.stem.split("_")[0]
+    amc, asf = cmu / "amc" / f"{name}.amc", cmu / "asf" / f"{subject}.asf"
+    four = cmu / "channels4d" / f"{name}.4d.txt"
+    if amc.is_file() and asf.is_file():
+        return amc, asf, kruger_truth(path), "skeleton"
+    if four.is_file():
+        return four, None, kruger_truth(path), "channels"
+    return None
+
+
+def discover(root: Path | None = None, *, channels: bool = True,
+             bvh: bool = True) -> tuple[list[LabelledTake], list[str]]:
+    """Every labelled take under ``root``, and one line per file that was skipped.
+
+    A take with labels but no motion, or motion but no labels, is skipped with a line
+    saying so. With ``channels``, each subject-86 take that has four-channel data is
+    listed as a four-channel take too (also when its full AMC is there); with ``bvh``
+    false, an AMC is preferred to a BVH.
     """
     root = Path(root) if root is not None else data_dir()
     if not root.is_dir():
         raise FileNotFoundError(f"benchmark data folder not found: {root}")
     cmu, labels = root / "cmu", root / "labels"
-    seg29 = labels / "mocap6" / "segments" / "13_29.csv"
-    if bvh:
-        take29 = LabelledTake(
-            "13_29", cmu / "bvh" / "13_29.bvh", None, mocap6_truth(seg29, frame_offset=1),
-            "mocap6",
-        )
-    else:
-        take29 = LabelledTake(
-            "13_29", cmu / "amc" / "13_29.amc", cmu / "asf" / "13.asf", mocap6_truth(seg29),
-            "mocap6",
-        )
-    return [
-        take29,
-        LabelledTake(
-            "13_30", cmu / "amc" / "13_30.amc", cmu / "asf" / "13.asf",
-            mocap6_truth(labels / "mocap6" / "segments" / "13_30.csv"), "mocap6",
-        ),
-        LabelledTake(
-            "86_01", cmu / "amc" / "86_01.amc", cmu / "asf" / "86.asf",
-            kruger_truth(labels / "cmu86_kruger2017" / "86_01.csv"), "kruger2017",
-        ),
-    ]
+    takes: list[LabelledTake] = []
+    skipped: list[str] = []
+    labelled: set[str] = set()
+    for source, folder in LABEL_SOURCES:
+        for path in sorted((labels / folder).glob("*.csv")):
+            labelled.add(path.stem)
+            found = _take_of(source, path, cmu, bvh)
+            if found is None:
+                skipped.append(f"skipped {path.relative_to(root)}: labels but no motion")
+                continue
+            takes.append(found)
+            four = cmu / "channels4d" / f"{path.stem}.4d.txt"
+            if channels and source == "kruger2017" and found.kind == "skeleton" and \
+                    four.is_file():
+                takes.append(LabelledTake(path.stem, four, None, found.truth, source,
+                                          "channels"))
+    for motion in sorted([*cmu.glob("amc/*.amc"), *cmu.glob("bvh/*.bvh"),
+                          *cmu.glob("channels4d/*.4d.txt")]):
+        if motion.name.split(".")[0] not in labelled:
+            skipped.append(f"skipped {motion.relative_to(root)}: motion but no labels")
+    if not channels:
+        takes = [t for t in takes if t.kind == "skeleton"]
+    return takes, skipped
+
+
+def _take_of(source: str, path: Path, cmu: Path, bvh: bool) -> LabelledTake | None:
+    if source == "mocap6":
+        found = _mocap6(path, cmu) if bvh else _mocap6_amc(path, cmu)
+        return None if found is None else LabelledTake(path.stem, *found, source)
+    found = _kruger(path, cmu)
+    if found is None:
+        return None
+    motion, asf, truth, kind = found
+    return LabelledTake(path.stem, motion, asf, truth, source, kind)
+
+
+def _mocap6_amc(path: Path, cmu: Path):
+    name, subject = path.stem, path.stem.split("_")[0]
+    amc, asf = cmu / "amc" / f"{name}.amc", cmu / "asf" / f"{subject}.asf"
+    if amc.is_file() and asf.is_file():
+        return amc, asf, mocap6_truth(path)
+    return _mocap6(path, cmu)
+
+
+def labelled_takes(root: Path | None = None, *, bvh: bool = True,
+                   channels: bool = False) -> list[LabelledTake]:
+    """The labelled takes under ``root`` (see :func:`discover`), full-skeleton ones only
+    unless ``channels``."""
+    return discover(root, channels=channels, bvh=bvh)[0]

@@ -16,6 +16,7 @@ Both are imported only here, and only when the bench runs.
 from __future__ import annotations
 
 import math
+import os
 import sys
 import time
 from collections.abc import Callable
@@ -23,10 +24,9 @@ from pathlib import Path
 
 import numpy as np
 
-from motionlib import benchdata, metrics
+from motionlib import adapt, benchdata, metrics, tuning
 from motionlib.segmenters import list_segmenters
-from motionlib.segmenters.base import take_positions
-from motionlib.segmenters.default import block_mean, pose_features
+from motionlib.segmenters.default import Default, block_mean, take_features
 
 RUPTURES_PENALTY = 3.0
 
@@ -39,21 +39,18 @@ COLUMNS = (
 
 
 def _peer_pose(take, rate_hz: float) -> tuple[np.ndarray, int, int]:
-    positions, joints, first = take_positions(take)
+    x, first = take_features(take)
     step = max(1, int(round(take.fps / rate_hz)))
-    x = pose_features(positions, joints, fps=take.fps, velocity_s=0.0)
     return block_mean(x, step), step, first
 
 
-def ruptures_kernel(take) -> np.ndarray:
+def ruptures_kernel(take, penalty: float = RUPTURES_PENALTY) -> np.ndarray:
     """Cuts from ruptures' kernel change-point detection (RBF, fixed penalty)."""
     import ruptures
 
     x, step, first = _peer_pose(take, 10.0)
     min_size = max(2, int(round(2.0 * take.fps / step)))
-    ends = ruptures.KernelCPD(kernel="rbf", min_size=min_size).fit(x).predict(
-        pen=RUPTURES_PENALTY
-    )
+    ends = ruptures.KernelCPD(kernel="rbf", min_size=min_size).fit(x).predict(pen=penalty)
     return np.asarray(ends[:-1], dtype=np.int64) * step + first
 
 
@@ -70,6 +67,11 @@ def clasp(take) -> np.ndarray:
     return np.asarray(found, dtype=np.int64).reshape(-1) * step + first
 
 
+# Methods that need only a feature stream run on four-channel takes too; the others
+# need a skeleton.
+FEATURE_ONLY = {"default", "ruptures_kernel", "clasp"}
+
+
 def methods() -> dict[str, Callable]:
     """Row name -> function(take) -> cut frames, registered segmenters first."""
     rows: dict[str, Callable] = {
@@ -81,31 +83,99 @@ def methods() -> dict[str, Callable]:
     return rows
 
 
-def run(root: Path | None = None, only: list[str] | None = None) -> dict[str, dict]:
-    """Evaluate every method on every labelled take.
+def title(labelled) -> str:
+    """A take's row label: its name, marked when only four channels are known."""
+    return labelled.name + (" (4 channels)" if labelled.kind == "channels" else "")
+
+
+def _timed_row(detect, take, truth) -> dict:
+    start = time.perf_counter()
+    cuts = detect(take)
+    row = metrics.evaluate(cuts, truth, fps=take.fps)
+    row["time_s"] = time.perf_counter() - start
+    row["n_cuts"] = len(cuts)
+    return row
+
+
+def run(root: Path | None = None, only: list[str] | None = None, *, loo: bool = False,
+        log=None) -> dict[str, dict]:
+    """Evaluate every method on every labelled take under ``root``.
+
+    With ``loo``, three more rows are scored leave-one-take-out (see ``LOO_ROWS``).
 
     Returns
     -------
-    take name -> method name -> metrics row (``metrics.evaluate`` plus time and count).
+    take title -> method name -> metrics row (``metrics.evaluate`` plus time and count).
     """
     rows = {k: v for k, v in methods().items() if not only or k in only}
+    takes, skipped = benchdata.discover(root)
+    for line in skipped:
+        print(line, file=log or sys.stderr)
+    cache = [tuning.TakeCache(t, t.read()) for t in takes]
     results: dict[str, dict] = {}
-    for labelled in benchdata.labelled_takes(root):
-        take = labelled.read()
-        results[labelled.name] = {}
-        for name, detect in rows.items():
-            start = time.perf_counter()
-            cuts = detect(take)
-            row = metrics.evaluate(cuts, labelled.truth, fps=take.fps)
-            row["time_s"] = time.perf_counter() - start
-            row["n_cuts"] = len(cuts)
-            results[labelled.name][name] = row
+    for c in cache:
+        results[title(c.labelled)] = {
+            name: _timed_row(detect, c.take, c.labelled.truth)
+            for name, detect in rows.items()
+            if c.labelled.kind == "skeleton" or name in FEATURE_ONLY
+        }
+    if loo:
+        for key, per_take in loo_rows(cache).items():
+            for c, row in zip(cache, per_take, strict=True):
+                results[title(c.labelled)][key] = row
     return results
 
 
+LOO_ROWS = {
+    "default/loo": "default settings chosen from tuning.GRID on the other takes",
+    "adapted/loo": "default adapted (motionlib.adapt) to the other takes of the same label "
+                   "source as examples",
+    "ruptures/loo": "ruptures_kernel with its penalty chosen on the other takes",
+}
+
+
+def loo_rows(cache: list[tuning.TakeCache]) -> dict[str, list[dict]]:
+    """The leave-one-take-out rows, one list of rows (in ``cache`` order) per name."""
+    selection = tuning.select(cache)
+    chosen = selection.leave_one_out()
+    out: dict[str, list[dict]] = {name: [] for name in LOO_ROWS}
+    for c, (params, _) in zip(cache, chosen, strict=True):
+        out["default/loo"].append(_timed_row(lambda t, p=params: Default(**p).fit_predict(t).cuts,
+                                             c.take, c.labelled.truth))
+        model = adapt.fit_cut_model(_examples(cache, c))
+        out["adapted/loo"].append(_timed_row(lambda t, m=model: adapt.detect(t, m).cuts,
+                                             c.take, c.labelled.truth))
+    out["ruptures/loo"] = _ruptures_loo(cache)
+    return out
+
+
+def _examples(cache, held_out) -> list[tuple]:
+    """The other takes of ``held_out``'s label source, with their best-estimate cuts."""
+    return [(c.take, c.labelled.truth[:, 1]) for c in cache
+            if c.labelled.source == held_out.labelled.source and c.key != held_out.key]
+
+
+RUPTURES_PENALTIES = (1.0, 2.0, 3.0, 5.0, 8.0)
+
+
+def _ruptures_loo(cache) -> list[dict]:
+    """ruptures_kernel with the penalty (of ``RUPTURES_PENALTIES``) best on the other takes."""
+    by_penalty = [[_timed_row(lambda t, pen=pen: ruptures_kernel(t, pen), c.take,
+                              c.labelled.truth) for c in cache] for pen in RUPTURES_PENALTIES]
+    out = []
+    for j, c in enumerate(cache):
+        keep = [other.key != c.key for other in cache]
+        best = max(range(len(RUPTURES_PENALTIES)), key=lambda i: tuning.objective(
+            [r for r, k in zip(by_penalty[i], keep, strict=True) if k]))
+        out.append(by_penalty[best][j])
+    return out
+
+
 def mean_rows(results: dict[str, dict]) -> dict[str, dict]:
-    """Per method, the mean of each column over the takes (NaN errors skipped)."""
-    names = next(iter(results.values())).keys() if results else []
+    """Per method present on every take, the mean of each column (NaN errors skipped)."""
+    if not results:
+        return {}
+    names = [n for n in next(iter(results.values())) if all(n in r for r in results.values())]
     out = {}
     for name in names:
         per_take = [results[t][name] for t in results]
@@ -134,24 +204,46 @@ def format_table(title: str, rows: dict[str, dict]) -> str:
     return "\n".join(lines)
 
 
-def main(root: Path | None = None, only: list[str] | None = None, out=None) -> int:
-    """Print a table per take and the mean table; 0 on success, 2 without data."""
+def main(root: Path | None = None, only: list[str] | None = None, out=None, *,
+         loo: bool = False) -> int:
+    """Print a table per take and the mean tables; 0 on success, 2 without data."""
     out = out or sys.stdout
     folder = Path(root) if root else benchdata.data_dir()
     if not folder.is_dir():
         print(f"error: benchmark data folder not found: {folder}", file=sys.stderr)
         return 2
-    results = run(folder, only)
-    for take, rows in results.items():
-        truth = len(next(t for t in benchdata.labelled_takes(folder) if t.name == take).truth)
-        print(format_table(f"\n{take} ({truth} true cuts)", rows), file=out)
-    print(format_table(f"\nmean over {len(results)} takes", mean_rows(results)), file=out)
-    if not only or "joint_distance_pca" in only:
+    started = time.perf_counter()
+    takes = {title(t): t for t in benchdata.discover(folder)[0]}
+    results = run(folder, only, loo=loo, log=out)
+    print(_legend(loo), file=out)
+    for name, rows in results.items():
+        print(format_table(f"\n{name} ({len(takes[name].truth)} true cuts, "
+                           f"{takes[name].source})", rows), file=out)
+    groups = [("full-skeleton", [n for n in results if takes[n].kind == "skeleton"]),
+              ("four-channel", [n for n in results if takes[n].kind == "channels"])]
+    for group, names in [*groups, ("labelled", list(results))]:
+        if names:
+            mean = mean_rows({n: results[n] for n in names})
+            print(format_table(f"\nmean over {len(names)} {group} takes", mean), file=out)
+    if (not only or "joint_distance_pca" in only) and "13_30" in takes:
         print("\n" + patent_comparison(folder), file=out)
-    if not only or "default" in only:
-        print(f"\ndefault on a 5-minute 120 fps synthetic take: {long_take_seconds():.2f} s",
-              file=out)
+    print(f"\nwhole benchmark: {time.perf_counter() - started:.0f} s, load average "
+          f"{' '.join(f'{x:.2f}' for x in os.getloadavg())}", file=out)
     return 0
+
+
+def _legend(loo: bool) -> str:
+    lines = ["Rows: registered segmenters with their default parameters (`default` uses the "
+             "shipped settings,",
+             "which were chosen on these takes: in-sample here), ruptures_kernel (one fixed "
+             "penalty) and clasp (its defaults)."]
+    if loo:
+        lines.append("Rows ending in /loo were scored leave-one-take-out (a take and its "
+                     "other views left out together):")
+        lines += [f"  {name}: {text}" for name, text in LOO_ROWS.items()]
+    lines.append("Four-channel takes (cmu/channels4d) run only the methods that need no "
+                 "skeleton.")
+    return "\n".join(lines)
 
 
 # CN102867300A's published run on CMU 13_30 (1-based AMC frames, first and last frame
@@ -166,7 +258,7 @@ def patent_comparison(root: Path) -> str:
     """joint_distance_pca's initial and final cuts on 13_30 beside the published ones."""
     from motionlib.segmenters import get_segmenter
 
-    take = next(t for t in benchdata.labelled_takes(root) if t.name == "13_30").read()
+    take = next(t for t in benchdata.labelled_takes(root) if t.name == "13_30").read()  # the patent's take
     seg = get_segmenter("joint_distance_pca")()
     final = seg.fit_predict(take).cuts
     ours = {
@@ -183,17 +275,6 @@ def patent_comparison(root: Path) -> str:
     return "\n".join(lines)
 
 
-def long_take_seconds(minutes: float = 5.0) -> float:
-    """Wall time of the default segmenter on a synthetic take of ``minutes`` at 120 fps."""
-    from motionlib import synth
-    from motionlib.segmenters import get_segmenter
-
-    take, _ = synth.generate(seed=0, fps=120.0, duration=60.0 * minutes)
-    start = time.perf_counter()
-    get_segmenter("default")().fit_predict(take)
-    return time.perf_counter() - start
-
-
 def add_bench(subparsers) -> None:
     """Register ``python -m motionlib bench`` (see ``motionlib.cli``)."""
     p = subparsers.add_parser(
@@ -203,4 +284,8 @@ def add_bench(subparsers) -> None:
     )
     p.add_argument("--data", help="benchmark data folder (default: ../shared/data)")
     p.add_argument("--method", action="append", help="only this row (repeatable)")
-    p.set_defaults(handler=lambda args: main(args.data, args.method))
+    p.add_argument("--loo", action="store_true",
+                   help="also score leave-one-take-out: the default settings chosen, the "
+                        "adapted model fitted and the ruptures penalty chosen without the "
+                        "take scored")
+    p.set_defaults(handler=lambda args: main(args.data, args.method, loo=args.loo))

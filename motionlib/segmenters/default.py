@@ -103,6 +103,23 @@ def pose_features(
     return x
 
 
+def take_features(take, *, velocity_s: float = 0.0) -> tuple[np.ndarray, int]:
+    """The detector's per-frame feature vectors of a take.
+
+    A take with a skeleton gives ``pose_features``; a take known only by a few angle
+    channels (``benchdata.ChannelTake``, no ``skeleton``) gives those angles in radians:
+    the kernel's width follows the data (median heuristic), so any unit works.
+
+    Returns
+    -------
+    x : (n_used, n_features); first : take frame of ``x[0]`` (after a rest pose).
+    """
+    if getattr(take, "skeleton", None) is None:
+        return np.radians(np.asarray(take.channels, dtype=float)), 0
+    positions, joints, first = take_positions(take)
+    return pose_features(positions, joints, fps=float(take.fps), velocity_s=velocity_s), first
+
+
 def block_mean(x: np.ndarray, step: int) -> np.ndarray:
     """Average consecutive blocks of ``step`` frames: (n, d) -> (n // step, d)."""
     n = len(x) // step
@@ -131,25 +148,43 @@ def mmd_novelty(x: np.ndarray, w: int, gamma: float) -> np.ndarray:
     -------
     (n,) biased MMD² estimate at each split t (0 where a window would leave the take).
     """
+    return multi_mmd_novelty(x, [w], gamma)[0]
+
+
+def multi_mmd_novelty(x: np.ndarray, widths, gamma: float) -> list[np.ndarray]:
+    """``mmd_novelty`` for several window lengths, sharing the kernel at each lag.
+
+    Returns
+    -------
+    list of (n,) arrays, one per width in ``widths``.
+    """
     n = len(x)
-    out = np.zeros(n)
-    if n < 2 * w or w < 1:
-        return out
-    t = np.arange(w, n - w + 1)
-    within = np.zeros(len(t))
-    cross = np.zeros(len(t))
-    for lag in range(0, 2 * w):
+    acc = {}
+    for w in widths:
+        if w >= 1 and n >= 2 * w:
+            t = np.arange(w, n - w + 1)
+            acc[w] = (t, np.zeros(len(t)), np.zeros(len(t)))
+    for lag in range(0, 2 * max(acc, default=0)):
         k = np.exp(-gamma * ((x[lag:] - x[: n - lag]) ** 2).sum(axis=1))
         c = np.concatenate([[0.0], np.cumsum(k)])  # c[i] = sum of k[:i]
-        if lag < w:  # pairs (i, i + lag) inside the past and inside the future window
-            mult = 1.0 if lag == 0 else 2.0
-            within += mult * (c[t - lag] - c[t - w] + c[t + w - lag] - c[t])
-        if lag >= 1:  # pairs with i in the past window and i + lag in the future one
-            lo = np.maximum(t - w, t - lag)
-            hi = np.minimum(t, t + w - lag)
-            cross += np.where(hi > lo, c[np.maximum(hi, lo)] - c[lo], 0.0)
-    out[t] = (within - 2 * cross) / (w * w)
-    return np.maximum(out, 0.0)
+        for w, (t, within, cross) in acc.items():
+            if lag >= 2 * w:
+                continue
+            if lag < w:  # pairs (i, i + lag) inside the past and inside the future window
+                mult = 1.0 if lag == 0 else 2.0
+                within += mult * (c[t - lag] - c[t - w] + c[t + w - lag] - c[t])
+            if lag >= 1:  # pairs with i in the past window and i + lag in the future one
+                lo = np.maximum(t - w, t - lag)
+                hi = np.minimum(t, t + w - lag)
+                cross += np.where(hi > lo, c[np.maximum(hi, lo)] - c[lo], 0.0)
+    out = []
+    for w in widths:
+        curve = np.zeros(n)
+        if w in acc:
+            t, within, cross = acc[w]
+            curve[t] = np.maximum((within - 2 * cross) / (w * w), 0.0)
+        out.append(curve)
+    return out
 
 
 def mirrored_novelty(x: np.ndarray, w: int, gamma: float) -> np.ndarray:
@@ -159,11 +194,19 @@ def mirrored_novelty(x: np.ndarray, w: int, gamma: float) -> np.ndarray:
     again, so an activity shorter than a window at the very start or end still
     produces a peak at its boundary.
     """
-    w = min(w, len(x) - 1)
-    if w < 1:
-        return np.zeros(len(x))
-    padded = np.concatenate([x[w:0:-1], x, x[-2 : -w - 2 : -1]])
-    return mmd_novelty(padded, w, gamma)[w : w + len(x)]
+    return mirrored_novelties(x, [w], gamma)[0]
+
+
+def mirrored_novelties(x: np.ndarray, widths, gamma: float) -> list[np.ndarray]:
+    """``mirrored_novelty`` for several widths at once (one mirror, shared kernels)."""
+    widths = [min(w, len(x) - 1) for w in widths]
+    pad = max(widths, default=0)
+    if pad < 1:
+        return [np.zeros(len(x)) for _ in widths]
+    padded = np.concatenate([x[pad:0:-1], x, x[-2 : -pad - 2 : -1]])
+    curves = multi_mmd_novelty(padded, widths, gamma)
+    return [c[pad : pad + len(x)] if w >= 1 else np.zeros(len(x))
+            for c, w in zip(curves, widths, strict=True)]
 
 
 # A pause is a slowest frame at most this fraction of the typical speed around it.
@@ -184,6 +227,38 @@ def settle_frame(speed: np.ndarray, cut: int, radius: int, context: int) -> int:
     slowest = a + int(np.argmin(speed[a:b]))
     typical = np.median(speed[max(0, cut - context) : cut + context])
     return slowest if speed[slowest] < PAUSE_RATIO * typical else cut
+
+
+# How far (s) the onset of the next activity may lie after a pause.
+ONSET_MAX_S = 3.0
+
+
+def onset_frame(speed: np.ndarray, cut: int, stop: int, context: int) -> int:
+    """The end of the pause ``cut`` lies in: where the next activity sets off.
+
+    When the speed at ``cut`` is below ``PAUSE_RATIO`` of the median speed over
+    ``±context`` frames, the performer may be standing between two activities, and
+    annotators who cut at the onset of the next one cut where the speed rises past that
+    level again. Only a pause that ends by frame ``stop``, lasts at most ``stop - cut``
+    frames in all and is followed by ``context`` frames at the typical speed (and at
+    least half the speed of the ``context`` frames before) counts: a
+    longer slow stretch, or one followed by slow motion, is an activity of its own
+    (standing, idling), not a pause between two. Elsewhere ``cut`` is returned unchanged.
+    """
+    level = PAUSE_RATIO * np.median(speed[max(0, cut - context) : cut + context])
+    if not speed[cut] < level or stop <= cut:
+        return cut
+    above = np.flatnonzero(speed[cut : stop + 1] >= level)
+    if not len(above):
+        return cut
+    end = cut + int(above[0])
+    before = np.flatnonzero(speed[max(0, end - (stop - cut)) : cut] >= level)
+    # The next activity must then move at least at the typical speed and at half the
+    # previous one's: a slow one (idling, swaying) is not set off by a rise of a moment.
+    after = np.median(speed[end : end + context])
+    moving = after >= max(level / PAUSE_RATIO,
+                          PAUSE_RATIO * np.median(speed[max(0, cut - context) : cut]))
+    return end if len(before) and moving else cut
 
 
 def split_gains(x: np.ndarray, gamma: float) -> np.ndarray:
@@ -254,7 +329,7 @@ def nearest(points: np.ndarray, target: int, radius: int) -> int:
     return int(best) if abs(best - target) <= radius else target
 
 
-PLACEMENTS = ("split", "turn", "pause")
+PLACEMENTS = ("split", "turn", "pause", "onset")
 
 
 def place_stages(x: np.ndarray, peaks: np.ndarray, fps: float, gamma: float, p: dict):
@@ -262,15 +337,18 @@ def place_stages(x: np.ndarray, peaks: np.ndarray, fps: float, gamma: float, p: 
 
     Returns
     -------
-    stages : {"split", "turn", "pause"} -> (n_cuts,) int frames of ``x``, each step
-        starting from the previous one's result.
+    stages : {"split", "turn", "pause", "onset"} -> (n_cuts,) int frames of ``x``, each
+        step starting from the previous one's result.
     speed : (n,) the 1 Hz pose speed.
     """
     speed = features.lowpass(features.frame_speed(x, fps=fps), fps=fps, cutoff_hz=1.0)
     step = max(1, int(round(fps / SPLIT_RATE_HZ)))
-    turns = turning_points(x, fps=fps)
+    smooth = features.lowpass(x, fps=fps, cutoff_hz=min(3.0, 0.45 * fps))
+    fine = features.frame_speed(smooth, fps=fps)  # the 3 Hz speed: sharper onsets
+    turns = features.local_extrema(fine)[0][~features.local_extrema(fine)[1]]
     radius = int(round(p["refine_s"] * fps))
     context = int(round(p["scale_min_s"] * fps))
+    onset_radius = int(round(ONSET_MAX_S * fps))
     stages = {name: [] for name in PLACEMENTS}
     for i, cut in enumerate(int(c) for c in peaks):
         # Never look past half-way to a neighbouring cut: that stretch is theirs.
@@ -280,9 +358,13 @@ def place_stages(x: np.ndarray, peaks: np.ndarray, fps: float, gamma: float, p: 
             hi = min(hi, (cut + int(peaks[i + 1])) // 2)
         split = best_split(x, cut, lo, hi, step=step, radius=radius, gamma=gamma)
         turn = nearest(turns, split, radius)
+        pause = settle_frame(speed, turn, radius, context)
         stages["split"].append(split)
         stages["turn"].append(turn)
-        stages["pause"].append(settle_frame(speed, turn, radius, context))
+        stages["pause"].append(pause)
+        limit = (cut + int(peaks[i + 1])) // 2 if i + 1 < len(peaks) else len(x) - 1
+        stages["onset"].append(onset_frame(fine, pause, min(limit, pause + onset_radius),
+                                           context))
     return {k: np.asarray(v, dtype=np.int64) for k, v in stages.items()}, speed
 
 
@@ -347,10 +429,10 @@ class Default(Segmenter):
     )
     params = {
         "threshold": Param(
-            "float", 0.25, 0.0, 2.0,
+            "float", 0.1, 0.0, 2.0,
             "Minimum mean MMD² (0 = same poses, 2 = disjoint) for a peak to become a cut.",
         ),
-        "min_segment_s": Param("float", 2.0, 0.1, 60.0, "Minimum time between two cuts (s)."),
+        "min_segment_s": Param("float", 1.5, 0.1, 60.0, "Minimum time between two cuts (s)."),
         "scale_min_s": Param("float", 3.0, 0.2, 30.0, "Shortest comparison window (s)."),
         "scale_max_s": Param("float", 6.0, 0.2, 60.0, "Longest comparison window (s)."),
         "bandwidth": Param(
@@ -366,6 +448,14 @@ class Default(Segmenter):
             "How far (s) each placement step (best split, turning point, pause) may move a cut.",
         ),
         "rate_hz": Param("float", 10.0, 1.0, 60.0, "Pose rate (Hz) for the novelty curve."),
+        "prominence": Param(
+            "float", 0.1, 0.0, 2.0,
+            "Minimum rise of a peak above the higher of the two valleys beside it (MMD²).",
+        ),
+        "onset": Param(
+            "bool", True, 0, 1,
+            "Move a cut that falls in a pause to its end, the onset of the next activity.",
+        ),
     }
 
     def _segment(self, take, **p) -> Segmentation:
@@ -376,8 +466,7 @@ class Default(Segmenter):
         peaks, strength = self._peaks(analysis.novelty, analysis.rate, p)
         cuts, speed = self._place(analysis.x, analysis.peak_frames(peaks), analysis.fps,
                                   analysis.gamma, p)
-        result = analysis.segmentation(cuts, strength / (strength + p["threshold"] + 1e-12),
-                                       speed)
+        result = analysis.segmentation(cuts, confidence(strength, p), speed)
         result.timings["cuts"] = time.perf_counter() - t0
         return result
 
@@ -394,9 +483,8 @@ class Default(Segmenter):
             )
         fps = float(take.fps)
         t0 = time.perf_counter()
-        positions, joints, first = take_positions(take)
+        x, first = take_features(take, velocity_s=p["velocity_s"])
         t1 = time.perf_counter()
-        x = pose_features(positions, joints, fps=fps, velocity_s=p["velocity_s"])
         step = max(1, int(round(fps / p["rate_hz"])))
         if len(x) < 2 * step:  # too short to compare anything: no cuts
             return None
@@ -415,7 +503,7 @@ class Default(Segmenter):
         Returns the placed cuts (frames of ``x``) and the 1 Hz pose speed.
         """
         stages, speed = place_stages(x, peaks, fps, gamma, p)
-        return stages["pause"], speed
+        return stages["onset" if p["onset"] else "pause"], speed
 
     @staticmethod
     def _novelty(x: np.ndarray, rate: float, gamma: float, p: dict) -> np.ndarray:
@@ -424,17 +512,29 @@ class Default(Segmenter):
             return np.zeros(len(x))
         scales = np.linspace(p["scale_min_s"], p["scale_max_s"], 3)
         widths = sorted({max(1, int(round(s * rate))) for s in scales})
-        return np.mean([mirrored_novelty(x, w, gamma) for w in widths], axis=0)
+        return np.mean(mirrored_novelties(x, widths, gamma), axis=0)
 
     @staticmethod
     def _peaks(novelty: np.ndarray, rate: float, p: dict) -> tuple[np.ndarray, np.ndarray]:
+        """Novelty peaks that become cuts, and each one's evidence (its prominence).
+
+        A peak must reach ``threshold``, stand ``prominence`` above the higher of the
+        valleys beside it, and lie ``min_segment_s`` from a higher peak.
+        """
         # Zero guards let a peak sit on the first or last sample.
         padded = np.concatenate([[0.0], novelty, [0.0]])
         distance = max(1, int(round(p["min_segment_s"] * rate)))
-        peaks, _ = find_peaks(padded, height=max(p["threshold"], 1e-12), distance=distance)
-        peaks = peaks - 1
+        peaks, props = find_peaks(padded, height=max(p["threshold"], 1e-12),
+                                  distance=distance, prominence=p["prominence"])
+        peaks, prominence = peaks - 1, props["prominences"]
         # The first and last segment may be shorter than the others, but not absurdly:
         # at least half the minimum segment.
         edge = p["min_segment_s"] * rate / 2
-        peaks = peaks[(peaks + 0.5 >= edge) & (len(novelty) - peaks - 0.5 >= edge)]
-        return peaks, novelty[peaks]
+        keep = (peaks + 0.5 >= edge) & (len(novelty) - peaks - 0.5 >= edge)
+        return peaks[keep], prominence[keep]
+
+
+def confidence(evidence: np.ndarray, p: dict) -> np.ndarray:
+    """Peak prominence -> confidence in [0, 1): 0.5 at the ``prominence`` setting."""
+    half = p["prominence"] if p["prominence"] > 0 else p["threshold"]
+    return evidence / (evidence + max(half, 1e-12))

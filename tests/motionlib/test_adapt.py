@@ -52,8 +52,7 @@ def test_it_counts_the_examples_it_learnt_from():
 
 
 def test_it_round_trips_a_model_through_json():
-    model = CutModel(n_takes=2, n_cuts=9, threshold=0.2, min_segment_s=1.5,
-                     scale_min_s=1.5, scale_max_s=3.0,
+    model = CutModel(n_takes=2, n_cuts=9, threshold=0.2, prominence=0.1, min_segment_s=1.5,
                      placement="split", offset_s=-0.1)
     text = model.to_json()
     assert '"format": 1' in text
@@ -64,9 +63,9 @@ def test_it_round_trips_a_model_through_json():
     ("{", "not JSON"),
     ('{"format": 2}', "format 2"),
     ('{"format": 1, "n_takes": 1, "n_cuts": 1, "threshold": "x", "min_segment_s": 1, '
-     '"scale_min_s": 1, "scale_max_s": 2, "offset_s": 0, "placement": "pause"}', "threshold"),
+     '"prominence": 1, "offset_s": 0, "placement": "pause"}', "threshold"),
     ('{"format": 1, "n_takes": 1, "n_cuts": 1, "threshold": 1, "min_segment_s": 1, '
-     '"scale_min_s": 1, "scale_max_s": 2, "offset_s": 0, "placement": "middle"}', "placement"),
+     '"prominence": 1, "offset_s": 0, "placement": "middle"}', "placement"),
 ])
 def test_it_refuses_a_stored_model_it_cannot_read(text, fault):
     with pytest.raises(ValueError, match=fault):

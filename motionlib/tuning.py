@@ -1,0 +1,154 @@
+"""Choosing the default detector's settings honestly: leave-one-take-out.
+
+The zero-shot defaults of ``segmenters.default`` are chosen from :data:`GRID`, a small set
+of principled options, by the best mean score over labelled takes. To know how that
+*choice* does on a take it has not seen, :func:`leave_one_out` repeats it without each
+take (and without every other view of the same take, e.g. the four-channel extract of a
+full AMC) and scores the result on the take left out.
+
+The score of a setting over some takes is the mean F1 at 1 s, ties broken by fewer
+edits per true cut (``metrics``).
+"""
+
+from __future__ import annotations
+
+import itertools
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from motionlib import metrics
+from motionlib.segmenters.default import Default, place_stages
+
+# The options the defaults are chosen from. Windows: (shortest, longest) in seconds.
+GRID = {
+    "windows": ((1.5, 3.0), (1.5, 6.0), (2.0, 4.0), (3.0, 6.0)),
+    "threshold": (0.1, 0.15, 0.2, 0.25, 0.3),
+    "prominence": (0.0, 0.05, 0.1, 0.15),
+    "min_segment_s": (1.5, 2.0),
+    "onset": (False, True),
+}
+
+
+def grid_choices(grid: dict | None = None) -> list[dict]:
+    """Every combination of :data:`GRID` as ``default`` segmenter parameters."""
+    grid = grid or GRID
+    keys = list(grid)
+    out = []
+    for values in itertools.product(*(grid[k] for k in keys)):
+        choice = dict(zip(keys, values, strict=True))
+        if "windows" in choice:
+            choice["scale_min_s"], choice["scale_max_s"] = choice.pop("windows")
+        out.append(choice)
+    return out
+
+
+@dataclass
+class TakeCache:
+    """One labelled take read once, with its novelty analyses by window setting."""
+
+    labelled: object  # benchdata.LabelledTake
+    take: object
+    analyses: dict = field(default_factory=dict)
+    placed: dict = field(default_factory=dict)
+
+    @property
+    def key(self) -> str:
+        """Takes sharing a name are views of one capture and are left out together."""
+        return self.labelled.name
+
+    def analysis(self, p: dict):
+        windows = (p["scale_min_s"], p["scale_max_s"], p["bandwidth"], p["rate_hz"],
+                   p["velocity_s"])
+        if windows not in self.analyses:
+            self.analyses[windows] = Default.analyse(self.take, p)
+        return self.analyses[windows]
+
+    def cuts(self, params: dict) -> np.ndarray:
+        """The default detector's cuts with ``params`` (0-based take frames)."""
+        p = Default.validate_params(params)
+        a = self.analysis(p)
+        if a is None:
+            return np.zeros(0, dtype=np.int64)
+        peaks, _ = Default._peaks(a.novelty, a.rate, p)
+        key = (id(a), p["refine_s"], tuple(peaks))
+        if key not in self.placed:
+            self.placed[key] = place_stages(a.x, a.peak_frames(peaks), a.fps, a.gamma, p)[0]
+        return self.placed[key]["onset" if p["onset"] else "pause"] + a.first
+
+
+def score_rows(cache: Sequence[TakeCache], params: dict) -> list[dict]:
+    """``metrics.evaluate`` of ``params`` on each take."""
+    return [metrics.evaluate(c.cuts(params), c.labelled.truth, fps=c.take.fps) for c in cache]
+
+
+def objective(rows: Sequence[dict]) -> tuple[float, float]:
+    """Higher is better: mean F1@1 s, then fewer edits per true cut."""
+    return (round(float(np.mean([r["f1@1s"] for r in rows])), 9),
+            -round(float(np.mean([r["edits_per_cut"] for r in rows])), 9))
+
+
+@dataclass
+class Selection:
+    """Scores of every choice on every take: ``rows[i][j]`` is choice i on take j."""
+
+    choices: list[dict]
+    cache: list[TakeCache]
+    rows: list[list[dict]]
+
+    def best(self, keep: Sequence[bool]) -> int:
+        """Index of the best choice on the takes where ``keep`` is true."""
+        scores = [objective([r for r, k in zip(rows, keep, strict=True) if k])
+                  for rows in self.rows]
+        return max(range(len(scores)), key=lambda i: scores[i])
+
+    def chosen(self) -> dict:
+        """The choice on every take: the shipped default."""
+        return self.choices[self.best([True] * len(self.cache))]
+
+    def leave_one_out(self) -> list[tuple[dict, dict]]:
+        """Per take: the choice made without it (and its other views), and its row there."""
+        out = []
+        for j, c in enumerate(self.cache):
+            keep = [other.key != c.key for other in self.cache]
+            i = self.best(keep)
+            out.append((self.choices[i], self.rows[i][j]))
+        return out
+
+
+def select(cache: Sequence[TakeCache], choices: list[dict] | None = None) -> Selection:
+    """Score every choice (default: the whole :data:`GRID`) on every take."""
+    choices = grid_choices() if choices is None else choices
+    return Selection(choices, list(cache), [score_rows(cache, ch) for ch in choices])
+
+
+def _value(choice: dict, key: str):
+    if key == "windows":
+        return (choice["scale_min_s"], choice["scale_max_s"])
+    return choice[key]
+
+
+def out_of_sample(selection: Selection, grid: dict | None = None) -> list[tuple[str, object,
+                                                                                 float, float]]:
+    """How each option of each setting scores out of sample.
+
+    For every setting and every value it can take, the leave-one-take-out mean F1@1 s and
+    edits per true cut when that value is imposed and the other settings are still chosen
+    on the other takes.
+
+    Returns
+    -------
+    list of (setting, value, mean F1@1 s, mean edits per true cut).
+    """
+    grid = grid or GRID
+    out = []
+    for key, values in grid.items():
+        for value in values:
+            idx = [i for i, ch in enumerate(selection.choices) if _value(ch, key) == value]
+            sub = Selection([selection.choices[i] for i in idx], selection.cache,
+                            [selection.rows[i] for i in idx])
+            rows = [row for _, row in sub.leave_one_out()]
+            out.append((key, value, float(np.mean([r["f1@1s"] for r in rows])),
+                        float(np.mean([r["edits_per_cut"] for r in rows]))))
+    return out

@@ -1,0 +1,77 @@
+"""Finding every labelled take in the shared data layout, whatever the takes are called."""
+
+import numpy as np
+import pytest
+
+from motionlib import benchdata, synth, tuning, write_bvh
+
+SEGMENTS = "start_block,end_block,start_frame,end_frame,label_id,action_name\n"
+KRUGER = "segment,label,end_lo,end_mid,end_hi\n"
+
+
+@pytest.fixture(scope="module")
+def layout(tmp_path_factory):
+    """A data folder with a BVH take, a four-channel take and the odd ones out."""
+    root = tmp_path_factory.mktemp("data")
+    for folder in ("cmu/bvh", "cmu/amc", "cmu/channels4d", "labels/mocap6/segments",
+                   "labels/cmu86_kruger2017"):
+        (root / folder).mkdir(parents=True)
+    take, _ = synth.generate(seed=1, fps=120.0, duration=12.0)
+    write_bvh(take, root / "cmu/bvh/77_05.bvh")
+    (root / "labels/mocap6/segments/77_05.csv").write_text(
+        SEGMENTS + f"1,50,1,600,1,JumpJack\n51,120,601,{take.n_frames},2,Jog\n")
+    (root / "labels/mocap6/segments/77_09.csv").write_text(SEGMENTS + "1,9,1,100,1,Jog\n")
+    rows = np.random.default_rng(0).normal(size=(900, 4))
+    np.savetxt(root / "cmu/channels4d/91_02.4d.txt", rows, fmt="%.4f")
+    (root / "labels/cmu86_kruger2017/91_02.csv").write_text(
+        KRUGER + "1,walk,380,400,420\n2,jump,900,900,900\n")
+    (root / "cmu/amc/12_34.amc").write_text(":FULLY-SPECIFIED\n:DEGREES\n")
+    return root
+
+
+def test_it_finds_labelled_takes_by_their_files_not_their_names(layout):
+    takes, _ = benchdata.discover(layout)
+    assert [(t.name, t.kind, t.source) for t in takes] == [
+        ("77_05", "skeleton", "mocap6"), ("91_02", "channels", "kruger2017")]
+
+
+def test_it_says_which_files_it_skipped_and_why(layout):
+    _, skipped = benchdata.discover(layout)
+    assert skipped == ["skipped labels/mocap6/segments/77_09.csv: labels but no motion",
+                       "skipped cmu/amc/12_34.amc: motion but no labels"]
+
+
+def test_it_shifts_mocap6_cuts_by_the_lines_a_bvh_adds_before_the_motion(layout):
+    take = benchdata.discover(layout)[0][0]
+    # The BVH has as many frames as the labels: no added T-pose line, no shift.
+    assert take.truth[:, 1].tolist() == [600]
+
+
+def test_it_reads_a_four_channel_take_as_angles_at_the_cmu_rate(layout):
+    take = benchdata.discover(layout)[0][1]
+    read = take.read()
+    assert (read.n_frames, read.channels.shape[1], read.fps) == (900, 4, 120.0)
+    assert take.truth.tolist() == [[380, 400, 420]]
+
+
+def test_it_names_the_line_of_a_bad_four_channel_row(tmp_path):
+    path = tmp_path / "x.4d.txt"
+    path.write_text("1 2 3 4\n1 2 x 4\n")
+    with pytest.raises(benchdata.LabelError, match=r"x\.4d\.txt: line 2: not numbers"):
+        benchdata.read_channels(path)
+
+
+def test_it_chooses_settings_without_the_take_scored_or_its_other_views():
+    class View:
+        def __init__(self, name):
+            self.labelled = type("L", (), {"name": name})()
+            self.key = name
+
+    cache = [View("a"), View("a"), View("b")]
+    good = {"f1@1s": 1.0, "edits_per_cut": 0.0}
+    bad = {"f1@1s": 0.0, "edits_per_cut": 1.0}
+    # Choice 0 is best on the two views of "a", choice 1 on "b".
+    selection = tuning.Selection([{"c": 0}, {"c": 1}], cache,
+                                 [[good, good, bad], [bad, bad, good]])
+    chosen = [choice["c"] for choice, _ in selection.leave_one_out()]
+    assert chosen == [1, 1, 0]
