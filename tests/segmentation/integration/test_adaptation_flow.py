@@ -22,7 +22,7 @@ SECONDS = 40.0
 @pytest.fixture
 def studio(transactional_db, settings):
     # Short, so the tests do not wait long for the folded retraining.
-    settings.CUTROOM_RETRAIN_DELAY = 2
+    settings.CUTROOM_RETRAIN_DELAY = 3
     users = get_user_model().objects
     people = {name: users.create_user(name, password=f"{name}-password")
               for name in ("alice", "bob", "rachel")}
@@ -63,6 +63,11 @@ def true_cuts(seed):
 
 def review_to_the_truth(studio, capture, seed):
     """bob deletes every candidate, inserts the true boundaries and submits, via the API."""
+    submit(studio, capture, edit_to_the_truth(studio, capture, seed))
+
+
+def edit_to_the_truth(studio, capture, seed):
+    """bob's review with the candidates deleted and the true boundaries inserted."""
     client, url = client_for(studio["bob"]), f"/api/captures/{capture.pk}/review"
     review = client.post(f"{url}/").json()
     for cut in review["cuts"]:
@@ -72,7 +77,12 @@ def review_to_the_truth(studio, capture, seed):
         response = client.post(f"{url}/cuts/", {"frame": frame, "version": review["version"]}, format="json")
         assert response.status_code == 201, response.content
         review = response.json()
-    response = client.post(f"{url}/submit/", {"version": review["version"]}, format="json")
+    return review
+
+
+def submit(studio, capture, review):
+    url = f"/api/captures/{capture.pk}/review/submit/"
+    response = client_for(studio["bob"]).post(url, {"version": review["version"]}, format="json")
     assert response.status_code == 200, response.content
 
 
@@ -83,8 +93,9 @@ def trainings_settled(project):
 def train_on(studio, seeds):
     """Upload and review ``seeds`` (submits in one burst) and wait for the training."""
     captures = [upload(studio, seed) for seed in seeds]
-    for capture, seed in zip(captures, seeds, strict=True):
-        review_to_the_truth(studio, capture, seed)
+    reviews = [edit_to_the_truth(studio, capture, seed) for capture, seed in zip(captures, seeds, strict=True)]
+    for capture, review in zip(captures, reviews, strict=True):
+        submit(studio, capture, review)
     wait_for(lambda: ProjectCutModel.objects.filter(project=studio["project"]).exists()
              and trainings_settled(studio["project"]), timeout=120, what="the retraining")
     return captures
