@@ -21,6 +21,7 @@ from django.db.models import Max
 from django.utils import timezone
 
 from motionlib.segmenters import get_segmenter
+from segmentation import takecache
 from segmentation.errors import NotReady, ReviewStarted
 from segmentation.models import Capture, ProjectCutModel, Review
 from segmentation.services.captures import do_start_run, read_take
@@ -101,9 +102,10 @@ def project_examples(project_id):
 
 
 def example_take(capture):
-    """The capture's take, named after the capture so that an error names it."""
+    """The capture's take (parsed once, then from ``takecache``), named after the capture
+    so that an error names it."""
     try:
-        take = read_take(capture)
+        take = takecache.read_cached(capture, read_take)
     except (ValueError, OSError) as exc:
         raise ValueError(f"reviewed capture {capture.pk} ({capture.name!r}) cannot be read: {exc}") from exc
     # motionlib names a take by its path when it has one: the stored file's name is a
