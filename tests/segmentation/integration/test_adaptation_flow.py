@@ -142,21 +142,22 @@ def test_a_submit_during_a_training_trains_again_after_it(running_workers, studi
 
 
 def test_a_failed_training_keeps_the_previous_model_and_says_why(running_workers, studio):
-    first, _ = train_on(studio, [51, 52])
+    train_on(studio, [51, 52])
     assert ProjectCutModel.objects.newest(studio["project"].pk).version == 1
-    # The stored original of a reviewed take is damaged (a storage fault).
-    with first.original.storage.open(first.original.name, "wb") as handle:
-        handle.write(b"HIERARCHY\nROOT Hips\n{\n")
     capture = upload(studio, 53)
+    # The stored original of the take being reviewed is damaged (a storage fault): the
+    # review works from the stored positions, the training must parse the original.
+    with capture.original.storage.open(capture.original.name, "wb") as handle:
+        handle.write(b"HIERARCHY\nROOT Hips\n{\n")
     review_to_the_truth(studio, capture, 53)
     wait_for(lambda: ProjectCutModel.objects.filter(project=studio["project"], status="failed").exists()
              and trainings_settled(studio["project"]), timeout=120, what="the failed retraining")
 
     failed = ProjectCutModel.objects.get(project=studio["project"], status="failed")
-    assert f"capture {first.pk}" in failed.error and failed.version is None
+    assert f"capture {capture.pk}" in failed.error and failed.version is None
     assert ProjectCutModel.objects.newest(studio["project"].pk).version == 1
     adaptation = client_for(studio["bob"]).get(f"/api/captures/{capture.pk}/review/").json()["adaptation"]
-    assert f"capture {first.pk}" in adaptation["training_error"]
+    assert f"capture {capture.pk}" in adaptation["training_error"]
     assert adaptation["project_model"]["version"] == 1
     later = upload(studio, 54)
     assert later.latest_run().model_version == 1
