@@ -1,8 +1,10 @@
 """The segmentation benchmark: every method, default parameters, every labelled take.
 
-Rows are the registered segmenters plus two peers from the change-point literature,
-run on the same heading-invariant pose stream the default detector uses (10 joints in
-the body frame plus root height; ``segmenters.default.pose_features``):
+Takes are found by ``benchdata.discover`` (every labelled take in the ``shared/data``
+layout, whatever its name; four-channel takes run only the methods that need no
+skeleton). Rows are the registered segmenters plus two peers from the change-point
+literature, run on the same heading-invariant pose stream the default detector uses (10
+joints in the body frame plus root height; ``segmenters.default.take_features``):
 
 - ``ruptures_kernel``: ruptures ``KernelCPD`` with the RBF kernel (median-heuristic
   bandwidth), on the pose averaged to 10 Hz, minimum segment 2 s, one fixed penalty
@@ -11,6 +13,13 @@ the body frame plus root height; ``segmenters.default.pose_features``):
   learned), on the pose averaged to 30 Hz.
 
 Both are imported only here, and only when the bench runs.
+
+With ``--loo`` three rows are scored leave-one-take-out (``LOO_ROWS``): the default's
+settings chosen from ``tuning.GRID`` without the take scored, the default adapted to the
+other takes of the same label source (``motionlib.adapt``), and ruptures with its
+penalty chosen without the take; the out-of-sample score of every option of every
+setting, and a short-activity check on synthetic takes, follow the tables. Each take is
+scored separately and the means are given per kind of take and over all.
 """
 
 from __future__ import annotations
@@ -98,7 +107,7 @@ def _timed_row(detect, take, truth) -> dict:
 
 
 def run(root: Path | None = None, only: list[str] | None = None, *, loo: bool = False,
-        log=None) -> dict[str, dict]:
+        log=None, selection_out: list | None = None) -> dict[str, dict]:
     """Evaluate every method on every labelled take under ``root``.
 
     With ``loo``, three more rows are scored leave-one-take-out (see ``LOO_ROWS``).
@@ -120,7 +129,10 @@ def run(root: Path | None = None, only: list[str] | None = None, *, loo: bool = 
             if c.labelled.kind == "skeleton" or name in FEATURE_ONLY
         }
     if loo:
-        for key, per_take in loo_rows(cache).items():
+        selection = tuning.select(cache)
+        if selection_out is not None:
+            selection_out.append(selection)
+        for key, per_take in loo_rows(cache, selection).items():
             for c, row in zip(cache, per_take, strict=True):
                 results[title(c.labelled)][key] = row
     return results
@@ -134,15 +146,18 @@ LOO_ROWS = {
 }
 
 
-def loo_rows(cache: list[tuning.TakeCache]) -> dict[str, list[dict]]:
+def loo_rows(cache: list[tuning.TakeCache], selection: tuning.Selection) -> dict[str, list[dict]]:
     """The leave-one-take-out rows, one list of rows (in ``cache`` order) per name."""
-    selection = tuning.select(cache)
     chosen = selection.leave_one_out()
     out: dict[str, list[dict]] = {name: [] for name in LOO_ROWS}
     for c, (params, _) in zip(cache, chosen, strict=True):
         out["default/loo"].append(_timed_row(lambda t, p=params: Default(**p).fit_predict(t).cuts,
                                              c.take, c.labelled.truth))
-        model = adapt.fit_cut_model(_examples(cache, c))
+        examples = _examples(cache, c)
+        if not examples:  # the only take of its label source: nothing to learn from
+            out["adapted/loo"].append({key: float("nan") for _, key in COLUMNS})
+            continue
+        model = adapt.fit_cut_model(examples)
         out["adapted/loo"].append(_timed_row(lambda t, m=model: adapt.detect(t, m).cuts,
                                              c.take, c.labelled.truth))
     out["ruptures/loo"] = _ruptures_loo(cache)
@@ -214,7 +229,8 @@ def main(root: Path | None = None, only: list[str] | None = None, out=None, *,
         return 2
     started = time.perf_counter()
     takes = {title(t): t for t in benchdata.discover(folder)[0]}
-    results = run(folder, only, loo=loo, log=out)
+    selections: list = []
+    results = run(folder, only, loo=loo, log=out, selection_out=selections)
     print(_legend(loo), file=out)
     for name, rows in results.items():
         print(format_table(f"\n{name} ({len(takes[name].truth)} true cuts, "
@@ -225,11 +241,61 @@ def main(root: Path | None = None, only: list[str] | None = None, out=None, *,
         if names:
             mean = mean_rows({n: results[n] for n in names})
             print(format_table(f"\nmean over {len(names)} {group} takes", mean), file=out)
+    if selections:
+        print("\n" + out_of_sample_table(selections[0]), file=out)
+    if not only or "default" in only:
+        print("\n" + short_activity_check(), file=out)
     if (not only or "joint_distance_pca" in only) and "13_30" in takes:
         print("\n" + patent_comparison(folder), file=out)
     print(f"\nwhole benchmark: {time.perf_counter() - started:.0f} s, load average "
           f"{' '.join(f'{x:.2f}' for x in os.getloadavg())}", file=out)
     return 0
+
+
+SHORT_S = 2.5
+
+
+def short_activity_check(seeds: int = 6) -> str:
+    """Recall of boundaries beside short activities on synthetic takes, zero-shot and
+    adapted (each take's model fitted on the other seeds' takes)."""
+    from motionlib import synth
+
+    takes = []
+    for seed in range(seeds):
+        take, segments = synth.generate(seed=seed, fps=60.0, duration=60.0,
+                                        segment_seconds=(1.5, 6.0))
+        cuts = np.asarray([s[0] for s in segments[1:]])
+        lengths = np.asarray([s[1] - s[0] for s in segments]) / take.fps
+        short = np.minimum(lengths[:-1], lengths[1:]) < SHORT_S
+        takes.append((take, cuts, short))
+    found = {"zero-shot": [0, 0], "adapted": [0, 0]}
+    for i, (take, cuts, short) in enumerate(takes):
+        model = adapt.fit_cut_model([(t, c) for j, (t, c, _) in enumerate(takes) if j != i])
+        for name, m in (("zero-shot", None), ("adapted", model)):
+            detected = adapt.detect(take, m).cuts
+            _, ti = metrics.match(detected, cuts, tolerance=int(take.fps))
+            hit = np.zeros(len(cuts), dtype=bool)
+            hit[ti] = True
+            found[name][0] += int(hit[short].sum())
+            found[name][1] += int(short.sum())
+    parts = [f"{name} {k}/{n} ({k / max(n, 1):.2f})" for name, (k, n) in found.items()]
+    return (f"short activities: synthetic takes ({seeds} seeds, 60 s at 60 fps, activities "
+            f"1.5-6 s), boundaries beside an activity shorter than {SHORT_S:g} s found "
+            f"within 1 s: " + ", ".join(parts) + " (adapted: fitted on the other seeds)")
+
+
+def out_of_sample_table(selection: tuning.Selection) -> str:
+    """The default's settings: what was chosen on all takes, and how each option of each
+    setting scores leave-one-take-out (the others still chosen without the take)."""
+    chosen = selection.chosen()
+    lines = [f"default settings chosen on all {len(selection.cache)} takes from tuning.GRID: "
+             + ", ".join(f"{k}={v:g}" if not isinstance(v, bool) else f"{k}={v}"
+                         for k, v in chosen.items()),
+             "out of sample (leave-one-take-out) with one setting imposed:",
+             f"  {'setting':<15}{'value':>12}{'F1@1s':>9}{'edits/cut':>11}"]
+    for key, value, f1, edits in tuning.out_of_sample(selection):
+        lines.append(f"  {key:<15}{str(value):>12}{f1:>9.3f}{edits:>11.3f}")
+    return "\n".join(lines)
 
 
 def _legend(loo: bool) -> str:

@@ -71,7 +71,7 @@ class TakeCache:
         a = self.analysis(p)
         if a is None:
             return np.zeros(0, dtype=np.int64)
-        peaks, _ = Default._peaks(a.novelty, a.rate, p)
+        peaks, _ = Default.select_peaks(a.novelty, a.rate, p)
         key = (id(a), p["refine_s"], tuple(peaks))
         if key not in self.placed:
             self.placed[key] = place_stages(a.x, a.peak_frames(peaks), a.fps, a.gamma, p)[0]
@@ -98,7 +98,10 @@ class Selection:
     rows: list[list[dict]]
 
     def best(self, keep: Sequence[bool]) -> int:
-        """Index of the best choice on the takes where ``keep`` is true."""
+        """Index of the best choice on the takes where ``keep`` is true (the first
+        choice when there is no such take: nothing to choose on)."""
+        if not any(keep):
+            return 0
         scores = [objective([r for r, k in zip(rows, keep, strict=True) if k])
                   for rows in self.rows]
         return max(range(len(scores)), key=lambda i: scores[i])

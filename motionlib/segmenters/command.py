@@ -58,8 +58,9 @@ def run_segment(args) -> int:
             out["adapted_from"] = {"takes": model.n_takes, "cuts": model.n_cuts}
         print(json.dumps(out))
         return 0
-    adapted = "" if model is None else \
-        f", adapted from {model.n_takes} example takes with {model.n_cuts} cuts"
+    adapted = "" if model is None else (
+        f", adapted from {model.n_takes} example take{'s' * (model.n_takes != 1)} with "
+        f"{model.n_cuts} cut{'s' * (model.n_cuts != 1)}")
     print(f"{args.file}: {len(cuts)} cuts by {cls.name} "
           f"({take.n_frames} frames at {take.fps:g} fps{adapted})")
     print(f"{'frame':>8} {'time s':>9} {'confidence':>10}")

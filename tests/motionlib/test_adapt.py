@@ -40,10 +40,16 @@ def test_it_learns_the_shortest_activity_from_the_examples():
     short = dict(segment_seconds=(1.5, 2.5), duration=30.0)
     model = fit_cut_model([_take(7, **short), _take(8, **short)])
     assert model.min_segment_s < 1.5
+    assert model.scale_min_s < 3.0  # windows short enough to see such an activity
     take, cuts = _take(9, **short)
     found = metrics.boundary_scores(detect(take, model).cuts, cuts, fps=FPS, tolerance_s=0.5)
     zero_shot = metrics.boundary_scores(detect(take).cuts, cuts, fps=FPS, tolerance_s=0.5)
     assert found["recall"] > zero_shot["recall"]
+
+
+def test_it_keeps_the_zero_shot_windows_without_short_activities():
+    model = fit_cut_model([_take(1), _take(2)])
+    assert (model.scale_min_s, model.scale_max_s) == (3.0, 6.0)
 
 
 def test_it_counts_the_examples_it_learnt_from():
@@ -53,7 +59,7 @@ def test_it_counts_the_examples_it_learnt_from():
 
 def test_it_round_trips_a_model_through_json():
     model = CutModel(n_takes=2, n_cuts=9, threshold=0.2, prominence=0.1, min_segment_s=1.5,
-                     placement="split", offset_s=-0.1)
+                     scale_min_s=3.0, scale_max_s=6.0, placement="split", offset_s=-0.1)
     text = model.to_json()
     assert '"format": 1' in text
     assert CutModel.from_json(text) == model
@@ -63,19 +69,31 @@ def test_it_round_trips_a_model_through_json():
     ("{", "not JSON"),
     ('{"format": 2}', "format 2"),
     ('{"format": 1, "n_takes": 1, "n_cuts": 1, "threshold": "x", "min_segment_s": 1, '
-     '"prominence": 1, "offset_s": 0, "placement": "pause"}', "threshold"),
+     '"prominence": 1, "scale_min_s": 3, "scale_max_s": 6, "offset_s": 0, "placement": "pause"}', "threshold"),
     ('{"format": 1, "n_takes": 1, "n_cuts": 1, "threshold": 1, "min_segment_s": 1, '
-     '"prominence": 1, "offset_s": 0, "placement": "middle"}', "placement"),
+     '"prominence": 1, "scale_min_s": 3, "scale_max_s": 6, "offset_s": 0, "placement": "middle"}', "placement"),
 ])
 def test_it_refuses_a_stored_model_it_cannot_read(text, fault):
     with pytest.raises(ValueError, match=fault):
         CutModel.from_json(text)
 
 
+def test_it_reads_a_stored_model_from_before_the_prominence_test_as_it_was():
+    text = ('{"format": 1, "n_takes": 1, "n_cuts": 4, "threshold": 0.3, "min_segment_s": 2, '
+            '"scale_min_s": 3, "scale_max_s": 6, "offset_s": 0, "placement": "pause"}')
+    assert CutModel.from_json(text).prominence == 0.0
+
+
 def test_it_refuses_a_cut_outside_the_example_take():
     take, _ = _take(1, duration=20.0)
     with pytest.raises(ExampleError, match=f"cut {take.n_frames + 5} is outside"):
         fit_cut_model([(take, [100, take.n_frames + 5])])
+
+
+def test_it_names_an_example_take_too_short_to_learn_from():
+    take, _ = _take(1, duration=20.0)
+    with pytest.raises(ExampleError, match=r"synth-1: too short to learn from \(3 frames\)"):
+        fit_cut_model([(_take(2)[0], []), (take.slice(0, 3), [1])])
 
 
 def test_it_refuses_an_empty_example_list():

@@ -91,3 +91,19 @@ def test_it_exits_2_with_one_line_on_a_bad_examples_csv(takes, capsys):
     err = capsys.readouterr().err
     assert err.count("\n") == 1
     assert "bad.csv:2: cannot read missing.bvh" in err
+
+
+def test_it_says_in_the_table_what_the_cuts_were_adapted_from(takes, capsys):
+    folder, rows = takes
+    path = _csv(folder, f"file,asf,cuts\n{rows[0][0]},,{' '.join(map(str, rows[0][1]))}\n")
+    assert main(["segment", str(folder / rows[1][0]), "--examples", str(path)]) == 0
+    first = capsys.readouterr().out.splitlines()[0]
+    assert first.endswith(f"adapted from 1 example take with {len(rows[0][1])} cuts)")
+
+
+def test_it_refuses_examples_for_a_method_that_does_not_adapt(takes, capsys):
+    folder, rows = takes
+    path = _csv(folder, f"file,asf,cuts\n{rows[0][0]},,100\n")
+    assert main(["segment", str(folder / rows[1][0]), "--method", "ppca",
+                 "--examples", str(path)]) == 2
+    assert "only the default method adapts" in capsys.readouterr().err

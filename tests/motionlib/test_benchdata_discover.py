@@ -75,3 +75,15 @@ def test_it_chooses_settings_without_the_take_scored_or_its_other_views():
                                  [[good, good, bad], [bad, bad, good]])
     chosen = [choice["c"] for choice, _ in selection.leave_one_out()]
     assert chosen == [1, 1, 0]
+
+
+def test_it_prints_leave_one_take_out_rows_beside_the_others(layout, capsys):
+    from motionlib import benchmark
+
+    assert benchmark.main(layout, ["bone_angle"], loo=True) == 0
+    out = capsys.readouterr().out
+    assert "Rows ending in /loo were scored leave-one-take-out" in out
+    for row in ("default/loo", "adapted/loo", "ruptures/loo"):
+        assert out.count(f"\n{row} ") == 2 + 3  # two takes, three mean tables
+    assert "mean over 1 full-skeleton takes" in out and "mean over 2 labelled takes" in out
+    assert "out of sample (leave-one-take-out)" in out
