@@ -203,6 +203,9 @@ CUTROOM_MAX_JOINT_FRAMES = envint("CUTROOM_MAX_JOINT_FRAMES", None)
 CUTROOM_MAX_EXPANSION = envint("CUTROOM_MAX_EXPANSION", None)
 # One /frames/ answer carries at most this many joint positions (frames × joints).
 CUTROOM_JOINT_FRAMES_PER_REQUEST = 250_000
+# A project's model retrains this many seconds after a review submit or gold save;
+# submits made meanwhile join the same training.
+CUTROOM_RETRAIN_DELAY = envint("CUTROOM_RETRAIN_DELAY", 10)
 
 # Celery. No result backend: a job's state is its row (status, error, timings).
 # (the host part only keeps kombu from warning that none was given)

@@ -8,6 +8,7 @@ from segmentation.models import (
     Label,
     Membership,
     Project,
+    ProjectCutModel,
     Review,
     ReviewEvent,
     SegmentLabel,
@@ -66,6 +67,13 @@ class CaptureAdmin(admin.ModelAdmin):
     list_filter = ("status", "format", "project")
     search_fields = ("name", "checksum")
     readonly_fields = ("checksum", "claim_token", "claimed_at", "attempts")
+
+
+@admin.register(ProjectCutModel)
+class ProjectCutModelAdmin(admin.ModelAdmin):
+    list_display = ("id", "project", "version", "status", "n_takes", "n_cuts", "created_at", "finished_at")
+    list_filter = ("status", "project")
+    readonly_fields = ("claim_token", "claimed_at", "attempts")
 
 
 @admin.register(DetectionRun)

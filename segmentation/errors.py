@@ -29,3 +29,7 @@ class StaleVersion(Exception):
             f"review {review.pk} is at version {review.version}; reload it and redo the change"
         )
         self.review = review
+
+
+class ReviewStarted(ValueError):
+    """Someone started reviewing the capture, so its candidates can no longer change."""

@@ -205,6 +205,9 @@ def do_save_gold(capture, user, cuts, labels, version, source_review=None):
         gold.updated_at = timezone.now()
         gold.save()
         refresh_capture_library(capture)
+        from segmentation.services.adaptation import on_examples_changed
+
+        on_examples_changed(capture.project_id)
     return gold
 
 

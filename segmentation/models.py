@@ -270,6 +270,10 @@ class DetectionRun(Job):
     )
     created_at = models.DateTimeField(default=timezone.now)
     finished_at = models.DateTimeField(null=True, blank=True)
+    # The project model a ``default`` run detected with (see ProjectCutModel); null for
+    # the zero-shot detector and for other methods.
+    model_version = models.PositiveIntegerField(null=True, blank=True)
+    model_n_takes = models.PositiveIntegerField(null=True, blank=True)
 
     objects = ClaimQuerySet.as_manager()
 
@@ -396,6 +400,58 @@ class ReviewEvent(models.Model):
 
     def __str__(self):
         return f"{self.action} by {self.user}"
+
+
+class CutModelQuerySet(ClaimQuerySet):
+    def claim(self, pk, token):
+        """Claim a training unless another training of the same project holds a live
+        claim: one training at a time per project. Zero rows updated means it is not
+        this job's turn (or another worker has it)."""
+        stale = timezone.now() - timezone.timedelta(seconds=settings.CUTROOM_CLAIM_TIMEOUT)
+        busy = self.model.objects.filter(
+            project=models.OuterRef("project"), status="processing", claimed_at__gte=stale
+        ).exclude(pk=models.OuterRef("pk"))
+        return super(CutModelQuerySet, self.filter(~models.Exists(busy))).claim(pk, token)
+
+    def newest(self, project_id):
+        """The project's newest trained model, or None (zero-shot)."""
+        return self.filter(project_id=project_id, status="ready").order_by("-version").first()
+
+
+class ProjectCutModel(Job):
+    """One training of a project's cut model from its reviewed takes.
+
+    A row is one request: queued when a review is submitted or a gold version saved
+    (later requests fold into the queued one), then trained by a worker. A trained row
+    gets the project's next ``version``; a failed one keeps its ``error`` and no version,
+    and detection goes on with the newest trained version. ``model`` is
+    ``motionlib.adapt.CutModel.to_json()``.
+    """
+
+    project = models.ForeignKey(Project, models.CASCADE, related_name="cut_models")
+    version = models.PositiveIntegerField(null=True, blank=True)
+    model = models.TextField(blank=True)
+    n_takes = models.PositiveIntegerField(default=0)
+    n_cuts = models.PositiveIntegerField(default=0)
+    seconds = models.FloatField(null=True, blank=True)
+    created_at = models.DateTimeField(default=timezone.now)
+    finished_at = models.DateTimeField(null=True, blank=True)
+
+    objects = CutModelQuerySet.as_manager()
+
+    class Meta:
+        ordering = ["-created_at", "-id"]
+        constraints = [
+            models.UniqueConstraint(fields=["project", "version"], name="one_cut_model_per_version"),
+            # Requests made while one is waiting join it: one queued training per project.
+            models.UniqueConstraint(
+                fields=["project"], condition=Q(status="queued"), name="one_queued_training"
+            ),
+        ]
+
+    def __str__(self):
+        return f"cut model v{self.version} of {self.project}" if self.version else (
+            f"training of {self.project} ({self.status})")
 
 
 # The clip library and agreement records, and invitations, live in their own modules

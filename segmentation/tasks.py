@@ -13,6 +13,7 @@ from celery.signals import worker_ready
 
 from segmentation import services
 from segmentation.models import Capture, DetectionRun
+from segmentation.services import adaptation
 from segmentation.services.captures import exhausted, give_up
 
 
@@ -44,10 +45,20 @@ def detect(self, run_id):
         services.detect_run(run)
 
 
+@shared_task(bind=True, acks_late=True, reject_on_worker_lost=True)
+def retrain(self, model_id):
+    """Train a project's cut model from its reviewed takes (one at a time per project:
+    the claim fails while another training of the project runs, which starts this one
+    when it ends)."""
+    job = adaptation.claim_training(model_id, self.request.id or uuid.uuid4().hex)
+    if job is not None:
+        adaptation.train_project_model(job)
+
+
 @shared_task
 def sweep():
     """Requeue (or fail) jobs whose claim went stale because their worker vanished."""
-    return services.sweep_stale_claims()
+    return services.sweep_stale_claims() + adaptation.sweep_stale_trainings()
 
 
 @worker_ready.connect

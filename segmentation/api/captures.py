@@ -5,11 +5,11 @@ import math
 
 import numpy as np
 from django.conf import settings
-from django.db.models import Prefetch
+from django.db.models import Exists, OuterRef, Prefetch
 from drf_spectacular.utils import OpenApiParameter, extend_schema
 from rest_framework import mixins, viewsets
 from rest_framework.decorators import action
-from rest_framework.exceptions import NotFound
+from rest_framework.exceptions import NotFound, PermissionDenied
 from rest_framework.pagination import PageNumberPagination
 from rest_framework.parsers import FormParser, JSONParser, MultiPartParser
 from rest_framework.response import Response
@@ -25,7 +25,8 @@ from segmentation.api.serializers import (
     UploadSerializer,
 )
 from segmentation.errors import NotReady, UploadTooLarge
-from segmentation.models import Capture, DetectionRun, JSONArrayLength
+from segmentation.models import Capture, DetectionRun, JSONArrayLength, Review
+from segmentation.services import adaptation
 
 
 class CapturePagination(PageNumberPagination):
@@ -54,6 +55,7 @@ class CaptureViewSet(
                 n_candidates=JSONArrayLength("candidates")
             )
             captures = captures.defer("skeleton").prefetch_related(Prefetch("runs", runs))
+            captures = captures.annotate(review_started=Exists(Review.objects.filter(capture=OuterRef("pk"))))
         else:
             captures = captures.prefetch_related("runs")
         project = int_param(self.request, "project", None)
@@ -128,6 +130,17 @@ class CaptureViewSet(
         services.do_retry_capture(capture)
         capture.refresh_from_db()
         return Response(CaptureSerializer(capture).data, status=202)
+
+    @extend_schema(request=None, responses=RunSerializer)
+    @action(detail=True, methods=["post"])
+    def redetect(self, request, pk=None):
+        """Detect again with the project's method and newest model (reviewers, admins),
+        on a capture nobody has started reviewing."""
+        capture = self.get_object()
+        if not capture.project.can_see_all_reviews(request.user):
+            raise PermissionDenied("Only the project's reviewers and admins can re-detect a capture.")
+        run = adaptation.do_redetect(capture, request.user)
+        return Response(RunSerializer(run).data, status=202)
 
     @extend_schema(request=RunRequestSerializer, responses=RunSerializer(many=True))
     @action(detail=True, methods=["get", "post"], serializer_class=RunRequestSerializer)

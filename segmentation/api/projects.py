@@ -11,7 +11,12 @@ from rest_framework.views import APIView
 from motionlib.segmenters import list_segmenters
 from segmentation import services
 from segmentation.api.invitations import InvitationSerializer, invited_response
-from segmentation.api.serializers import LabelSerializer, MemberSerializer, ProjectSerializer
+from segmentation.api.serializers import (
+    CutModelSerializer,
+    LabelSerializer,
+    MemberSerializer,
+    ProjectSerializer,
+)
 from segmentation.models import Membership, Project
 
 
@@ -86,6 +91,14 @@ class ProjectViewSet(
         invitation = get_object_or_404(project.invitations.pending(), pk=invitation_id)
         services.do_cancel_invitation(invitation, request.user)
         return Response(status=204)
+
+
+    @extend_schema(responses=CutModelSerializer(many=True))
+    @action(detail=True, url_path="cut-models")
+    def cut_models(self, request, pk=None):
+        """The project's trainings, newest first: versions learnt from its reviews, and
+        failed trainings with their reason (detection keeps the newest version)."""
+        return Response(CutModelSerializer(self.get_object().cut_models.all()[:50], many=True).data)
 
 
 class MeView(APIView):

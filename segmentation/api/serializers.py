@@ -3,7 +3,15 @@ check the request's shape, and the services check its meaning."""
 
 from rest_framework import serializers
 
-from segmentation.models import ROLES, Capture, DetectionRun, Label, Review, ReviewEvent
+from segmentation.models import (
+    ROLES,
+    Capture,
+    DetectionRun,
+    Label,
+    ProjectCutModel,
+    Review,
+    ReviewEvent,
+)
 
 
 class LabelSerializer(serializers.ModelSerializer):
@@ -42,11 +50,27 @@ class RunSerializer(serializers.ModelSerializer):
         model = DetectionRun
         fields = [
             "id", "method", "params", "status", "error", "created_at", "finished_at",
-            "timings", "candidates",
+            "timings", "candidates", "model_version", "model_n_takes",
         ]
 
     def get_error(self, run) -> str | None:
         return run.error or None
+
+
+class CutModelSerializer(serializers.ModelSerializer):
+    """One training of a project's cut model: a version, or why it failed."""
+
+    error = serializers.SerializerMethodField()
+
+    class Meta:
+        model = ProjectCutModel
+        fields = [
+            "id", "version", "status", "error", "n_takes", "n_cuts", "seconds", "created_at",
+            "finished_at",
+        ]
+
+    def get_error(self, job) -> str | None:
+        return job.error or None
 
 
 class RunRequestSerializer(serializers.Serializer):
@@ -85,7 +109,10 @@ class RunSummarySerializer(serializers.ModelSerializer):
 
     class Meta:
         model = DetectionRun
-        fields = ["id", "method", "status", "error", "created_at", "finished_at", "n_candidates"]
+        fields = [
+            "id", "method", "status", "error", "created_at", "finished_at", "n_candidates",
+            "model_version", "model_n_takes",
+        ]
 
     def get_error(self, run) -> str | None:
         return run.error or None
@@ -97,9 +124,11 @@ class CaptureListSerializer(CaptureSerializer):
     neither; ``GET /api/captures/{id}/`` has them."""
 
     latest_run = RunSummarySerializer(read_only=True, allow_null=True)
+    # Someone opened it for review: its candidates can no longer be re-detected.
+    review_started = serializers.BooleanField(read_only=True, default=False)
 
     class Meta(CaptureSerializer.Meta):
-        fields = [f for f in CaptureSerializer.Meta.fields if f != "skeleton"]
+        fields = [f for f in CaptureSerializer.Meta.fields if f != "skeleton"] + ["review_started"]
 
 
 class UploadSerializer(serializers.Serializer):
@@ -121,10 +150,21 @@ class ReviewSerializer(serializers.ModelSerializer):
     annotator = serializers.SerializerMethodField()
     cuts = serializers.SerializerMethodField()
     segments = serializers.SerializerMethodField()
+    adaptation = serializers.SerializerMethodField()
 
     class Meta:
         model = Review
-        fields = ["id", "capture", "annotator", "run", "status", "version", "cuts", "segments"]
+        fields = [
+            "id", "capture", "annotator", "run", "status", "version", "cuts", "segments",
+            "adaptation",
+        ]
+
+    def get_adaptation(self, review) -> dict:
+        """Which project model the review's candidates came from (model_version null:
+        the zero-shot detector), the project's newest model and its last failed training."""
+        from segmentation.services.adaptation import adaptation_summary
+
+        return adaptation_summary(review.run, review.capture.project_id)
 
     def get_annotator(self, review) -> dict:
         return {"id": review.annotator_id, "username": review.annotator.username}

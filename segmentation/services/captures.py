@@ -291,9 +291,11 @@ def detect_run(run):
 
 
 def _detect(run, take=None):
+    from segmentation.services import adaptation
+
     take = read_take(run.capture) if take is None else take
-    segmenter = get_segmenter(run.method)
-    result = segmenter(**segmenter.validate_params(run.params)).fit_predict(take)
+    # Runs of the default method detect with the project's newest learnt model.
+    result, model_fields = adaptation.detect(run, take)
     candidates = [
         {"frame": int(f), "confidence": round(float(c), 4)}
         for f, c in zip(result.cuts, result.confidence, strict=True)
@@ -305,6 +307,7 @@ def _detect(run, take=None):
         timings={k: round(float(v), 4) for k, v in result.timings.items()},
         signals=run.signals.name,
         finished_at=timezone.now(),
+        **model_fields,
     )
 
 

@@ -151,4 +151,8 @@ def do_submit_review(review, user, version):
         from segmentation.library import on_review_submitted
 
         on_review_submitted(review)
+        # The project's cut model learns from the new example once this commits.
+        from segmentation.services.adaptation import on_examples_changed
+
+        on_examples_changed(review.capture.project_id)
     return review

@@ -44,6 +44,9 @@ export interface Run {
   created_at: string;
   finished_at: string | null;
   candidates: { frame: number; confidence: number }[];
+  /** The project model the candidates came from; null: the zero-shot detector. */
+  model_version?: number | null;
+  model_n_takes?: number | null;
 }
 
 export interface Capture {
@@ -74,10 +77,14 @@ export interface RunSummary {
   created_at: string;
   finished_at: string | null;
   n_candidates: number;
+  model_version?: number | null;
+  model_n_takes?: number | null;
 }
 
 export interface CaptureSummary extends Omit<Capture, "skeleton" | "latest_run"> {
   latest_run: RunSummary | null;
+  /** Someone opened it for review; its candidates can no longer be re-detected. */
+  review_started?: boolean;
 }
 
 export interface Page<T> {
@@ -140,6 +147,20 @@ export interface Review {
   version: number;
   cuts: Cut[];
   segments: Segment[];
+  adaptation?: Adaptation;
+}
+
+/** Where a review's candidates came from, and the project's learnt model. */
+export interface Adaptation {
+  /** Model version of the review's run; null: the zero-shot detector. */
+  model_version: number | null;
+  /** Reviewed takes that model learnt from. */
+  n_takes: number | null;
+  project_model: { version: number; n_takes: number; n_cuts: number } | null;
+  /** A training is queued or running. */
+  training: boolean;
+  /** Why the last training failed (the project keeps its previous model). */
+  training_error: string | null;
 }
 
 export interface ReviewEvent {

@@ -2,7 +2,7 @@
 // them (with progress); rows still being processed refresh themselves.
 
 import { get, post } from "../api/client";
-import type { CaptureSummary, Me, Page, Project } from "../api/types";
+import type { CaptureSummary, Me, Page, Project, Role } from "../api/types";
 import { clear, formatDuration, h, toast } from "../ui/dom";
 import { logoutButton } from "../ui/logout";
 import { invitationsBox } from "./invitations";
@@ -46,6 +46,7 @@ export async function renderCaptureList(root: HTMLElement): Promise<() => void> 
   const uploads = h("div", { class: "uploads", "data-testid": "uploads" });
   const fileInput = h("input", { type: "file", multiple: true, accept: ".bvh,.amc,.asf", hidden: true });
   const projectName = new Map(projects.map((p) => [p.id, p.name]));
+  const projectRole = new Map(projects.map((p) => [p.id, p.role]));
 
   const select = (name: keyof Filters, options: [string, string][]) => {
     const el = h("select", { class: "select", "data-testid": `filter-${name}`, "aria-label": name }, ...options.map(([v, t]) => h("option", { value: v, selected: String(filters[name]) === v }, t)));
@@ -148,7 +149,7 @@ export async function renderCaptureList(root: HTMLElement): Promise<() => void> 
       return null;
     });
     if (!data || request !== latest || !mounted) return;
-    clear(rows, ...data.results.map((c) => row(c, projectName.get(c.project) ?? String(c.project), load)));
+    clear(rows, ...data.results.map((c) => row(c, projectName.get(c.project) ?? String(c.project), projectRole.get(c.project), load)));
     if (!data.results.length) rows.append(h("tr", {}, h("td", { colspan: 9, class: "muted empty" }, "No captures match. Drop a file above to add one.")));
     clear(
       pager,
@@ -156,7 +157,7 @@ export async function renderCaptureList(root: HTMLElement): Promise<() => void> 
       data.previous ? h("button", { class: "btn", onclick: () => apply({ ...filters, page: filters.page - 1 }) }, "← Previous") : null,
       data.next ? h("button", { class: "btn", onclick: () => apply({ ...filters, page: filters.page + 1 }) }, "Next →") : null,
     );
-    if (data.results.some((c) => c.status === "queued" || c.status === "processing")) timer = window.setTimeout(() => void load(), 2000);
+    if (data.results.some((c) => busy(c.status) || busy(c.latest_run?.status))) timer = window.setTimeout(() => void load(), 2000);
   }
 
   function apply(next: Filters): void {
@@ -191,10 +192,38 @@ function retryButton(c: CaptureSummary, reload: () => Promise<void>): HTMLElemen
   return h("button", { class: "btn btn-small", "data-testid": `retry-${c.id}`, title: "Read the stored original again", onclick: retry }, "Retry");
 }
 
-function row(c: CaptureSummary, project: string, reload: () => Promise<void>): HTMLElement {
+const busy = (status: string | undefined) => status === "queued" || status === "processing";
+
+/** Reviewers and admins may detect again, with the project's newest learnt model, until
+ * someone opens the capture for review. */
+export function canRedetect(c: CaptureSummary, role: Role | undefined): boolean {
+  return (role === "reviewer" || role === "admin") && c.status === "ready" && !c.review_started && !busy(c.latest_run?.status);
+}
+
+function redetectButton(c: CaptureSummary, reload: () => Promise<void>): HTMLElement {
+  const redetect = (e: Event) => {
+    e.stopPropagation();
+    (e.currentTarget as HTMLButtonElement).disabled = true;
+    post(`/api/captures/${c.id}/redetect/`)
+      .then(() => {
+        toast(`${c.name}: detecting again with the project's model.`);
+        return reload();
+      })
+      .catch((err: Error) => toast(`${c.name}: ${err.message}`, "error"));
+  };
+  return h("button", { class: "btn btn-small", "data-testid": `redetect-${c.id}`, title: "Nobody has opened it for review yet: propose its cuts again with the project's newest learnt model", onclick: redetect }, "Re-detect");
+}
+
+function cutsCell(c: CaptureSummary): HTMLElement {
+  const run = c.latest_run;
+  if (busy(run?.status)) return h("td", { class: "num muted" }, "detecting…");
+  const adapted = run?.model_version ? h("span", { class: "muted small", title: `adapted from ${run.model_n_takes} reviewed take${run.model_n_takes === 1 ? "" : "s"}` }, ` v${run.model_version}`) : null;
+  return h("td", { class: "num" }, String(run?.n_candidates ?? "—"), adapted);
+}
+
+function row(c: CaptureSummary, project: string, role: Role | undefined, reload: () => Promise<void>): HTMLElement {
   const open = () => navigate(`/captures/${c.id}/`);
   const status = h("span", { class: `badge badge-${c.status}`, title: c.error ?? "" }, c.status);
-  const cuts = c.latest_run?.n_candidates;
   return h(
     "tr",
     { class: "capture-row", "data-testid": `capture-${c.id}`, tabindex: 0, onclick: open, onkeydown: (e: Event) => (e as KeyboardEvent).key === "Enter" && open() },
@@ -205,7 +234,7 @@ function row(c: CaptureSummary, project: string, reload: () => Promise<void>): H
     h("td", { class: "num" }, c.duration ? formatDuration(c.duration) : "—"),
     h("td", { class: "num" }, c.fps ?? "—"),
     h("td", { class: "num" }, c.n_joints ?? "—"),
-    h("td", { class: "num" }, cuts ?? "—"),
-    h("td", {}, c.created_at ? new Date(c.created_at).toLocaleString() : ""),
+    cutsCell(c),
+    h("td", {}, c.created_at ? new Date(c.created_at).toLocaleString() : "", canRedetect(c, role) ? h("div", {}, redetectButton(c, reload)) : null),
   );
 }

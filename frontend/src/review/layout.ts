@@ -88,7 +88,13 @@ function side(el: Elements): HTMLElement {
     { class: "side" },
     h("section", {}, h("h3", {}, "Labels"), (el.labels = h("div", { class: "label-list", "data-testid": "labels" }))),
     h("section", {}, h("h3", {}, "Selection"), (el.selection = h("div", { class: "selection", "data-testid": "selection" }))),
-    h("section", {}, h("h3", {}, "Review"), (el.stats = h("div", { class: "stats", "data-testid": "stats" }))),
+    h(
+      "section",
+      {},
+      h("h3", {}, "Review"),
+      (el.adaptation = h("div", { class: "adaptation", "data-testid": "adaptation" })),
+      (el.stats = h("div", { class: "stats", "data-testid": "stats" })),
+    ),
     h("section", { class: "grow" }, (el.eventsTitle = h("h3", {}, "Activity")), (el.events = h("ol", { class: "events", "data-testid": "events" }))),
   );
 }

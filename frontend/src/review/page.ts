@@ -14,7 +14,7 @@ import { commandFor, HELP, isTypingTarget, type Command } from "./keymap";
 import { Saver } from "./saver";
 import { applyEdit, clampFrame, describeDifferences, EditError, neighbourCut, segmentAt, type Edit } from "./state";
 import { buildLayout, type Elements } from "./layout";
-import { renderEvents, renderLabels, renderSelection, renderStats } from "./panels";
+import { renderAdaptation, renderEvents, renderLabels, renderSelection, renderStats } from "./panels";
 import { Timeline } from "./timeline";
 import { formatTime } from "./timescale";
 
@@ -251,6 +251,7 @@ class ReviewPage {
     renderLabels(this.el.labels, this.labels, segment?.label ?? null, this.locked() !== null, (name) => this.labelCurrent(name));
     renderSelection(this.el.selection, this.selectedCut(), segment, this.capture.fps);
     renderStats(this.el.stats, this.review);
+    renderAdaptation(this.el.adaptation, this.review.adaptation);
   }
 
   private selectedCut(): Cut | undefined {

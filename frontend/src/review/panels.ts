@@ -1,6 +1,6 @@
 // The side panels of the review page, each redrawn whole from the current state.
 
-import type { Cut, Label, Review, ReviewEvent, Segment } from "../api/types";
+import type { Adaptation, Cut, Label, Review, ReviewEvent, Segment } from "../api/types";
 import { clear, formatDuration, h } from "../ui/dom";
 import { eventDetail } from "./events";
 import { FATE_TEXT } from "./state";
@@ -87,4 +87,31 @@ export function renderEvents(el: HTMLElement, events: ReviewEvent[]): void {
     );
   clear(el, ...events.slice().reverse().map(item));
   if (!events.length) el.append(h("li", { class: "muted" }, "No edits yet."));
+}
+
+const takes = (n: number) => `${n} reviewed take${n === 1 ? "" : "s"}`;
+
+/**
+ * Where the candidates came from — "adapted from 12 reviewed takes" or "not adapted yet" —
+ * then the project's newer model, a training under way, or why the last one failed.
+ */
+export function adaptationLines(a: Adaptation | undefined): { line: string; notes: string[] } {
+  if (!a) return { line: "", notes: [] };
+  const adapted = a.model_version !== null && a.n_takes !== null;
+  const line = adapted ? `Candidates adapted from ${takes(a.n_takes!)} (model v${a.model_version}).` : "Candidates not adapted yet (zero-shot detector).";
+  const notes: string[] = [];
+  const project = a.project_model;
+  if (project && project.version !== a.model_version) notes.push(`The project's model is now v${project.version}, from ${takes(project.n_takes)}.`);
+  if (a.training) notes.push("Retraining on the newest reviews…");
+  if (a.training_error) notes.push(`Last retraining failed: ${a.training_error} The project keeps ${project ? `model v${project.version}` : "the zero-shot detector"}.`);
+  return { line, notes };
+}
+
+export function renderAdaptation(el: HTMLElement, a: Adaptation | undefined): void {
+  const { line, notes } = adaptationLines(a);
+  clear(
+    el,
+    line ? h("div", { "data-testid": "adaptation-line" }, line) : null,
+    ...notes.map((note) => h("div", { class: note.startsWith("Last retraining failed") ? "error-text small" : "muted small", "data-testid": "adaptation-note" }, note)),
+  );
 }

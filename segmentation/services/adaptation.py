@@ -1,0 +1,310 @@
+"""Learning each project's cutting from its own reviews.
+
+A project's examples are its reviewed takes: the gold version of a capture where one was
+saved, else its most recently submitted review (one example per take, so every take
+weighs the same and "learnt from N reviewed takes" counts takes). After a submit or a
+gold save, ``request_training`` queues one training per project (requests made while one
+waits join it); a worker trains with ``motionlib.adapt.fit_cut_model`` and stores the
+model as the project's next version. Runs of the ``default`` method detect with the
+newest version; a project without one uses the zero-shot detector. A failed training
+stores its reason and leaves the newest version in use.
+"""
+
+import dataclasses
+import functools
+import logging
+import time
+
+from django.conf import settings
+from django.db import IntegrityError, transaction
+from django.db.models import Max
+from django.utils import timezone
+
+from motionlib.segmenters import get_segmenter
+from segmentation import takecache
+from segmentation.errors import NotReady, ReviewStarted
+from segmentation.models import Capture, ProjectCutModel, Review
+from segmentation.services.captures import do_start_run, read_take
+
+log = logging.getLogger(__name__)
+
+
+# ---- requesting a training ---------------------------------------------------------------
+
+
+def on_examples_changed(project_id):
+    """Called inside a submit or gold-save transaction: retrain once it commits.
+
+    The request is made after the commit so that a training claimed from now on reads the
+    new example; a training already running read the examples before it and is followed
+    by the one queued here.
+    """
+    # robust: the submit is committed by then; a failure here is logged (the next submit
+    # asks again) instead of turning the submit's answer into an error.
+    transaction.on_commit(lambda: request_training(project_id), robust=True)
+
+
+def request_training(project_id):
+    """Queue a training of the project's model, unless one is queued already (it will
+    read the current examples when it starts). Returns the queued row, or None.
+
+    The job is sent ``CUTROOM_RETRAIN_DELAY`` seconds later, so that a burst of submits
+    costs one training.
+    """
+    if ProjectCutModel.objects.filter(project_id=project_id, status="queued").exists():
+        return None
+    try:
+        with transaction.atomic():
+            job = ProjectCutModel.objects.create(project_id=project_id)
+            transaction.on_commit(
+                lambda: _send_training(job.pk, countdown=settings.CUTROOM_RETRAIN_DELAY)
+            )
+    except IntegrityError:
+        return None  # a concurrent request queued it (one queued training per project)
+    return job
+
+
+def _send_training(pk, countdown=0):
+    from segmentation import tasks
+
+    try:
+        tasks.retrain.apply_async((pk,), countdown=countdown)
+    except Exception:
+        # The row stays queued; the sweep sends it again later.
+        log.exception("could not send retrain(%s); the sweep will retry", pk)
+
+
+# ---- training ----------------------------------------------------------------------------
+
+
+def project_examples(project_id):
+    """``[(capture, cuts)]``: each reviewed ready capture of the project with its gold
+    cuts, else the kept cuts of its most recently submitted review (0-based frames)."""
+    captures = Capture.objects.filter(project_id=project_id, status="ready").select_related(
+        "adjudication"
+    ).order_by("id")
+    reviews = (
+        Review.objects.filter(capture__project_id=project_id, status="submitted")
+        .prefetch_related("cuts")
+        .order_by("capture_id", "-submitted_at", "-id")
+    )
+    latest = {}
+    for review in reviews:
+        latest.setdefault(review.capture_id, review)
+    examples = []
+    for capture in captures:
+        gold = getattr(capture, "adjudication", None)
+        if gold is not None:
+            examples.append((capture, sorted(gold.cuts)))
+        elif capture.pk in latest:
+            examples.append((capture, sorted(c.frame for c in latest[capture.pk].kept_cuts())))
+    return examples
+
+
+def example_take(capture):
+    """The capture's take (parsed once, then from ``takecache``), named after the capture
+    so that an error names it."""
+    try:
+        take = takecache.read_cached(capture, read_take)
+    except (ValueError, OSError) as exc:
+        raise ValueError(f"reviewed capture {capture.pk} ({capture.name!r}) cannot be read: {exc}") from exc
+    # motionlib names a take by its path when it has one: the stored file's name is a
+    # random folder away from what the studio knows, so name the capture instead.
+    return dataclasses.replace(take, name=f"capture {capture.pk} ({capture.name})", path=None)
+
+
+def claim_training(pk, token):
+    """The claimed training row, or None when it is not its turn (another training of
+    the project runs), another worker has it, or it is done. A training that was
+    started too often without finishing (it keeps killing its worker) fails instead."""
+    if not ProjectCutModel.objects.claim(pk, token):
+        return None
+    job = ProjectCutModel.objects.get(pk=pk)
+    if job.attempts > settings.CUTROOM_MAX_ATTEMPTS:
+        _give_up(job)
+        return None
+    return job
+
+
+def _give_up(job):
+    failed = job.fail(
+        f"training started {job.attempts} times and never finished (the worker was killed or "
+        "lost); the project keeps its previous model",
+        finished_at=timezone.now(),
+    )
+    _start_waiting(job.project_id)
+    return failed
+
+
+def train_project_model(job):
+    """Train a claimed ProjectCutModel row from the project's current examples, store it
+    as the next version (or the reason it failed), then start the training that waited."""
+    try:
+        _train(job)
+    except ValueError as exc:
+        job.fail(f"training: {exc}", finished_at=timezone.now())
+    except Exception as exc:
+        log.exception("training of project %s failed", job.project_id)
+        job.fail(
+            f"training failed with an internal error ({type(exc).__name__}: {exc}); "
+            "report this to the service's administrators",
+            finished_at=timezone.now(),
+        )
+    finally:
+        _start_waiting(job.project_id)
+
+
+def _train(job):
+    started = time.perf_counter()
+    examples = project_examples(job.project_id)
+    if not examples:
+        raise ValueError("the project has no submitted review or gold version to learn from")
+    takes = [(example_take(capture), cuts) for capture, cuts in examples]
+    from motionlib import adapt
+
+    model = adapt.fit_cut_model(takes)
+    with transaction.atomic():
+        newest = ProjectCutModel.objects.filter(project_id=job.project_id).aggregate(v=Max("version"))
+        job.finish(
+            version=(newest["v"] or 0) + 1,
+            model=model.to_json(),
+            n_takes=model.n_takes,
+            n_cuts=model.n_cuts,
+            seconds=round(time.perf_counter() - started, 3),
+            finished_at=timezone.now(),
+        )
+
+
+def _start_waiting(project_id):
+    """Send the project's queued training now: its own message may have found this one
+    running and been dropped (one training at a time per project)."""
+    waiting = ProjectCutModel.objects.filter(project_id=project_id, status="queued").first()
+    if waiting is not None:
+        transaction.on_commit(lambda: _send_training(waiting.pk))
+
+
+def sweep_stale_trainings():
+    """Requeue trainings whose worker vanished (or fail them when a newer one waits or
+    they were tried too often) and resend queued trainings whose message may be lost.
+
+    Returns the number of trainings requeued, failed or resent.
+    """
+    count = 0
+    for job in ProjectCutModel.objects.stale():
+        waiting = ProjectCutModel.objects.filter(project_id=job.project_id, status="queued")
+        if job.attempts >= settings.CUTROOM_MAX_ATTEMPTS or waiting.exists():
+            count += _give_up(job)
+            continue
+        try:
+            with transaction.atomic():
+                requeued = ProjectCutModel.objects.filter(
+                    pk=job.pk, status="processing", claim_token=job.claim_token
+                ).update(status="queued", claim_token="", claimed_at=timezone.now())
+                if requeued:
+                    transaction.on_commit(functools.partial(_send_training, job.pk))
+                count += requeued
+        except IntegrityError:
+            continue  # a request queued another training meanwhile; the next sweep fails this one
+    for job in ProjectCutModel.objects.waiting_too_long():
+        with transaction.atomic():
+            ProjectCutModel.objects.filter(pk=job.pk, status="queued").update(claimed_at=timezone.now())
+            transaction.on_commit(functools.partial(_send_training, job.pk))
+        count += 1
+    return count
+
+
+# ---- detecting with the project's model --------------------------------------------------
+
+
+def detect(run, take):
+    """(segmentation, run fields) of ``take`` for ``run``.
+
+    A ``default`` run in a project with a trained model detects with its newest version
+    and records it; anything else runs the registry's segmenter as before.
+    """
+    segmenter = get_segmenter(run.method)
+    params = segmenter.validate_params(run.params)
+    newest = None
+    if run.method == "default":
+        newest = ProjectCutModel.objects.newest(run.capture.project_id)
+    model = _loaded(newest.pk, newest.version) if newest is not None else None
+    if model is None:
+        return segmenter(**params).fit_predict(take), {"model_version": None, "model_n_takes": None}
+    from motionlib import adapt
+
+    result = adapt.detect(take, model, **params)
+    return result, {"model_version": newest.version, "model_n_takes": newest.n_takes}
+
+
+@functools.lru_cache(maxsize=32)
+def _loaded(pk, version):
+    """A stored model, parsed once per worker process (rows never change once trained).
+
+    A model this version of motionlib cannot read (stored by an older release) is logged
+    and detection falls back to the zero-shot detector until the project retrains.
+    """
+    from motionlib import adapt
+
+    text = ProjectCutModel.objects.values_list("model", flat=True).get(pk=pk)
+    try:
+        return adapt.CutModel.from_json(text)
+    except ValueError:
+        log.exception("cut model v%s (row %s) cannot be read; detecting zero-shot", version, pk)
+        return None
+
+
+# ---- re-detecting ------------------------------------------------------------------------
+
+
+def do_redetect(capture, user):
+    """Queue a new detection of ``capture`` with the project's method, parameters and
+    newest model, for a capture nobody has started reviewing.
+
+    A review is started as soon as someone opens the capture for review (its candidates
+    are copied into the review then); new candidates would not reach that review, so
+    re-detection is refused with the annotators' names.
+    """
+    if capture.status != "ready":
+        raise NotReady(f"capture {capture.pk} is {capture.status}; detection needs a ready capture")
+    project = capture.project
+    with transaction.atomic():
+        # One re-detection or review start at a time per capture.
+        Capture.objects.select_for_update().filter(pk=capture.pk).first()
+        names = sorted(capture.reviews.values_list("annotator__username", flat=True))
+        if names:
+            raise ReviewStarted(
+                f"capture: {', '.join(names)} started reviewing {capture.name!r}; "
+                "re-detection would change the candidates under their review"
+            )
+        if capture.runs.filter(status__in=("queued", "processing")).exists():
+            raise NotReady(f"capture {capture.pk} already has a detection queued or running")
+        return do_start_run(capture, user, project.default_method, project.default_params)
+
+
+# ---- what the review page shows ----------------------------------------------------------
+
+
+def adaptation_summary(run, project_id):
+    """What a review page says about adaptation: the model its candidates came from
+    (None: zero-shot) and the project's current model and last failed training."""
+    newest = ProjectCutModel.objects.newest(project_id)
+    # Trainings end in the order they were asked for (one at a time per project).
+    last = (
+        ProjectCutModel.objects.filter(project_id=project_id, status__in=("ready", "failed"))
+        .order_by("-id")
+        .first()
+    )
+    training = ProjectCutModel.objects.filter(
+        project_id=project_id, status__in=("queued", "processing")
+    ).exists()
+    return {
+        "model_version": run.model_version if run else None,
+        "n_takes": run.model_n_takes if run else None,
+        "project_model": (
+            {"version": newest.version, "n_takes": newest.n_takes, "n_cuts": newest.n_cuts}
+            if newest else None
+        ),
+        "training": training,
+        "training_error": last.error if last is not None and last.status == "failed" else None,
+    }
+

@@ -1,0 +1,74 @@
+"""Adaptation in the browser: the review page says where its candidates came from, and a
+reviewer re-detects an untouched capture from the capture list (an annotator is not
+offered to)."""
+
+from django.core.files.uploadedfile import SimpleUploadedFile
+from playwright.sync_api import expect
+
+from motionlib import synth
+from segmentation import services, tasks
+from segmentation.models import Capture, DetectionRun, ProjectCutModel
+from tests.e2e.conftest import synthetic_bvh
+
+SECONDS = 30.0
+
+
+def ingest(studio, seed):
+    """Upload a synthetic take and run the worker's jobs for it here, in-process."""
+    upload = SimpleUploadedFile(f"session_{seed}.bvh", synthetic_bvh(seed=seed, duration=SECONDS))
+    capture, _ = services.do_upload_capture(studio["project"], studio["alice"], upload)
+    tasks.ingest(capture.pk)
+    for run in DetectionRun.objects.filter(capture=capture, status="queued"):
+        tasks.detect(run.pk)
+    capture = Capture.objects.get(pk=capture.pk)
+    assert capture.status == "ready", capture.error
+    return capture
+
+
+def review_to_the_truth(capture, user, seed):
+    """``user`` replaces the candidates by the take's true boundaries and submits."""
+    _take, segments = synth.generate(seed=seed, fps=120.0, duration=SECONDS)
+    review = services.get_or_create_review(capture, user)
+    for cut in list(review.cuts.all()):
+        services.do_change_cut(review, user, cut, review.version, fate="deleted")
+    for start, _stop, _label in segments[1:]:
+        services.do_insert_cut(review, user, start, review.version)
+    services.do_submit_review(review, user, review.version)
+
+
+def test_the_review_page_says_the_candidates_are_not_adapted_yet(live_server, new_page, studio):
+    capture = ingest(studio, seed=81)
+    page = new_page("ann")
+    page.goto(f"{live_server.url}/captures/{capture.pk}/")
+    expect(page.get_by_test_id("adaptation-line")).to_have_text("Candidates not adapted yet (zero-shot detector).")
+
+
+def test_the_review_page_says_how_many_reviewed_takes_the_candidates_came_from(live_server, new_page, studio):
+    for seed in (82, 83):
+        review_to_the_truth(ingest(studio, seed), studio["bob"], seed)
+    job = ProjectCutModel.objects.get(project=studio["project"], status="queued")
+    tasks.retrain(job.pk)
+    assert ProjectCutModel.objects.get(pk=job.pk).version == 1
+    capture = ingest(studio, seed=84)
+
+    page = new_page("ann")
+    page.goto(f"{live_server.url}/captures/{capture.pk}/")
+
+    expect(page.get_by_test_id("adaptation-line")).to_have_text("Candidates adapted from 2 reviewed takes (model v1).")
+    assert page.errors == []
+
+
+def test_a_reviewer_redetects_an_untouched_capture_from_the_list(live_server, new_page, studio):
+    capture = ingest(studio, seed=85)
+    annotator = new_page("ann")
+    expect(annotator.get_by_test_id(f"capture-{capture.pk}")).to_contain_text("ready")
+    expect(annotator.get_by_test_id(f"redetect-{capture.pk}")).to_have_count(0)
+
+    page = new_page("rachel")
+    page.get_by_test_id(f"redetect-{capture.pk}").click()
+
+    expect(page.get_by_text("detecting again with the project's model")).to_be_visible()
+    expect(page.get_by_test_id(f"capture-{capture.pk}")).to_contain_text("detecting…")
+    expect(page.get_by_test_id(f"redetect-{capture.pk}")).to_have_count(0)
+    run = capture.runs.order_by("-id").first()
+    assert (run.status, run.created_by) == ("queued", studio["rachel"])
