@@ -8,12 +8,12 @@ import sys
 # every module in turn and names the first one after which a forbidden package is loaded.
 WALK = r"""
 import importlib, pkgutil, sys
-import motionlib
 
 FORBIDDEN = ("django", "bpy")
+motionlib = importlib.import_module("motionlib")
 names = sorted(m.name for m in pkgutil.walk_packages(motionlib.__path__, "motionlib.")
                if not m.name.endswith(".__main__"))
-for name in names:
+for name in ["motionlib", *names]:
     importlib.import_module(name)
     loaded = [f for f in FORBIDDEN if f in sys.modules]
     if loaded:

@@ -1,3 +1,5 @@
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -95,10 +97,12 @@ def test_it_sorts_dedupes_and_clips_what_a_method_returns(synth_takes):
 
 
 # Sorted interior cuts and confidence in [0, 1] are enforced by Segmenter.fit for every
-# method (tested above); the signals are each method's own.
+# method (tested above); the signals are each method's own. A take that starts with a
+# rest pose is detected from the frame after it, and its signals still cover every frame.
+@pytest.mark.parametrize("rest_pose_frame", [None, 0])
 @pytest.mark.parametrize("name", METHODS)
-def test_it_returns_a_finite_signal_value_per_frame(name, synth_takes):
-    take, _ = synth_takes[0]
+def test_it_returns_a_finite_signal_value_per_frame(name, rest_pose_frame, synth_takes):
+    take = dataclasses.replace(synth_takes[0][0], rest_pose_frame=rest_pose_frame)
     result = get_segmenter(name)().fit_predict(take)
     assert len(result.cuts) > 0
     assert result.signals and all(s.shape == (take.n_frames,) for s in result.signals.values())
