@@ -51,8 +51,8 @@ pytest: install
 	$(INTEGRATION_ENV) $(PY) -m pytest -m integration
 
 bench: install
-	$(PY) -m motionlib.bench io
-	$(PY) -m motionlib bench
+	$(PY) -m motionlib bench-speed io
+	$(PY) -m motionlib bench-quality
 	$(PY) benchmarks/upload_to_candidates.py
 	@command -v wrk >/dev/null || { apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq wrk; } \
 		|| echo "wrk not installed: the capture list benchmark uses its Python client"

@@ -25,10 +25,12 @@ import numpy as np
 
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
-DATA = REPO / ".." / "shared" / "data"
 
 import motionlib  # noqa: E402
+from motionlib.benchdata import data_dir  # noqa: E402
 from motionlib.similarity import body_scale, rank_similar, segment_descriptor  # noqa: E402
+
+DATA = data_dir()
 
 
 def clips(seq, clip_frames):

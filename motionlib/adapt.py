@@ -33,7 +33,7 @@ Each example take is analysed once and then dropped (only its peaks and offsets 
 kept), so a project's examples can be read one at a time.
 
 Scored on the 11 labelled takes under ``shared/data`` with the other takes of the same
-label source as examples (``python -m motionlib bench --loo``, row ``adapted/loo``):
+label source as examples (``python -m motionlib bench-quality --loo``, row ``adapted/loo``):
 mean F1@1 s 0.947 and 0.40 edits per true cut, against 0.957 and 0.41 for the zero-shot
 default chosen without the take: on these takes the zero-shot settings already are what
 the examples would teach (mocap6 13_29 and 13_30 teach each other nothing new; the

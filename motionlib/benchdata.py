@@ -31,7 +31,9 @@ class LabelError(ValueError):
 
 
 def data_dir() -> Path:
-    """The benchmark data folder (``$CUTROOM_BENCH_DATA`` overrides the default)."""
+    """The shared data folder (real CMU takes and their labels), found the same way by the
+    benchmarks, the tests and the demo: ``$CUTROOM_BENCH_DATA`` if set, else ``shared/data``
+    beside the repository. It may not exist; callers say so or skip."""
     return Path(os.environ.get("CUTROOM_BENCH_DATA", DEFAULT_DATA_DIR)).resolve()
 
 

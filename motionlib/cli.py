@@ -11,7 +11,8 @@ from __future__ import annotations
 import argparse
 import sys
 
-from motionlib.benchmark import add_bench
+from motionlib.bench_quality import add_bench_quality
+from motionlib.bench_speed import add_bench_speed
 from motionlib.errors import CaptureError
 from motionlib.segmenters.command import add_segment
 
@@ -75,7 +76,7 @@ def run_convert(args) -> int:
     return 0
 
 
-COMMANDS = [add_info, add_convert, add_segment, add_bench]
+COMMANDS = [add_info, add_convert, add_segment, add_bench_quality, add_bench_speed]
 
 
 class _Parser(argparse.ArgumentParser):

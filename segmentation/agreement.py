@@ -10,7 +10,7 @@ from statistics import median
 
 from django.db.models import Count, Q
 
-from motionlib import agreement as metrics
+from motionlib.agreement import take_agreement
 from segmentation.models import Capture, Review, ReviewEvent
 from segmentation.models_library import Adjudication, CaptureAgreement, LibrarySegment
 
@@ -43,7 +43,7 @@ def review_segments(review):
 
 def compute(capture, reviews, tolerance_s=DEFAULT_TOLERANCE_S):
     """motionlib's take agreement over ``reviews`` (at least one)."""
-    return metrics.take_agreement(
+    return take_agreement(
         [review_segments(r) for r in reviews],
         [review_cuts(r) for r in reviews],
         n_frames=capture.n_frames,

@@ -24,8 +24,8 @@ from django.db import transaction
 from django.utils import timezone
 
 import motionlib
-from motionlib import agreement as metrics
 from motionlib import similarity
+from motionlib.agreement import label_codes, segment_support
 from segmentation import agreement, storage
 from segmentation.models_library import Adjudication, LibrarySegment
 from segmentation.services.captures import read_take
@@ -119,7 +119,7 @@ def refresh_capture_library(capture):
     lists = [agreement.review_segments(r) for r in reviews]
     if gold:
         lists.append(gold.segments())
-    codes, _ = metrics.label_codes(lists, capture.n_frames)
+    codes, _ = label_codes(lists, capture.n_frames)
     labels = {label.name: label for label in capture.project.labels.all()}
     n = len(reviews)
     rows = []
@@ -128,7 +128,7 @@ def refresh_capture_library(capture):
         for start, stop, name in segments:
             if name is None or stop <= start:
                 continue
-            support = (metrics.segment_support(codes[:n], row, start, stop) if review
+            support = (segment_support(codes[:n], row, start, stop) if review
                        else _gold_support(codes, n, start, stop))
             rows.append(LibrarySegment(
                 project_id=capture.project_id, capture=capture, review=review,

@@ -1,16 +1,16 @@
 """Fixtures shared by every test folder. Keep this small; folder-specific fixtures live
 in the folder's own conftest.py."""
 
-from pathlib import Path
-
 import pytest
 
-SHARED_DATA = Path(__file__).resolve().parents[1] / ".." / "shared" / "data"
+from motionlib.benchdata import data_dir
+
+SHARED_DATA = data_dir()
 
 
 @pytest.fixture(scope="session")
 def shared_data():
     """The real CMU captures and labels beside the repository (skips if absent)."""
     if not SHARED_DATA.is_dir():
-        pytest.skip(f"real CMU data not found at {SHARED_DATA.resolve()}")
-    return SHARED_DATA.resolve()
+        pytest.skip(f"real CMU data not found at {SHARED_DATA}")
+    return SHARED_DATA

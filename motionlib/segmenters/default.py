@@ -55,7 +55,7 @@ under ``shared/data`` (13_29 BVH, 13_30 and 86_01 AMC, and the eight subject-86
 four-channel takes, 86_01's counted as the same take as its AMC), and the defaults are
 the combination with the best mean F1 at 1 s (ties: fewer edits per true cut). Scored
 leave-one-take-out, i.e. each take with the combination chosen without it
-(``python -m motionlib bench --loo``), that choice gets mean F1@1 s 0.957 and 0.41
+(``python -m motionlib bench-quality --loo``), that choice gets mean F1@1 s 0.957 and 0.41
 edits per true cut (the earlier defaults, threshold 0.25 and no prominence test: 0.862
 and 0.60, chosen on 3 takes). Each option with the others still chosen without the take
 scored, mean F1@1 s / edits per true cut:

@@ -37,6 +37,16 @@ class ProjectSerializer(serializers.Serializer):
         return project.role_of(self.context["request"].user)
 
 
+class ErrorField(serializers.CharField):
+    """A record's error text: null, not "", while it has none."""
+
+    def __init__(self, **kwargs):
+        super().__init__(read_only=True, allow_null=True, **kwargs)
+
+    def to_representation(self, value):
+        return value or None
+
+
 class MemberSerializer(serializers.Serializer):
     id = serializers.IntegerField(source="user.id", read_only=True)
     username = serializers.CharField(source="user.username")
@@ -44,7 +54,7 @@ class MemberSerializer(serializers.Serializer):
 
 
 class RunSerializer(serializers.ModelSerializer):
-    error = serializers.SerializerMethodField()
+    error = ErrorField()
 
     class Meta:
         model = DetectionRun
@@ -52,9 +62,6 @@ class RunSerializer(serializers.ModelSerializer):
             "id", "method", "params", "status", "error", "created_at", "finished_at",
             "timings", "candidates", "model_version", "model_n_takes",
         ]
-
-    def get_error(self, run) -> str | None:
-        return run.error or None
 
 
 class CutModelSerializer(serializers.ModelSerializer):
@@ -79,7 +86,7 @@ class RunRequestSerializer(serializers.Serializer):
 
 
 class CaptureSerializer(serializers.ModelSerializer):
-    error = serializers.SerializerMethodField()
+    error = ErrorField()
     duration = serializers.FloatField(read_only=True)
     # A nested field, not RunSerializer(run) per row: that rebuilt the run's fields from
     # the model for every capture and was most of the capture list's time.
@@ -94,9 +101,6 @@ class CaptureSerializer(serializers.ModelSerializer):
             "latest_run", "skeleton",
         ]
 
-    def get_error(self, capture) -> str | None:
-        return capture.error or None
-
     def get_skeleton(self, capture) -> dict | None:
         return capture.skeleton if capture.status == "ready" else None
 
@@ -104,7 +108,7 @@ class CaptureSerializer(serializers.ModelSerializer):
 class RunSummarySerializer(serializers.ModelSerializer):
     """A run in a capture list row: its state and how many candidates, not the candidates."""
 
-    error = serializers.SerializerMethodField()
+    error = ErrorField()
     n_candidates = serializers.IntegerField(read_only=True)
 
     class Meta:
@@ -113,9 +117,6 @@ class RunSummarySerializer(serializers.ModelSerializer):
             "id", "method", "status", "error", "created_at", "finished_at", "n_candidates",
             "model_version", "model_n_takes",
         ]
-
-    def get_error(self, run) -> str | None:
-        return run.error or None
 
 
 class CaptureListSerializer(CaptureSerializer):

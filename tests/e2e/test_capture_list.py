@@ -2,14 +2,14 @@
 gets to them, filter by status, project and name, and open one."""
 
 import time
-from pathlib import Path
 
 import pytest
 from playwright.sync_api import expect
 
+from motionlib.benchdata import data_dir
 from tests.e2e.conftest import synthetic_bvh
 
-SHARED_DATA = Path(__file__).resolve().parents[2] / ".." / "shared" / "data"
+SHARED_DATA = data_dir()
 
 DROP = """([name, text]) => {
     const data = new DataTransfer();

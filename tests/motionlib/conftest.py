@@ -4,7 +4,9 @@ from pathlib import Path
 
 import pytest
 
-DATA = Path(__file__).resolve().parents[2] / ".." / "shared" / "data"
+from motionlib.benchdata import data_dir
+
+DATA = data_dir()
 CMU = DATA / "cmu"
 
 

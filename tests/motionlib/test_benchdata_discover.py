@@ -78,9 +78,9 @@ def test_it_chooses_settings_without_the_take_scored_or_its_other_views():
 
 
 def test_it_prints_leave_one_take_out_rows_beside_the_others(layout, capsys):
-    from motionlib import benchmark
+    from motionlib import bench_quality
 
-    assert benchmark.main(layout, ["bone_angle"], loo=True) == 0
+    assert bench_quality.main(layout, ["bone_angle"], loo=True) == 0
     out = capsys.readouterr().out
     assert "Rows ending in /loo were scored leave-one-take-out" in out
     for row in ("default/loo", "adapted/loo", "ruptures/loo"):

@@ -2,8 +2,9 @@ import json
 
 import pytest
 
-from motionlib import synth, write_bvh
+from motionlib import read, synth, write_bvh
 from motionlib.cli import main
+from motionlib.segmenters import get_segmenter
 
 
 @pytest.fixture(scope="module")
@@ -21,7 +22,9 @@ def test_it_prints_cuts_as_json_with_exactly_the_documented_keys(bvh_path, capsy
     assert set(out) == {"fps", "n_frames", "method", "cuts"}
     assert (out["fps"], out["n_frames"], out["method"]) == (60.0, segments[-1][1], "default")
     assert out["cuts"] and all(set(c) == {"frame", "confidence"} for c in out["cuts"])
-    assert all(isinstance(c["frame"], int) and 0 <= c["confidence"] <= 1 for c in out["cuts"])
+    expected = get_segmenter("default")().fit_predict(read(path))
+    assert [c["frame"] for c in out["cuts"]] == expected.cuts.tolist()
+    assert [c["confidence"] for c in out["cuts"]] == pytest.approx(expected.confidence, abs=5e-5)
 
 
 def test_it_prints_a_table_for_people(bvh_path, capsys):

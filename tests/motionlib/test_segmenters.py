@@ -1,10 +1,11 @@
-import sys
+import dataclasses
 
 import numpy as np
 import pytest
 
 from motionlib import metrics, synth
 from motionlib.segmenters import ParamError, get_segmenter, list_segmenters
+from motionlib.segmenters.base import Segmentation, Segmenter
 
 METHODS = ["default", "bone_angle", "joint_distance_pca", "ppca"]
 
@@ -78,18 +79,34 @@ def test_it_refuses_predict_before_fit():
         get_segmenter("default")().predict()
 
 
+class Sloppy(Segmenter):
+    """Returns cuts out of order, duplicated, outside the take, and odd confidences."""
+
+    name = "sloppy"
+
+    def _segment(self, take, **params):
+        cuts = [50, 0, 10, 10, take.n_frames, 30]
+        return Segmentation(cuts=np.array(cuts), confidence=np.array([0.2, 0.9, 1.5, 0.4, 0.5, -0.3]))
+
+
+def test_it_sorts_dedupes_and_clips_what_a_method_returns(synth_takes):
+    result = Sloppy().fit_predict(synth_takes[0][0])
+    assert result.cuts.tolist() == [10, 30, 50]
+    assert result.confidence.tolist() == [1.0, 0.0, 0.2]
+    assert result.timings["total"] > 0
+
+
+# Sorted interior cuts and confidence in [0, 1] are enforced by Segmenter.fit for every
+# method (tested above); the signals are each method's own. A take that starts with a
+# rest pose is detected from the frame after it, and its signals still cover every frame.
+@pytest.mark.parametrize("rest_pose_frame", [None, 0])
 @pytest.mark.parametrize("name", METHODS)
-def test_it_returns_the_documented_result(name, synth_takes):
-    take, _ = synth_takes[0]
+def test_it_returns_a_finite_signal_value_per_frame(name, rest_pose_frame, synth_takes):
+    take = dataclasses.replace(synth_takes[0][0], rest_pose_frame=rest_pose_frame)
     result = get_segmenter(name)().fit_predict(take)
-    assert result.cuts.dtype.kind == "i"
-    assert np.all(np.diff(result.cuts) > 0)
-    assert np.all((result.cuts > 0) & (result.cuts < take.n_frames))
-    assert result.confidence.shape == result.cuts.shape
-    assert np.all((result.confidence >= 0) & (result.confidence <= 1))
+    assert len(result.cuts) > 0
     assert result.signals and all(s.shape == (take.n_frames,) for s in result.signals.values())
     assert all(np.isfinite(s).all() for s in result.signals.values())
-    assert result.timings["total"] > 0
 
 
 @pytest.mark.parametrize(
@@ -137,14 +154,6 @@ def test_it_rejects_scales_in_the_wrong_order(synth_takes):
     seg = get_segmenter("default")(scale_min_s=4.0, scale_max_s=2.0)
     with pytest.raises(ParamError, match=r"scale_max_s: must be at least scale_min_s \(4\), got 2"):
         seg.fit(synth_takes[0][0])
-
-
-def test_it_never_imports_django():
-    import subprocess
-
-    code = "import motionlib.segmenters, motionlib.metrics, motionlib.benchmark, sys; "
-    code += "assert 'django' not in sys.modules"
-    subprocess.run([sys.executable, "-c", code], check=True)
 
 
 def test_it_moves_a_cut_to_a_nearby_pause():

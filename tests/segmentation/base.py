@@ -5,7 +5,6 @@ with a project of his own.
 """
 
 import io
-from pathlib import Path
 
 import numpy as np
 from django.contrib.auth import get_user_model
@@ -14,10 +13,11 @@ from django.core.files.uploadedfile import SimpleUploadedFile
 from django.test import TestCase
 from rest_framework.test import APIClient
 
+from motionlib.benchdata import data_dir
 from segmentation import services, storage, tasks
 from segmentation.models import Capture, DetectionRun
 
-SHARED_DATA = Path(__file__).resolve().parents[2] / ".." / "shared" / "data"
+SHARED_DATA = data_dir()
 
 
 def synthetic_bvh(seed=0, **kwargs):

@@ -40,6 +40,14 @@ class CaptureListTestCase(BaseTestCase):
         self.assertEqual([c["frame"] for c in body["latest_run"]["candidates"]], [100, 200, 300])
         self.assertIsNone(body["error"])
 
+    def test_it_gives_no_error_as_null_for_captures_and_runs_alike(self):
+        detail = self.client.get(f"/api/captures/{self.walk_take.pk}/").json()
+        row = next(c for c in self.client.get("/api/captures/").json()["results"]
+                   if c["name"] == "walking.bvh")
+        errors = [detail["error"], detail["latest_run"]["error"], row["error"],
+                  row["latest_run"]["error"]]
+        self.assertEqual(errors, [None, None, None, None])
+
     def test_outsider_sees_nothing(self):
         self.login(self.charlie)
         self.assertEqual(self.client.get("/api/captures/").json()["count"], 0)

@@ -3,6 +3,8 @@ the integration tests run the same tasks in real worker processes)."""
 
 import numpy as np
 
+import motionlib
+from motionlib.segmenters import get_segmenter
 from segmentation import storage, tasks
 from segmentation.models import Capture, DetectionRun
 from tests.segmentation.base import SHARED_DATA, BaseTestCase
@@ -38,9 +40,11 @@ class IngestTestCase(BaseTestCase):
         run = DetectionRun.objects.get(capture=capture)
         self.assertEqual((run.method, run.status), ("default", "ready"))
         self.assertGreater(len(run.candidates), 0)
-        frames = [c["frame"] for c in run.candidates]
-        self.assertEqual(frames, sorted(frames))
-        self.assertTrue(all(0 < f < 4593 and 0 <= c["confidence"] <= 1 for f, c in zip(frames, run.candidates, strict=True)))
+        # The stored candidates are the default method's cuts of the file as motionlib reads it.
+        expected = get_segmenter("default")(**run.params).fit_predict(motionlib.read(BVH_13_29))
+        self.assertEqual([c["frame"] for c in run.candidates], expected.cuts.tolist())
+        for stored, confidence in zip(run.candidates, expected.confidence, strict=True):
+            self.assertAlmostEqual(stored["confidence"], confidence, delta=1e-4)
         self.assertIn("total", run.timings)
         self.assertTrue(storage.load_npz(run.signals))
 

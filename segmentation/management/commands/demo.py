@@ -3,13 +3,13 @@
 import io
 from pathlib import Path
 
-from django.conf import settings
 from django.contrib.auth import get_user_model
 from django.core.files.base import ContentFile
 from django.core.management.base import BaseCommand
 from django.db import transaction
 
 from motionlib import synth, write_bvh
+from motionlib.benchdata import data_dir
 from segmentation import importing, services
 from segmentation.models import Project
 
@@ -34,10 +34,6 @@ CMU_TAKES = [
     ("cmu/amc/13_30.amc", "cmu/asf/13.asf"),
     ("cmu/amc/86_01.amc", "cmu/asf/86.asf"),
 ]
-
-
-def default_shared_data():
-    return Path(settings.BASE_DIR).parent / "shared" / "data"
 
 
 class Command(BaseCommand):
@@ -83,7 +79,7 @@ class Command(BaseCommand):
                                  capture=capture)
 
     def add_cmu(self, project, user, folder):
-        folder = folder or default_shared_data()
+        folder = folder or data_dir()
         if not folder.is_dir():
             self.stdout.write(f"No CMU takes: {folder} not found (only generated takes added)")
             return []

@@ -1,4 +1,7 @@
-"""Benchmarks that print tables: ``python -m motionlib.bench io|adapt``.
+"""The speed benchmarks, printing tables: ``python -m motionlib bench-speed io|adapt``.
+
+How well the segmenters cut is measured by ``python -m motionlib bench-quality``
+(``motionlib.bench_quality``); this module measures only how fast things run.
 
 ``io``: read + forward kinematics of the CMU take 13_29 as BVH and as AMC + ASF, against the
 PyPI ``bvh`` package's parse of the same BVH (median of several interleaved runs, one process,
@@ -15,7 +18,6 @@ load average (run it with ``OMP_NUM_THREADS=1`` for one core).
 
 from __future__ import annotations
 
-import argparse
 import os
 import statistics
 import sys
@@ -23,7 +25,8 @@ import time
 import tracemalloc
 from pathlib import Path
 
-DATA = Path(__file__).resolve().parents[1] / ".." / "shared" / "data"
+from motionlib.benchdata import data_dir
+
 TARGET_MS, TARGET_SPEEDUP, TARGET_MEMORY = 40.0, 10.0, 5.0
 
 
@@ -83,7 +86,8 @@ def _synth_case():
 def run_io(args) -> int:
     cmu = Path(args.data) / "cmu"
     if not (cmu / "bvh" / "13_29.bvh").is_file():
-        print(f"motionlib.bench io: error: CMU captures not found under {cmu}", file=sys.stderr)
+        print(f"motionlib bench-speed io: error: CMU captures not found under {cmu}",
+              file=sys.stderr)
         return 2
     cases = _cases(cmu)
     timings = _timed_rounds(cases, args.runs)
@@ -164,26 +168,21 @@ def run_adapt(args) -> int:
     return 0
 
 
-def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="python -m motionlib.bench",
-                                     description="motionlib benchmarks (print tables).")
+def add_bench_speed(subparsers) -> None:
+    """Register ``python -m motionlib bench-speed io|adapt`` (see ``motionlib.cli``)."""
+    parser = subparsers.add_parser(
+        "bench-speed", help="benchmark read and detection speed (prints tables)",
+        description="How fast motionlib reads takes and detects cuts; the segmentation "
+                    "quality is `bench-quality`.")
     sub = parser.add_subparsers(dest="benchmark", required=True, metavar="benchmark")
     io = sub.add_parser("io", help="read + FK speed and memory on CMU 13_29")
     io.add_argument("--runs", type=int, default=21, help="timed runs per motionlib case")
-    io.add_argument("--data", default=str(DATA), help="the shared data folder")
+    io.add_argument("--data", default=str(data_dir()),
+                    help="the shared data folder (default: $CUTROOM_BENCH_DATA or "
+                         "../shared/data)")
     io.set_defaults(handler=run_io)
     ad = sub.add_parser("adapt", help="adapted detection and fitting speed, 5-min takes")
     ad.add_argument("--takes", type=int, default=50, help="example takes to fit on")
     ad.add_argument("--minutes", type=float, default=5.0, help="length of each take")
     ad.add_argument("--runs", type=int, default=5, help="timed detection runs")
     ad.set_defaults(handler=run_adapt)
-    return parser
-
-
-def main(argv: list[str] | None = None) -> int:
-    args = build_parser().parse_args(argv)
-    return args.handler(args)
-
-
-if __name__ == "__main__":
-    sys.exit(main())

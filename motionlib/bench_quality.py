@@ -1,4 +1,7 @@
-"""The segmentation benchmark: every method, default parameters, every labelled take.
+"""The segmentation quality benchmark: every method, default parameters, every labelled take.
+
+``python -m motionlib bench-quality [--loo]``; how fast things run is measured by
+``python -m motionlib bench-speed`` (``motionlib.bench_speed``).
 
 Takes are found by ``benchdata.discover`` (every labelled take in the ``shared/data``
 layout, whatever its name; four-channel takes run only the methods that need no
@@ -341,14 +344,15 @@ def patent_comparison(root: Path) -> str:
     return "\n".join(lines)
 
 
-def add_bench(subparsers) -> None:
-    """Register ``python -m motionlib bench`` (see ``motionlib.cli``)."""
+def add_bench_quality(subparsers) -> None:
+    """Register ``python -m motionlib bench-quality`` (see ``motionlib.cli``)."""
     p = subparsers.add_parser(
-        "bench", help="benchmark the segmenters on the labelled CMU takes",
+        "bench-quality", help="benchmark how well the segmenters cut the labelled CMU takes",
         description="Every segmenter (default parameters) and two change-point peers on "
                     "every labelled take: a table per take and the mean.",
     )
-    p.add_argument("--data", help="benchmark data folder (default: ../shared/data)")
+    p.add_argument("--data", help="benchmark data folder (default: $CUTROOM_BENCH_DATA or "
+                                 "../shared/data)")
     p.add_argument("--method", action="append", help="only this row (repeatable)")
     p.add_argument("--loo", action="store_true",
                    help="also score leave-one-take-out: the default settings chosen, the "

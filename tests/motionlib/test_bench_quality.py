@@ -1,0 +1,74 @@
+import json
+import math
+
+import numpy as np
+import pytest
+
+from motionlib import bench_quality, benchdata, metrics
+from motionlib.segmenters import get_segmenter
+
+DATA = benchdata.data_dir()
+
+
+def row(f1, err):
+    base = {key: 0.5 for _, key in bench_quality.COLUMNS}
+    return {**base, "f1@1s": f1, "median_error_s": err}
+
+
+def test_it_averages_each_method_over_the_takes_skipping_missing_errors():
+    results = {"a": {"m": row(1.0, float("nan"))}, "b": {"m": row(0.5, 0.2)}}
+    mean = bench_quality.mean_rows(results)["m"]
+    assert mean["f1@1s"] == 0.75
+    assert mean["median_error_s"] == 0.2
+
+
+def test_it_prints_one_line_per_method_under_a_header():
+    text = bench_quality.format_table("13_30", {"default": row(0.9, 0.1), "ppca": row(0.1, math.nan)})
+    lines = text.splitlines()
+    assert lines[0] == "13_30"
+    assert lines[1].split()[:2] == ["method", "P@.5s"]
+    assert lines[3].startswith("default") and "0.900" in lines[3]
+    assert lines[4].startswith("ppca") and "nan" in lines[4]
+
+
+def test_it_fails_cleanly_without_the_data_folder(tmp_path, capsys):
+    assert bench_quality.main(tmp_path / "missing") == 2
+    assert "benchmark data folder not found" in capsys.readouterr().err
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not DATA.is_dir(), reason=f"CMU benchmark data not found at {DATA}")
+def test_it_scores_each_take_against_its_own_labels():
+    results = bench_quality.run(only=["bone_angle"])
+    skeleton = [name for name in results if "4 channels" not in name]
+    assert skeleton == ["13_29", "13_30", "86_01"]
+    for labelled in benchdata.labelled_takes():
+        take = labelled.read()
+        cuts = get_segmenter("bone_angle")().fit_predict(take).cuts
+        expected = metrics.evaluate(cuts, labelled.truth, fps=take.fps)
+        row = results[labelled.name]["bone_angle"]
+        assert row["n_cuts"] == len(cuts) > 0
+        assert {key: row[key] for key in expected} == pytest.approx(expected, nan_ok=True)
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not DATA.is_dir(), reason=f"CMU benchmark data not found at {DATA}")
+def test_it_runs_only_skeleton_free_methods_on_four_channel_takes():
+    results = bench_quality.run(only=["bone_angle", "default"])
+    four = [rows for name, rows in results.items() if name.endswith("(4 channels)")]
+    assert len(four) == 8
+    assert all(list(rows) == ["default"] for rows in four)
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not DATA.is_dir(), reason=f"CMU benchmark data not found at {DATA}")
+def test_it_reports_the_patent_run_beside_the_published_cuts():
+    text = bench_quality.patent_comparison(DATA)
+    lists = {line.split(":")[0].strip(): json.loads(line.split(":", 1)[1])
+             for line in text.splitlines()[1:] if "[" in line}
+    differences = [int(line.split(":")[1].split()[0])
+                   for line in text.splitlines() if "max difference" in line]
+    for stage, difference in zip(("initial", "final"), differences, strict=True):
+        ours, published = np.array(lists[f"{stage} ours"]), lists[f"{stage} published"]
+        assert difference == np.abs(ours - published).max(), stage
+    assert differences[-1] <= 30

@@ -1,0 +1,47 @@
+"""python -m motionlib bench-speed io prints its table (speed is read from it, never asserted)."""
+
+import pytest
+
+from motionlib.cli import main
+
+CASES = ["motionlib read+FK 13_29.bvh", "motionlib read+FK 13_29.amc",
+         "bvh package parse 13_29.bvh", "synth.generate 5 min @120fps"]
+
+
+def table_rows(lines):
+    """case -> (wall ms, min ms, cpu ms, runs, peak MiB, file MiB, peak/file) from the table."""
+    rows = {}
+    for line in lines[1:1 + len(CASES)]:
+        cells = [None if cell == "-" else float(cell) for cell in line[30:].split()]
+        rows[line[:30].strip()] = cells
+    return rows
+
+
+def value_after(lines, prefix, separator):
+    line = next(line for line in lines if line.startswith(prefix))
+    return float(line.split(separator, 1)[1].split("x")[0].split()[0])
+
+
+@pytest.mark.slow
+def test_it_prints_numbers_that_agree_with_each_other(bvh_13_29, capsys):
+    data = bvh_13_29.parents[2]
+    assert main(["bench-speed", "io", "--runs", "2", "--data", str(data)]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    rows = table_rows(lines)
+    assert list(rows) == CASES
+    # The bvh package runs every fourth round only: once in two rounds.
+    assert [row[3] for row in rows.values()] == [2, 2, 1, 2]
+    for wall, fastest, _, _, peak, size, ratio in rows.values():
+        assert 0 < fastest <= wall and peak > 0
+        if size is not None:
+            assert ratio == pytest.approx(peak / size, abs=0.02)
+    ours, theirs = rows[CASES[0]][0], rows[CASES[2]][0]
+    assert value_after(lines, "speed-up over the bvh package", ":") == \
+        pytest.approx(theirs / ours, rel=0.05, abs=0.1)
+    assert value_after(lines, "peak memory of read+FK 13_29.bvh", ":") == rows[CASES[0]][6]
+
+
+def test_it_says_when_the_captures_are_missing(tmp_path, capsys):
+    assert main(["bench-speed", "io", "--data", str(tmp_path)]) == 2
+    assert capsys.readouterr().err.startswith(
+        "motionlib bench-speed io: error: CMU captures not found under")
