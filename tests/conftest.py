@@ -5,6 +5,8 @@ from pathlib import Path
 
 import pytest
 
+from tests.fbx.files import made_fbx  # noqa: F401  (the FBX files Blender writes for tests)
+
 SHARED_DATA = Path(__file__).resolve().parents[1] / ".." / "shared" / "data"
 
 
