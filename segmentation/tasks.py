@@ -6,10 +6,13 @@ abandoned. Failures are stored on the row (``status="failed"``, ``error``), neve
 logged.
 """
 
+import os
+import threading
 import uuid
 
 from celery import shared_task
-from celery.signals import worker_ready
+from celery.signals import worker_process_init, worker_ready
+from django.conf import settings
 
 from segmentation import services
 from segmentation.models import Capture, DetectionRun
@@ -34,6 +37,27 @@ def ingest(self, capture_id):
     capture = _claim(Capture, capture_id, self)
     if capture is not None:
         services.ingest_capture(capture)
+
+
+@shared_task(bind=True, acks_late=True, reject_on_worker_lost=True,
+             time_limit=settings.CUTROOM_CONVERT_TIME_LIMIT)
+def convert(self, capture_id):
+    """Read an FBX capture with Blender (convert queue), then queue each animation's ingest."""
+    from segmentation.services.convert import convert_capture
+
+    capture = _claim(Capture, capture_id, self)
+    if capture is not None:
+        convert_capture(capture)
+
+
+@worker_process_init.connect
+def start_blender(**kwargs):
+    # The convert worker loads Blender as its pool process starts, not on its first file (in
+    # the background: a pool process must report for work within seconds).
+    if os.environ.get("CUTROOM_CONVERT_WORKER") == "1":
+        from motionlib.io.blender import shared
+
+        threading.Thread(target=shared().start, daemon=True).start()
 
 
 @shared_task(bind=True, acks_late=True, reject_on_worker_lost=True)

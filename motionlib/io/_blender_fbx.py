@@ -43,6 +43,7 @@ def main():
     parser.add_argument("--reply-fd", type=int, required=True)
     args = parser.parse_args()
     reply = os.fdopen(args.reply_fd, "w", buffering=1)
+    _exit_with_parent()
     os.dup2(2, 1)  # Blender and its add-ons print to stdout; keep that off the reply channel
     sys.stdout = sys.stderr
     import bpy  # noqa: F401  (the slow part, once)
@@ -57,6 +58,22 @@ def main():
             traceback.print_exc()
             answer = {"ok": False, "error": f"{type(exc).__name__}: {exc}", "internal": True}
         reply.write(json.dumps(answer) + "\n")
+
+
+def _exit_with_parent():
+    """End when the process that started us is gone (killed by a time limit, say) instead of
+    living on as an orphan, possibly stuck in a file that made Blender hang."""
+    import threading
+    import time
+
+    parent = os.getppid()
+
+    def watch():
+        while os.getppid() == parent:
+            time.sleep(1.0)
+        os._exit(3)
+
+    threading.Thread(target=watch, daemon=True).start()
 
 
 def op_ping(request):
