@@ -166,6 +166,8 @@ CUTROOM_CONVERT_QUEUE = os.environ.get("CUTROOM_CONVERT_QUEUE") or "convert"
 # Seconds Celery lets one conversion run before killing its process (Blender itself is stopped
 # after MOTIONLIB_BLENDER_TIMEOUT, 300 s by default; this is the backstop).
 CUTROOM_CONVERT_TIME_LIMIT = envint("CUTROOM_CONVERT_TIME_LIMIT", 420)
+# Set on the convert worker: its pool processes load Blender as they start.
+CUTROOM_CONVERT_WORKER = envbool("CUTROOM_CONVERT_WORKER", False)
 CUTROOM_FRAMES_PER_REQUEST = 5000
 
 # Celery. No result backend: a job's state is its row (status, error, timings).

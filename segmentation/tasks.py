@@ -6,7 +6,6 @@ abandoned. Failures are stored on the row (``status="failed"``, ``error``), neve
 logged.
 """
 
-import os
 import threading
 import uuid
 
@@ -54,7 +53,7 @@ def convert(self, capture_id):
 def start_blender(**kwargs):
     # The convert worker loads Blender as its pool process starts, not on its first file (in
     # the background: a pool process must report for work within seconds).
-    if os.environ.get("CUTROOM_CONVERT_WORKER") == "1":
+    if settings.CUTROOM_CONVERT_WORKER:
         from motionlib.io.blender import shared
 
         threading.Thread(target=shared().start, daemon=True).start()
