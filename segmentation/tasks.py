@@ -6,7 +6,9 @@ abandoned. Failures are stored on the row (``status="failed"``, ``error``), neve
 logged.
 """
 
+import logging
 import threading
+import time
 import uuid
 
 from celery import shared_task
@@ -16,6 +18,8 @@ from django.conf import settings
 from segmentation import services
 from segmentation.models import Capture, DetectionRun
 from segmentation.services.captures import exhausted, give_up
+
+log = logging.getLogger(__name__)
 
 
 def _claim(model, pk, task):
@@ -54,9 +58,20 @@ def start_blender(**kwargs):
     # The convert worker loads Blender as its pool process starts, not on its first file (in
     # the background: a pool process must report for work within seconds).
     if settings.CUTROOM_CONVERT_WORKER:
-        from motionlib.io.blender import shared
+        threading.Thread(target=_warm_blender, daemon=True).start()
 
-        threading.Thread(target=shared().start, daemon=True).start()
+
+def _warm_blender():
+    from motionlib.errors import CaptureError
+    from motionlib.io.blender import shared
+
+    started = time.perf_counter()
+    try:
+        shared().start()
+    except CaptureError as exc:  # the first file will try again, and fail with the reason
+        log.warning("Blender did not start: %s", exc)
+        return
+    log.info("Blender ready in %.1f s (pid %s)", time.perf_counter() - started, shared().pid)
 
 
 @shared_task(bind=True, acks_late=True, reject_on_worker_lost=True)
