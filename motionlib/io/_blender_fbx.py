@@ -16,6 +16,10 @@ Requests:
 ``{"op": "write", "in": NPZ, "meta": {...}, "out": PATH, "format": "fbx"|"glb"}``
     Build an armature from rest heads and per-frame bone rotations/positions, key it, and export
     it as binary FBX or glTF binary.
+``{"op": "trim", "path": FBX, "animation": NAME|null, "start": I, "stop": J, "fps": F,
+"out": PATH, "format": "fbx"|"glb"}``
+    Import the original FBX and export frames [start, stop) of one of its animations, with
+    the same armature (bones, rest orientations, meshes).
 ``{"op": "evaluate", "path": FBX, "frames": [...]}``
     Blender's own pose evaluation of the first armature's assigned action: each bone's head in
     world coordinates on the given scene frames (an oracle for motionlib's pose arithmetic).
@@ -102,16 +106,14 @@ def op_read(request):
         raise InputProblem(f"no armature (skeleton) in the file; it holds {', '.join(kinds)}. "
                            "Export the take with its skeleton and animation")
     arrays, animations = {}, []
-    for armature in armatures:
-        for action in _actions_of(armature):
-            key = f"a{len(animations)}"
-            frames, paths, values = _sample(_curves(action, armature), key)
-            if frames is None:
-                continue
-            arrays[f"{key}_frames"] = frames
-            arrays[f"{key}_curves"] = values
-            animations.append({"key": key, "action": action.name, "armature": armature.name,
-                               "curves": paths, **_armature_description(armature, arrays, key)})
+    for armature, action, name in _animations(armatures):
+        key = f"a{len(animations)}"
+        frames, paths, values = _sample(_curves(action, armature), key)
+        arrays[f"{key}_frames"] = frames
+        arrays[f"{key}_curves"] = values
+        animations.append({"key": key, "name": name, "action": action.name,
+                           "armature": armature.name, "curves": paths,
+                           **_armature_description(armature, arrays, key)})
     if not animations:
         names = ", ".join(repr(a.name) for a in armatures)
         raise InputProblem(f"the armature {names} has no animation (no keyed bones); export "
@@ -128,6 +130,24 @@ def _import_error(exc):
         return ("ASCII FBX is not supported (Blender reads binary FBX only); export the take "
                 "again as binary FBX")
     return f"Blender's FBX importer could not read the file (corrupt or truncated?): {last}"
+
+
+def _animations(armatures):
+    """(armature, action, name) of every keyed armature animation, in file order.
+
+    The name is the action's without the armature's prefix that Blender's importer adds
+    ("Armature|mixamo.com|Layer0" -> "mixamo.com|Layer0"), kept whole when several armatures
+    are animated.
+    """
+    found = [(arm, act) for arm in armatures for act in _actions_of(arm) if _curves(act, arm)]
+    several = len({arm.name for arm, _ in found}) > 1
+    named = []
+    for armature, action in found:
+        name, prefix = action.name, armature.name + "|"
+        while not several and name.startswith(prefix):
+            name = name[len(prefix):]
+        named.append((armature, action, name or action.name))
+    return named
 
 
 def _actions_of(armature):
@@ -234,37 +254,102 @@ def op_evaluate(request):
 # --- writing ------------------------------------------------------------------------------
 
 def op_write(request):
+    """A new armature from a take's rest heads and per-frame local poses, exported."""
     import bpy
 
     meta = request["meta"]
     with np.load(request["in"]) as data:
-        heads, quats, root = data["heads"], data["quaternions"], data["root"]
+        heads, quats, locations = data["heads"], data["quaternions"], data["locations"]
     bpy.ops.wm.read_factory_settings(use_empty=True)
-    scene = bpy.context.scene
-    fps = float(meta["fps"])
-    scene.render.fps = max(1, round(fps))
-    scene.render.fps_base = scene.render.fps / fps
+    _set_fps(meta["fps"])
     armature = _build_armature(meta["name"], meta["bones"], meta["parents"], heads)
-    _key_pose(armature, meta["bones"], meta["parents"], heads, quats, root)
+    _key_pose(armature, meta["bones"], quats, locations, meta["moving"])
     n = quats.shape[0]
-    scene.frame_start, scene.frame_end = 1, n
-    os.makedirs(os.path.dirname(os.path.abspath(request["out"])), exist_ok=True)
-    if request["format"] == "fbx":
-        bpy.ops.export_scene.fbx(filepath=request["out"], use_selection=False,
-                                 object_types={"ARMATURE"}, add_leaf_bones=False,
-                                 bake_anim=True, bake_anim_use_all_actions=False,
-                                 bake_anim_use_nla_strips=False, bake_anim_simplify_factor=0.0,
-                                 bake_anim_force_startend_keying=True)
-    else:
-        bpy.ops.export_scene.gltf(filepath=request["out"], export_format="GLB",
-                                  export_animations=True, export_force_sampling=True,
-                                  export_frame_range=True, export_yup=True)
+    bpy.context.scene.frame_start, bpy.context.scene.frame_end = 1, n
+    _export(request["out"], request["format"], {"ARMATURE"})
     return {"frames": int(n)}
 
 
+def op_trim(request):
+    """The original FBX again, cut to frames [start, stop) of one animation.
+
+    The animation's armature (and the meshes it deforms) are kept as they are, every other
+    armature removed. A baked animation keeps its keys, renumbered 1, 2, … (its key times may
+    drift from whole frames by float rounding, as Blender's BVH round trip leaves them); any
+    other is sampled by the exporter on the scene frames of the range.
+    """
+    import bpy
+
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    bpy.ops.import_scene.fbx(filepath=request["path"], use_anim=True, ignore_leaf_bones=False,
+                             automatic_bone_orientation=False)
+    scene = bpy.context.scene
+    armatures = [o for o in scene.objects if o.type == "ARMATURE"]
+    found = [(arm, act) for arm, act, name in _animations(armatures)
+             if request["animation"] in (None, name)]
+    if not found:
+        raise InputProblem(f"no animation {request['animation']!r} in the file any more")
+    armature, action = found[0]
+    for other in [o for o in scene.objects if o.type == "ARMATURE" and o is not armature]:
+        for child in list(other.children_recursive) + [other]:
+            bpy.data.objects.remove(child)
+    armature.animation_data.action = action
+    start, stop = int(request["start"]), int(request["stop"])
+    curves = _curves(action, armature)
+    keys = [len(c.keyframe_points) for c in curves]
+    if len(set(keys)) == 1 and stop <= keys[0]:
+        for c in curves:
+            _renumber(c, start, stop)
+        first, last = 1, stop - start
+    else:
+        frames, _, _ = _sample(curves, None)
+        first, last = int(round(frames[start])), int(round(frames[stop - 1]))
+    scene.frame_start, scene.frame_end = first, last
+    _set_fps(request["fps"])
+    _export(request["out"], request["format"], {"ARMATURE", "MESH"})
+    return {"frames": stop - start}
+
+
+def _renumber(fcurve, start, stop):
+    co = np.empty(2 * len(fcurve.keyframe_points))
+    fcurve.keyframe_points.foreach_get("co", co)
+    values = co[1::2][start:stop].copy()
+    fcurve.keyframe_points.clear()
+    frames = np.arange(1, len(values) + 1, dtype=np.float64)
+    _set_keys(fcurve, frames, values)
+
+
+def _set_fps(fps):
+    import bpy
+
+    render = bpy.context.scene.render
+    fps = float(fps)
+    render.fps = max(1, round(fps))
+    render.fps_base = render.fps / fps
+
+
+def _export(out, fmt, object_types):
+    import bpy
+
+    os.makedirs(os.path.dirname(os.path.abspath(out)), exist_ok=True)
+    if fmt == "fbx":
+        bpy.ops.export_scene.fbx(filepath=out, use_selection=False, object_types=object_types,
+                                 add_leaf_bones=False, bake_anim=True,
+                                 bake_anim_use_all_actions=False, bake_anim_use_nla_strips=False,
+                                 bake_anim_simplify_factor=0.0,
+                                 bake_anim_force_startend_keying=True)
+    elif fmt == "glb":
+        bpy.ops.export_scene.gltf(filepath=out, export_format="GLB", export_animations=True,
+                                  export_force_sampling=True, export_frame_range=True,
+                                  export_anim_single_armature=True, export_yup=True)
+    else:
+        raise InputProblem(f"unknown export format {fmt!r}; expected fbx or glb")
+
+
 def _build_armature(name, bones, parents, heads):
-    """An armature whose bones sit at ``heads`` (Blender world, Z up) with identity rest
-    orientation's Y along the bone where possible; every bone has a tail."""
+    """An armature whose bones sit at ``heads`` (Blender world, Z up), each with the identity
+    as its rest orientation (tail straight along +Y, no roll): a BVH-shaped skeleton, whose
+    pose rotations are then the take's local rotations as they are."""
     import bpy
 
     data = bpy.data.armatures.new(name)
@@ -277,8 +362,6 @@ def _build_armature(name, bones, parents, heads):
     for i, bone_name in enumerate(bones):
         bone = data.edit_bones.new(bone_name)
         bone.head = heads[i]
-        # Rest frame = world frame (a BVH-shaped skeleton): tail straight up +Y, no roll, so
-        # the bone's rest matrix is the identity rotation and pose rotations are world ones.
         bone.tail = heads[i] + np.array([0.0, length, 0.0])
         bone.roll = 0.0
         if parents[i] >= 0:
@@ -288,50 +371,45 @@ def _build_armature(name, bones, parents, heads):
     return obj
 
 
-def _key_pose(armature, bones, parents, heads, quats, root):
-    """Key every bone's rotation (local, quaternion) and the root bone's location per frame.
-
-    ``quats`` (F, B, 4) (w, x, y, z) are each bone's rotation relative to its parent, in the
-    world frame of the rest pose; with rest matrices of identity rotation (see
-    ``_build_armature``) they are exactly the bones' pose rotations. ``root`` (F, 3) is the
-    root head's position.
-    """
-    n = quats.shape[0]
-    frames = np.arange(1, n + 1, dtype=np.float64)
-    armature.animation_data_create()
-    action = bpy_new_action(armature.name)
-    armature.animation_data.action = action
-    for b, bone_name in enumerate(bones):
-        pose_bone = armature.pose.bones[bone_name]
-        pose_bone.rotation_mode = "QUATERNION"
-        path = f'pose.bones["{bone_name}"].rotation_quaternion'
-        for k in range(4):
-            _key_curve(action, path, k, frames, quats[:, b, k], group=bone_name)
-        if parents[b] < 0:
-            path = f'pose.bones["{bone_name}"].location'
-            offset = root - heads[b]
-            for k in range(3):
-                _key_curve(action, path, k, frames, offset[:, k], group=bone_name)
-
-
-def bpy_new_action(name):
+def _key_pose(armature, bones, quats, locations, moving):
+    """Key every bone's rotation (quaternion, w x y z) and the location of the bones that move
+    (the root; any bone whose distance to its parent changes) on frames 1…F."""
     import bpy
 
-    return bpy.data.actions.new(name)
+    frames = np.arange(1, quats.shape[0] + 1, dtype=np.float64)
+    armature.animation_data_create()
+    action = bpy.data.actions.new(armature.name)
+    armature.animation_data.action = action
+    for b, bone_name in enumerate(bones):
+        armature.pose.bones[bone_name].rotation_mode = "QUATERNION"
+        path = f'pose.bones["{bone_name}"]'
+        for k in range(4):
+            _key_curve(action, f"{path}.rotation_quaternion", k, frames, quats[:, b, k],
+                       bone_name)
+        if moving[b]:
+            for k in range(3):
+                _key_curve(action, f"{path}.location", k, frames, locations[:, b, k], bone_name)
+    if hasattr(armature.animation_data, "action_slot") and action.slots:
+        # Blender 4.4+: curves made through the legacy API sit in a slot nobody is bound to.
+        armature.animation_data.action_slot = action.slots[0]
 
 
 def _key_curve(action, path, index, frames, values, group):
-    fcurve = action.fcurves.new(path, index=index, action_group=group)
+    _set_keys(action.fcurves.new(path, index=index, action_group=group), frames, values)
+
+
+def _set_keys(fcurve, frames, values):
     fcurve.keyframe_points.add(len(frames))
     co = np.empty(2 * len(frames))
     co[0::2], co[1::2] = frames, values
     fcurve.keyframe_points.foreach_set("co", co)
-    interpolation = np.full(len(frames), 2, dtype=np.int32)  # LINEAR (keyed on every frame)
-    fcurve.keyframe_points.foreach_set("interpolation", interpolation)
+    # LINEAR: keyed on every frame, nothing to smooth between keys.
+    fcurve.keyframe_points.foreach_set("interpolation", np.full(len(frames), 2, np.int32))
     fcurve.update()
 
 
-OPS = {"read": op_read, "write": op_write, "evaluate": op_evaluate, "ping": op_ping}
+OPS = {"read": op_read, "write": op_write, "trim": op_trim, "evaluate": op_evaluate,
+       "ping": op_ping}
 
 if __name__ == "__main__":
     main()

@@ -34,8 +34,9 @@ BINARY_MAGIC = b"Kaydara FBX Binary  \x00"
 CENTIMETRES_PER_METRE = 100.0
 # Blender's Z-up world to Y up: (x, y, z) -> (x, z, -y).
 Z_UP_TO_Y_UP = np.array([[1.0, 0, 0], [0, 0, 1], [0, -1, 0]])
-# A bone whose head moves more than this (cm) from where its rest offset puts it gets channels.
-MOVING_BONE_CM = 1e-4
+# A bone whose head strays from where its rest offset puts it by more than this share of the
+# skeleton's size gets position channels (Blender computes in float32: ~1e-7 is noise).
+MOVING_BONE_SHARE = 1e-5
 
 
 def check_fbx_header(path) -> None:
@@ -92,10 +93,8 @@ def read_fbx_all(path, *, blender=None, timeout=None) -> list[Take]:
     """
     reply, arrays = read_fbx_raw(path, blender=blender, timeout=timeout)
     animations = reply["animations"]
-    names = _animation_names(animations)
     single = len(animations) == 1
-    return [_take(path, a, name, arrays, reply["fps"], single)
-            for a, name in zip(animations, names, strict=True)]
+    return [_take(path, a, a["name"], arrays, reply["fps"], single) for a in animations]
 
 
 def read_fbx(path, *, animation: str | int | None = None, blender=None, timeout=None) -> Take:
@@ -119,21 +118,6 @@ def pick_animation(takes: list[Take], animation, path) -> Take:
                 return take
     there = ", ".join(repr(t.animation) for t in takes)
     raise CaptureError(f"no animation {animation!r}; the file has {there}", path=path)
-
-
-def _animation_names(animations) -> list[str]:
-    """The stack part of Blender's action names ("Armature|mixamo.com|Layer0" ->
-    "mixamo.com|Layer0"), the armature kept when several armatures are animated."""
-    armatures = {a["armature"] for a in animations}
-    names = []
-    for a in animations:
-        action = a["action"]
-        prefix = a["armature"] + "|"
-        short = action
-        while len(armatures) == 1 and short.startswith(prefix):
-            short = short[len(prefix):]
-        names.append(short or action)
-    return names
 
 
 def _take(path, animation, name, arrays, scene_fps, single) -> Take:
@@ -296,6 +280,7 @@ def bvh_shape(names, parents, world, rest_world) -> tuple[Skeleton, np.ndarray]:
     has_parent = parents >= 0
     offsets[has_parent] = rest_positions[has_parent] - rest_positions[parents[has_parent]]
     columns, layout = [], []
+    tolerance = MOVING_BONE_SHARE * max(float(np.ptp(rest_positions, axis=0).max()), 1.0)
     for j in range(len(names)):
         p = parents[j]
         if p < 0:
@@ -304,7 +289,7 @@ def bvh_shape(names, parents, world, rest_world) -> tuple[Skeleton, np.ndarray]:
             parent_T = np.swapaxes(G[:, p], -1, -2)
             local_pos = np.einsum("fij,fj->fi", parent_T, positions[:, j] - positions[:, p])
             local_rot = parent_T @ G[:, j]
-        moves = p < 0 or np.abs(local_pos - offsets[j]).max() > MOVING_BONE_CM
+        moves = p < 0 or np.abs(local_pos - offsets[j]).max() > tolerance
         channel_names = ("Xposition", "Yposition", "Zposition") if moves else ()
         if moves:
             columns.append(local_pos)
