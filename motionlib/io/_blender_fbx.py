@@ -16,8 +16,8 @@ Requests:
 ``{"op": "write", "in": NPZ, "meta": {...}, "out": PATH, "format": "fbx"|"glb"}``
     Build an armature from rest heads and per-frame bone rotations/positions, key it, and export
     it as binary FBX or glTF binary.
-``{"op": "trim", "path": FBX, "animation": NAME|null, "start": I, "stop": J, "fps": F,
-"out": PATH, "format": "fbx"|"glb"}``
+``{"op": "trim", "path": FBX, "animation": NAME|null, "fps": F, "format": "fbx"|"glb",
+"clips": [{"start": I, "stop": J, "out": PATH}, ...]}``
     Import the original FBX and export frames [start, stop) of one of its animations, with
     the same armature (bones, rest orientations, meshes).
 ``{"op": "evaluate", "path": FBX, "frames": [...]}``
@@ -271,12 +271,13 @@ def op_write(request):
 
 
 def op_trim(request):
-    """The original FBX again, cut to frames [start, stop) of one animation.
+    """The original FBX again, cut to frames [start, stop) of one animation, once per clip.
 
     The animation's armature (and the meshes it deforms) are kept as they are, every other
-    armature removed. A baked animation keeps its keys, renumbered 1, 2, … (its key times may
-    drift from whole frames by float rounding, as Blender's BVH round trip leaves them); any
-    other is sampled by the exporter on the scene frames of the range.
+    armature removed; the file is imported once for all clips. A baked animation keeps its keys,
+    renumbered 1, 2, … (its key times may drift from whole frames by float rounding, as Blender's
+    BVH round trip leaves them); any other is sampled by the exporter on the scene frames of
+    the range.
     """
     import bpy
 
@@ -290,24 +291,37 @@ def op_trim(request):
     if not found:
         raise InputProblem(f"no animation {request['animation']!r} in the file any more")
     armature, action = found[0]
-    for other in [o for o in scene.objects if o.type == "ARMATURE" and o is not armature]:
+    for other in [o for o in armatures if o is not armature]:
         for child in list(other.children_recursive) + [other]:
             bpy.data.objects.remove(child)
-    armature.animation_data.action = action
-    start, stop = int(request["start"]), int(request["stop"])
-    curves = _curves(action, armature)
-    keys = [len(c.keyframe_points) for c in curves]
-    if len(set(keys)) == 1 and stop <= keys[0]:
-        for c in curves:
-            _renumber(c, start, stop)
-        first, last = 1, stop - start
-    else:
-        frames, _, _ = _sample(curves, None)
-        first, last = int(round(frames[start])), int(round(frames[stop - 1]))
-    scene.frame_start, scene.frame_end = first, last
     _set_fps(request["fps"])
-    _export(request["out"], request["format"], {"ARMATURE", "MESH"})
-    return {"frames": stop - start}
+    curves = _curves(action, armature)
+    counts = {len(c.keyframe_points) for c in curves}
+    frames, _, _ = _sample(curves, None)
+    for clip in request["clips"]:
+        start, stop = int(clip["start"]), int(clip["stop"])
+        if len(counts) == 1 and stop <= next(iter(counts)):  # baked: one key per frame
+            cut = action.copy()
+            _bind(armature, cut)
+            for c in _curves(cut, armature):
+                _renumber(c, start, stop)
+            scene.frame_start, scene.frame_end = 1, stop - start
+        else:
+            cut = None
+            _bind(armature, action)
+            scene.frame_start = int(round(frames[start]))
+            scene.frame_end = int(round(frames[stop - 1]))
+        _export(clip["out"], request["format"], {"ARMATURE", "MESH"})
+        if cut is not None:
+            _bind(armature, action)
+            bpy.data.actions.remove(cut)
+    return {"clips": len(request["clips"])}
+
+
+def _bind(armature, action):
+    armature.animation_data.action = action
+    if hasattr(armature.animation_data, "action_slot") and action.slots:
+        armature.animation_data.action_slot = action.slots[0]
 
 
 def _renumber(fcurve, start, stop):
@@ -341,7 +355,8 @@ def _export(out, fmt, object_types):
     elif fmt == "glb":
         bpy.ops.export_scene.gltf(filepath=out, export_format="GLB", export_animations=True,
                                   export_force_sampling=True, export_frame_range=True,
-                                  export_anim_single_armature=True, export_yup=True)
+                                  export_anim_single_armature=True, export_yup=True,
+                                  export_anim_slide_to_zero=True)  # clip time starts at 0
     else:
         raise InputProblem(f"unknown export format {fmt!r}; expected fbx or glb")
 

@@ -22,8 +22,12 @@ import numpy as np
 
 from motionlib.errors import CaptureError
 from motionlib.io.bvh import write_bvh
-from motionlib.io.fbx import CENTIMETRES_PER_METRE, Z_UP_TO_Y_UP, check_fbx_header, \
-    matrix_to_quaternion
+from motionlib.io.fbx import (
+    CENTIMETRES_PER_METRE,
+    Z_UP_TO_Y_UP,
+    check_fbx_header,
+    matrix_to_quaternion,
+)
 from motionlib.kinematics import euler_to_matrix
 from motionlib.take import Take, frame_range
 
@@ -55,25 +59,39 @@ def write_clip(take: Take, out, *, format: str, start: int | None = None,
     CaptureError
         Unknown format, a frame range outside the take, Blender failing on the file.
     """
+    write_clips(take, [(start, stop, out)], format=format, original=original, blender=blender,
+                timeout=timeout)
+
+
+def write_clips(take: Take, clips, *, format: str, original=None, blender=None,
+                timeout: float | None = None) -> None:
+    """Write several clips of one take: ``clips`` is a list of ``(start, stop, out)``.
+
+    Like :func:`write_clip`, but an original FBX is imported once for all of them.
+    """
     if format not in FORMATS:
         raise CaptureError(f"unknown export format {format!r}; expected one of "
                            f"{', '.join(FORMATS)}")
-    start, stop = frame_range(take.n_frames, start, stop)
-    out = os.fspath(out)
+    clips = [(*frame_range(take.n_frames, start, stop), os.fspath(out))
+             for start, stop, out in clips]
     if format == "bvh":
-        write_bvh(take, out, start=start, stop=stop)
+        for start, stop, out in clips:
+            write_bvh(take, out, start=start, stop=stop)
         return
     from motionlib.io import blender as blender_module
 
     blender = blender or blender_module.shared()
+    what = f"writing {format.upper()} clips"
     if original is not None and take.format == "fbx":
         check_fbx_header(original)
-        request = {"op": "trim", "path": os.path.abspath(os.fspath(original)),
-                   "animation": take.animation, "start": start, "stop": stop, "fps": take.fps}
-        blender.request({**request, "out": os.path.abspath(out), "format": format},
-                        path=original, what=f"writing the {format.upper()} clip", timeout=timeout)
+        blender.request({
+            "op": "trim", "path": os.path.abspath(os.fspath(original)),
+            "animation": take.animation, "fps": take.fps, "format": format,
+            "clips": [{"start": a, "stop": b, "out": os.path.abspath(o)} for a, b, o in clips],
+        }, path=original, what=what, timeout=timeout)
         return
-    _write_new_armature(take.slice(start, stop), out, format, blender, timeout)
+    for start, stop, out in clips:
+        _write_new_armature(take.slice(start, stop), out, format, blender, timeout)
 
 
 def _write_new_armature(take, out, format, blender, timeout):
