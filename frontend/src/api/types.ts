@@ -48,7 +48,7 @@ export interface Capture {
   id: number;
   project: number;
   name: string;
-  format: "bvh" | "amc";
+  format: "bvh" | "amc" | "fbx";
   status: CaptureStatus;
   error: string | null;
   fps: number;
@@ -60,6 +60,9 @@ export interface Capture {
   created_at: string;
   latest_run: Run | null;
   skeleton: Skeleton | null;
+  /** FBX: which animation of the file ("" otherwise); another animation's capture id. */
+  animation?: string;
+  source?: number | null;
   duplicate?: boolean;
 }
 
