@@ -5,6 +5,7 @@ import { get } from "../api/client";
 import type { Page, Project } from "../api/types";
 import { clear, formatDuration, h, toast } from "../ui/dom";
 import { topbar } from "./nav";
+import { GlbPreview } from "./gltfPreview";
 import { ClipPreview } from "./preview";
 import type { LibrarySegment } from "./types";
 
@@ -58,6 +59,7 @@ export async function renderLibrary(root: HTMLElement): Promise<() => void> {
   zipFormat.addEventListener("change", () => exportZip.setAttribute("href", zipHref()));
   const preview = h("aside", { class: "lib-preview", "data-testid": "preview" }, h("p", { class: "muted" }, "Play a segment to preview it here."));
   const player = new ClipPreview(preview);
+  const glbPlayer = new GlbPreview(preview);
 
   const field = (key: (typeof KEYS)[number], el: HTMLInputElement | HTMLSelectElement) => {
     el.value = filters[key];
@@ -121,6 +123,7 @@ export async function renderLibrary(root: HTMLElement): Promise<() => void> {
         h("a", { class: "btn", href: `/api/segments/${s.id}/export.bvh`, download: "" }, "BVH"),
         h("a", { class: "btn", "data-testid": `fbx-${s.id}`, href: `/api/segments/${s.id}/export.fbx`, download: "" }, "FBX"),
         h("a", { class: "btn", "data-testid": `glb-${s.id}`, href: `/api/segments/${s.id}/export.glb`, download: "", title: "glTF binary" }, "glTF"),
+        h("button", { class: "btn", "data-testid": `play-glb-${s.id}`, title: "Play the glTF export as three.js loads it", onclick: () => void playGlb(s) }, "▶ glTF"),
       ),
     );
   }
@@ -152,7 +155,17 @@ export async function renderLibrary(root: HTMLElement): Promise<() => void> {
     }
   }
 
+  async function playGlb(s: LibrarySegment): Promise<void> {
+    player.stop();
+    try {
+      await glbPlayer.play(`/api/segments/${s.id}/export.glb`, `${s.label} · ${s.capture.name} · frames ${s.start}–${s.stop}`, `glb:${s.id}`);
+    } catch (err) {
+      toast(`glTF export of ${s.label} ${s.start}–${s.stop}: ${(err as Error).message}`, "error");
+    }
+  }
+
   async function play(s: LibrarySegment): Promise<void> {
+    glbPlayer.stop();
     await player.play(s.capture.id, s.start, s.stop, `${s.label} · ${s.capture.name} · frames ${s.start}–${s.stop}`, String(s.id));
   }
 
@@ -164,5 +177,8 @@ export async function renderLibrary(root: HTMLElement): Promise<() => void> {
   }
 
   await load();
-  return () => player.stop();
+  return () => {
+    player.stop();
+    glbPlayer.stop();
+  };
 }
