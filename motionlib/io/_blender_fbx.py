@@ -266,7 +266,7 @@ def op_write(request):
     _key_pose(armature, meta["bones"], quats, locations, meta["moving"])
     n = quats.shape[0]
     bpy.context.scene.frame_start, bpy.context.scene.frame_end = 1, n
-    _export(request["out"], request["format"], {"ARMATURE"})
+    _export(request["out"], request["format"], {"ARMATURE"}, sample=True)
     return {"frames": int(n)}
 
 
@@ -306,12 +306,13 @@ def op_trim(request):
             for c in _curves(cut, armature):
                 _renumber(c, start, stop)
             scene.frame_start, scene.frame_end = 1, stop - start
+            sample = False
         else:
-            cut = None
+            cut, sample = None, True
             _bind(armature, action)
             scene.frame_start = int(round(frames[start]))
             scene.frame_end = int(round(frames[stop - 1]))
-        _export(clip["out"], request["format"], {"ARMATURE", "MESH"})
+        _export(clip["out"], request["format"], {"ARMATURE", "MESH"}, sample)
         if cut is not None:
             _bind(armature, action)
             bpy.data.actions.remove(cut)
@@ -342,7 +343,12 @@ def _set_fps(fps):
     render.fps_base = render.fps / fps
 
 
-def _export(out, fmt, object_types):
+def _export(out, fmt, object_types, sample=False):
+    """Write the scene's armature (and ``object_types``) over the scene's frame range.
+
+    ``sample``: glTF samples the pose on every frame instead of converting the keys, for
+    animations not keyed on every frame (a baked one converts exactly, and much faster).
+    """
     import bpy
 
     os.makedirs(os.path.dirname(os.path.abspath(out)), exist_ok=True)
@@ -353,9 +359,12 @@ def _export(out, fmt, object_types):
                                  bake_anim_simplify_factor=0.0,
                                  bake_anim_force_startend_keying=True)
     elif fmt == "glb":
+        # The active action only (the default writes every action of the file).
         bpy.ops.export_scene.gltf(filepath=out, export_format="GLB", export_animations=True,
-                                  export_force_sampling=True, export_frame_range=True,
+                                  export_animation_mode="ACTIVE_ACTIONS",
+                                  export_force_sampling=sample, export_frame_range=True,
                                   export_anim_single_armature=True, export_yup=True,
+                                  export_optimize_animation_size=False,
                                   export_anim_slide_to_zero=True)  # clip time starts at 0
     else:
         raise InputProblem(f"unknown export format {fmt!r}; expected fbx or glb")
