@@ -2,15 +2,20 @@
 
 import json
 import struct
+import subprocess
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 import motionlib
 from motionlib.errors import CaptureError
+from motionlib.io.blender import blender_python
 from motionlib.io.export import write_clip, write_clips
 from motionlib.io.fbx import read_fbx_all, read_fbx_raw
 from tests.fbx.files import shared_bvh_13_29, shared_fbx
+
+GLTF_HEADS = Path(__file__).resolve().parents[1] / "fbx" / "gltf_heads.py"
 
 
 def positions(take):
@@ -91,6 +96,28 @@ def test_it_writes_a_bvh_take_as_a_glb(tmp_path):
     names = {node["name"] for node in gltf["nodes"]}
     assert set(take.skeleton.names) <= names
     assert gltf["accessors"][gltf["animations"][0]["samplers"][0]["input"]]["count"] == 240
+
+
+def gltf_positions(path, fps, frames):
+    """Joint positions (cm) of a .glb on ``frames``, as Blender's glTF importer poses them."""
+    done = subprocess.run([blender_python(), "-I", str(GLTF_HEADS), str(path), str(fps),
+                           *map(str, frames)], capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr[-2000:]
+    body = json.loads(done.stdout.strip().splitlines()[-1])
+    return body["names"], np.array(body["heads"]) * 100.0
+
+
+@pytest.mark.parametrize("source", ["samba_dancing.fbx", "13_29.bvh"])
+def test_it_writes_a_glb_that_poses_the_clip_as_the_take(tmp_path, source):
+    path = shared_bvh_13_29() if source.endswith(".bvh") else shared_fbx(source)
+    take = motionlib.read(path)
+    original = path if source.endswith(".fbx") else None
+    write_clip(take, tmp_path / "clip.glb", format="glb", start=50, stop=350, original=original)
+    frames = [0, 101, 237, 299]
+    names, heads = gltf_positions(tmp_path / "clip.glb", take.fps, frames)
+    columns = [take.skeleton.names.index(name) for name in names]
+    expected = positions(take)[[50 + f for f in frames]][:, columns]
+    assert np.abs(heads - expected).max() < 1e-4 * motionlib.skeleton_height(take)
 
 
 def test_it_refuses_an_unknown_format(tmp_path):
