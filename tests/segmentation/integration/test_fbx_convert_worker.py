@@ -87,13 +87,17 @@ def test_it_converts_then_ingests_and_detects_an_fbx_upload(fbx_workers, owner):
 
 def test_it_makes_a_capture_per_animation(fbx_workers, owner, made_fbx):
     start_convert, _ = fbx_workers
-    start_convert()
+    worker = start_convert()
+    wait_for(lambda: "Blender ready in" in worker.log.read_text(), what="Blender to start")
+    blender = blender_pids(worker)
     first = settled(upload(owner, made_fbx / "two_armatures.fbx"))
     assert first.status == "ready", first.error
     other = Capture.objects.get(source=first)
     assert settled(other.pk).status == "ready"
     assert sorted([first.name, other.name]) == ["two_armatures.fbx#Breakdance|Scene",
                                                 "two_armatures.fbx#Flair|Scene"]
+    # The Blender loaded as the worker started read the file: none started for it.
+    assert blender_pids(worker) == blender and len(blender) == 1
 
 
 def test_a_blender_crash_fails_that_capture_and_the_worker_converts_the_next(fbx_workers, owner):
