@@ -111,7 +111,10 @@ class Blender:
         """
         timeout = DEFAULT_TIMEOUT if timeout is None else timeout
         with self._lock:
-            self._ensure_started()
+            try:
+                self._ensure_started()
+            except BlenderUnavailable as exc:
+                raise BlenderUnavailable(exc.reason, path=path) from None
             reply = self._exchange(message, timeout, what, path)
         if not reply.get("ok"):
             raise CaptureError(reply.get("error") or "Blender failed", path=path)

@@ -1,6 +1,7 @@
 """Reading FBX through Blender: the real Mixamo and CMU takes, Blender-made edge cases, bad files."""
 
 import os
+import subprocess
 import sys
 import threading
 
@@ -174,3 +175,20 @@ def test_it_keeps_one_blender_for_many_files():
 def test_it_never_imports_blender_into_the_reading_process():
     motionlib.read(shared_fbx("flair.fbx"))
     assert "bpy" not in sys.modules
+
+
+def test_it_works_without_blender_until_an_fbx_is_read(tmp_path):
+    script = (
+        "import sys, motionlib, motionlib.io.fbx, motionlib.io.export\n"
+        "from motionlib.io import blender\n"
+        "assert 'bpy' not in sys.modules and blender._shared is None\n"
+        f"print(motionlib.read({str(shared_bvh_13_29())!r}).n_frames)\n"
+        f"motionlib.read({str(shared_fbx('flair.fbx'))!r})\n"
+    )
+    env = {**os.environ, "MOTIONLIB_BLENDER_PYTHON": str(tmp_path / "no-python")}
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                          env=env)
+    assert done.stdout == "4593\n"
+    assert done.stderr.strip().splitlines()[-1] == (
+        f"motionlib.io.blender.BlenderUnavailable: flair.fbx: MOTIONLIB_BLENDER_PYTHON="
+        f"{tmp_path / 'no-python'}: no such file")
