@@ -29,7 +29,8 @@ def fbx_segments(studio):
     return list(LibrarySegment.objects.order_by("start"))
 
 
-def test_it_loads_a_segments_glb_export_with_threejs(live_server, new_page, fbx_segments):
+def test_it_loads_a_segments_glb_export_with_threejs(live_server, new_page, fbx_segments,
+                                                    screenshots):
     segment = fbx_segments[1]  # frames 150-300 at 30 fps
     page = new_page("ann")
     page.goto(f"{live_server.url}/library/")
@@ -41,4 +42,6 @@ def test_it_loads_a_segments_glb_export_with_threejs(live_server, new_page, fbx_
     assert float(preview.get_attribute("data-gltf-duration")) == pytest.approx(149 / 30, abs=1e-3)
     expect(page.get_by_test_id("preview-caption")).to_contain_text("glTF · 65 joints · 4.97 s")
     expect(preview.locator("canvas")).to_be_visible()
+    page.wait_for_timeout(500)  # a few frames of the clip
+    page.screenshot(path=str(screenshots / "library-gltf.png"))
     assert page.errors == []
