@@ -8,10 +8,17 @@ import uuid
 import pytest
 
 from tests.fbx.files import shared_fbx
-from tests.segmentation.test_command_up import up as up_fixture  # noqa: F401  (the "up" fixture)
-from tests.segmentation.test_command_up import wait_until
+from tests.segmentation.test_command_up import Up, free_port, wait_until
 
 pytestmark = pytest.mark.slow
+
+
+@pytest.fixture
+def server(tmp_path):
+    """One ``up.py`` on a fresh var folder, stopped (with its children) after the test."""
+    started = Up(tmp_path / "var", free_port())
+    yield started
+    started.close()
 
 
 def upload(server, token, path, project):
@@ -31,8 +38,7 @@ def upload(server, token, path, project):
         return json.loads(response.read())
 
 
-def test_it_converts_an_fbx_upload_on_the_convert_worker(up):
-    server = up()
+def test_it_converts_an_fbx_upload_on_the_convert_worker(server):
     output = server.wait_for("FBX convert worker pid")
     assert re.search(r"FBX convert worker pid \d+ \(Blender\), log .*convert-worker.log", output)
     token = server.api("/api/auth/token/", data={"username": "admin",
