@@ -93,8 +93,7 @@ def op_read(request):
 
     bpy.ops.wm.read_factory_settings(use_empty=True)
     try:
-        result = bpy.ops.import_scene.fbx(filepath=request["path"], use_anim=True,
-                                          ignore_leaf_bones=False, automatic_bone_orientation=False)
+        result = _import(request["path"])
     except RuntimeError as exc:
         raise InputProblem(_import_error(exc)) from None
     if "FINISHED" not in result:
@@ -121,6 +120,17 @@ def op_read(request):
     np.savez(request["out"], **arrays)
     render = scene.render
     return {"fps": render.fps / render.fps_base, "animations": animations}
+
+
+def _import(path):
+    """Blender's FBX importer as motionlib uses it: bones as the file has them (no leaf bones
+    dropped, no orientation guessed), and no search of the file's folder for textures (a take
+    needs none, and a big folder makes the search slow)."""
+    import bpy
+
+    return bpy.ops.import_scene.fbx(filepath=path, use_anim=True, ignore_leaf_bones=False,
+                                    automatic_bone_orientation=False, use_image_search=False,
+                                    use_custom_props=False)
 
 
 def _import_error(exc):
@@ -239,8 +249,7 @@ def op_evaluate(request):
     import bpy
 
     bpy.ops.wm.read_factory_settings(use_empty=True)
-    bpy.ops.import_scene.fbx(filepath=request["path"], use_anim=True, ignore_leaf_bones=False,
-                             automatic_bone_orientation=False)
+    _import(request["path"])
     scene = bpy.context.scene
     armature = next(o for o in scene.objects if o.type == "ARMATURE")
     heads = []
@@ -282,8 +291,7 @@ def op_trim(request):
     import bpy
 
     bpy.ops.wm.read_factory_settings(use_empty=True)
-    bpy.ops.import_scene.fbx(filepath=request["path"], use_anim=True, ignore_leaf_bones=False,
-                             automatic_bone_orientation=False)
+    _import(request["path"])
     scene = bpy.context.scene
     armatures = [o for o in scene.objects if o.type == "ARMATURE"]
     found = [(arm, act) for arm, act, name in _animations(armatures)
