@@ -121,6 +121,11 @@ def pick_animation(takes: list[Take], animation, path) -> Take:
 
 
 def _take(path, animation, name, arrays, scene_fps, single) -> Take:
+    roots = [b for b, p in zip(animation["bones"], animation["parents"], strict=True) if p < 0]
+    if len(roots) != 1:
+        raise CaptureError(f"the armature {animation['armature']!r} has {len(roots)} root bones "
+                           f"({', '.join(roots[:5])}); a take needs one skeleton: parent them "
+                           "under one bone before exporting", path=path)
     key = animation["key"]
     frames = arrays[f"{key}_frames"]
     world = world_matrices(animation, arrays[f"{key}_curves"], arrays[f"{key}_rest"],

@@ -7,7 +7,8 @@ never imported. Every file is a real Blender FBX export:
 - ``still_armature.fbx``: an armature with no animation;
 - ``two_armatures.fbx``: the Mixamo ``flair`` and ``breakdance_1990`` rigs side by side, each
   with its own animation;
-- ``two_actions.fbx``: the ``flair`` rig with two actions (flair, and breakdance's motion).
+- ``two_actions.fbx``: the ``flair`` rig with two actions (flair, and breakdance's motion);
+- ``two_roots.fbx``: an animated armature of two bones, neither the other's parent.
 """
 
 import sys
@@ -59,6 +60,21 @@ def main(shared, out):
     bpy.context.scene.frame_end = 106
     export(f"{out}/two_actions.fbx", object_types={"ARMATURE"}, bake_anim_use_all_actions=True,
            bake_anim_use_nla_strips=False)
+
+    empty()
+    bpy.ops.object.armature_add()
+    rig = armatures()[0]
+    bpy.context.view_layer.objects.active = rig
+    bpy.ops.object.mode_set(mode="EDIT")
+    second = rig.data.edit_bones.new("Second")
+    second.head, second.tail = (1.0, 0.0, 0.0), (1.0, 0.0, 1.0)
+    bpy.ops.object.mode_set(mode="OBJECT")
+    bone = rig.pose.bones["Bone"]
+    bone.keyframe_insert("location", frame=1)
+    bone.location.x = 0.5
+    bone.keyframe_insert("location", frame=10)
+    bpy.context.scene.frame_end = 10
+    export(f"{out}/two_roots.fbx", object_types={"ARMATURE"})
 
 
 if __name__ == "__main__":

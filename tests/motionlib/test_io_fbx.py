@@ -104,6 +104,12 @@ def test_it_refuses_an_armature_without_animation(made_fbx):
         motionlib.read(made_fbx / "still_armature.fbx")
 
 
+def test_it_refuses_an_armature_of_several_skeletons(made_fbx):
+    with pytest.raises(CaptureError, match=r"two_roots.fbx: the armature 'Armature' has 2 root "
+                                           r"bones \(Bone, Second\); a take needs one skeleton"):
+        motionlib.read(made_fbx / "two_roots.fbx")
+
+
 def test_it_refuses_a_truncated_file(tmp_path):
     data = shared_fbx("flair.fbx").read_bytes()
     path = tmp_path / "cut.fbx"
