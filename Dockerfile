@@ -27,6 +27,14 @@ RUN apt-get update && apt-get install -y --no-install-recommends gcc libc6-dev \
     && pip install -e . \
     && apt-get purge -y --auto-remove gcc libc6-dev && rm -rf /var/lib/apt/lists/* \
     && rm -rf frontend/node_modules build
+# Blender as a module (FBX), in a virtualenv of its own: bpy pins numpy<2 and is GPL, so it
+# runs only as a child process of the convert worker. The X11/GL libraries are what its
+# manylinux wheel links against, even headless.
+RUN apt-get update && apt-get install -y --no-install-recommends libx11-6 libxrender1 \
+        libxxf86vm1 libxfixes3 libxi6 libxkbcommon0 libsm6 libgl1 libgomp1 \
+    && rm -rf /var/lib/apt/lists/* \
+    && python -m venv /opt/bpy && /opt/bpy/bin/pip install -r requirements-bpy.txt
+ENV MOTIONLIB_BLENDER_PYTHON=/opt/bpy/bin/python
 COPY --from=frontend --chown=cutroom:cutroom /app/frontend/dist frontend/dist
 USER cutroom
 EXPOSE 8000

@@ -4,16 +4,17 @@ SHELL := /bin/bash
 PY := .venv/bin/python
 PIP := .venv/bin/pip
 STAMP := .venv/.installed
+BPY_STAMP := .venv-bpy/.installed
 FRONT_STAMP := frontend/node_modules/.installed
 HOST ?= 127.0.0.1
 PORT ?= 8000
 
-.PHONY: up test install frontend browser lint pytest vitest bench screenshots clean
+.PHONY: up test install bpy frontend browser lint pytest vitest bench screenshots clean
 
-up: install frontend
+up: install bpy frontend
 	$(PY) scripts/up.py --host $(HOST) --port $(PORT)
 
-test: install frontend browser lint vitest pytest
+test: install bpy frontend browser lint vitest pytest
 
 install: $(STAMP)
 
@@ -22,6 +23,14 @@ $(STAMP): pyproject.toml setup.py motionlib/io/_parse.c motionlib/_kinematics.c
 	$(PIP) install -q --upgrade pip
 	$(PIP) install -q -e ".[dev,bench]"
 	touch $(STAMP)
+
+# Blender as a module (FBX) in a virtualenv of its own: bpy pins numpy<2 (see the file).
+bpy: $(BPY_STAMP)
+
+$(BPY_STAMP): requirements-bpy.txt
+	test -x .venv-bpy/bin/python || python3 -m venv .venv-bpy
+	.venv-bpy/bin/pip install -q -r requirements-bpy.txt
+	touch $(BPY_STAMP)
 
 $(FRONT_STAMP): frontend/package.json frontend/package-lock.json
 	cd frontend && npm ci --no-audit --no-fund
@@ -63,4 +72,4 @@ screenshots: install frontend browser
 	CUTROOM_SCREENSHOTS=1 $(PY) -m pytest tests/e2e -q -k "restores_the_review or gold_version"
 
 clean:
-	rm -rf .venv frontend/node_modules frontend/dist var
+	rm -rf .venv .venv-bpy frontend/node_modules frontend/dist var

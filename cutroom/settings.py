@@ -193,6 +193,13 @@ FILE_UPLOAD_MAX_MEMORY_SIZE = 10 * 1024 * 1024
 CUTROOM_CLAIM_TIMEOUT = envint("CUTROOM_CLAIM_TIMEOUT", 15 * 60)
 # After this many claims a job that keeps killing its worker is marked failed.
 CUTROOM_MAX_ATTEMPTS = envint("CUTROOM_MAX_ATTEMPTS", 3)
+# FBX uploads are read by Blender on this queue, served by its own worker (`make up`, compose).
+CUTROOM_CONVERT_QUEUE = os.environ.get("CUTROOM_CONVERT_QUEUE") or "convert"
+# Seconds Celery lets one conversion run before killing its process (Blender itself is stopped
+# after MOTIONLIB_BLENDER_TIMEOUT, 300 s by default; this is the backstop).
+CUTROOM_CONVERT_TIME_LIMIT = envint("CUTROOM_CONVERT_TIME_LIMIT", 420)
+# Set on the convert worker: its pool processes load Blender as they start.
+CUTROOM_CONVERT_WORKER = envbool("CUTROOM_CONVERT_WORKER", False)
 CUTROOM_FRAMES_PER_REQUEST = 5000
 # What one capture may hold, checked before its frames are allocated (motionlib.take.Limits;
 # unset means motionlib's default, given in .env.example).

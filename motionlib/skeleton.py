@@ -120,7 +120,8 @@ def _is_preorder(parents: np.ndarray) -> bool:
 
 
 # Candidate joint names per canonical part, per naming convention; compared after lower-casing
-# and dropping a namespace prefix ("mixamorig:Hips" -> "hips"). The first present name wins.
+# and dropping a namespace prefix ("mixamorig:Hips" -> "hips"), and also without a character
+# prefix ("Character1_Hips" -> "hips", "DEF-thigh.L" -> "thigh.l"). The first present name wins.
 def _sided(left: dict[str, list[str]]) -> dict[str, list[str]]:
     table = dict(left)
     for part, names in left.items():
@@ -130,6 +131,9 @@ def _sided(left: dict[str, list[str]]) -> dict[str, list[str]]:
 
 
 def _mirror(name: str) -> str:
+    for a, b in ((".l", ".r"), ("_l", "_r")):  # Blender's side suffixes
+        if name.endswith(a):
+            return name[: -len(a)] + b
     for a, b in (("left", "right"), ("l", "r")):
         if name.startswith(a):
             return b + name[len(a):]
@@ -160,6 +164,27 @@ CONVENTIONS: dict[str, dict[str, list[str]]] = {
         "left_hip": ["lthigh", "lthighbend"], "left_knee": ["lshin"], "left_ankle": ["lfoot"],
         "left_toe": ["ltoe", "lmetatarsals"],
     }),
+    # MotionBuilder HumanIK (Mixamo's ancestor), usually under a character prefix
+    # ("Character1_Hips", dropped before matching); the chest is Spine2, or Spine1 when the
+    # spine has two bones.
+    "humanik": _sided({
+        "root": ["hips"], "spine": ["spine"], "chest": ["spine2", "spine1"], "neck": ["neck"],
+        "head": ["head"], "left_shoulder": ["leftarm"], "left_elbow": ["leftforearm"],
+        "left_wrist": ["lefthand"], "left_hip": ["leftupleg"], "left_knee": ["leftleg"],
+        "left_ankle": ["leftfoot"], "left_toe": ["lefttoebase"],
+    }),
+    # Blender's own naming (the Human meta-rig, Rigify's deform bones without "DEF-", and the
+    # ".L"/"_L" side suffixes).
+    "blender": _sided({
+        "root": ["spine", "hips", "pelvis"], "spine": ["spine.001"],
+        "chest": ["spine.003", "spine.002", "chest"], "neck": ["spine.004", "neck"],
+        "head": ["spine.006", "head"], "left_shoulder": ["upper_arm.l", "upperarm.l",
+                                                         "upper_arm_l"],
+        "left_elbow": ["forearm.l", "lower_arm.l", "forearm_l"],
+        "left_wrist": ["hand.l", "hand_l"], "left_hip": ["thigh.l", "upper_leg.l", "thigh_l"],
+        "left_knee": ["shin.l", "lower_leg.l", "calf.l", "shin_l"],
+        "left_ankle": ["foot.l", "foot_l"], "left_toe": ["toe.l", "toes.l", "toe_l"],
+    }),
     # CMU ASF bone names; a joint sits where its bone starts.
     "cmu": _sided({
         "root": ["root"], "spine": ["upperback"], "chest": ["thorax"], "neck": ["lowerneck"],
@@ -174,10 +199,22 @@ def _plain(name: str) -> str:
     return name.rsplit(":", 1)[-1].strip().lower()
 
 
+def _unprefixed(plain: str) -> str | None:
+    for separator in ("-", "_"):
+        head, sep, rest = plain.partition(separator)
+        if sep and rest and head not in ("upper", "lower", "left", "right"):
+            return rest
+    return None
+
+
 def _match(names: list[str], table: dict[str, list[str]]) -> dict[str, int]:
     lookup = {}
     for i, name in enumerate(names):
         lookup.setdefault(_plain(name), i)
+    for i, name in enumerate(names):
+        bare = _unprefixed(_plain(name))
+        if bare:
+            lookup.setdefault(bare, i)
     found = {}
     for part, candidates in table.items():
         hit = next((lookup[c] for c in candidates if c in lookup), None)
@@ -206,7 +243,8 @@ def canonical_indices(take) -> dict[str, int]:
     Raises
     ------
     CaptureError
-        If no known naming convention (CMU ASF, cgspeed BVH, DAZ, Mixamo) covers the skeleton;
+        If no known naming convention (CMU ASF, cgspeed BVH, DAZ, Mixamo, MotionBuilder
+        HumanIK, Blender) covers the skeleton;
         the message lists the parts that could not be found.
     """
     found, missing = match_parts(take)
@@ -214,7 +252,7 @@ def canonical_indices(take) -> dict[str, int]:
         names = _skeleton_of(take).names
         raise CaptureError(
             "cannot map the skeleton to body parts (known namings: CMU ASF, cgspeed BVH, DAZ, "
-            f"Mixamo); no joint found for {', '.join(missing)}; joints are "
+            f"Mixamo, MotionBuilder HumanIK, Blender); no joint found for {', '.join(missing)}; joints are "
             f"{', '.join(names[:40])}",
             path=getattr(take, "path", None))
     return found

@@ -18,7 +18,7 @@ class Take:
     ----------
     name : str
         Usually the file stem (``"13_29"``).
-    format : {"bvh", "amc"}
+    format : {"bvh", "amc", "fbx"}
         The format it was read from.
     fps : float
         Frames per second (``1 / frame_time``, snapped to a whole number when within 0.1 %).
@@ -32,6 +32,8 @@ class Take:
         Index of a rest (T-) pose frame detected at the start of the take, else None.
     path : str or None
         The file it was read from, if any (used in error messages).
+    animation : str or None
+        Which animation of a file holding several (FBX actions), else None.
     """
 
     name: str
@@ -42,6 +44,7 @@ class Take:
     skeleton: Skeleton
     rest_pose_frame: int | None = None
     path: str | None = None
+    animation: str | None = None
 
     @property
     def n_frames(self) -> int:

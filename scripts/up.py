@@ -141,6 +141,19 @@ def worker(env, logs, concurrency):
     return Child("worker", argv, env, logs / "worker.log")
 
 
+def convert_worker(env, logs):
+    """The worker of the FBX convert queue: Blender loaded once per pool process, which is
+    replaced after some files (Blender's memory), each file under a time limit."""
+    argv = [
+        str(BIN / "celery"), "-A", "cutroom", "worker", "--loglevel", "INFO",
+        "--queues", env.get("CUTROOM_CONVERT_QUEUE") or "convert", "--concurrency", "1",
+        "--max-tasks-per-child", "50", "--hostname", "cutroom-convert@%h",
+        "--without-mingle", "--without-gossip",
+    ]
+    return Child("convert worker", argv, {**env, "CUTROOM_CONVERT_WORKER": "1"},
+                 logs / "convert-worker.log")
+
+
 def web(env, logs, host, port):
     argv = [
         str(BIN / "gunicorn"), "cutroom.wsgi:application", "--bind", f"{host}:{port}",
@@ -185,11 +198,13 @@ def on_signal(signum, frame):
     raise Stop(signal.Signals(signum).name)
 
 
-def supervise(worker_child, web_child):
-    """Watch both children until a signal arrives; returns the exit code for up.py."""
+def supervise(worker_child, web_child, convert_child=None):
+    """Watch the children until a signal arrives; returns the exit code for up.py."""
     deaths = 0
     while True:
         time.sleep(0.5)
+        if convert_child is not None and convert_child.exited() is not None:
+            restart_convert_worker(convert_child)
         if web_child.exited() is not None:
             say(f"the web server stopped unexpectedly (exit code {web_child.exited()}); "
                 f"end of {web_child.log}:\n{web_child.tail()}")
@@ -208,6 +223,18 @@ def supervise(worker_child, web_child):
         say("restarting the worker")
         worker_child.start()
         say(f"worker restarted, pid {worker_child.proc.pid}")
+
+
+def restart_convert_worker(child):
+    """A convert worker that died is restarted at once. (Its conversion in hand is requeued
+    by the periodic sweep once its claim is stale: sweeping now would also take the other
+    worker's running jobs.) Blender crashing or hanging on a file does not get here: that
+    costs Blender's process only, and fails that capture."""
+    say(f"the convert worker died (exit code {child.exited()}); end of {child.log}:\n"
+        f"{child.tail()}")
+    child.kill()
+    child.start()
+    say(f"convert worker restarted, pid {child.proc.pid}")
 
 
 def requeue_abandoned(env):
@@ -257,25 +284,29 @@ def main(argv=None):
         manage(env, "demo", *(["--no-shared-data"] if args.no_shared_data else []))
     url = f"http://{args.host}:{args.port}/"
     worker_child = worker(env, logs, args.concurrency)
+    convert_child = convert_worker(env, logs)
     web_child = web(env, logs, args.host, args.port)
     signal.signal(signal.SIGINT, on_signal)
     signal.signal(signal.SIGTERM, on_signal)
     code = 1
     try:
         worker_child.start()
+        convert_child.start()
         web_child.start()
         if wait_ready(worker_child, web_child, url):
             banner(url, worker_child, web_child, logs, not args.no_demo)
-            code = supervise(worker_child, web_child)
+            say(f"FBX convert worker pid {convert_child.proc.pid} (Blender), log "
+                f"{convert_child.log}")
+            code = supervise(worker_child, web_child, convert_child)
     except Stop as stop:
         say(f"{stop} received; stopping the web server and the worker")
         code = 0
     finally:
         signal.signal(signal.SIGINT, signal.SIG_IGN)
         signal.signal(signal.SIGTERM, signal.SIG_IGN)
-        for child in (web_child, worker_child):
+        for child in (web_child, worker_child, convert_child):
             child.stop()
-        for child in (web_child, worker_child):
+        for child in (web_child, worker_child, convert_child):
             if child.proc:
                 child.wait(30)
     say("stopped")

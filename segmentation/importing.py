@@ -13,9 +13,10 @@ from pathlib import Path
 from django.core.files import File
 
 import motionlib
+from motionlib.io.fbx import check_fbx_header
 from segmentation import services
 
-CAPTURE_SUFFIXES = (".bvh", ".amc")
+CAPTURE_SUFFIXES = (".bvh", ".amc", ".fbx")
 
 
 class ImportProblem(ValueError):
@@ -65,7 +66,7 @@ def _not_a_capture(path):
     if not path.exists():
         return f"{path}: no such file or folder"
     return (f"{path}: extension {path.suffix or '(none)'!r} is not a capture; "
-            "expected .bvh, or .amc with its .asf")
+            "expected .bvh, .fbx, or .amc with its .asf")
 
 
 def find_asf(amc, asf=None):
@@ -96,7 +97,13 @@ def find_asf(amc, asf=None):
 
 def check_readable(path, asf=None):
     """Parse the file with motionlib under the service's input limits; CaptureError names
-    the file, line and value at fault."""
+    the file, line and value at fault.
+
+    An FBX is only checked to be binary FBX here: Blender reads it on the convert queue (its
+    problems then fail the capture, with the reason)."""
+    if Path(path).suffix.lower() == ".fbx":
+        check_fbx_header(path)
+        return
     motionlib.read(path, asf=asf, limits=services.captures.input_limits())
 
 

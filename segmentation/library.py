@@ -9,6 +9,7 @@ whenever another review of the capture comes in). Each row carries its motion de
 
 import csv
 import io
+import itertools
 import json
 import logging
 import re
@@ -228,9 +229,9 @@ def bvh_text(take, segment):
     return out.getvalue()
 
 
-def manifest_row(segment, name):
+def manifest_row(segment, name, fmt="bvh"):
     return {
-        "file": name, "segment": segment.pk, "capture": segment.capture.name,
+        "file": name, "format": fmt, "segment": segment.pk, "capture": segment.capture.name,
         "capture_id": segment.capture_id, "start": segment.start, "stop": segment.stop,
         "label": segment.label_name, "gold": segment.is_gold,
         "annotator": segment.annotator.username if segment.annotator else None,
@@ -256,31 +257,29 @@ class _Sink:
         return data
 
 
-def stream_zip(segments):
-    """Yield a zip archive of one BVH per segment plus ``manifest.csv`` and ``manifest.json``.
+def stream_zip(segments, fmt="bvh"):
+    """Yield a zip archive of one clip per segment (BVH, FBX or glTF binary: ``fmt``) plus
+    ``manifest.csv`` and ``manifest.json``.
 
     ``segments`` should be ordered by capture so each take is read once; the archive is
-    written as it goes (at most one take and one BVH are in memory). A take that cannot
-    be read any more cannot turn into an error response once streaming has begun: its
+    written as it goes (at most one take and one capture's clips are in memory). A take that
+    cannot be read any more cannot turn into an error response once streaming has begun: its
     segments are left out and ``errors.txt`` says why.
     """
     sink = _Sink()
-    manifest, errors, take, take_of = [], [], None, None
+    manifest, errors = [], []
     with zipfile.ZipFile(sink, "w", compression=zipfile.ZIP_DEFLATED) as archive:
-        for segment in segments:
-            if take_of != segment.capture_id:
-                take_of = segment.capture_id
-                try:
-                    take = read_take(segment.capture)
-                except ValueError as exc:
-                    take = None
-                    errors.append(f"capture {segment.capture_id} ({segment.capture.name}): {exc}")
-            if take is None:
-                continue
-            name = file_name(segment)
-            archive.writestr(name, bvh_text(take, segment))
-            manifest.append(manifest_row(segment, name))
-            yield sink.drain()
+        for _, group in itertools.groupby(segments, key=lambda s: s.capture_id):
+            group = list(group)
+            capture = group[0].capture
+            try:
+                take = read_take(capture)
+                for segment, name, data in _clips(capture, take, group, fmt):
+                    archive.writestr(name, data)
+                    manifest.append(manifest_row(segment, name, fmt))
+                    yield sink.drain()
+            except ValueError as exc:
+                errors.append(f"capture {capture.pk} ({capture.name}): {exc}")
         archive.writestr("manifest.json", json.dumps(manifest, indent=1))
         archive.writestr("manifest.csv", _csv(manifest))
         if errors:
@@ -288,9 +287,17 @@ def stream_zip(segments):
     yield sink.drain()
 
 
+def _clips(capture, take, segments, fmt):
+    if fmt == "bvh":
+        return ((s, file_name(s), bvh_text(take, s)) for s in segments)
+    from segmentation.exports import clip_files
+
+    return clip_files(capture, take, segments, fmt)
+
+
 def _csv(rows):
     out = io.StringIO()
-    fields = ["file", "segment", "capture", "capture_id", "start", "stop", "label", "gold",
+    fields = ["file", "format", "segment", "capture", "capture_id", "start", "stop", "label", "gold",
               "annotator", "agreement"]
     writer = csv.DictWriter(out, fieldnames=fields)
     writer.writeheader()

@@ -221,6 +221,14 @@ class Capture(Job):
     skeleton = models.JSONField(null=True, blank=True)
     positions = models.FileField(upload_to=derived_path, max_length=500, blank=True)
     created_at = models.DateTimeField(default=timezone.now)
+    # FBX: the take Blender read (a saved .npz), written by the convert worker; ingest reads
+    # it instead of the original. A file with several animations gives one capture each, all
+    # sharing the first one's stored original (``source``), named ``file.fbx#animation``.
+    converted = models.FileField(upload_to=derived_path, max_length=500, blank=True)
+    animation = models.CharField(max_length=255, blank=True)
+    source = models.ForeignKey(
+        "self", models.SET_NULL, null=True, blank=True, related_name="animations"
+    )
 
     objects = CaptureQuerySet.as_manager()
 
@@ -242,6 +250,11 @@ class Capture(Job):
         if self.fps and self.n_frames is not None:
             return self.n_frames / self.fps
         return None
+
+    @property
+    def needs_conversion(self):
+        """An FBX not yet read by Blender: its next job is ``convert``, not ``ingest``."""
+        return self.format == "fbx" and not self.converted
 
     def latest_run(self):
         """The newest detection run (uses ``prefetch_related("runs")`` when present)."""

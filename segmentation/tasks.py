@@ -6,15 +6,21 @@ abandoned. Failures are stored on the row (``status="failed"``, ``error``), neve
 logged.
 """
 
+import logging
+import threading
+import time
 import uuid
 
 from celery import shared_task
-from celery.signals import worker_ready
+from celery.signals import worker_process_init, worker_ready
+from django.conf import settings
 
 from segmentation import services
 from segmentation.models import Capture, DetectionRun
 from segmentation.services import adaptation
 from segmentation.services.captures import exhausted, give_up
+
+log = logging.getLogger(__name__)
 
 
 def _claim(model, pk, task):
@@ -35,6 +41,38 @@ def ingest(self, capture_id):
     capture = _claim(Capture, capture_id, self)
     if capture is not None:
         services.ingest_capture(capture)
+
+
+@shared_task(bind=True, acks_late=True, reject_on_worker_lost=True,
+             time_limit=settings.CUTROOM_CONVERT_TIME_LIMIT)
+def convert(self, capture_id):
+    """Read an FBX capture with Blender (convert queue), then queue each animation's ingest."""
+    from segmentation.services.convert import convert_capture
+
+    capture = _claim(Capture, capture_id, self)
+    if capture is not None:
+        convert_capture(capture)
+
+
+@worker_process_init.connect
+def start_blender(**kwargs):
+    # The convert worker loads Blender as its pool process starts, not on its first file (in
+    # the background: a pool process must report for work within seconds).
+    if settings.CUTROOM_CONVERT_WORKER:
+        threading.Thread(target=_warm_blender, daemon=True).start()
+
+
+def _warm_blender():
+    from motionlib.errors import CaptureError
+    from motionlib.io.blender import shared
+
+    started = time.perf_counter()
+    try:
+        shared().start()
+    except CaptureError as exc:  # the first file will try again, and fail with the reason
+        log.warning("Blender did not start: %s", exc)
+        return
+    log.info("Blender ready in %.1f s (pid %s)", time.perf_counter() - started, shared().pid)
 
 
 @shared_task(bind=True, acks_late=True, reject_on_worker_lost=True)

@@ -44,8 +44,15 @@ describe("capture list", () => {
     const file = (name: string) => new File(["x"], name);
     expect(pairFiles([file("13_29.amc"), file("notes.txt")]).problems).toEqual([
       "13_29.amc: an .amc needs its skeleton; drop the matching .asf with it.",
-      "notes.txt: not a .bvh or .amc file.",
+      "notes.txt: not a .bvh, .fbx or .amc file.",
     ]);
+  });
+
+  it("test_it_uploads_an_fbx_alone", () => {
+    const file = (name: string) => new File(["x"], name);
+    const { items, problems } = pairFiles([file("samba.FBX")]);
+    expect(items.map((i) => [i.file.name, i.asf])).toEqual([["samba.FBX", null]]);
+    expect(problems).toEqual([]);
   });
 });
 

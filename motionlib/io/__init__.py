@@ -1,4 +1,4 @@
-"""Reading and writing capture files: BVH and CMU ASF/AMC."""
+"""Reading and writing capture files: BVH, CMU ASF/AMC and FBX (through Blender, on demand)."""
 
 from __future__ import annotations
 
@@ -14,8 +14,9 @@ __all__ = ["read", "read_amc", "read_asf", "read_bvh", "write_bvh"]
 
 
 def read(path: str | os.PathLike, *, asf: str | os.PathLike | None = None,
-         limits: Limits = DEFAULT_LIMITS) -> Take:
-    """Read a capture: BVH by its ``.bvh`` extension, CMU ``.amc`` with its ``asf`` skeleton.
+         limits: Limits = DEFAULT_LIMITS, animation: str | int | None = None) -> Take:
+    """Read a capture: BVH by its ``.bvh`` extension, CMU ``.amc`` with its ``asf`` skeleton,
+    FBX by ``.fbx`` (Blender reads it in a child process; see :mod:`motionlib.io.fbx`).
 
     Parameters
     ----------
@@ -24,6 +25,9 @@ def read(path: str | os.PathLike, *, asf: str | os.PathLike | None = None,
         Required for ``.amc``.
     limits : Limits, optional
         What the file may hold and expand to (joints, frames, sizes, physical values).
+    animation : str or int, optional
+        For an FBX file with several animations: which one (name or 0-based number); the first
+        by default.
 
     Returns
     -------
@@ -37,14 +41,18 @@ def read(path: str | os.PathLike, *, asf: str | os.PathLike | None = None,
     """
     path = os.fspath(path)
     suffix = Path(path).suffix.lower()
-    if suffix not in (".bvh", ".amc"):
+    if suffix not in (".bvh", ".amc", ".fbx"):
         raise CaptureError(f"unknown capture format {suffix or '(no extension)'!r}; "
-                           "expected .bvh, or .amc with its .asf", path=path)
+                           "expected .bvh, .fbx, or .amc with its .asf", path=path)
     for p in (path, asf):
         if p is not None and not Path(p).is_file():
             raise CaptureError("no such file", path=p)
     if suffix == ".bvh":
         return read_bvh(path, limits=limits)
+    if suffix == ".fbx":
+        from motionlib.io.fbx import read_fbx  # starts Blender only when an FBX is read
+
+        return read_fbx(path, animation=animation)
     if asf is None:
         raise CaptureError("an .amc motion needs its .asf skeleton (pass the .asf file too)", path=path)
     return read_amc(path, asf, limits=limits)

@@ -11,8 +11,10 @@ def add_segment(subparsers) -> None:
         description="Run a segmentation method on a capture and print its candidate cuts "
                     "(0-based frames) with their confidence.",
     )
-    p.add_argument("file", help="a .bvh file, or an .amc file with --asf")
+    p.add_argument("file", help="a .bvh or .fbx file, or an .amc file with --asf")
     p.add_argument("--asf", help="the ASF skeleton of an .amc file")
+    p.add_argument("--animation", help="which animation of an FBX file (name or number; "
+                                       "default: the first)")
     p.add_argument("--method", default="default", help="segmentation method (default: default)")
     p.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
                    help="method parameter, repeatable")
@@ -26,6 +28,7 @@ def add_segment(subparsers) -> None:
 
 
 def run_segment(args) -> int:
+    from motionlib.cli import animation_arg
     from motionlib.io import read
     from motionlib.segmenters import ParamError, get_segmenter, parse_param_args
 
@@ -38,7 +41,7 @@ def run_segment(args) -> int:
         from motionlib.adapt import fit_cut_model, read_examples
 
         model = fit_cut_model(read_examples(args.examples))
-    take = read(args.file, asf=args.asf)
+    take = read(args.file, asf=args.asf, animation=animation_arg(args.animation))
     if model is not None:
         from motionlib.adapt import detect
 

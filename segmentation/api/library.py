@@ -1,8 +1,9 @@
 """The clip library, agreement, adjudication and the project dashboard.
 
 - ``GET /api/segments/?project=&label=&capture=&annotator=&min_duration=&max_duration=&min_agreement=&gold=&ordering=``
-- ``GET /api/segments/{id}/``, ``…/export.bvh``, ``…/similar/?k=10``
-- ``GET /api/segments/export.zip?<same filters>`` (streamed)
+- ``GET /api/segments/{id}/``, ``…/export.bvh``, ``…/export.fbx``, ``…/export.glb``,
+  ``…/similar/?k=10``
+- ``GET /api/segments/export.zip?<same filters>&file_format=bvh|fbx|glb`` (streamed)
 - ``GET /api/captures/{id}/agreement/?tolerance=0.25`` (reviewers and admins)
 - ``GET/PUT /api/captures/{id}/adjudication/`` (reviewers and admins)
 - ``GET /api/projects/{id}/dashboard/`` (reviewers and admins)
@@ -14,14 +15,14 @@ exist (404, like any object the caller may not see).
 
 from django.http import HttpResponse, StreamingHttpResponse
 from django.urls import path
-from drf_spectacular.utils import extend_schema
+from drf_spectacular.utils import OpenApiParameter, extend_schema
 from rest_framework import serializers
 from rest_framework.exceptions import NotFound
 from rest_framework.pagination import PageNumberPagination
 from rest_framework.response import Response
 from rest_framework.views import APIView
 
-from segmentation import agreement, library
+from segmentation import agreement, exports, library
 from segmentation.api.captures import capture_for
 from segmentation.api.params import bool_param, float_param, int_param
 from segmentation.api.projects import project_for
@@ -125,9 +126,28 @@ class SegmentBvhView(APIView):
         return response
 
 
+class SegmentClipView(APIView):
+    """``…/export.fbx`` and ``…/export.glb``: the segment as FBX or glTF binary."""
+
+    @extend_schema(responses={(200, "application/octet-stream"): bytes})
+    def get(self, request, pk, fmt):
+        fmt = exports.check_format(fmt)
+        segment = segment_for(request.user, pk)
+        capture = segment.capture
+        [(_, name, data)] = exports.clip_files(capture, library.read_take(capture), [segment], fmt)
+        response = HttpResponse(data, content_type=exports.CONTENT_TYPES[fmt])
+        response["Content-Disposition"] = f'attachment; filename="{name}"'
+        return response
+
+
 class SegmentZipView(APIView):
-    @extend_schema(responses={(200, "application/zip"): bytes})
+    @extend_schema(responses={(200, "application/zip"): bytes},
+                   parameters=[OpenApiParameter("file_format", str,
+                                                enum=list(exports.EXPORT_FORMATS),
+                                                description="clip format (default bvh)")])
     def get(self, request):
+        # Not "format": DRF reads that one to pick a renderer.
+        fmt = exports.check_format(request.query_params.get("file_format"))
         segments = segment_query(request)
         count = segments.count()
         if count > library.MAX_EXPORT_SEGMENTS:
@@ -135,8 +155,9 @@ class SegmentZipView(APIView):
                              f"{library.MAX_EXPORT_SEGMENTS} at a time (narrow the filters)")
         rows = (segments.select_related("capture", "annotator").defer("descriptor", "profile")
                 .order_by("capture_id", "start", "id").iterator(chunk_size=200))
-        response = StreamingHttpResponse(library.stream_zip(rows), content_type="application/zip")
-        response["Content-Disposition"] = 'attachment; filename="segments.zip"'
+        response = StreamingHttpResponse(library.stream_zip(rows, fmt),
+                                         content_type="application/zip")
+        response["Content-Disposition"] = f'attachment; filename="segments-{fmt}.zip"'
         return response
 
 
@@ -248,6 +269,7 @@ urlpatterns = [
     path("segments/export.zip", SegmentZipView.as_view(), name="api-segments-zip"),
     path("segments/<int:pk>/", SegmentView.as_view(), name="api-segment"),
     path("segments/<int:pk>/export.bvh", SegmentBvhView.as_view(), name="api-segment-bvh"),
+    path("segments/<int:pk>/export.<str:fmt>", SegmentClipView.as_view(), name="api-segment-clip"),
     path("segments/<int:pk>/similar/", SimilarView.as_view(), name="api-segment-similar"),
     path("captures/<int:pk>/agreement/", AgreementView.as_view(), name="api-agreement"),
     path("captures/<int:pk>/adjudication/", AdjudicationView.as_view(), name="api-adjudication"),

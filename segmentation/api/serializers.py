@@ -98,7 +98,7 @@ class CaptureSerializer(serializers.ModelSerializer):
         fields = [
             "id", "project", "name", "format", "status", "error", "fps", "n_frames",
             "duration", "n_joints", "checksum", "rest_pose_frame", "created_at",
-            "latest_run", "skeleton",
+            "latest_run", "skeleton", "animation", "source",
         ]
 
     def get_skeleton(self, capture) -> dict | None:

@@ -1,6 +1,7 @@
 """Captures and detection runs: upload, ingest, detect, and recovery of abandoned jobs."""
 
 import hashlib
+import io
 import logging
 import os
 import re
@@ -13,6 +14,7 @@ from django.utils import timezone
 
 import motionlib
 from motionlib.errors import shorten
+from motionlib.io.npz import load_take
 from motionlib.segmenters import ParamError, get_segmenter, list_segmenters
 from motionlib.take import Limits
 from segmentation import storage
@@ -21,7 +23,7 @@ from segmentation.models import Capture, DetectionRun
 
 log = logging.getLogger(__name__)
 
-FORMATS = {".bvh": "bvh", ".amc": "amc"}
+FORMATS = {".bvh": "bvh", ".amc": "amc", ".fbx": "fbx"}
 # Stored file names keep word characters only and stay well under the 255 bytes a file
 # system allows per name (the capture's name keeps what the user uploaded; Django has cut
 # it to 255 characters, which may be up to 1,020 bytes).
@@ -50,7 +52,7 @@ def check_upload(upload, asf=None):
     if extension not in FORMATS:
         raise UploadError(
             f"file: {shorten(upload.name)} has extension {shorten(extension or '(none)')}; "
-            "upload a .bvh file, or an .amc file with its .asf skeleton"
+            "upload a .bvh or binary .fbx file, or an .amc file with its .asf skeleton"
         )
     for field, item in (("file", upload), ("asf", asf)):
         if item is None:
@@ -102,7 +104,7 @@ def do_upload_capture(project, user, upload, asf=None):
     try:
         with transaction.atomic():
             capture.save()
-            _enqueue("ingest", capture.pk)
+            _enqueue(first_job(capture), capture.pk)
     except IntegrityError:
         # The same file arrived twice at once; the other request stored it.
         return Capture.objects.get(project=project, checksum=digest), False
@@ -137,7 +139,7 @@ def _requeue_failed(capture):
     with transaction.atomic():
         if not Capture.objects.requeue_failed(capture.pk):
             return False
-        _enqueue("ingest", capture.pk)
+        _enqueue(first_job(capture), capture.pk)
     return True
 
 
@@ -154,16 +156,23 @@ def do_start_run(capture, user, method, params):
     return run
 
 
+def first_job(capture):
+    """``convert`` for an FBX Blender has not read yet (the convert queue), else ``ingest``."""
+    return "convert" if capture.needs_conversion else "ingest"
+
+
 def _enqueue(task_name, pk):
     """Send the job once the row is committed (a worker must be able to see it)."""
     from segmentation import tasks
 
-    transaction.on_commit(lambda: _send(getattr(tasks, task_name), pk))
+    # FBX conversion runs Blender: its own queue, served by its own worker.
+    options = {"queue": settings.CUTROOM_CONVERT_QUEUE} if task_name == "convert" else {}
+    transaction.on_commit(lambda: _send(getattr(tasks, task_name), pk, options))
 
 
-def _send(task, pk):
+def _send(task, pk, options=None):
     try:
-        task.delay(pk)
+        task.apply_async((pk,), **(options or {}))
     except Exception:
         # The row is stored and stays queued; the sweep sends it again later, so an
         # unreachable broker costs a delay, never the upload.
@@ -184,7 +193,13 @@ def input_limits():
 
 
 def read_take(capture):
-    """The parsed take of a capture's stored original (BVH, or AMC with its ASF)."""
+    """The parsed take of a capture's stored original (BVH, or AMC with its ASF), or of the
+    take the convert worker saved for an FBX."""
+    if capture.converted:
+        with capture.converted.open("rb") as handle:
+            return load_take(io.BytesIO(handle.read()), path=capture.name)
+    if capture.needs_conversion:
+        raise NotReady(f"capture {capture.pk} is an FBX not converted yet")
     limits = input_limits()
     with storage.local_path(capture.original) as path:
         if capture.asf:
@@ -333,7 +348,7 @@ def sweep_stale_claims():
     Returns the number of jobs requeued, failed or resent.
     """
     count = 0
-    for model, task_name in ((Capture, "ingest"), (DetectionRun, "detect")):
+    for model, task_name in ((Capture, first_job), (DetectionRun, "detect")):
         count += _resend_waiting(model, task_name)
         count += _rescue_stale(model, task_name)
     return count
@@ -344,9 +359,13 @@ def _resend_waiting(model, task_name):
     for job in model.objects.waiting_too_long():
         with transaction.atomic():
             model.objects.filter(pk=job.pk, status="queued").update(claimed_at=timezone.now())
-            _enqueue(task_name, job.pk)
+            _enqueue(_job_name(task_name, job), job.pk)
         count += 1
     return count
+
+
+def _job_name(task_name, job):
+    return task_name(job) if callable(task_name) else task_name
 
 
 def _rescue_stale(model, task_name):
@@ -360,6 +379,6 @@ def _rescue_stale(model, task_name):
                 pk=job.pk, status="processing", claim_token=job.claim_token
             ).update(status="queued", claim_token="", claimed_at=timezone.now())
             if requeued:
-                _enqueue(task_name, job.pk)
+                _enqueue(_job_name(task_name, job), job.pk)
         count += requeued
     return count

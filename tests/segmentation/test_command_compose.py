@@ -8,7 +8,7 @@ from pathlib import Path
 import yaml
 
 REPO = Path(__file__).resolve().parents[2]
-APP_SERVICES = ("migrate", "web", "worker", "beat")
+APP_SERVICES = ("migrate", "web", "worker", "convert", "beat")
 
 
 def compose():
@@ -64,7 +64,7 @@ def test_the_secret_key_must_be_set_rather_than_defaulted():
 
 def test_web_and_workers_start_after_healthy_services_and_migrations():
     services = compose()["services"]
-    for name in ("web", "worker", "beat"):
+    for name in ("web", "worker", "convert", "beat"):
         depends = services[name]["depends_on"]
         assert depends["postgres"]["condition"] == "service_healthy", name
         assert depends["redis"]["condition"] == "service_healthy", name
@@ -74,7 +74,7 @@ def test_web_and_workers_start_after_healthy_services_and_migrations():
 
 def test_every_long_running_service_has_a_health_check():
     services = compose()["services"]
-    for name in ("postgres", "redis", "web", "worker"):
+    for name in ("postgres", "redis", "web", "worker", "convert"):
         assert services[name]["healthcheck"]["test"], name
 
 

@@ -53,7 +53,7 @@ export interface Capture {
   id: number;
   project: number;
   name: string;
-  format: "bvh" | "amc";
+  format: "bvh" | "amc" | "fbx";
   status: CaptureStatus;
   error: string | null;
   fps: number;
@@ -65,6 +65,9 @@ export interface Capture {
   created_at: string;
   latest_run: Run | null;
   skeleton: Skeleton | null;
+  /** FBX: which animation of the file ("" otherwise); another animation's capture id. */
+  animation?: string;
+  source?: number | null;
   duplicate?: boolean;
 }
 

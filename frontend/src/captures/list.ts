@@ -44,7 +44,7 @@ export async function renderCaptureList(root: HTMLElement): Promise<() => void> 
   const rows = h("tbody", { "data-testid": "capture-rows" });
   const pager = h("div", { class: "pager" });
   const uploads = h("div", { class: "uploads", "data-testid": "uploads" });
-  const fileInput = h("input", { type: "file", multiple: true, accept: ".bvh,.amc,.asf", hidden: true });
+  const fileInput = h("input", { type: "file", multiple: true, accept: ".bvh,.fbx,.amc,.asf", hidden: true });
   const projectName = new Map(projects.map((p) => [p.id, p.name]));
   const projectRole = new Map(projects.map((p) => [p.id, p.role]));
 

@@ -9,7 +9,7 @@ export interface UploadItem {
 }
 
 /**
- * Pair dropped files into uploads: every .bvh alone, every .amc with an .asf (the one
+ * Pair dropped files into uploads: every .bvh and .fbx alone, every .amc with an .asf (the one
  * sharing its subject prefix, e.g. 13_29.amc ↔ 13.asf, else the only one dropped).
  * Returns the uploads and, per file that cannot be uploaded, why.
  */
@@ -18,14 +18,14 @@ export function pairFiles(files: File[]): { items: UploadItem[]; problems: strin
   const items: UploadItem[] = [];
   const problems: string[] = [];
   for (const file of files) {
-    if (/\.bvh$/i.test(file.name)) items.push({ file, asf: null });
+    if (/\.(bvh|fbx)$/i.test(file.name)) items.push({ file, asf: null });
     else if (/\.amc$/i.test(file.name)) {
       const subject = file.name.split(/[_.]/)[0];
       const asf = asfs.find((a) => a.name.replace(/\.asf$/i, "") === subject) ?? (asfs.length === 1 ? asfs[0] : null);
       if (asf) items.push({ file, asf });
       else problems.push(`${file.name}: an .amc needs its skeleton; drop the matching .asf with it.`);
     } else if (!/\.asf$/i.test(file.name)) {
-      problems.push(`${file.name}: not a .bvh or .amc file.`);
+      problems.push(`${file.name}: not a .bvh, .fbx or .amc file.`);
     }
   }
   if (asfs.length && !files.some((f) => /\.amc$/i.test(f.name))) problems.push("An .asf alone is only a skeleton; drop it together with its .amc takes.");

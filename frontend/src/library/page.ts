@@ -5,6 +5,7 @@ import { get } from "../api/client";
 import type { Page, Project } from "../api/types";
 import { clear, formatDuration, h, toast } from "../ui/dom";
 import { topbar } from "./nav";
+import { GlbPreview } from "./gltfPreview";
 import { ClipPreview } from "./preview";
 import type { LibrarySegment } from "./types";
 
@@ -47,8 +48,18 @@ export async function renderLibrary(root: HTMLElement): Promise<() => void> {
   const rows = h("tbody", { "data-testid": "segment-rows" });
   const pager = h("div", { class: "pager" });
   const exportZip = h("a", { class: "btn", "data-testid": "export-zip", download: "" }, "Export these as zip");
+  const zipFormat = h(
+    "select",
+    { class: "select", "data-testid": "export-format", "aria-label": "export format", title: "Clip format in the zip" },
+    h("option", { value: "bvh" }, "BVH"),
+    h("option", { value: "fbx" }, "FBX"),
+    h("option", { value: "glb" }, "glTF"),
+  ) as HTMLSelectElement;
+  const zipHref = () => `/api/segments/export.zip?${libraryQuery(filters, false)}&file_format=${zipFormat.value}`;
+  zipFormat.addEventListener("change", () => exportZip.setAttribute("href", zipHref()));
   const preview = h("aside", { class: "lib-preview", "data-testid": "preview" }, h("p", { class: "muted" }, "Play a segment to preview it here."));
   const player = new ClipPreview(preview);
+  const glbPlayer = new GlbPreview(preview);
 
   const field = (key: (typeof KEYS)[number], el: HTMLInputElement | HTMLSelectElement) => {
     el.value = filters[key];
@@ -70,6 +81,7 @@ export async function renderLibrary(root: HTMLElement): Promise<() => void> {
     field("min_agreement", h("input", { class: "input num-input", type: "number", step: "0.05", min: "0", max: "1", placeholder: "min agreement" })),
     field("gold", h("select", { class: "select" }, ...options([["", "Gold where made"], ["true", "Gold only"], ["false", "Annotators' versions"]]))),
     field("ordering", h("select", { class: "select" }, ...options(ORDERINGS))),
+    zipFormat,
     exportZip,
   );
 
@@ -109,13 +121,16 @@ export async function renderLibrary(root: HTMLElement): Promise<() => void> {
         h("button", { class: "btn", "data-testid": `play-${s.id}`, onclick: () => void play(s) }, "▶ Play"),
         h("button", { class: "btn", "data-testid": `similar-${s.id}`, onclick: () => void similar(s) }, "Similar"),
         h("a", { class: "btn", href: `/api/segments/${s.id}/export.bvh`, download: "" }, "BVH"),
+        h("a", { class: "btn", "data-testid": `fbx-${s.id}`, href: `/api/segments/${s.id}/export.fbx`, download: "" }, "FBX"),
+        h("a", { class: "btn", "data-testid": `glb-${s.id}`, href: `/api/segments/${s.id}/export.glb`, download: "", title: "glTF binary" }, "glTF"),
+        h("button", { class: "btn", "data-testid": `play-glb-${s.id}`, title: "Play the glTF export as three.js loads it", onclick: () => void playGlb(s) }, "▶ glTF"),
       ),
     );
   }
 
   async function load(): Promise<void> {
     const query = libraryQuery(filters);
-    exportZip.setAttribute("href", `/api/segments/export.zip?${libraryQuery(filters, false)}`);
+    exportZip.setAttribute("href", zipHref());
     const data = await get<Page<LibrarySegment>>(`/api/segments/?${query}`).catch((err: Error) => {
       clear(rows, h("tr", {}, h("td", { colspan: 7, class: "error-text", "data-testid": "lib-error" }, err.message)));
       return null;
@@ -140,7 +155,17 @@ export async function renderLibrary(root: HTMLElement): Promise<() => void> {
     }
   }
 
+  async function playGlb(s: LibrarySegment): Promise<void> {
+    player.stop();
+    try {
+      await glbPlayer.play(`/api/segments/${s.id}/export.glb`, `${s.label} · ${s.capture.name} · frames ${s.start}–${s.stop}`, `glb:${s.id}`);
+    } catch (err) {
+      toast(`glTF export of ${s.label} ${s.start}–${s.stop}: ${(err as Error).message}`, "error");
+    }
+  }
+
   async function play(s: LibrarySegment): Promise<void> {
+    glbPlayer.stop();
     await player.play(s.capture.id, s.start, s.stop, `${s.label} · ${s.capture.name} · frames ${s.start}–${s.stop}`, String(s.id));
   }
 
@@ -152,5 +177,8 @@ export async function renderLibrary(root: HTMLElement): Promise<() => void> {
   }
 
   await load();
-  return () => player.stop();
+  return () => {
+    player.stop();
+    glbPlayer.stop();
+  };
 }

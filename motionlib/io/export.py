@@ -1,0 +1,166 @@
+"""Writing clips of a take as BVH, FBX or glTF binary (``.glb``).
+
+BVH is written here (:func:`motionlib.io.bvh.write_bvh`); FBX and glTF by Blender's exporters,
+in the Blender process of :mod:`motionlib.io.blender`:
+
+- a take read from FBX, given its original file, is cut from that file: the same armature (bone
+  names, rest orientations, the meshes it deforms) with the animation's frames [start, stop);
+- any other take becomes a new armature with the take's joint names, hierarchy and rest offsets,
+  each bone's rest orientation the world's (BVH-shaped), keyed on every frame.
+
+Either way one frame of the clip is one key, at the take's frame rate, Y up; lengths are the
+take's unit divided by 100 in Blender's metres, so an FBX take (centimetres) keeps its size and an
+FBX written here reads back (:mod:`motionlib.io.fbx`) in the unit it was written from.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+
+import numpy as np
+
+from motionlib.errors import CaptureError
+from motionlib.io.bvh import write_bvh
+from motionlib.io.fbx import (
+    CENTIMETRES_PER_METRE,
+    Z_UP_TO_Y_UP,
+    check_fbx_header,
+    matrix_to_quaternion,
+)
+from motionlib.kinematics import euler_to_matrix
+from motionlib.take import Take, frame_range
+
+FORMATS = ("bvh", "fbx", "glb")
+Y_UP_TO_Z_UP = Z_UP_TO_Y_UP.T
+
+
+def write_clip(take: Take, out, *, format: str, start: int | None = None,
+               stop: int | None = None, original=None, blender=None,
+               timeout: float | None = None) -> None:
+    """Write frames [start, stop) of ``take`` to the file ``out``.
+
+    Parameters
+    ----------
+    take : Take
+    out : str or PathLike
+        The file to write.
+    format : {"bvh", "fbx", "glb"}
+    start, stop : int, optional
+        0-based, stop exclusive (default: the whole take).
+    original : str or PathLike, optional
+        The FBX file an FBX take was read from: the clip is cut from it, keeping its armature.
+    blender : motionlib.io.blender.Blender, optional
+    timeout : float, optional
+        Seconds Blender may take (default: its time limit).
+
+    Raises
+    ------
+    CaptureError
+        Unknown format, a frame range outside the take, Blender failing on the file.
+    """
+    write_clips(take, [(start, stop, out)], format=format, original=original, blender=blender,
+                timeout=timeout)
+
+
+def write_clips(take: Take, clips, *, format: str, original=None, blender=None,
+                timeout: float | None = None) -> None:
+    """Write several clips of one take: ``clips`` is a list of ``(start, stop, out)``.
+
+    Like :func:`write_clip`, but an original FBX is imported once for all of them.
+    """
+    if format not in FORMATS:
+        raise CaptureError(f"unknown export format {format!r}; expected one of "
+                           f"{', '.join(FORMATS)}")
+    clips = [(*frame_range(take.n_frames, start, stop), os.fspath(out))
+             for start, stop, out in clips]
+    if format == "bvh":
+        for start, stop, out in clips:
+            write_bvh(take, out, start=start, stop=stop)
+        return
+    from motionlib.io import blender as blender_module
+
+    blender = blender or blender_module.shared()
+    what = f"writing {format.upper()} clips"
+    if original is not None and take.format == "fbx":
+        check_fbx_header(original)
+        blender.request({
+            "op": "trim", "path": os.path.abspath(os.fspath(original)),
+            "animation": take.animation, "fps": take.fps, "format": format,
+            "clips": [{"start": a, "stop": b, "out": os.path.abspath(o)} for a, b, o in clips],
+        }, path=original, what=what, timeout=timeout)
+        return
+    for start, stop, out in clips:
+        _write_new_armature(take.slice(start, stop), out, format, blender, timeout)
+
+
+def _write_new_armature(take, out, format, blender, timeout):
+    meta, arrays = armature_pose(take)
+    with tempfile.TemporaryDirectory(prefix="motionlib-export-") as folder:
+        pose = os.path.join(folder, "pose.npz")
+        np.savez(pose, **arrays)
+        blender.request({"op": "write", "in": pose, "meta": meta, "out": os.path.abspath(out),
+                         "format": format}, path=take.path or take.name,
+                        what=f"writing the {format.upper()} clip", timeout=timeout)
+
+
+def armature_pose(take: Take) -> tuple[dict, dict[str, np.ndarray]]:
+    """The take as Blender bones: rest heads, and per frame each bone's local rotation and
+    location offset, in Blender's Z-up metres.
+
+    Returns
+    -------
+    meta : dict
+        ``name``, ``fps``, ``bones``, ``parents``, ``moving`` (bones with position channels).
+    arrays : dict
+        ``heads`` (n_bones, 3); ``quaternions`` (n_frames, n_bones, 4) as (w, x, y, z), each
+        continuous over time; ``locations`` (n_frames, n_bones, 3).
+    """
+    sk = take.skeleton
+    scale = 1.0 / CENTIMETRES_PER_METRE
+    rest = np.zeros((sk.n_joints, 3))
+    for j in range(sk.n_joints):
+        p = sk.parents[j]
+        rest[j] = sk.offsets[j] + (rest[p] if p >= 0 else 0.0)
+    rotations, translations = local_transforms(take)
+    to_z = Y_UP_TO_Z_UP
+    R = to_z @ rotations @ to_z.T
+    n, J = rotations.shape[:2]
+    quats = matrix_to_quaternion(R.reshape(-1, 3, 3)).reshape(n, J, 4)
+    flips = np.cumsum(np.sum(quats[1:] * quats[:-1], axis=-1) < 0, axis=0) % 2
+    quats[1:][flips.astype(bool)] *= -1
+    locations = (translations - sk.offsets[None]) @ to_z.T * scale
+    meta = {"name": take.name, "fps": take.fps, "bones": list(sk.names),
+            "parents": [int(p) for p in sk.parents],
+            "moving": [any(c.endswith("position") for c in ch) for ch in sk.channels]}
+    arrays = {"heads": rest @ to_z.T * scale, "quaternions": quats, "locations": locations}
+    return meta, arrays
+
+
+def local_transforms(take: Take) -> tuple[np.ndarray, np.ndarray]:
+    """Each joint's rotation and translation relative to its parent, every frame.
+
+    Returns
+    -------
+    rotations : ndarray, shape (n_frames, n_joints, 3, 3)
+        From the rotation channels in the joint's order (``C @ R @ C.T`` with ASF axes).
+    translations : ndarray, shape (n_frames, n_joints, 3)
+        The offset, with position channels replacing its axes where the joint has them.
+    """
+    sk = take.skeleton
+    n = take.n_frames
+    rotations = np.broadcast_to(np.eye(3), (n, sk.n_joints, 3, 3)).copy()
+    translations = np.broadcast_to(sk.offsets, (n, sk.n_joints, 3)).copy()
+    for j, (names, first) in enumerate(zip(sk.channels, sk.channel_starts, strict=True)):
+        column = {name: first + k for k, name in enumerate(names)}
+        for a, axis in enumerate("XYZ"):
+            if f"{axis}position" in column:
+                translations[:, j, a] = take.channels[:, column[f"{axis}position"]]
+        order = "".join(a for a in sk.rotation_orders[j] if f"{a}rotation" in column)
+        if order:
+            angles = take.channels[:, [column[f"{a}rotation"] for a in order]]
+            R = euler_to_matrix(angles, order)
+            if sk.axes is not None:
+                R = sk.axes[j] @ R @ sk.axes[j].T
+            rotations[:, j] = R
+    return rotations, translations

@@ -1,0 +1,130 @@
+"""FBX uploads through real workers: a convert worker (Blender) on its own queue, then the usual
+ingest and detection on another; Blender crashing or hanging costs one capture, not the worker."""
+
+import os
+import signal
+import subprocess
+
+import pytest
+from django.contrib.auth import get_user_model
+from django.core.files.uploadedfile import SimpleUploadedFile
+from rest_framework.test import APIClient
+
+from segmentation import services
+from segmentation.models import Capture, DetectionRun
+from tests.fbx.files import shared_fbx
+from tests.segmentation.integration.conftest import Workers, new_queue, wait_for
+
+pytestmark = pytest.mark.integration
+
+
+@pytest.fixture
+def owner(transactional_db):
+    alice = get_user_model().objects.create_user("alice", password="alice-password")
+    services.do_create_project(alice, "Studio A")
+    return alice
+
+
+@pytest.fixture
+def fbx_workers(workers, shared_media, tmp_path, settings):
+    """An ingest worker on the test's queue and a convert worker on a convert queue of its own
+    (``start_convert(**env)`` starts one, with extra environment)."""
+    convert_queue = new_queue() + "-convert"
+    settings.CUTROOM_CONVERT_QUEUE = convert_queue
+    workers.env["CUTROOM_CONVERT_QUEUE"] = convert_queue
+    workers.start()
+    converters = Workers(convert_queue, shared_media, tmp_path, claim_timeout=300)
+    converters.env["CUTROOM_CONVERT_WORKER"] = "1"
+
+    def start_convert(**env):
+        converters.env.update(env)
+        return converters.start(f"convert-{len(converters.procs)}")
+
+    yield start_convert, converters
+    converters.stop_all()
+
+
+def upload(owner, path, name=None):
+    client = APIClient()
+    client.force_authenticate(owner)
+    data = {"project": owner.memberships.get().project_id,
+            "file": SimpleUploadedFile(name or path.name, path.read_bytes())}
+    response = client.post("/api/captures/", data, format="multipart")
+    assert response.status_code == 201, response.content
+    return response.json()["id"]
+
+
+def settled(capture_id, timeout=120):
+    wait_for(lambda: Capture.objects.get(pk=capture_id).status in ("ready", "failed"),
+             timeout=timeout, what="the capture to be converted and ingested")
+    return Capture.objects.get(pk=capture_id)
+
+
+def blender_pids(worker):
+    """Blender processes started by this worker's pool process."""
+    out = subprocess.run(["pgrep", "-f", "_blender_fbx.py"], capture_output=True, text=True)
+    pool = set(Workers.children(None, worker))
+    return [int(p) for p in out.stdout.split() if _parent(int(p)) in pool]
+
+
+def _parent(pid):
+    try:
+        with open(f"/proc/{pid}/stat") as stat:
+            return int(stat.read().rsplit(")", 1)[1].split()[1])
+    except OSError:
+        return None
+
+
+def test_it_converts_then_ingests_and_detects_an_fbx_upload(fbx_workers, owner):
+    start_convert, _ = fbx_workers
+    start_convert()
+    capture = settled(upload(owner, shared_fbx("samba_dancing.fbx")))
+    assert capture.status == "ready", capture.error
+    assert (capture.format, capture.n_frames, capture.fps) == ("fbx", 595, 30.0)
+    wait_for(lambda: DetectionRun.objects.filter(capture=capture, status="ready").exists(),
+             what="detection")
+
+
+def test_it_makes_a_capture_per_animation(fbx_workers, owner, made_fbx):
+    start_convert, _ = fbx_workers
+    worker = start_convert()
+    wait_for(lambda: "Blender ready in" in worker.log.read_text(), what="Blender to start")
+    blender = blender_pids(worker)
+    first = settled(upload(owner, made_fbx / "two_armatures.fbx"))
+    assert first.status == "ready", first.error
+    other = Capture.objects.get(source=first)
+    assert settled(other.pk).status == "ready"
+    assert sorted([first.name, other.name]) == ["two_armatures.fbx#Breakdance|Scene",
+                                                "two_armatures.fbx#Flair|Scene"]
+    # The Blender loaded as the worker started read the file: none started for it.
+    assert blender_pids(worker) == blender and len(blender) == 1
+
+
+def test_a_blender_crash_fails_that_capture_and_the_worker_converts_the_next(fbx_workers, owner):
+    start_convert, _ = fbx_workers
+    worker = start_convert()
+    wait_for(lambda: "Blender ready in" in worker.log.read_text(), what="Blender to start")
+    capture_id = upload(owner, shared_fbx("13_29_blender.fbx"))
+    wait_for(lambda: Capture.objects.get(pk=capture_id).status == "processing", interval=0.01,
+             what="conversion to start")
+    doomed = blender_pids(worker)
+    assert len(doomed) == 1
+    for pid in doomed:
+        os.kill(pid, signal.SIGKILL)
+    crashed = settled(capture_id)
+    assert crashed.status == "failed"
+    assert "13_29_blender.fbx: Blender was killed by signal SIGKILL while reading the FBX" in \
+        crashed.error
+    assert settled(upload(owner, shared_fbx("flair.fbx"))).status == "ready"
+    assert worker.poll() is None
+
+
+def test_a_blender_past_its_time_limit_fails_that_capture_only(fbx_workers, owner):
+    start_convert, _ = fbx_workers
+    # Reading 13_29 takes Blender a second or more: 0.3 s is "hanging" for this test.
+    worker = start_convert(MOTIONLIB_BLENDER_TIMEOUT="0.3")
+    slow = settled(upload(owner, shared_fbx("13_29_blender.fbx")))
+    assert slow.status == "failed"
+    assert "Blender did not finish reading the FBX within 0.3 s and was stopped" in slow.error
+    assert settled(upload(owner, shared_fbx("flair.fbx"))).status == "ready"
+    assert worker.poll() is None

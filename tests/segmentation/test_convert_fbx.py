@@ -1,0 +1,87 @@
+"""FBX uploads: the convert job (Blender, in its own process) then the usual ingest, run
+in-process by calling the task functions; the integration tests run them in real workers."""
+
+import pytest
+
+from segmentation import tasks
+from segmentation.models import Capture, DetectionRun
+from segmentation.services.captures import first_job
+from tests.fbx.files import shared_fbx
+from tests.segmentation.base import BaseTestCase
+
+
+@pytest.fixture(autouse=True)
+def _files(request, made_fbx):
+    request.cls.made = made_fbx
+
+
+class ConvertTestCase(BaseTestCase):
+    def setUp(self):
+        super().setUp()
+        self.login(self.bob)
+
+    def upload_file(self, path, name=None):
+        response = self.upload(path.read_bytes(), name=name or path.name)
+        self.assertEqual(response.status_code, 201, response.content)
+        return response.json()["id"]
+
+    def convert_and_ingest(self, capture_id):
+        """The convert job, then every ingest and detection it queued."""
+        tasks.convert(capture_id)
+        for capture in Capture.objects.filter(status="queued", format="fbx"):
+            tasks.ingest(capture.pk)
+        for run in DetectionRun.objects.filter(status="queued"):
+            tasks.detect(run.pk)
+        return Capture.objects.get(pk=capture_id)
+
+    def test_it_converts_a_mixamo_fbx_and_proposes_cuts(self):
+        capture = self.convert_and_ingest(self.upload_file(shared_fbx("samba_dancing.fbx")))
+        self.assertEqual(capture.status, "ready", capture.error)
+        self.assertEqual((capture.format, capture.fps, capture.n_frames, capture.n_joints),
+                         ("fbx", 30.0, 595, 65))
+        self.assertEqual(capture.name, "samba_dancing.fbx")
+        self.assertEqual(DetectionRun.objects.get(capture=capture).status, "ready")
+
+    def test_it_makes_one_capture_per_animation_sharing_one_original(self):
+        first = self.convert_and_ingest(self.upload_file(self.made / "two_actions.fbx"))
+        captures = {c.name: c for c in Capture.objects.filter(project=self.project)}
+        self.assertEqual(sorted(captures), ["two_actions.fbx#breakdance", "two_actions.fbx#flair"])
+        other = captures["two_actions.fbx#flair"]
+        self.assertEqual((first.name, first.n_frames), ("two_actions.fbx#breakdance", 106))
+        self.assertEqual((other.status, other.n_frames, other.source_id), ("ready", 31, first.pk))
+        self.assertEqual(other.original.name, first.original.name)
+
+    def test_it_converts_a_file_again_without_duplicating_its_animations(self):
+        capture_id = self.upload_file(self.made / "two_actions.fbx")
+        self.convert_and_ingest(capture_id)
+        Capture.objects.filter(pk=capture_id).update(status="queued", converted="")
+        self.convert_and_ingest(capture_id)
+        self.assertEqual(Capture.objects.filter(project=self.project).count(), 2)
+
+    def test_it_fails_an_fbx_without_armature_with_the_reason(self):
+        capture = self.convert_and_ingest(self.upload_file(self.made / "mesh_only.fbx"))
+        self.assertEqual(capture.status, "failed")
+        self.assertIn("mesh_only.fbx: no armature (skeleton) in the file", capture.error)
+
+    def test_it_fails_an_ascii_fbx_saying_to_export_binary(self):
+        path = self.made / "ascii.fbx"
+        path.write_text("; FBX 7.4.0 project file\nFBXHeaderExtension:  {\n}\n")
+        capture = self.convert_and_ingest(self.upload_file(path))
+        self.assertEqual(capture.status, "failed")
+        self.assertIn("ASCII FBX is not supported", capture.error)
+        with capture.original.open("rb") as handle:
+            self.assertEqual(handle.read(), path.read_bytes())
+
+    def test_it_fails_a_truncated_fbx_and_keeps_the_original(self):
+        data = shared_fbx("flair.fbx").read_bytes()[:50_000]
+        capture_id = self.upload(data, name="cut.fbx").json()["id"]
+        capture = self.convert_and_ingest(capture_id)
+        self.assertEqual(capture.status, "failed")
+        self.assertRegex(capture.error, r"^cut\.fbx: Blender's FBX importer could not read")
+        response = self.client.get(f"/api/captures/{capture_id}/")
+        self.assertEqual((response.status_code, response.json()["status"]), (200, "failed"))
+
+    def test_it_queues_an_fbx_upload_for_conversion_not_ingest(self):
+        capture = Capture.objects.get(pk=self.upload_file(shared_fbx("flair.fbx")))
+        self.assertTrue(capture.needs_conversion)
+        self.assertEqual(first_job(capture), "convert")
