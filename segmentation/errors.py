@@ -29,3 +29,7 @@ class StaleVersion(Exception):
             f"review {review.pk} is at version {review.version}; reload it and redo the change"
         )
         self.review = review
+
+
+class NotAllowed(PermissionError):
+    """The caller's role does not allow the action: a 403 whose text says who may."""

@@ -53,7 +53,9 @@ class CaptureViewSet(
             runs = DetectionRun.objects.defer("candidates", "params", "timings").annotate(
                 n_candidates=JSONArrayLength("candidates")
             )
-            captures = captures.defer("skeleton").prefetch_related(Prefetch("runs", runs))
+            captures = captures.defer("skeleton").prefetch_related(
+                Prefetch("runs", runs), "assignments__annotator", "reviews__annotator"
+            )
         else:
             captures = captures.prefetch_related("runs")
         project = int_param(self.request, "project", None)

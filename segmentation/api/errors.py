@@ -2,6 +2,7 @@
 
 - ``StaleVersion`` -> 409 with the current review;
 - ``UploadTooLarge`` -> 413;
+- ``NotAllowed`` (a role refusal on a project the caller sees) -> 403;
 - any other ``ValueError`` (motionlib's ``CaptureError``/``ParamError``, the service's
   own) -> 400 with its message, which names the field, file, line or value at fault;
 - DRF's own errors keep their status, and always carry a readable ``detail``.
@@ -14,7 +15,7 @@ from rest_framework.response import Response
 from rest_framework.views import exception_handler as drf_exception_handler
 
 from motionlib.segmenters import ParamError
-from segmentation.errors import StaleVersion, UploadTooLarge
+from segmentation.errors import NotAllowed, StaleVersion, UploadTooLarge
 
 FIELD = re.compile(r"^(\w+): (.+)$", re.DOTALL)
 
@@ -25,6 +26,8 @@ def exception_handler(exc, context):
 
         body = {"detail": str(exc), "review": ReviewSerializer(exc.review).data}
         return Response(body, status=status.HTTP_409_CONFLICT)
+    if isinstance(exc, NotAllowed):
+        return Response({"detail": str(exc)}, status=status.HTTP_403_FORBIDDEN)
     if isinstance(exc, ValueError):
         code = 413 if isinstance(exc, UploadTooLarge) else 400
         return Response(_value_error_body(exc), status=code)

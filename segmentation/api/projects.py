@@ -57,6 +57,8 @@ class ProjectViewSet(
     def members(self, request, pk=None):
         project = self._admin_project()
         if request.method == "GET":
+            if not project.can_see_all_reviews(request.user):
+                raise PermissionDenied("Only the project's reviewers and admins see its members.")
             members = project.memberships.select_related("user").order_by("id")
             return Response(MemberSerializer(members, many=True).data)
         serializer = MemberSerializer(data=request.data)

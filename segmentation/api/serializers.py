@@ -12,7 +12,8 @@ class LabelSerializer(serializers.ModelSerializer):
 
     class Meta:
         model = Label
-        fields = ["id", "name", "color", "hotkey"]
+        fields = ["id", "name", "color", "hotkey", "position", "retired"]
+        read_only_fields = ["position", "retired"]
         # Uniqueness is checked by the service with a message naming the clash.
         validators = []
 
@@ -23,6 +24,7 @@ class ProjectSerializer(serializers.Serializer):
     role = serializers.SerializerMethodField()
     default_method = serializers.CharField(required=False, allow_blank=True, default="")
     default_params = serializers.DictField(required=False, default=dict)
+    annotators_pick_unassigned = serializers.BooleanField(required=False, default=True)
     labels = LabelSerializer(many=True, read_only=True)
 
     def get_role(self, project) -> str | None:
@@ -97,9 +99,18 @@ class CaptureListSerializer(CaptureSerializer):
     neither; ``GET /api/captures/{id}/`` has them."""
 
     latest_run = RunSummarySerializer(read_only=True, allow_null=True)
+    team = serializers.SerializerMethodField()
 
     class Meta(CaptureSerializer.Meta):
-        fields = [f for f in CaptureSerializer.Meta.fields if f != "skeleton"]
+        fields = [f for f in CaptureSerializer.Meta.fields if f != "skeleton"] + ["team"]
+
+    def get_team(self, capture) -> dict:
+        """Who is assigned, and each review's annotator and state (from the prefetch)."""
+        return {
+            "assigned": [a.annotator.username for a in capture.assignments.all()],
+            "reviews": [{"id": r.pk, "annotator": r.annotator.username, "status": r.status}
+                        for r in sorted(capture.reviews.all(), key=lambda r: r.pk)],
+        }
 
 
 class UploadSerializer(serializers.Serializer):
@@ -124,7 +135,8 @@ class ReviewSerializer(serializers.ModelSerializer):
 
     class Meta:
         model = Review
-        fields = ["id", "capture", "annotator", "run", "status", "version", "cuts", "segments"]
+        fields = ["id", "capture", "annotator", "run", "status", "version", "return_comment", "cuts",
+                  "segments"]
 
     def get_annotator(self, review) -> dict:
         return {"id": review.annotator_id, "username": review.annotator.username}
