@@ -97,7 +97,10 @@ class MeView(APIView):
             {"id": m.project_id, "name": m.project.name, "role": m.role}
             for m in request.user.memberships.select_related("project").order_by("project_id")
         ]
-        return Response({"id": request.user.pk, "username": request.user.username, "projects": projects})
+        from segmentation.services.team import can_create_accounts
+
+        return Response({"id": request.user.pk, "username": request.user.username, "projects": projects,
+                         "can_create_accounts": can_create_accounts(request.user)})
 
 
 class MethodsView(APIView):

@@ -81,3 +81,18 @@ class NewAccountTestCase(BaseTestCase):
         r = self.create("charlie")
         self.assertEqual(r.status_code, 400)
         self.assertIn("already exists", r.json()["detail"])
+
+
+class SchemaTestCase(BaseTestCase):
+    def test_the_schema_documents_members_assignments_queue_and_return(self):
+        self.login(self.bob)
+        paths = self.client.get("/api/schema/", HTTP_ACCEPT="application/json").json()["paths"]
+        for path, method in [
+            ("/api/projects/{id}/members/{user_id}/", "patch"),
+            ("/api/projects/{id}/members/new-account/", "post"),
+            ("/api/projects/{id}/assignments/", "post"),
+            ("/api/projects/{id}/assignments/{assignment_id}/", "delete"),
+            ("/api/queue/", "get"),
+            ("/api/captures/{id}/reviews/{review_id}/return/", "post"),
+        ]:
+            self.assertIn(method, paths[path], path)
