@@ -12,5 +12,5 @@ urlpatterns = [
     path("login/", throttled_sign_in(auth_views.LoginView.as_view()), name="login"),
     path("logout/", views.logout_view, name="logout"),
     path("", views.app, name="app"),
-    re_path(r"^(?P<path>(captures|library|projects)(/.*)?)$", views.app),
+    re_path(r"^(?P<path>(captures|library|projects|queue)(/.*)?)$", views.app),
 ]

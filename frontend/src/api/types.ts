@@ -5,6 +5,9 @@ export interface Label {
   name: string;
   color: string;
   hotkey: string | null;
+  position?: number;
+  /** Retired: stays on existing segments, not offered for new ones. */
+  retired?: boolean;
 }
 
 export type Role = "annotator" | "reviewer" | "admin";
@@ -16,12 +19,14 @@ export interface Project {
   default_method: string;
   default_params: Record<string, unknown>;
   labels: Label[];
+  annotators_pick_unassigned?: boolean;
 }
 
 export interface Me {
   id: number;
   username: string;
   projects: { id: number; name: string; role: Role }[];
+  can_create_accounts?: boolean;
 }
 
 export interface Skeleton {
@@ -76,6 +81,8 @@ export interface RunSummary {
 
 export interface CaptureSummary extends Omit<Capture, "skeleton" | "latest_run"> {
   latest_run: RunSummary | null;
+  /** Who is assigned, and each review's annotator and state. */
+  team?: { assigned: string[]; reviews: { id: number; annotator: string; status: Review["status"] }[] };
 }
 
 export interface Page<T> {
@@ -134,8 +141,9 @@ export interface Review {
   capture: number;
   annotator: { id: number; username: string };
   run: number | null;
-  status: "in_progress" | "submitted";
+  status: "in_progress" | "submitted" | "returned";
   version: number;
+  return_comment?: string;
   cuts: Cut[];
   segments: Segment[];
 }
