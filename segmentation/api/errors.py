@@ -10,7 +10,9 @@
 
 import re
 
+from django.http import Http404
 from rest_framework import status
+from rest_framework.exceptions import NotFound
 from rest_framework.response import Response
 from rest_framework.views import exception_handler as drf_exception_handler
 
@@ -18,6 +20,7 @@ from motionlib.segmenters import ParamError
 from segmentation.errors import NotAllowed, StaleVersion, UploadTooLarge
 
 FIELD = re.compile(r"^(\w+): (.+)$", re.DOTALL)
+NO_MATCH = re.compile(r"^No (\w+) matches the given query\.$")
 
 
 def exception_handler(exc, context):
@@ -31,6 +34,10 @@ def exception_handler(exc, context):
     if isinstance(exc, ValueError):
         code = 413 if isinstance(exc, UploadTooLarge) else 400
         return Response(_value_error_body(exc), status=code)
+    if isinstance(exc, Http404):
+        # Django's "No Cut matches the given query." names a model class, not a thing.
+        found = NO_MATCH.match(str(exc))
+        exc = NotFound(f"No such {_words(found.group(1))}." if found else "Not found.")
     response = drf_exception_handler(exc, context)
     if response is not None and isinstance(response.data, dict) and "detail" not in response.data:
         response.data = {"detail": _summary(response.data), **response.data}
@@ -59,3 +66,8 @@ def _summary(data):
     if isinstance(data, list):
         return " ".join(_summary(item) for item in data)
     return str(data)
+
+
+def _words(class_name):
+    """"SegmentLabel" -> "segment label"."""
+    return re.sub(r"(?<!^)(?=[A-Z])", " ", class_name).lower()

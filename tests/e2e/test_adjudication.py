@@ -76,6 +76,9 @@ def test_it_makes_a_gold_version_from_two_annotators_reviews(live_server, new_pa
     similar_rows = page.locator("[data-testid=segment-rows] tr[data-testid^=segment-]")
     expect(similar_rows).to_have_count(3)
     expect(similar_rows.first).to_contain_text("d ")
+    # Distances are headed as distances, and the count is of the similar clips shown.
+    expect(page.get_by_test_id("metric-head")).to_have_text("Distance")
+    expect(page.get_by_test_id("segment-count")).to_have_text("3 similar clips")
 
     page.goto(f"{live_server.url}/projects/{studio['project'].pk}/dashboard/")
     expect(page.get_by_test_id("state-adjudicated")).to_have_text("1")
@@ -93,12 +96,12 @@ def test_it_refuses_the_adjudication_view_to_an_annotator(live_server, new_page,
     two_reviews(ingested_capture, studio)
     page = new_page("bob")
     page.goto(f"{live_server.url}/captures/{ingested_capture.pk}/adjudicate/")
-    expect(page.get_by_text("No such capture.")).to_be_visible()
+    expect(page.get_by_text("Only the project's reviewers and admins see agreement")).to_be_visible()
     csrf = next(c["value"] for c in page.context.cookies() if c["name"] == "csrftoken")
     response = page.request.put(f"{live_server.url}/api/captures/{ingested_capture.pk}/adjudication/",
                                 data={"cuts": [], "labels": ["walk"], "version": 0},
                                 headers={"X-CSRFToken": csrf})
-    assert response.status == 404, response.text()
+    assert response.status == 403, response.text()
 
 
 def test_it_accepts_a_suggested_label_with_one_key(live_server, new_page, ingested_capture, studio):

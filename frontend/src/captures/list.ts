@@ -61,10 +61,13 @@ export async function renderCaptureList(root: HTMLElement): Promise<() => void> 
     searchDelay = window.setTimeout(() => apply({ ...filters, search: search.value.trim(), page: 1 }), 250);
   });
 
-  const uploadProject = () => Number(filters.project) || projects[0]?.id;
+  // With "All projects" selected and several projects, nothing says where a file should
+  // go: ask instead of guessing.
+  const uploadProject = () => Number(filters.project) || (projects.length === 1 ? projects[0].id : undefined);
   const startUploads = (files: File[]) => {
     const project = uploadProject();
-    if (!project) return toast("Create or join a project before uploading.", "error");
+    if (!projects.length) return toast("Create or join a project before uploading.", "error");
+    if (!project) return toast("Choose the project to upload to in the project filter first.", "error");
     const { items, problems } = pairFiles(files);
     problems.forEach((p) => toast(p, "error"));
     for (const item of items) {

@@ -386,9 +386,12 @@ class ReviewPage {
     this.review = current;
     this.history = emptyHistory();
     this.refresh();
+    // The server's text is for API clients (it names the review and says to reload); the
+    // page has already loaded the current version, so it says that instead.
+    void message;
     await dialog("This review changed elsewhere", [
-      h("p", {}, message),
-      h("p", {}, "The current version is shown now. What changed:"),
+      h("p", { "data-testid": "conflict-text" }, "Your review was saved from another tab or window first. This page shows that version now."),
+      h("p", {}, "What changed:"),
       h("ul", { "data-testid": "conflict-changes" }, ...(changes.length ? changes : ["(nothing visible)"]).map((line) => h("li", {}, line))),
       unsaved.length ? h("p", {}, "Not saved — redo these if you still want them:") : null,
       unsaved.length ? h("ul", { "data-testid": "conflict-unsaved" }, ...unsaved.map((t) => h("li", {}, t))) : null,
