@@ -92,6 +92,7 @@ def test_a_reviewer_assigns_and_the_annotator_works_through_the_queue(live_serve
     expect(ann.get_by_test_id(f"queue-item-{first.pk}")).to_have_attribute("data-state", "returned")
     expect(ann.get_by_test_id(f"queue-comment-{first.pk}")).to_have_text("The first segment is a walk only up to the turn.")
     expect(ann.get_by_test_id(f"queue-item-{second.pk}")).to_have_attribute("data-state", "in_progress")
+    ann.evaluate("document.querySelector('.toasts')?.replaceChildren()")  # a clean picture
     ann.screenshot(path=str(screenshots / "queue.png"))
     ann.get_by_test_id(f"queue-open-{first.pk}").click()
     expect(ann.get_by_test_id("readonly-banner")).to_contain_text("walk only up to the turn")
