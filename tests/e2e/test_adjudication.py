@@ -152,6 +152,10 @@ def test_tiers_feed_the_gold_tier_with_undo_snap_and_the_409_rule(live_server, n
     expect(page.get_by_test_id("viewport").locator("canvas")).to_be_visible()
     gold = page.get_by_test_id("track-gold")
     expect(gold.locator(".tier-seg")).to_have_count(1)
+    page.keyboard.press("?")
+    expect(page.get_by_test_id("help")).to_contain_text("take it into gold")
+    page.keyboard.press("?")
+    expect(page.get_by_test_id("help")).to_have_count(0)
 
     # A tier's cut, then a tier's segment (its bounds and its label), into gold.
     page.get_by_test_id("track-bob-cut-1").click()

@@ -149,3 +149,36 @@ def test_a_reviewer_unassigns_and_reassigns_from_a_members_queue(live_server, ne
     rachel.get_by_test_id(f"unassign-{first.pk}").click()
     expect(rachel.get_by_test_id(f"queue-item-{first.pk}")).to_have_count(0)
     assert not Assignment.objects.exists()
+
+
+def test_each_capture_goes_to_n_annotators_spread_evenly(live_server, new_page, studio, takes):
+    from segmentation.models import Assignment
+
+    project = studio["project"]
+    rachel = new_page("rachel")
+    rachel.get_by_test_id("filter-project").select_option(str(project.pk))
+    for capture in takes[:2]:
+        rachel.get_by_test_id(f"select-{capture.pk}").check()
+    rachel.get_by_test_id("assign-to-ann").check()
+    rachel.get_by_test_id("assign-to-bob").check()
+    rachel.get_by_test_id("assign-per-capture").fill("1")
+    rachel.get_by_test_id("assign-go").click()
+    expect(rachel.get_by_test_id(f"team-{takes[0].pk}")).not_to_have_text("—")
+    expect(rachel.get_by_test_id(f"team-{takes[1].pk}")).not_to_have_text("—")
+    per_person = sorted(Assignment.objects.filter(annotator__username=u).count() for u in ("ann", "bob"))
+    assert per_person == [1, 1]
+    assert all(c.assignments.count() == 1 for c in takes[:2])
+
+
+def test_a_project_can_keep_annotators_to_their_assignments(live_server, new_page, studio, takes):
+    project = studio["project"]
+    alice = new_page("alice")
+    alice.goto(f"{live_server.url}/projects/{project.pk}/team/")
+    alice.get_by_test_id("pick-unassigned").uncheck()
+    expect(alice.locator(".toast")).to_contain_text("only what is assigned")
+    project.refresh_from_db()
+    assert project.annotators_pick_unassigned is False
+
+    ann = new_page("ann")
+    ann.goto(f"{live_server.url}/captures/{takes[2].pk}/")
+    expect(ann.get_by_text("is not assigned to you")).to_be_visible()

@@ -31,6 +31,23 @@ export async function renderAdjudication(root: HTMLElement, captureId: number): 
 
 type Review = Adjudication["reviews"][number];
 
+/** The review page's keys, as they act on the gold tier here. */
+const ADJ_HELP: [string, string][] = [
+  ["Space", "play / pause"],
+  ["← / →, , / .", "1 or 10 frames back / forward"],
+  ["Shift + ← / →", "jump to the previous / next cut of any tier"],
+  ["Home / End", "first / last frame"],
+  ["I", "insert a gold cut at the playhead"],
+  ["D or Delete", "delete the selected gold cut"],
+  ["1 – 9, /", "label the gold segment under the playhead (/ opens the palette)"],
+  ["0 or Backspace", "clear that gold segment's label"],
+  ["Z / Shift+Z", "undo / redo"],
+  ["+ / −, wheel", "zoom the tiers"],
+  ["Click a tier's cut or segment", "take it into gold"],
+  ["Drag a gold cut", "move it; it snaps to the tiers' cuts"],
+  ["?", "show / hide this help"],
+];
+
 class AdjudicationPage {
   private history: Timeline<Draft>;
   private saved: Draft | null;
@@ -285,8 +302,16 @@ class AdjudicationPage {
     if (this.playback.playing) this.raf = requestAnimationFrame(this.tick);
   };
 
+  private toggleHelp(): void {
+    const open = document.querySelector(".adj-help");
+    if (open) return open.remove();
+    const rows = ADJ_HELP.map(([keys, what]) => h("tr", {}, h("th", {}, h("kbd", {}, keys)), h("td", {}, what)));
+    const box = h("div", { class: "modal-backdrop help adj-help", "data-testid": "help", onclick: () => box.remove() }, h("div", { class: "modal" }, h("h2", {}, "Keyboard"), h("table", { class: "keys" }, ...rows)));
+    document.body.append(box);
+  }
+
   private handleKey(e: KeyboardEvent): void {
-    if (isTypingTarget(e.target) || document.querySelector(".modal-backdrop")) return;
+    if (isTypingTarget(e.target) || document.querySelector(".modal-backdrop:not(.help)")) return;
     const c = commandFor(e);
     if (!c) return;
     e.preventDefault();
@@ -343,7 +368,11 @@ class AdjudicationPage {
       case "palette":
         openPalette(this.labels, (name) => this.labelUnderPlayhead(name));
         return;
+      case "help":
+        this.toggleHelp();
+        return;
       case "escape":
+        if (document.querySelector(".adj-help")) this.toggleHelp();
         this.selectedCut = null;
         break;
       default:

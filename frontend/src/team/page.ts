@@ -146,7 +146,7 @@ export async function renderTeam(root: HTMLElement, projectId: number): Promise<
   });
 
   append(main, [
-    h("section", { class: "team-section" }, h("h2", {}, "Members"), h("table", { class: "captures members" }, h("thead", {}, h("tr", {}, ...["User", "Role", "", ""].map((t) => h("th", {}, t)))), members)),
+    h("section", { class: "team-section" }, h("h2", {}, "Members"), h("table", { class: "captures members" }, h("thead", {}, h("tr", {}, ...["User", "Role", "Queue", ""].map((t) => h("th", {}, t)))), members)),
     isAdmin
       ? h(
           "section",
