@@ -16,6 +16,8 @@ from segmentation.api.projects import project_for
 from segmentation.api.serializers import ReviewSerializer
 from segmentation.models import Assignment, Project
 from segmentation.services import assignments as service
+from segmentation.services import queue as queues
+from segmentation.services import returns
 
 
 class AssignmentSerializer(serializers.ModelSerializer):
@@ -55,7 +57,7 @@ class ReturnRequest(serializers.Serializer):
 
 class QueueItemSerializer(serializers.Serializer):
     capture = serializers.DictField()
-    state = serializers.ChoiceField(choices=service.QUEUE_STATES)
+    state = serializers.ChoiceField(choices=queues.QUEUE_STATES)
     assigned = serializers.BooleanField()
     since = serializers.DateTimeField()
     review = serializers.DictField(allow_null=True)
@@ -136,7 +138,7 @@ class QueueView(APIView):
                 raise PermissionDenied("Only a project's reviewers and admins see another member's "
                                        "queue, and only with ?project=.")
             user = get_object_or_404(get_user_model(), username=username, memberships__project=project)
-        items = service.queue(user, project)
+        items = queues.queue(user, project)
         if project is None:
             visible = set(Project.objects.for_user(request.user).values_list("id", flat=True))
             items = [i for i in items if i["capture"]["project"] in visible]
@@ -152,7 +154,7 @@ class ReturnView(APIView):
             raise PermissionDenied("Only the project's reviewers and admins return reviews.")
         review = get_object_or_404(capture.reviews, pk=review_id)
         data = body(request, ReturnRequest)
-        review = service.do_return_review(review, request.user, data["comment"])
+        review = returns.do_return_review(review, request.user, data["comment"])
         return Response(ReviewSerializer(review).data)
 
 

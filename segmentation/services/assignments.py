@@ -7,13 +7,10 @@ already assigned to someone in the pool counts towards its N.
 """
 
 from django.db import transaction
-from django.db.models import F
 from django.utils import timezone
 
-from segmentation.errors import NotAllowed, ReviewClosed
-from segmentation.models import Assignment, Capture, Membership, Review, ReviewEvent
-
-QUEUE_STATES = ("assigned", "in_progress", "returned", "submitted")
+from segmentation.errors import NotAllowed
+from segmentation.models import Assignment, Capture, Membership, Review
 
 
 def members_by_username(project, usernames):
@@ -107,69 +104,6 @@ def check_may_start(capture, user):
     if not capture.assignments.filter(annotator=user).exists():
         raise NotAllowed(f"{capture.name!r} is not assigned to you, and this project lets "
                          "annotators review only the captures assigned to them")
-
-
-def queue(user, project=None):
-    """The user's queue: assigned captures and own reviews, oldest first.
-
-    Each item: capture (id, name, project, duration, n_candidates), state (assigned,
-    in_progress, returned, submitted), since (assignment or review creation time),
-    the review's id, version and return comment.
-    """
-    assignments = Assignment.objects.filter(annotator=user).select_related("capture")
-    reviews = Review.objects.filter(annotator=user).select_related("capture", "run")
-    if project is not None:
-        assignments = assignments.filter(capture__project=project)
-        reviews = reviews.filter(capture__project=project)
-    by_capture = {r.capture_id: r for r in reviews}
-    items = {}
-    for a in assignments:
-        items[a.capture_id] = _item(a.capture, by_capture.get(a.capture_id), a.created_at, True)
-    for r in by_capture.values():
-        items.setdefault(r.capture_id, _item(r.capture, r, r.created_at, False))
-    return sorted(items.values(), key=lambda i: (i["since"], i["capture"]["id"]))
-
-
-def _item(capture, review, since, assigned):
-    run = review.run if review and review.run else capture.latest_finished_run()
-    return {
-        "capture": {"id": capture.pk, "name": capture.name, "project": capture.project_id,
-                    "duration": capture.duration, "n_frames": capture.n_frames,
-                    "n_candidates": len(run.candidates) if run else None},
-        "state": review.status if review else "assigned",
-        "assigned": assigned,
-        "since": since,
-        "review": None if review is None else {
-            "id": review.pk, "version": review.version, "submitted_at": review.submitted_at,
-            "return_comment": review.return_comment or None, "returned_at": review.returned_at},
-    }
-
-
-def do_return_review(review, reviewer, comment):
-    """Send a submitted review back to its annotator with a comment.
-
-    It leaves agreement and the library at once (they use submitted reviews only) and
-    takes edits again until the annotator resubmits.
-    """
-    comment = (comment or "").strip()
-    if not comment:
-        raise ValueError("comment: say what the annotator should change")
-    from segmentation.library import on_review_submitted
-
-    with transaction.atomic():
-        now = timezone.now()
-        updated = Review.objects.filter(pk=review.pk, status="submitted").update(
-            status="returned", return_comment=comment, returned_at=now,
-            version=F("version") + 1, updated_at=now)
-        review.refresh_from_db()
-        if not updated:
-            raise ReviewClosed(f"review {review.pk} is {review.get_status_display().lower()}; "
-                               "only a submitted review can be returned")
-        ReviewEvent.objects.create(review=review, user=reviewer, action="return",
-                                   before={"status": "submitted"},
-                                   after={"status": "returned", "comment": comment})
-        on_review_submitted(review)
-    return review
 
 
 def assignment_summary(capture_ids):
