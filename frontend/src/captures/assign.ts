@@ -25,8 +25,16 @@ export function assignmentBar(projects: Project[], project: () => number | null,
     return role === "reviewer" || role === "admin";
   };
 
+  // The annotators ticked and "each to N" survive redraws (ticking another capture redraws
+  // the bar), and only the newest redraw may draw: members load asynchronously.
+  const chosen = new Set<string>();
+  let perCapture = "";
+  let latest = 0;
+  const members = new Map<number, Promise<Member[]>>();
+
   const draw = async () => {
     const id = project();
+    const request = ++latest;
     if (!selection.size) {
       el.hidden = true;
       return;
@@ -36,17 +44,21 @@ export function assignmentBar(projects: Project[], project: () => number | null,
       clear(el, h("span", { class: "muted" }, id ? "Only the project's reviewers and admins assign captures." : "Pick one project in the filter to assign its captures."));
       return;
     }
-    const members = await get<Member[]>(`/api/projects/${id}/members/`);
-    const boxes = members.map((m) => {
-      const box = h("input", { type: "checkbox", value: m.username, "data-testid": `assign-to-${m.username}` });
-      return { box, label: h("label", { class: "check" }, box, m.username) };
+    if (!members.has(id)) members.set(id, get<Member[]>(`/api/projects/${id}/members/`));
+    const people = await members.get(id)!;
+    if (request !== latest) return;
+    const boxes = people.map((m) => {
+      const box = h("input", { type: "checkbox", value: m.username, checked: chosen.has(m.username), "data-testid": `assign-to-${m.username}` });
+      box.addEventListener("change", () => (box.checked ? chosen.add(m.username) : chosen.delete(m.username)));
+      return h("label", { class: "check" }, box, m.username);
     });
-    const each = h("input", { class: "input input-small", type: "number", min: 1, placeholder: "all", "data-testid": "assign-per-capture", "aria-label": "annotators per capture" });
+    const each = h("input", { class: "input input-small", type: "number", min: 1, placeholder: "all", value: perCapture, "data-testid": "assign-per-capture", "aria-label": "annotators per capture" });
+    each.addEventListener("input", () => (perCapture = each.value));
     const go = async () => {
-      const annotators = boxes.filter((b) => b.box.checked).map((b) => b.box.value);
+      const annotators = people.map((m) => m.username).filter((u) => chosen.has(u));
       if (!annotators.length) return toast("Tick at least one annotator.", "error");
       try {
-        const made = await assign(id, [...selection], annotators, each.value ? Number(each.value) : null);
+        const made = await assign(id, [...selection], annotators, perCapture ? Number(perCapture) : null);
         toast(`${made.length} assignment${made.length === 1 ? "" : "s"} made.`);
         selection.clear();
         reload();
@@ -58,7 +70,7 @@ export function assignmentBar(projects: Project[], project: () => number | null,
     clear(
       el,
       h("b", {}, `Assign ${selection.size} capture${selection.size === 1 ? "" : "s"} to`),
-      ...boxes.map((b) => b.label),
+      ...boxes,
       h("span", { class: "muted" }, "each capture to"),
       each,
       h("span", { class: "muted" }, "of them"),
