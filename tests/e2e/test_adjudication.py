@@ -180,6 +180,11 @@ def test_tiers_feed_the_gold_tier_with_undo_snap_and_the_409_rule(live_server, n
     page.mouse.move(lane["x"] + c1 / n * lane["width"] + 3, handle["y"] + 10, steps=5)
     page.mouse.up()
     expect(page.get_by_test_id("gold-selected-cut")).to_contain_text(f"at {c1}")
+    # D deletes the selected gold cut; undo brings it back.
+    page.keyboard.press("d")
+    expect(gold.locator(".tier-cut")).to_have_count(1)
+    page.keyboard.press("z")
+    expect(gold.locator(".tier-cut")).to_have_count(2)
     page.get_by_test_id("save-gold").click()
     expect(page.get_by_test_id("gold-status")).to_have_text("Saved")
     assert Adjudication.objects.get(capture=ingested_capture).cuts == [c0, c1]
