@@ -116,6 +116,11 @@ def test_an_admin_edits_the_taxonomy_and_the_palette_applies_a_label(live_server
     alice.get_by_test_id("new-label").get_by_role("button").click()
     expect(alice.get_by_test_id("label-row-cartwheel")).to_be_visible()
     assert [label.name for label in project.labels.all()][:2] == ["punch", "walk"]
+    alice.get_by_test_id("label-color-punch").fill("#123456")
+    expect(alice.locator(".toast", has_text="punch: new colour.")).to_be_visible()
+    alice.get_by_test_id("label-hotkey-crouch").select_option("6")
+    expect(alice.locator(".toast", has_text="crouch answers to 6.")).to_be_visible()
+    assert project.labels.get(name="punch").color == "#123456"
 
     # Twelve labels in use: the annotator applies one by typing its name in the palette.
     ann = new_page("ann")
@@ -130,3 +135,6 @@ def test_an_admin_edits_the_taxonomy_and_the_palette_applies_a_label(live_server
     expect(ann.get_by_test_id("save-state")).to_have_text("Saved")
     review = Review.objects.get(capture=ingested_capture, annotator=studio["ann"])
     assert review.segments()[0][3] == "cartwheel"
+    # The new hotkey applies its label at once.
+    ann.keyboard.press("6")
+    expect(ann.get_by_test_id("current-segment")).to_contain_text("labelled crouch")
