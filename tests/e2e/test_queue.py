@@ -181,4 +181,6 @@ def test_a_project_can_keep_annotators_to_their_assignments(live_server, new_pag
 
     ann = new_page("ann")
     ann.goto(f"{live_server.url}/captures/{takes[2].pk}/")
-    expect(ann.get_by_text("is not assigned to you")).to_be_visible()
+    expect(ann.get_by_test_id("review-refused")).to_contain_text("is not assigned to you")
+    ann.get_by_role("link", name="← My queue").click()
+    expect(ann.get_by_test_id("queue-rows")).to_contain_text("Nothing is assigned yet.")

@@ -2,7 +2,7 @@
 // activity log at the side. Every edit is applied on screen at once and saved through
 // the API straight away (saver.ts); undo/redo are edits too, so the audit log is complete.
 
-import { get, post } from "../api/client";
+import { ApiError, get, post } from "../api/client";
 import type { Capture, Cut, Label, Me, Project, Review, ReviewEvent, Segment, Signal, SignalResponse } from "../api/types";
 import { advance, frameOf, nextSpeed, seek, togglePlay, type Playback } from "../player/clock";
 import { SkeletonView } from "../player/skeletonView";
@@ -42,6 +42,12 @@ export async function renderReview(root: HTMLElement, captureId: number): Promis
     return () => page.dispose();
   } catch (err) {
     frames.abort.abort();
+    // A refusal (e.g. a capture not assigned to an annotator who may not pick it) says so
+    // and points to the caller's queue instead of a generic error page.
+    if (err instanceof ApiError && err.status === 403) {
+      clear(root, h("div", { class: "loading-page", "data-testid": "review-refused" }, h("h1", {}, capture.name), h("p", { class: "error-text" }, err.message), h("a", { href: "/queue/" }, "← My queue")));
+      return () => {};
+    }
     throw err;
   }
 }
