@@ -224,10 +224,11 @@ class AdjudicationView(APIView):
         data = body.validated_data
         source = None
         if data.get("source_review") is not None:
-            source = Review.objects.filter(pk=data["source_review"], capture=capture).first()
+            source = Review.objects.filter(pk=data["source_review"], capture=capture,
+                                           status="submitted").first()
             if source is None:
                 raise ValueError(f"source_review: review {data['source_review']} is not a "
-                                 "review of this capture")
+                                 "submitted review of this capture")
         try:
             library.do_save_gold(capture, request.user, data["cuts"], data["labels"],
                                  data["version"], source)

@@ -67,3 +67,14 @@ class ReturnTestCase(BaseTestCase):
         r = self.give_back()
         self.assertEqual(r.status_code, 400)
         self.assertIn("only a submitted review", r.json()["detail"])
+
+    def test_a_returned_review_cannot_be_the_source_of_gold(self):
+        self.give_back()
+        # rachel's own submitted review means gold could be saved, just not from bob's.
+        self.client.post(self.review_url)
+        self.client.post(self.review_url + "submit/", {"version": 1}, format="json")
+        url = f"/api/captures/{self.capture.pk}/adjudication/"
+        r = self.client.put(url, {"cuts": [], "labels": ["walk"], "version": 0,
+                                  "source_review": self.review.pk}, format="json")
+        self.assertEqual(r.status_code, 400)
+        self.assertIn("not a submitted review", r.json()["detail"])
