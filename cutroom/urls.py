@@ -11,6 +11,8 @@ urlpatterns = [
     path("api/", include("segmentation.api.urls")),
     path("login/", throttled_sign_in(auth_views.LoginView.as_view()), name="login"),
     path("logout/", views.logout_view, name="logout"),
+    path("favicon.ico", views.favicon),
+    path("favicon.svg", views.favicon, name="favicon"),
     path("", views.app, name="app"),
-    re_path(r"^(?P<path>(captures|library|projects)(/.*)?)$", views.app),
+    re_path(r"^(?P<path>(captures|library|projects|queue)(/.*)?)$", views.app),
 ]

@@ -152,6 +152,12 @@ def dashboard(project):
             "boundary_f1": summary.boundary_f1 if summary else None,
             "label_agreement": summary.label_agreement if summary else None,
         })
+    from segmentation.services.assignments import assignment_summary
+
+    team = assignment_summary([row["id"] for row in rows])
+    for row in rows:
+        row["assigned"] = team[row["id"]]["assigned"]
+        row["review_states"] = team[row["id"]]["reviews"]
     return {"project": project.pk, "states": counts, "captures": rows,
             "annotators": annotator_throughput(project), "labels": label_agreement(summaries),
             "library": library_counts(project)}

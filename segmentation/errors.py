@@ -33,3 +33,7 @@ class StaleVersion(Exception):
 
 class ReviewStarted(ValueError):
     """Someone started reviewing the capture, so its candidates can no longer change."""
+
+
+class NotAllowed(PermissionError):
+    """The caller's role does not allow the action: a 403 whose text says who may."""

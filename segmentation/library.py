@@ -223,10 +223,30 @@ def file_name(segment):
 
 
 def bvh_text(take, segment):
-    """The segment's frames as BVH with the take's own hierarchy and frame time."""
+    """The segment's frames as BVH with the take's own hierarchy and frame time.
+
+    A cgspeed BVH's added T-pose frame (``take.rest_pose_frame``) is not part of the
+    performance, so a clip that starts on or before it starts just after it.
+    """
+    start = segment.start
+    if take.rest_pose_frame is not None and start <= take.rest_pose_frame < segment.stop - 1:
+        start = take.rest_pose_frame + 1
     out = io.StringIO()
-    motionlib.write_bvh(take, out, start=segment.start, stop=segment.stop)
+    motionlib.write_bvh(take, out, start=start, stop=segment.stop)
     return out.getvalue()
+
+
+def unique_name(name, segment, used):
+    """``name``, or with the annotator (then the segment id) added if the archive already
+    holds it: two annotators' versions of one range and label would share a name."""
+    if name in used:
+        stem, dot, ext = name.rpartition(".")
+        who = slug(segment.annotator.username) if segment.annotator else "gold"
+        name = f"{stem}_{who}{dot}{ext}"
+        if name in used:
+            name = f"{stem}_{who}_{segment.pk}{dot}{ext}"
+    used.add(name)
+    return name
 
 
 def manifest_row(segment, name, fmt="bvh"):
@@ -267,7 +287,7 @@ def stream_zip(segments, fmt="bvh"):
     segments are left out and ``errors.txt`` says why.
     """
     sink = _Sink()
-    manifest, errors = [], []
+    manifest, errors, used = [], [], set()
     with zipfile.ZipFile(sink, "w", compression=zipfile.ZIP_DEFLATED) as archive:
         for _, group in itertools.groupby(segments, key=lambda s: s.capture_id):
             group = list(group)
@@ -275,6 +295,7 @@ def stream_zip(segments, fmt="bvh"):
             try:
                 take = read_take(capture)
                 for segment, name, data in _clips(capture, take, group, fmt):
+                    name = unique_name(name, segment, used)
                     archive.writestr(name, data)
                     manifest.append(manifest_row(segment, name, fmt))
                     yield sink.drain()

@@ -39,6 +39,8 @@ class Project(models.Model):
     name = models.CharField(max_length=200)
     default_method = models.CharField(max_length=100, blank=True)
     default_params = models.JSONField(default=dict, blank=True)
+    # Whether annotators may start reviewing captures nobody assigned to them.
+    annotators_pick_unassigned = models.BooleanField(default=True)
     created_at = models.DateTimeField(default=timezone.now)
 
     objects = ProjectQuerySet.as_manager()
@@ -82,9 +84,13 @@ class Label(models.Model):
     color = models.CharField(max_length=7, default="#888888")
     # NULL, not "", means "no hotkey" so that only real hotkeys must be unique.
     hotkey = models.CharField(max_length=1, null=True, blank=True)  # noqa: DJ001
+    # The taxonomy's order in the app; a retired label stays on existing segments but
+    # is no longer offered for new ones.
+    position = models.PositiveIntegerField(default=0)
+    retired = models.BooleanField(default=False)
 
     class Meta:
-        ordering = ["id"]
+        ordering = ["position", "id"]
         constraints = [
             models.UniqueConstraint(fields=["project", "name"], name="unique_label_name"),
             models.UniqueConstraint(
@@ -304,7 +310,10 @@ class Review(models.Model):
     version is refused instead of merged.
     """
 
-    STATUSES = (("in_progress", "In progress"), ("submitted", "Submitted"))
+    # "returned": a reviewer sent a submitted review back with ``return_comment``; it
+    # takes edits again and counts nowhere until it is submitted again.
+    STATUSES = (("in_progress", "In progress"), ("submitted", "Submitted"), ("returned", "Returned"))
+    EDITABLE = ("in_progress", "returned")
 
     capture = models.ForeignKey(Capture, models.CASCADE, related_name="reviews")
     annotator = models.ForeignKey(settings.AUTH_USER_MODEL, models.CASCADE, related_name="reviews")
@@ -314,6 +323,8 @@ class Review(models.Model):
     created_at = models.DateTimeField(default=timezone.now)
     updated_at = models.DateTimeField(default=timezone.now)
     submitted_at = models.DateTimeField(null=True, blank=True)
+    return_comment = models.TextField(blank=True)
+    returned_at = models.DateTimeField(null=True, blank=True)
 
     class Meta:
         ordering = ["id"]
@@ -469,6 +480,7 @@ class ProjectCutModel(Job):
 
 # The clip library and agreement records, and invitations, live in their own modules
 # (same app, same migrations); importing them here registers them with the app.
+from segmentation.models_assignments import Assignment  # noqa: E402, F401
 from segmentation.models_invitations import Invitation  # noqa: E402, F401
 from segmentation.models_library import (  # noqa: E402, F401
     Adjudication,

@@ -54,7 +54,9 @@ class CaptureViewSet(
             runs = DetectionRun.objects.defer("candidates", "params", "timings").annotate(
                 n_candidates=JSONArrayLength("candidates")
             )
-            captures = captures.defer("skeleton").prefetch_related(Prefetch("runs", runs))
+            captures = captures.defer("skeleton").prefetch_related(
+                Prefetch("runs", runs), "assignments__annotator", "reviews__annotator"
+            )
             captures = captures.annotate(review_started=Exists(Review.objects.filter(capture=OuterRef("pk"))))
         else:
             captures = captures.prefetch_related("runs")

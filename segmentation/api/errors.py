@@ -2,6 +2,7 @@
 
 - ``StaleVersion`` -> 409 with the current review;
 - ``UploadTooLarge`` -> 413;
+- ``NotAllowed`` (a role refusal on a project the caller sees) -> 403;
 - any other ``ValueError`` (motionlib's ``CaptureError``/``ParamError``, the service's
   own) -> 400 with its message, which names the field, file, line or value at fault;
 - DRF's own errors keep their status, and always carry a readable ``detail``.
@@ -9,14 +10,17 @@
 
 import re
 
+from django.http import Http404
 from rest_framework import status
+from rest_framework.exceptions import NotFound
 from rest_framework.response import Response
 from rest_framework.views import exception_handler as drf_exception_handler
 
 from motionlib.segmenters import ParamError
-from segmentation.errors import StaleVersion, UploadTooLarge
+from segmentation.errors import NotAllowed, StaleVersion, UploadTooLarge
 
 FIELD = re.compile(r"^(\w+): (.+)$", re.DOTALL)
+NO_MATCH = re.compile(r"^No (\w+) matches the given query\.$")
 
 
 def exception_handler(exc, context):
@@ -25,9 +29,15 @@ def exception_handler(exc, context):
 
         body = {"detail": str(exc), "review": ReviewSerializer(exc.review).data}
         return Response(body, status=status.HTTP_409_CONFLICT)
+    if isinstance(exc, NotAllowed):
+        return Response({"detail": str(exc)}, status=status.HTTP_403_FORBIDDEN)
     if isinstance(exc, ValueError):
         code = 413 if isinstance(exc, UploadTooLarge) else 400
         return Response(_value_error_body(exc), status=code)
+    if isinstance(exc, Http404):
+        # Django's "No Cut matches the given query." names a model class, not a thing.
+        found = NO_MATCH.match(str(exc))
+        exc = NotFound(f"No such {_words(found.group(1))}." if found else "Not found.")
     response = drf_exception_handler(exc, context)
     if response is not None and isinstance(response.data, dict) and "detail" not in response.data:
         response.data = {"detail": _summary(response.data), **response.data}
@@ -56,3 +66,8 @@ def _summary(data):
     if isinstance(data, list):
         return " ".join(_summary(item) for item in data)
     return str(data)
+
+
+def _words(class_name):
+    """"SegmentLabel" -> "segment label"."""
+    return re.sub(r"(?<!^)(?=[A-Z])", " ", class_name).lower()

@@ -17,7 +17,7 @@ from django.http import HttpResponse, StreamingHttpResponse
 from django.urls import path
 from drf_spectacular.utils import OpenApiParameter, extend_schema
 from rest_framework import serializers
-from rest_framework.exceptions import NotFound
+from rest_framework.exceptions import NotFound, PermissionDenied
 from rest_framework.pagination import PageNumberPagination
 from rest_framework.response import Response
 from rest_framework.views import APIView
@@ -175,10 +175,12 @@ class SimilarView(APIView):
 
 
 def staff_capture(user, pk):
-    """A capture whose project the user reviews or administers, else 404."""
+    """A capture whose project the user reviews or administers; 404 for outsiders, 403
+    (saying why) for an annotator, who sees the capture anyway."""
     capture = capture_for(user, pk)
     if not capture.project.can_see_all_reviews(user):
-        raise NotFound("No such capture.")
+        raise PermissionDenied("Only the project's reviewers and admins see agreement and "
+                               "adjudicate; you annotate in this project.")
     return capture
 
 
@@ -243,10 +245,11 @@ class AdjudicationView(APIView):
         data = body.validated_data
         source = None
         if data.get("source_review") is not None:
-            source = Review.objects.filter(pk=data["source_review"], capture=capture).first()
+            source = Review.objects.filter(pk=data["source_review"], capture=capture,
+                                           status="submitted").first()
             if source is None:
                 raise ValueError(f"source_review: review {data['source_review']} is not a "
-                                 "review of this capture")
+                                 "submitted review of this capture")
         try:
             library.do_save_gold(capture, request.user, data["cuts"], data["labels"],
                                  data["version"], source)
@@ -260,7 +263,7 @@ class DashboardView(APIView):
     def get(self, request, pk):
         project = project_for(request.user, pk)
         if not project.can_see_all_reviews(request.user):
-            raise NotFound("No such project.")
+            raise PermissionDenied("Only the project's reviewers and admins see its dashboard.")
         return Response(agreement.dashboard(project))
 
 

@@ -62,6 +62,8 @@ class ProjectViewSet(
     def members(self, request, pk=None):
         project = self._admin_project()
         if request.method == "GET":
+            if not project.can_see_all_reviews(request.user):
+                raise PermissionDenied("Only the project's reviewers and admins see its members.")
             members = project.memberships.select_related("user").order_by("id")
             return Response(MemberSerializer(members, many=True).data)
         serializer = MemberSerializer(data=request.data)
@@ -108,10 +110,12 @@ class MeView(APIView):
             {"id": m.project_id, "name": m.project.name, "role": m.role}
             for m in request.user.memberships.select_related("project").order_by("project_id")
         ]
+        from segmentation.services.team import can_create_accounts
+
         # What the service admits, so the pages refuse the same (e.g. a skeleton too big to draw).
         limits = {"max_joints": services.captures.input_limits().max_joints}
         return Response({"id": request.user.pk, "username": request.user.username, "projects": projects,
-                         "limits": limits})
+                         "limits": limits, "can_create_accounts": can_create_accounts(request.user)})
 
 
 class MethodsView(APIView):

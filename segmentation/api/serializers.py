@@ -20,7 +20,8 @@ class LabelSerializer(serializers.ModelSerializer):
 
     class Meta:
         model = Label
-        fields = ["id", "name", "color", "hotkey"]
+        fields = ["id", "name", "color", "hotkey", "position", "retired"]
+        read_only_fields = ["position", "retired"]
         # Uniqueness is checked by the service with a message naming the clash.
         validators = []
 
@@ -31,6 +32,7 @@ class ProjectSerializer(serializers.Serializer):
     role = serializers.SerializerMethodField()
     default_method = serializers.CharField(required=False, allow_blank=True, default="")
     default_params = serializers.DictField(required=False, default=dict)
+    annotators_pick_unassigned = serializers.BooleanField(required=False, default=True)
     labels = LabelSerializer(many=True, read_only=True)
 
     def get_role(self, project) -> str | None:
@@ -127,9 +129,18 @@ class CaptureListSerializer(CaptureSerializer):
     latest_run = RunSummarySerializer(read_only=True, allow_null=True)
     # Someone opened it for review: its candidates can no longer be re-detected.
     review_started = serializers.BooleanField(read_only=True, default=False)
+    team = serializers.SerializerMethodField()
 
     class Meta(CaptureSerializer.Meta):
-        fields = [f for f in CaptureSerializer.Meta.fields if f != "skeleton"] + ["review_started"]
+        fields = [f for f in CaptureSerializer.Meta.fields if f != "skeleton"] + ["review_started", "team"]
+
+    def get_team(self, capture) -> dict:
+        """Who is assigned, and each review's annotator and state (from the prefetch)."""
+        return {
+            "assigned": [a.annotator.username for a in capture.assignments.all()],
+            "reviews": [{"id": r.pk, "annotator": r.annotator.username, "status": r.status}
+                        for r in sorted(capture.reviews.all(), key=lambda r: r.pk)],
+        }
 
 
 class UploadSerializer(serializers.Serializer):
@@ -156,7 +167,7 @@ class ReviewSerializer(serializers.ModelSerializer):
     class Meta:
         model = Review
         fields = [
-            "id", "capture", "annotator", "run", "status", "version", "cuts", "segments",
+            "id", "capture", "annotator", "run", "status", "version", "return_comment", "cuts", "segments",
             "adaptation",
         ]
 

@@ -3,7 +3,7 @@ from drf_spectacular.views import SpectacularAPIView, SpectacularSwaggerSplitVie
 from rest_framework.routers import SimpleRouter
 
 from cutroom.accounts import api as accounts_api
-from segmentation.api import invitations, library, reviews
+from segmentation.api import assignments, invitations, library, reviews, team
 from segmentation.api.captures import CaptureViewSet
 from segmentation.api.projects import MethodsView, MeView, ProjectViewSet
 
@@ -28,5 +28,7 @@ urlpatterns = [
     path("captures/<int:pk>/reviews/", reviews.AllReviewsView.as_view(), name="api-reviews"),
     *library.urlpatterns,
     *invitations.urlpatterns,
+    *assignments.urlpatterns,
+    *team.urlpatterns,
     *router.urls,
 ]

@@ -11,12 +11,14 @@ from segmentation.services.captures import validate_method
 COLOR = re.compile(r"^#[0-9a-fA-F]{6}$")
 
 
-def do_create_project(user, name, default_method="", default_params=None):
+def do_create_project(user, name, default_method="", default_params=None,
+                      annotators_pick_unassigned=True):
     """A new project with ``user`` as its admin; ParamError names a bad default."""
     params = checked_defaults(default_method, default_params)
     with transaction.atomic():
         project = Project.objects.create(
-            name=name, default_method=default_method or "", default_params=params
+            name=name, default_method=default_method or "", default_params=params,
+            annotators_pick_unassigned=annotators_pick_unassigned,
         )
         Membership.objects.create(project=project, user=user, role="admin")
     return project
@@ -46,12 +48,15 @@ def do_set_member(project, username, role):
     user = get_user_model().objects.filter(username=username).first()
     if user is None:
         raise ValueError(f"username: no user named {username!r}")
-    demoted = project.role_of(user) == "admin" and role != "admin"
-    if demoted and project.memberships.filter(role="admin").count() == 1:
-        raise ValueError(f"role: {username!r} is the project's only admin; add another admin first")
-    membership, _ = Membership.objects.update_or_create(
-        project=project, user=user, defaults={"role": role}
-    )
+    with transaction.atomic():
+        # The project row lock serialises role changes (see services.team).
+        Project.objects.select_for_update().get(pk=project.pk)
+        demoted = project.role_of(user) == "admin" and role != "admin"
+        if demoted and project.memberships.filter(role="admin").count() == 1:
+            raise ValueError(f"role: {username!r} is the project's only admin; add another admin first")
+        membership, _ = Membership.objects.update_or_create(
+            project=project, user=user, defaults={"role": role}
+        )
     return membership
 
 
@@ -68,4 +73,6 @@ def do_add_label(project, name, color="#888888", hotkey=None):
         raise ValueError(f"name: the project already has a label {name!r}")
     if hotkey and project.labels.filter(hotkey=hotkey).exists():
         raise ValueError(f"hotkey: {hotkey!r} is already used by another label")
-    return Label.objects.create(project=project, name=name, color=color.lower(), hotkey=hotkey)
+    position = project.labels.count()  # new labels go to the end of the taxonomy
+    return Label.objects.create(project=project, name=name, color=color.lower(), hotkey=hotkey,
+                                position=position)

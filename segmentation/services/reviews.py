@@ -25,6 +25,9 @@ def get_or_create_review(capture, user):
         raise NotReady(
             f"capture {capture.pk} is {capture.status}; it can be reviewed once it is ready"
         )
+    from segmentation.services.assignments import check_may_start
+
+    check_may_start(capture, user)
     try:
         with transaction.atomic():
             return _create_review(capture, user)
@@ -54,7 +57,7 @@ def _create_review(capture, user):
 
 def _write(review, version):
     """Claim the next version of ``review`` or raise StaleVersion / ReviewClosed."""
-    updated = Review.objects.filter(pk=review.pk, version=version, status="in_progress").update(
+    updated = Review.objects.filter(pk=review.pk, version=version, status__in=Review.EDITABLE).update(
         version=F("version") + 1, updated_at=timezone.now()
     )
     review.refresh_from_db()
@@ -129,6 +132,8 @@ def do_label_segment(review, user, index, label_name, version):
         label = None
         if label_name is not None:
             label = review.capture.project.labels.filter(name=label_name).first()
+            if label is not None and label.retired:
+                raise ValueError(f"label: {label_name!r} is retired; pick a label in use")
             if label is None:
                 names = ", ".join(review.capture.project.labels.values_list("name", flat=True))
                 raise ValueError(f"label: {label_name!r} is not a label of this project ({names})")
@@ -143,10 +148,13 @@ def do_label_segment(review, user, index, label_name, version):
 def do_submit_review(review, user, version):
     with transaction.atomic():
         _write(review, version)
+        was = review.status  # as of the write that claimed the version
         now = timezone.now()
         Review.objects.filter(pk=review.pk).update(status="submitted", submitted_at=now)
         review.status, review.submitted_at = "submitted", now
-        _log(review, user, "submit", before={"status": "in_progress"}, after={"status": "submitted"})
+        # A returned review submitted again is a "resubmit" in the audit log.
+        action = "resubmit" if was == "returned" else "submit"
+        _log(review, user, action, before={"status": was}, after={"status": "submitted"})
         # Materialise the capture's library rows and agreement with the submit itself.
         from segmentation.library import on_review_submitted
 

@@ -24,19 +24,21 @@ def test_it_makes_a_gold_version_from_two_annotators_reviews(live_server, new_pa
     page.goto(f"{live_server.url}/captures/{ingested_capture.pk}/adjudicate/")
     expect(page.get_by_test_id("adj-title")).to_have_text(f"Adjudicate {ingested_capture.name}")
     # Both annotators' versions are overlaid; their cuts at c0 and c2 agree exactly.
-    expect(page.get_by_test_id("track-ann").locator(".adj-seg")).to_have_count(4)
-    expect(page.get_by_test_id("track-bob").locator(".adj-seg")).to_have_count(3)
+    expect(page.get_by_test_id("track-ann").locator(".tier-seg")).to_have_count(4)
+    expect(page.get_by_test_id("track-bob").locator(".tier-seg")).to_have_count(3)
     expect(page.get_by_test_id("agreement-f1")).to_have_text("0.80")
     expect(page.get_by_test_id("gold-status")).to_have_text("Unsaved changes")
+    # Disagreements are marked where they are: the cut only ann made, and the range
+    # where ann says squat and bob says punch.
+    expect(page.get_by_test_id("track-ann-cut-0")).to_have_attribute("data-mark", "agreed")
+    expect(page.get_by_test_id("track-ann-cut-1")).to_have_attribute("data-mark", "lone")
+    expect(page.get_by_test_id("label-conflict-0")).to_be_visible()
 
     page.get_by_test_id("use-ann").click()
     gold = page.get_by_test_id("track-gold")
-    expect(gold.locator(".adj-seg")).to_have_count(4)
+    expect(gold.locator(".tier-seg")).to_have_count(4)
     gold.get_by_test_id("track-gold-seg-2").click()
-    # Picking a segment also plays it beside the editor.
-    expect(page.get_by_test_id("preview")).to_have_attribute("data-playing", f"gold:{cuts[1]}")
-    page.get_by_test_id("track-bob-seg-1").click()
-    expect(page.get_by_test_id("preview-caption")).to_have_text(f"bob · punch · frames {cuts[0]}–{cuts[2]}")
+    expect(page.get_by_test_id("gold-segment")).to_contain_text(f"frames {cuts[1]}–{cuts[2]}")
     page.get_by_test_id("gold-label").select_option("walk")
     expect(gold.get_by_test_id("track-gold-seg-2")).to_have_text("walk")
     page.get_by_test_id("save-gold").click()
@@ -74,6 +76,9 @@ def test_it_makes_a_gold_version_from_two_annotators_reviews(live_server, new_pa
     similar_rows = page.locator("[data-testid=segment-rows] tr[data-testid^=segment-]")
     expect(similar_rows).to_have_count(3)
     expect(similar_rows.first).to_contain_text("d ")
+    # Distances are headed as distances, and the count is of the similar clips shown.
+    expect(page.get_by_test_id("metric-head")).to_have_text("Distance")
+    expect(page.get_by_test_id("segment-count")).to_have_text("3 similar clips")
 
     page.goto(f"{live_server.url}/projects/{studio['project'].pk}/dashboard/")
     expect(page.get_by_test_id("state-adjudicated")).to_have_text("1")
@@ -91,12 +96,12 @@ def test_it_refuses_the_adjudication_view_to_an_annotator(live_server, new_page,
     two_reviews(ingested_capture, studio)
     page = new_page("bob")
     page.goto(f"{live_server.url}/captures/{ingested_capture.pk}/adjudicate/")
-    expect(page.get_by_text("No such capture.")).to_be_visible()
+    expect(page.get_by_text("Only the project's reviewers and admins see agreement")).to_be_visible()
     csrf = next(c["value"] for c in page.context.cookies() if c["name"] == "csrftoken")
     response = page.request.put(f"{live_server.url}/api/captures/{ingested_capture.pk}/adjudication/",
                                 data={"cuts": [], "labels": ["walk"], "version": 0},
                                 headers={"X-CSRFToken": csrf})
-    assert response.status == 404, response.text()
+    assert response.status == 403, response.text()
 
 
 def test_it_accepts_a_suggested_label_with_one_key(live_server, new_page, ingested_capture, studio):
@@ -133,4 +138,64 @@ def test_it_accepts_a_suggested_label_with_one_key(live_server, new_page, ingest
     assert segments[0]["label"] == "squat" and segments[0]["suggested_label"] is None
     suggested = [s["suggested_label"] for s in segments[1:]]
     assert suggested == ["punch", "squat", "jumping_jack", "squat"]
+    assert page.errors == []
+
+
+def test_tiers_feed_the_gold_tier_with_undo_snap_and_the_409_rule(live_server, new_page, ingested_capture, studio):
+    from segmentation.library import do_save_gold
+    from segmentation.models_library import Adjudication
+
+    _ann, (c0, c1, c2) = two_reviews(ingested_capture, studio)
+    n = ingested_capture.n_frames
+    page = new_page("rachel")
+    page.goto(f"{live_server.url}/captures/{ingested_capture.pk}/adjudicate/")
+    expect(page.get_by_test_id("viewport").locator("canvas")).to_be_visible()
+    gold = page.get_by_test_id("track-gold")
+    expect(gold.locator(".tier-seg")).to_have_count(1)
+    page.keyboard.press("?")
+    expect(page.get_by_test_id("help")).to_contain_text("take it into gold")
+    page.keyboard.press("?")
+    expect(page.get_by_test_id("help")).to_have_count(0)
+
+    # A tier's cut, then a tier's segment (its bounds and its label), into gold.
+    page.get_by_test_id("track-bob-cut-1").click()
+    expect(gold.locator(".tier-cut")).to_have_count(1)
+    page.get_by_test_id("track-ann-seg-1").click()
+    expect(gold.locator(".tier-cut")).to_have_count(3)
+    expect(gold.get_by_test_id("track-gold-seg-1")).to_have_text("punch")
+    page.keyboard.press("z")
+    expect(gold.locator(".tier-cut")).to_have_count(1)
+    page.keyboard.press("Shift+Z")
+    expect(gold.locator(".tier-cut")).to_have_count(3)
+    expect(page.get_by_test_id("hud-frame")).to_contain_text(f"Frame {c0}")
+
+    # Start over from bob's version (cuts c0, c2) and drag the c2 cut next to ann's c1:
+    # it snaps onto c1 exactly.
+    page.get_by_test_id("use-bob").click()
+    expect(gold.locator(".tier-cut")).to_have_count(2)
+    lane = gold.bounding_box()
+    handle = page.get_by_test_id("gold-cut-handle-1").bounding_box()
+    page.mouse.move(handle["x"] + handle["width"] / 2, handle["y"] + 10)
+    page.mouse.down()
+    page.mouse.move(lane["x"] + c1 / n * lane["width"] + 3, handle["y"] + 10, steps=5)
+    page.mouse.up()
+    expect(page.get_by_test_id("gold-selected-cut")).to_contain_text(f"at {c1}")
+    # D deletes the selected gold cut; undo brings it back.
+    page.keyboard.press("d")
+    expect(gold.locator(".tier-cut")).to_have_count(1)
+    page.keyboard.press("z")
+    expect(gold.locator(".tier-cut")).to_have_count(2)
+    page.get_by_test_id("save-gold").click()
+    expect(page.get_by_test_id("gold-status")).to_have_text("Saved")
+    assert Adjudication.objects.get(capture=ingested_capture).cuts == [c0, c1]
+
+    # Someone else saves meanwhile: this page's next save is refused (409) and shows theirs.
+    do_save_gold(ingested_capture, studio["alice"], [c2], ["walk", "kick"], version=1)
+    page.get_by_test_id("track-ann-cut-2").click()
+    page.get_by_test_id("save-gold").click()
+    expect(page.get_by_role("dialog")).to_contain_text("alice saved gold version 2")
+    page.get_by_test_id("dialog-ok").click()
+    expect(gold.locator(".tier-cut")).to_have_count(1)
+    saved = Adjudication.objects.get(capture=ingested_capture)
+    assert (saved.version, saved.cuts) == (2, [c2])
     assert page.errors == []

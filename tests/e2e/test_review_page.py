@@ -219,6 +219,12 @@ def test_it_shows_what_changed_when_the_review_was_edited_elsewhere(live_server,
     page.mouse.click(screen.x(second["frame"]), screen.signal_y())
     dialog = page.get_by_role("dialog")
     expect(dialog).to_contain_text("This review changed elsewhere")
+    # It says what happened in words: no internal review id, and no "reload" (it already
+    # shows the current version).
+    expect(dialog.get_by_test_id("conflict-text")).to_have_text(
+        "Your review was saved from another tab or window first. This page shows that version now.")
+    expect(dialog).not_to_contain_text(f"review {start['id']}")
+    expect(dialog).not_to_contain_text("reload")
     expect(dialog.get_by_test_id("conflict-changes")).to_contain_text(f"cut at frame {first['frame']} is deleted")
     expect(dialog.get_by_test_id("conflict-unsaved")).to_contain_text(f"accept cut at {second['frame']}")
     dialog.get_by_test_id("dialog-ok").click()

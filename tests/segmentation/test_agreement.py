@@ -65,11 +65,17 @@ class AgreementApiTest(LibraryTestCase):
         body = self.agreement(capture).json()
         assert body["n_reviews"] == 1 and body["pairs"] == [] and body["boundary_f1"] is None
 
-    def test_it_hides_agreement_from_annotators_and_outsiders(self):
+    def test_it_hides_agreement_from_outsiders(self):
         capture, _, _ = self.two_reviews()
-        for user in (self.bob, self.charlie):
-            self.login(user)
-            assert self.agreement(capture).status_code == 404
+        self.login(self.charlie)
+        assert self.agreement(capture).status_code == 404
+
+    def test_it_tells_an_annotator_agreement_is_for_reviewers(self):
+        capture, _, _ = self.two_reviews()
+        self.login(self.bob)
+        response = self.agreement(capture)
+        assert response.status_code == 403
+        assert "reviewers and admins" in response.json()["detail"]
 
     def test_it_rejects_a_bad_tolerance_naming_it(self):
         capture, _, _ = self.two_reviews()
@@ -143,10 +149,10 @@ class AdjudicationApiTest(LibraryTestCase):
             assert message in response.json()["detail"]
         assert not Adjudication.objects.exists()
 
-    def test_it_hides_adjudication_from_annotators(self):
+    def test_it_refuses_adjudication_to_annotators(self):
         self.login(self.bob)
-        assert self.client.get(self.url).status_code == 404
-        assert self.save([100], ["walk", "punch"]).status_code == 404
+        assert self.client.get(self.url).status_code == 403
+        assert self.save([100], ["walk", "punch"]).status_code == 403
         assert not LibrarySegment.objects.filter(is_gold=True).exists()
 
 
@@ -185,7 +191,11 @@ class DashboardApiTest(LibraryTestCase):
         live = self.client.get(f"/api/captures/{disputed.pk}/agreement/").json()
         assert (row["boundary_f1"], row["label_agreement"]) == (live["boundary_f1"], live["labels"]["value"])
 
-    def test_it_hides_the_dashboard_from_annotators_and_outsiders(self):
-        for user in (self.bob, self.charlie):
-            self.login(user)
-            assert self.client.get(f"/api/projects/{self.project.pk}/dashboard/").status_code == 404
+    def test_it_hides_the_dashboard_from_outsiders(self):
+        self.login(self.charlie)
+        assert self.client.get(f"/api/projects/{self.project.pk}/dashboard/").status_code == 404
+
+    def test_it_tells_an_annotator_the_dashboard_is_for_reviewers(self):
+        self.login(self.bob)
+        response = self.client.get(f"/api/projects/{self.project.pk}/dashboard/")
+        assert response.status_code == 403 and "reviewers and admins" in response.json()["detail"]

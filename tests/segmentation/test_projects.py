@@ -9,7 +9,8 @@ class ProjectsTestCase(BaseTestCase):
         self.assertEqual([p["name"] for p in projects], ["Studio A"])
         self.assertEqual(projects[0]["role"], "annotator")
         self.assertEqual(
-            projects[0]["labels"][0], {"id": self.walk.pk, "name": "walk", "color": "#2563eb", "hotkey": "1"}
+            projects[0]["labels"][0], {"id": self.walk.pk, "name": "walk", "color": "#2563eb", "hotkey": "1",
+             "position": 0, "retired": False}
         )
 
     def test_it_makes_the_creator_admin(self):

@@ -5,6 +5,9 @@ export interface Label {
   name: string;
   color: string;
   hotkey: string | null;
+  position?: number;
+  /** Retired: stays on existing segments, not offered for new ones. */
+  retired?: boolean;
 }
 
 export type Role = "annotator" | "reviewer" | "admin";
@@ -16,6 +19,7 @@ export interface Project {
   default_method: string;
   default_params: Record<string, unknown>;
   labels: Label[];
+  annotators_pick_unassigned?: boolean;
 }
 
 export interface Me {
@@ -24,6 +28,7 @@ export interface Me {
   projects: { id: number; name: string; role: Role }[];
   /** What the service admits (CUTROOM_MAX_JOINTS…). */
   limits?: { max_joints: number };
+  can_create_accounts?: boolean;
 }
 
 export interface Skeleton {
@@ -88,6 +93,8 @@ export interface CaptureSummary extends Omit<Capture, "skeleton" | "latest_run">
   latest_run: RunSummary | null;
   /** Someone opened it for review; its candidates can no longer be re-detected. */
   review_started?: boolean;
+  /** Who is assigned, and each review's annotator and state. */
+  team?: { assigned: string[]; reviews: { id: number; annotator: string; status: Review["status"] }[] };
 }
 
 export interface Page<T> {
@@ -146,8 +153,9 @@ export interface Review {
   capture: number;
   annotator: { id: number; username: string };
   run: number | null;
-  status: "in_progress" | "submitted";
+  status: "in_progress" | "submitted" | "returned";
   version: number;
+  return_comment?: string;
   cuts: Cut[];
   segments: Segment[];
   adaptation?: Adaptation;

@@ -1,10 +1,13 @@
 // The capture list: filter by project, status and name; drop files anywhere to upload
 // them (with progress); rows still being processed refresh themselves.
 
+import "../queue/queue.css";
 import { get, post } from "../api/client";
 import type { CaptureSummary, Me, Page, Project, Role } from "../api/types";
 import { clear, formatDuration, h, toast } from "../ui/dom";
 import { logoutButton } from "../ui/logout";
+import { appLinks } from "../ui/appnav";
+import { assignmentBar, teamCell } from "./assign";
 import { invitationsBox } from "./invitations";
 import { navigate } from "../router";
 import { pairFiles, upload, type UploadItem } from "./upload";
@@ -59,10 +62,13 @@ export async function renderCaptureList(root: HTMLElement): Promise<() => void> 
     searchDelay = window.setTimeout(() => apply({ ...filters, search: search.value.trim(), page: 1 }), 250);
   });
 
-  const uploadProject = () => Number(filters.project) || projects[0]?.id;
+  // With "All projects" selected and several projects, nothing says where a file should
+  // go: ask instead of guessing.
+  const uploadProject = () => Number(filters.project) || (projects.length === 1 ? projects[0].id : undefined);
   const startUploads = (files: File[]) => {
     const project = uploadProject();
-    if (!project) return toast("Create or join a project before uploading.", "error");
+    if (!projects.length) return toast("Create or join a project before uploading.", "error");
+    if (!project) return toast("Choose the project to upload to in the project filter first.", "error");
     const { items, problems } = pairFiles(files);
     problems.forEach((p) => toast(p, "error"));
     for (const item of items) {
@@ -95,11 +101,19 @@ export async function renderCaptureList(root: HTMLElement): Promise<() => void> 
     fileInput.value = "";
   });
 
+  const nav = h("span", { class: "nav-links" });
+  const drawNav = () => {
+    const project = projects.find((p) => String(p.id) === filters.project);
+    clear(nav, ...appLinks(project?.id ?? (projects.length === 1 ? projects[0].id : null), project?.role ?? (projects.length === 1 ? projects[0].role : null)));
+  };
+  const selection = new Set<number>();
+  const assignBar = assignmentBar(projects, () => Number(filters.project) || null, selection, () => void load());
+  drawNav();
   const dropzone = h("div", { class: "dropzone", "data-testid": "dropzone" }, h("b", {}, "Drop .bvh, or .amc with its .asf, here"), h("span", {}, " or "), h("button", { class: "btn btn-primary", onclick: () => fileInput.click() }, "Choose files"));
   const page = h(
     "div",
     { class: "list-page" },
-    h("header", { class: "topbar" }, h("a", { class: "brand", href: "/" }, "Cutroom"), h("nav", { class: "crumbs" }, h("strong", {}, "Captures")), h("span", { class: "spacer" }), h("a", { class: "btn btn-ghost", href: "/library/", "data-testid": "nav-library" }, "Library"), h("span", { class: "user" }, me.username), logoutButton()),
+    h("header", { class: "topbar" }, h("a", { class: "brand", href: "/" }, "Cutroom"), h("nav", { class: "crumbs" }, h("strong", {}, "Captures")), h("span", { class: "spacer" }), nav, h("span", { class: "user" }, me.username), logoutButton()),
     h(
       "main",
       { class: "list-main" },
@@ -114,10 +128,11 @@ export async function renderCaptureList(root: HTMLElement): Promise<() => void> 
       dropzone,
       fileInput,
       uploads,
+      assignBar.el,
       h(
         "table",
         { class: "captures" },
-        h("thead", {}, h("tr", {}, ...["Name", "Project", "Status", "Frames", "Duration", "fps", "Joints", "Cuts", "Uploaded"].map((t) => h("th", {}, t)))),
+        h("thead", {}, h("tr", {}, h("th", {}, ""), ...["Name", "Project", "Status", "Frames", "Duration", "fps", "Joints", "Cuts", "Team", "Uploaded"].map((t) => h("th", {}, t)))),
         rows,
       ),
       pager,
@@ -144,13 +159,13 @@ export async function renderCaptureList(root: HTMLElement): Promise<() => void> 
     const q = new URLSearchParams(queryOf(filters).slice(1));
     const data = await get<Page<CaptureSummary>>(`/api/captures/?${q}`).catch((err: Error) => {
       if (request !== latest || !mounted) return null;
-      clear(rows, h("tr", {}, h("td", { colspan: 9, class: "error-text" }, `Could not load captures: ${err.message} (trying again)`)));
+      clear(rows, h("tr", {}, h("td", { colspan: 11, class: "error-text" }, `Could not load captures: ${err.message} (trying again)`)));
       timer = window.setTimeout(() => void load(), 4000);
       return null;
     });
     if (!data || request !== latest || !mounted) return;
-    clear(rows, ...data.results.map((c) => row(c, projectName.get(c.project) ?? String(c.project), projectRole.get(c.project), load)));
-    if (!data.results.length) rows.append(h("tr", {}, h("td", { colspan: 9, class: "muted empty" }, "No captures match. Drop a file above to add one.")));
+    clear(rows, ...data.results.map((c) => row(c, projectName.get(c.project) ?? String(c.project), projectRole.get(c.project), load, assignBar.checkbox(c))));
+    if (!data.results.length) rows.append(h("tr", {}, h("td", { colspan: 11, class: "muted empty" }, "No captures match. Drop a file above to add one.")));
     clear(
       pager,
       h("span", { class: "muted" }, `${data.count} capture${data.count === 1 ? "" : "s"}`),
@@ -163,6 +178,8 @@ export async function renderCaptureList(root: HTMLElement): Promise<() => void> 
   function apply(next: Filters): void {
     if (!mounted) return;
     filters = next;
+    selection.clear();
+    drawNav();
     history.replaceState(null, "", `/${queryOf(filters)}`);
     void load();
   }
@@ -221,12 +238,13 @@ function cutsCell(c: CaptureSummary): HTMLElement {
   return h("td", { class: "num" }, String(run?.n_candidates ?? "—"), adapted);
 }
 
-function row(c: CaptureSummary, project: string, role: Role | undefined, reload: () => Promise<void>): HTMLElement {
+function row(c: CaptureSummary, project: string, role: Role | undefined, reload: () => Promise<void>, check: HTMLElement): HTMLElement {
   const open = () => navigate(`/captures/${c.id}/`);
   const status = h("span", { class: `badge badge-${c.status}`, title: c.error ?? "" }, c.status);
   return h(
     "tr",
     { class: "capture-row", "data-testid": `capture-${c.id}`, tabindex: 0, onclick: open, onkeydown: (e: Event) => (e as KeyboardEvent).key === "Enter" && open() },
+    h("td", { onclick: (e: Event) => e.stopPropagation() }, check),
     h("td", {}, h("a", { href: `/captures/${c.id}/`, onclick: (e: Event) => e.preventDefault() }, c.name), c.status === "failed" && c.error ? h("div", { class: "error-text small" }, c.error) : null, c.status === "failed" ? retryButton(c, reload) : null),
     h("td", {}, project),
     h("td", {}, status),
@@ -235,6 +253,7 @@ function row(c: CaptureSummary, project: string, role: Role | undefined, reload:
     h("td", { class: "num" }, c.fps ?? "—"),
     h("td", { class: "num" }, c.n_joints ?? "—"),
     cutsCell(c),
+    h("td", { class: "team-cell", "data-testid": `team-${c.id}` }, ...teamCell(c.team)),
     h("td", {}, c.created_at ? new Date(c.created_at).toLocaleString() : "", canRedetect(c, role) ? h("div", {}, redetectButton(c, reload)) : null),
   );
 }

@@ -3,6 +3,7 @@
 
 import { get } from "../api/client";
 import { clear, h } from "../ui/dom";
+import { teamCell } from "../captures/assign";
 import { topbar } from "./nav";
 import type { CaptureState, Dashboard } from "./types";
 
@@ -24,6 +25,7 @@ export async function renderDashboard(root: HTMLElement, projectId: number): Pro
       h("td", {}, h("a", { href: `/captures/${c.id}/` }, c.name)),
       h("td", {}, h("span", { class: `badge state-badge state-${c.state}` }, STATE_NAMES[c.state])),
       h("td", { class: "num" }, `${c.submitted} / ${c.reviews}`),
+      h("td", { class: "team-cell" }, ...teamCell({ assigned: c.assigned ?? [], reviews: c.review_states ?? [] })),
       h("td", { class: "num" }, num(c.boundary_f1)),
       h("td", { class: "num" }, num(c.label_agreement)),
       h("td", {}, c.submitted > 0 ? h("a", { class: "btn", href: `/captures/${c.id}/adjudicate/`, "data-testid": `adjudicate-${c.id}` }, "Adjudicate") : null),
@@ -54,7 +56,7 @@ export async function renderDashboard(root: HTMLElement, projectId: number): Pro
         { class: "list-main" },
         h("div", { class: "stat-grid dash-states" }, ...states, h("div", { class: "stat" }, h("b", {}, `${d.library.total}`), h("span", {}, `library segments (${d.library.gold} gold)`))),
         h("h2", {}, "Captures"),
-        table(["Capture", "State", "Submitted / reviews", "Boundary F1", "Label agreement", ""], captures, "dash-captures"),
+        table(["Capture", "State", "Submitted / reviews", "Team", "Boundary F1", "Label agreement", ""], captures, "dash-captures"),
         h("h2", {}, "Annotators"),
         table(["Annotator", "Submitted", "In progress", "Edits", "By kind", "Edits per review", "Median time per review"], people, "dash-annotators"),
         h("h2", {}, "Agreement per label"),

@@ -85,6 +85,8 @@ export async function renderLibrary(root: HTMLElement): Promise<() => void> {
     exportZip,
   );
 
+  // The list shows agreement; "Similar" shows motion distance in the same column.
+  const metricHead = h("th", { "data-testid": "metric-head" }, "Agreement");
   clear(
     root,
     h(
@@ -98,7 +100,7 @@ export async function renderLibrary(root: HTMLElement): Promise<() => void> {
         h(
           "div",
           { class: "lib-layout" },
-          h("div", { class: "lib-table" }, h("table", { class: "captures" }, h("thead", {}, h("tr", {}, ...["Label", "Capture", "Frames", "Duration", "Annotator", "Agreement", ""].map((t) => h("th", {}, t)))), rows), pager),
+          h("div", { class: "lib-table" }, h("table", { class: "captures" }, h("thead", {}, h("tr", {}, ...["Label", "Capture", "Frames", "Duration", "Annotator"].map((t) => h("th", {}, t)), metricHead, h("th", {}))), rows), pager),
           preview,
         ),
       ),
@@ -136,6 +138,7 @@ export async function renderLibrary(root: HTMLElement): Promise<() => void> {
       return null;
     });
     if (!data) return;
+    metricHead.textContent = "Agreement";
     clear(rows, ...data.results.map(row));
     if (!data.results.length) rows.append(h("tr", {}, h("td", { colspan: 7, class: "muted empty" }, "No segments match. Segments appear here when reviews are submitted.")));
     clear(
@@ -149,6 +152,9 @@ export async function renderLibrary(root: HTMLElement): Promise<() => void> {
   async function similar(s: LibrarySegment): Promise<void> {
     try {
       const body = await get<{ results: LibrarySegment[] }>(`/api/segments/${s.id}/similar/?k=10`);
+      metricHead.textContent = "Distance";
+      const n = body.results.length;
+      clear(pager, h("span", { class: "muted", "data-testid": "segment-count" }, `${n} similar clip${n === 1 ? "" : "s"}`));
       clear(rows, h("tr", {}, h("td", { colspan: 7, class: "lib-similar-head" }, `Clips that move like ${s.label} ${s.start}–${s.stop} of ${s.capture.name} `, h("button", { class: "btn btn-ghost", onclick: () => void load() }, "× back to the list"))), ...body.results.map(row));
     } catch (err) {
       toast((err as Error).message, "error");

@@ -1,7 +1,7 @@
 // Routes of the library pages, registered by main.ts before the router starts.
 
 import { registerRoute } from "../router";
-import { renderAdjudication } from "./adjudicate";
+import { renderAdjudication } from "../adjudicate/page";
 import { renderDashboard } from "./dashboard";
 import { renderLibrary } from "./page";
 

@@ -68,7 +68,8 @@ export type CaptureState = "unreviewed" | "in_review" | "agreed" | "adjudicated"
 export interface Dashboard {
   project: number;
   states: Record<CaptureState, number>;
-  captures: { id: number; name: string; state: CaptureState; reviews: number; submitted: number; boundary_f1: number | null; label_agreement: number | null }[];
+  captures: { id: number; name: string; state: CaptureState; reviews: number; submitted: number; boundary_f1: number | null; label_agreement: number | null;
+    assigned?: string[]; review_states?: { id: number; annotator: string; status: "in_progress" | "submitted" | "returned" }[] }[];
   annotators: {
     id: number;
     username: string;

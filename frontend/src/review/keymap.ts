@@ -11,6 +11,7 @@ export type Command =
   | { kind: "label"; hotkey: string }
   | { kind: "clearLabel" }
   | { kind: "acceptSuggestion" }
+  | { kind: "palette" }
   | { kind: "undo" }
   | { kind: "redo" }
   | { kind: "loop" }
@@ -49,6 +50,7 @@ const SIMPLE: Record<string, Command> = {
   Delete: { kind: "delete" },
   i: { kind: "insert" },
   s: { kind: "acceptSuggestion" },
+  "/": { kind: "palette" },
   z: { kind: "undo" },
   "shift+z": { kind: "redo" },
   l: { kind: "loop" },
@@ -78,6 +80,7 @@ export const HELP: [string, string][] = [
   ["1 – 9", "label the segment under the playhead"],
   ["0 or Backspace", "clear that segment's label"],
   ["S", "accept that segment's suggested label"],
+  ["/", "label palette: type to filter, Enter applies"],
   ["Z or Ctrl+Z", "undo"],
   ["Shift+Z or Ctrl+Shift+Z", "redo"],
   ["L", "loop the segment under the playhead (again: stop)"],

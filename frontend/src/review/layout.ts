@@ -4,12 +4,14 @@
 import type { Capture, Me } from "../api/types";
 import { SPEEDS } from "../player/clock";
 import { formatDuration, h } from "../ui/dom";
+import { appLinks } from "../ui/appnav";
 import { icon } from "../ui/icons";
 import type { Command } from "./keymap";
 
 export interface LayoutActions {
   command(c: Command): void;
   submit(): void;
+  submitNext(): void;
   help(): void;
   follow(): void;
   speed(value: number): void;
@@ -63,6 +65,8 @@ function topbar(c: Capture, me: Me, el: Elements, button: ButtonMaker, actions: 
     (el.reviewPicker = h("span", { class: "review-picker" })),
     (el.saveState = h("span", { class: "save-state", "data-testid": "save-state" }, "Saved")),
     button("submit", "Submit review", "Mark this review finished; it can no longer be edited", actions.submit, "btn-primary"),
+    button("submit-next", "Submit & next", "Submit, then open the oldest open capture of your queue", actions.submitNext),
+    ...appLinks(c.project, null),
     button("help-button", "?", "Keyboard shortcuts (?)", actions.help, "btn-ghost"),
     h("span", { class: "user" }, me.username),
   );

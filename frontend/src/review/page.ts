@@ -2,15 +2,19 @@
 // activity log at the side. Every edit is applied on screen at once and saved through
 // the API straight away (saver.ts); undo/redo are edits too, so the audit log is complete.
 
-import { get, post } from "../api/client";
+import { ApiError, get, post } from "../api/client";
 import type { Capture, Cut, Label, Me, Project, Review, ReviewEvent, Segment, Signal, SignalResponse } from "../api/types";
 import { advance, frameOf, nextSpeed, seek, togglePlay, type Playback } from "../player/clock";
 import { MAX_JOINTS, SkeletonView, TooManyJoints } from "../player/skeletonView";
 import { clear, confirmDialog, dialog, h, toast } from "../ui/dom";
 import { icon } from "../ui/icons";
+import { nextInQueue, returnReview } from "../queue/api";
+import { navigate } from "../router";
+import { promptDialog } from "../ui/prompt";
 import { FrameStore, loadFrames } from "./frames";
 import { changeFor, emptyHistory, record, redo, undo, type Change, type History } from "./history";
 import { commandFor, HELP, isTypingTarget, type Command } from "./keymap";
+import { openPalette } from "./palette";
 import { Saver } from "./saver";
 import { applyEdit, clampFrame, describeDifferences, EditError, neighbourCut, segmentAt, type Edit } from "./state";
 import { buildLayout, type Elements } from "./layout";
@@ -38,6 +42,12 @@ export async function renderReview(root: HTMLElement, captureId: number): Promis
     return () => page.dispose();
   } catch (err) {
     frames.abort.abort();
+    // A refusal (e.g. a capture not assigned to an annotator who may not pick it) says so
+    // and points to the caller's queue instead of a generic error page.
+    if (err instanceof ApiError && err.status === 403) {
+      clear(root, h("div", { class: "loading-page", "data-testid": "review-refused" }, h("h1", {}, capture.name), h("p", { class: "error-text" }, err.message), h("a", { href: "/queue/" }, "← My queue")));
+      return () => {};
+    }
     throw err;
   }
 }
@@ -134,7 +144,8 @@ class ReviewPage {
     });
     const layout = buildLayout(capture, me, {
       command: (c) => this.command(c),
-      submit: () => void this.submit(),
+      submit: () => void this.submit(false),
+      submitNext: () => void this.submit(true),
       help: () => this.toggleHelp(),
       follow: () => this.toggleFollow(),
       speed: (v) => this.setSpeed(v),
@@ -225,9 +236,10 @@ class ReviewPage {
     const locked = this.locked() !== null;
     this.el.undo.toggleAttribute("disabled", locked || this.history.past.length === 0);
     this.el.redo.toggleAttribute("disabled", locked || this.history.future.length === 0);
-    for (const id of ["accept", "delete", "insert", "submit"]) this.el[id].toggleAttribute("disabled", locked);
-    this.el.submit.textContent = this.review.status === "submitted" ? "Submitted" : "Submit review";
-    const banner = this.readOnly ? `Viewing ${this.review.annotator.username}'s review — read-only.` : locked ? "You submitted this review — read-only." : "";
+    for (const id of ["accept", "delete", "insert", "submit", "submit-next"]) this.el[id].toggleAttribute("disabled", locked);
+    this.el.submit.textContent = this.review.status === "submitted" ? "Submitted" : this.review.status === "returned" ? "Resubmit" : "Submit review";
+    const returned = this.review.status === "returned" ? `Returned by a reviewer: “${this.review.return_comment ?? ""}” — edit and resubmit.` : "";
+    const banner = this.readOnly ? `Viewing ${this.review.annotator.username}'s review — read-only.` : locked ? "You submitted this review — read-only." : returned;
     this.el.banner.textContent = banner;
     this.el.banner.toggleAttribute("hidden", !banner);
   }
@@ -248,7 +260,7 @@ class ReviewPage {
   private renderSide(): void {
     const segment = segmentAt(this.review.segments, this.frame());
     this.panelSegment = segment;
-    renderLabels(this.el.labels, this.labels, segment?.label ?? null, this.locked() !== null, (name) => this.labelCurrent(name));
+    renderLabels(this.el.labels, this.activeLabels(), segment?.label ?? null, this.locked() !== null, (name) => this.labelCurrent(name));
     renderSelection(this.el.selection, this.selectedCut(), segment, this.capture.fps);
     renderStats(this.el.stats, this.review);
     renderAdaptation(this.el.adaptation, this.review.adaptation);
@@ -338,11 +350,11 @@ class ReviewPage {
     this.refresh();
   }
 
-  private async submit(): Promise<void> {
+  private async submit(next: boolean): Promise<void> {
     if (this.locked() || this.saver.pending) return;
     const pending = this.review.cuts.filter((c) => c.fate === "pending").length;
     const unlabelled = this.review.segments.filter((s) => !s.label).length;
-    const ok = await confirmDialog("Submit this review?", [
+    const ok = await confirmDialog(next ? "Submit and open the next capture?" : "Submit this review?", [
       h("p", {}, "A submitted review counts towards agreement and the library, and can no longer be edited."),
       pending || unlabelled ? h("p", { class: "muted" }, `Still open: ${pending} pending candidate${pending === 1 ? "" : "s"}, ${unlabelled} unlabelled segment${unlabelled === 1 ? "" : "s"}.`) : null,
     ], "Submit");
@@ -355,8 +367,25 @@ class ReviewPage {
       void this.loadEvents();
     } catch (err) {
       toast(`Not submitted: ${err instanceof Error ? err.message : String(err)}`, "error");
+      next = false;
     }
     this.refresh();
+    if (next) await this.openNext();
+  }
+
+  /** The oldest open capture of the caller's queue in this project, or the queue itself. */
+  private async openNext(): Promise<void> {
+    const item = await nextInQueue(this.capture.project, this.capture.id).catch(() => null);
+    if (item) navigate(`/captures/${item.capture.id}/`);
+    else {
+      toast("Your queue has nothing else open.");
+      navigate(`/queue/?project=${this.capture.project}`);
+    }
+  }
+
+  /** Labels that may be applied: the taxonomy without its retired labels, in order. */
+  private activeLabels(): Label[] {
+    return this.labels.filter((l) => !l.retired);
   }
 
   private labelCurrent(label: string | null): void {
@@ -382,9 +411,12 @@ class ReviewPage {
     this.review = current;
     this.history = emptyHistory();
     this.refresh();
+    // The server's text is for API clients (it names the review and says to reload); the
+    // page has already loaded the current version, so it says that instead.
+    void message;
     await dialog("This review changed elsewhere", [
-      h("p", {}, message),
-      h("p", {}, "The current version is shown now. What changed:"),
+      h("p", { "data-testid": "conflict-text" }, "Your review was saved from another tab or window first. This page shows that version now."),
+      h("p", {}, "What changed:"),
       h("ul", { "data-testid": "conflict-changes" }, ...(changes.length ? changes : ["(nothing visible)"]).map((line) => h("li", {}, line))),
       unsaved.length ? h("p", {}, "Not saved — redo these if you still want them:") : null,
       unsaved.length ? h("ul", { "data-testid": "conflict-unsaved" }, ...unsaved.map((t) => h("li", {}, t))) : null,
@@ -521,13 +553,17 @@ class ReviewPage {
         return true;
       case "label": {
         // Labels without hotkeys answer to their position in the taxonomy instead.
-        const label = this.labels.find((l) => l.hotkey === c.hotkey) ?? (this.labels.some((l) => l.hotkey) ? undefined : this.labels[Number(c.hotkey) - 1]);
+        const active = this.activeLabels();
+        const label = active.find((l) => l.hotkey === c.hotkey) ?? (active.some((l) => l.hotkey) ? undefined : active[Number(c.hotkey) - 1]);
         if (label) this.labelCurrent(label.name);
         else toast(`No label has hotkey ${c.hotkey}.`);
         return true;
       }
       case "clearLabel":
         this.labelCurrent(null);
+        return true;
+      case "palette":
+        if (!this.locked()) openPalette(this.activeLabels(), (name) => this.labelCurrent(name));
         return true;
       case "acceptSuggestion":
         if (segment?.suggested_label) this.labelCurrent(segment.suggested_label);
@@ -584,6 +620,23 @@ class ReviewPage {
     renderEvents(this.el.events, listOf(events));
   }
 
+  private async giveBack(others: Review[], select: HTMLSelectElement): Promise<void> {
+    const review = others.find((r) => String(r.id) === select.value);
+    if (!review) return;
+    const comment = await promptDialog(`Return ${review.annotator.username}'s review`, "Say what should change; they see it in their queue, edit and resubmit. Until then the review leaves agreement and the library.", "Return");
+    if (!comment) return;
+    try {
+      await returnReview(this.capture.id, review.id, comment);
+      toast(`Returned to ${review.annotator.username}.`);
+      select.value = "";
+      select.dispatchEvent(new Event("change"));
+      clear(this.el.reviewPicker);
+      void this.loadOtherReviews();
+    } catch (err) {
+      toast((err as Error).message, "error");
+    }
+  }
+
   private async loadOtherReviews(): Promise<void> {
     if (!this.project || this.project.role === "annotator") return;
     const reviews = await get<Review[] | { results: Review[] }>(`/api/captures/${this.capture.id}/reviews/`).catch(() => null);
@@ -603,8 +656,10 @@ class ReviewPage {
       this.readOnly = other !== undefined;
       this.review = other ?? this.saver.server ?? this.own;
       this.selectedCutId = null;
+      giveBack.hidden = other?.status !== "submitted";
       this.refresh();
     });
-    clear(this.el.reviewPicker, select);
+    const giveBack = h("button", { class: "btn", hidden: true, "data-testid": "return-review", title: "Send this submitted review back to its annotator with a comment", onclick: () => void this.giveBack(others, select) }, "Return…");
+    clear(this.el.reviewPicker, select, giveBack);
   }
 }

@@ -1,0 +1,383 @@
+// Adjudication on the shared timeline (reviewers, admins): the 3D player and the keys of
+// the review page, one tier per submitted review with the gold tier on top, disagreements
+// marked where they are. Click a tier's cut or segment to take it into gold; drag gold
+// cuts (they snap to the tiers' cuts); undo/redo; saving refuses a stale version (409).
+
+import { ApiError, api, get } from "../api/client";
+import type { Capture, Label } from "../api/types";
+import { addCut, fromSpans, moveCut, removeCut, sameDraft, segmentAt, setLabel, toSpans, type Draft } from "../library/gold";
+import { topbar } from "../library/nav";
+import type { Adjudication, Span } from "../library/types";
+import { advance, frameOf, seek, togglePlay, type Playback } from "../player/clock";
+import { SkeletonView } from "../player/skeletonView";
+import { FrameStore, loadFrames } from "../review/frames";
+import { commandFor, isTypingTarget, type Command } from "../review/keymap";
+import { openPalette } from "../review/palette";
+import { formatTime } from "../review/timescale";
+import { clear, dialog, h, toast } from "../ui/dom";
+import { agreementBox } from "./agreement";
+import { back, cutMarks, forward, labelConflicts, push, start, type Timeline } from "./marks";
+import { Tiers } from "./tiers";
+import "./adjudicate.css";
+
+export async function renderAdjudication(root: HTMLElement, captureId: number): Promise<() => void> {
+  const [data, capture] = await Promise.all([
+    get<Adjudication>(`/api/captures/${captureId}/adjudication/`),
+    get<Capture>(`/api/captures/${captureId}/`),
+  ]);
+  const page = new AdjudicationPage(root, data, capture);
+  return () => page.dispose();
+}
+
+type Review = Adjudication["reviews"][number];
+
+/** The review page's keys, as they act on the gold tier here. */
+const ADJ_HELP: [string, string][] = [
+  ["Space", "play / pause"],
+  ["← / →, , / .", "1 or 10 frames back / forward"],
+  ["Shift + ← / →", "jump to the previous / next cut of any tier"],
+  ["Home / End", "first / last frame"],
+  ["I", "insert a gold cut at the playhead"],
+  ["D or Delete", "delete the selected gold cut"],
+  ["1 – 9, /", "label the gold segment under the playhead (/ opens the palette)"],
+  ["0 or Backspace", "clear that gold segment's label"],
+  ["Z / Shift+Z", "undo / redo"],
+  ["+ / −, wheel", "zoom the tiers"],
+  ["Click a tier's cut or segment", "take it into gold"],
+  ["Drag a gold cut", "move it; it snaps to the tiers' cuts"],
+  ["?", "show / hide this help"],
+];
+
+class AdjudicationPage {
+  private history: Timeline<Draft>;
+  private saved: Draft | null;
+  private source: number | null;
+  private playback: Playback;
+  private selectedCut: number | null = null;
+  private raf = 0;
+  private lastTick = 0;
+  private readonly reviews: Review[];
+  private readonly labels: Label[];
+  private readonly store: FrameStore;
+  private readonly abort = new AbortController();
+  private readonly player: SkeletonView | null = null;
+  private readonly tiers: Tiers;
+  private readonly el: Record<string, HTMLElement> = {};
+  private readonly onKey = (e: KeyboardEvent) => this.handleKey(e);
+  private readonly onResize = () => this.refresh();
+
+  constructor(
+    root: HTMLElement,
+    private data: Adjudication,
+    private readonly capture: Capture,
+  ) {
+    // Only submitted reviews are tiers: in-progress and returned ones are not final.
+    this.reviews = data.reviews.filter((r) => r.status === "submitted");
+    this.labels = data.labels.map((l, i) => ({ id: i, ...l }));
+    const gold = data.gold ? fromSpans(data.gold.segments) : { cuts: [], labels: [null] };
+    this.history = start(gold);
+    this.saved = data.gold ? gold : null;
+    this.source = data.gold?.source_review ?? null;
+    this.playback = { position: 0, playing: false, speed: 1, fps: capture.fps!, nFrames: capture.n_frames!, loop: null };
+    clear(root, this.layout());
+    try {
+      this.player = new SkeletonView(this.el.viewport, capture.skeleton!);
+    } catch (err) {
+      this.el.viewport.append(h("div", { class: "no-webgl" }, `3D view unavailable (${err instanceof Error ? err.message : "no WebGL"}).`));
+    }
+    this.store = new FrameStore(capture.n_frames!, capture.n_joints || capture.skeleton!.joints.length);
+    void loadFrames(capture.id, this.store, 0, () => this.showPose(true), this.abort.signal);
+    this.tiers = new Tiers(this.el.tiers, {
+      seek: (f) => this.seekTo(f),
+      takeCut: (f) => this.takeCut(f),
+      takeSegment: (s) => this.takeSegment(s),
+      selectGoldCut: (i) => {
+        this.selectedCut = i;
+        this.seekTo(this.draft.cuts[i]);
+      },
+      moveGoldCut: (i, f) => {
+        this.selectedCut = i;
+        this.edit(moveCut(this.draft, i, f, this.n), `moved a gold cut to ${f}`);
+      },
+      snapTargets: () => this.reviews.flatMap((r) => r.cuts),
+    }, capture.n_frames!);
+    document.addEventListener("keydown", this.onKey);
+    window.addEventListener("resize", this.onResize);
+    this.refresh();
+  }
+
+  dispose(): void {
+    this.abort.abort();
+    cancelAnimationFrame(this.raf);
+    document.removeEventListener("keydown", this.onKey);
+    window.removeEventListener("resize", this.onResize);
+    this.player?.dispose();
+  }
+
+  private get n(): number {
+    return this.capture.n_frames!;
+  }
+
+  private get draft(): Draft {
+    return this.history.present;
+  }
+
+  private frame(): number {
+    return frameOf(this.playback);
+  }
+
+  // ---- layout --------------------------------------------------------------------------
+
+  private layout(): HTMLElement {
+    const el = this.el;
+    const button = (id: string, text: string, title: string, action: () => void, extra = "") =>
+      (el[id] = h("button", { class: `btn ${extra}`, title, "data-testid": id, onclick: (e: Event) => { (e.currentTarget as HTMLElement).blur(); action(); } }, text));
+    el.viewport = h("div", { class: "viewport adj-viewport", "data-testid": "viewport" });
+    el.hud = h("div", { class: "hud-frame", "data-testid": "hud-frame" });
+    el.status = h("span", { class: "muted", "data-testid": "gold-status" });
+    el.editor = h("div", { class: "adj-side", "data-testid": "gold-editor" });
+    el.tiers = h("div", { class: "tiers", "data-testid": "adj-tracks" });
+    el.agreement = agreementBox(this.data.agreement);
+    const uses = this.reviews.map((r) => h("button", { class: "btn btn-small", "data-testid": `use-${r.annotator.username}`, title: "Replace the gold draft with this review", onclick: () => this.useReview(r) }, `Start gold from ${r.annotator.username}`));
+    const legend = h("div", { class: "adj-legend muted small" },
+      h("span", { class: "tier-cut-key mark-agreed" }), " all agree ",
+      h("span", { class: "tier-cut-key mark-shifted" }), " matched but further apart than the tolerance ",
+      h("span", { class: "tier-cut-key mark-lone" }), " only some annotators ",
+      h("span", { class: "tier-conflict-key" }), " labels differ");
+    return h(
+      "div",
+      { class: "list-page adj-page" },
+      topbar([["Captures", "/"], [this.data.capture.name, `/captures/${this.capture.id}/`], ["Adjudication", null]], this.data.capture.project),
+      h(
+        "main",
+        { class: "list-main adj-main" },
+        h("div", { class: "adj-head" }, h("h1", { class: "page-title", "data-testid": "adj-title" }, `Adjudicate ${this.data.capture.name}`), el.agreement),
+        h(
+          "div",
+          { class: "adj-work" },
+          h("div", { class: "adj-stage" }, el.viewport, h("div", { class: "hud adj-hud" }, el.hud)),
+          h(
+            "div",
+            { class: "adj-panel" },
+            h("div", { class: "adj-actions" }, button("play", "Play", "Play / pause (Space)", () => this.command({ kind: "play" })), button("undo", "Undo", "Undo (Z, Ctrl+Z)", () => this.command({ kind: "undo" })), button("redo", "Redo", "Redo (Shift+Z)", () => this.command({ kind: "redo" })), button("save-gold", "Save gold version", "Save the gold version", () => void this.save(), "btn-primary"), el.status),
+            el.editor,
+            h("div", { class: "adj-uses" }, ...uses),
+            legend,
+          ),
+        ),
+        el.tiers,
+      ),
+    );
+  }
+
+  // ---- drawing -------------------------------------------------------------------------
+
+  private refresh(): void {
+    const spans = toSpans(this.draft, this.n);
+    const tolerance = Math.round(this.data.agreement.tolerance_s * this.capture.fps!);
+    const marks = cutMarks(this.reviews.map((r) => r.cuts), tolerance);
+    this.tiers.update({
+      nFrames: this.n, fps: this.capture.fps!, colors: new Map(this.labels.map((l) => [l.name, l.color])),
+      gold: { cuts: this.draft.cuts, segments: spans },
+      tiers: this.reviews.map((r, i) => ({ id: String(r.id), name: r.annotator.username, cuts: r.cuts, marks: marks[i], segments: r.segments })),
+      conflicts: labelConflicts(this.reviews.map((r) => r.segments), this.n),
+      playhead: this.frame(), selectedCut: this.selectedCut,
+    });
+    this.drawEditor(spans);
+    const dirty = !this.saved || !sameDraft(this.draft, this.saved);
+    this.el.status.textContent = dirty ? "Unsaved changes" : "Saved";
+    this.el["save-gold"].toggleAttribute("disabled", !dirty);
+    this.el.undo.toggleAttribute("disabled", !this.history.past.length);
+    this.el.redo.toggleAttribute("disabled", !this.history.future.length);
+    this.el.play.textContent = this.playback.playing ? "Pause" : "Play";
+    this.showPose(false);
+  }
+
+  private drawEditor(spans: Span[]): void {
+    const index = segmentAt(this.draft, this.frame());
+    const s = spans[index];
+    const select = h(
+      "select",
+      { class: "select", "data-testid": "gold-label", "aria-label": "label of the gold segment under the playhead" },
+      h("option", { value: "", selected: s.label === null }, "(unlabelled)"),
+      ...this.labels.map((l) => h("option", { value: l.name, selected: s.label === l.name }, l.hotkey ? `${l.name} (${l.hotkey})` : l.name)),
+    );
+    select.addEventListener("change", () => {
+      select.blur();
+      this.edit(setLabel(this.draft, index, select.value || null), `labelled gold segment ${index + 1}`);
+    });
+    const cut = this.selectedCut !== null ? this.draft.cuts[this.selectedCut] : undefined;
+    clear(
+      this.el.editor,
+      h("div", { "data-testid": "gold-segment" }, h("b", {}, `Gold segment ${index + 1} of ${spans.length}`), ` · frames ${s.start}–${s.stop}`),
+      h("div", { class: "filters" }, select),
+      cut !== undefined ? h("div", { class: "muted", "data-testid": "gold-selected-cut" }, `Selected gold cut at ${cut} (D deletes, drag moves)`) : h("div", { class: "muted" }, "I inserts a gold cut at the playhead; 1–9 or / label the gold segment under it."),
+    );
+  }
+
+  private showPose(force: boolean): void {
+    const frame = this.frame();
+    this.el.hud.textContent = `Frame ${frame} / ${this.n - 1} · ${formatTime(frame, this.capture.fps!)}`;
+    if (!this.player) return;
+    const shown = this.store.has(frame) ? frame : this.store.nearestLoaded(frame);
+    if (shown !== null && (force || shown === frame)) this.player.setPose(this.store.pose(shown));
+  }
+
+  // ---- gold edits ----------------------------------------------------------------------
+
+  private edit(next: Draft, what: string): void {
+    if (sameDraft(next, this.draft)) {
+      toast(`Gold unchanged (${what}).`);
+      return this.refresh();
+    }
+    this.history = push(this.history, next);
+    this.refresh();
+  }
+
+  private takeCut(frame: number): void {
+    this.edit(addCut(this.draft, frame, this.n), `cut at ${frame} is already in gold`);
+    this.seekTo(frame);
+  }
+
+  /** The segment's bounds become gold cuts and the gold segment between them takes its label. */
+  private takeSegment(s: Span): void {
+    let next = addCut(addCut(this.draft, s.start, this.n), s.stop, this.n);
+    next = setLabel(next, segmentAt(next, s.start), s.label);
+    this.edit(next, `segment ${s.start}–${s.stop} is already gold`);
+    this.seekTo(s.start);
+  }
+
+  private useReview(r: Review): void {
+    this.source = r.id;
+    this.selectedCut = null;
+    this.edit(fromSpans(r.segments), `gold already equals ${r.annotator.username}'s version`);
+  }
+
+  private labelUnderPlayhead(name: string | null): void {
+    const index = segmentAt(this.draft, this.frame());
+    this.edit(setLabel(this.draft, index, name), "same label");
+  }
+
+  private async save(): Promise<void> {
+    const body = { cuts: this.draft.cuts, labels: this.draft.labels, version: this.data.gold?.version ?? 0, source_review: this.source };
+    try {
+      this.data = await api<Adjudication>("PUT", `/api/captures/${this.capture.id}/adjudication/`, body);
+      this.saved = fromSpans(this.data.gold!.segments);
+      toast(`Gold version ${this.data.gold!.version} saved.`);
+      const box = agreementBox(this.data.agreement);
+      this.el.agreement.replaceWith(box);
+      this.el.agreement = box;
+    } catch (err) {
+      if (err instanceof ApiError && err.status === 409) await this.onConflict(err.body as { gold: Adjudication["gold"] });
+      else toast((err as Error).message, "error");
+    }
+    this.refresh();
+  }
+
+  /** Someone saved gold meanwhile: show theirs now; undo brings this draft back to save over it. */
+  private async onConflict(body: { gold: Adjudication["gold"] }): Promise<void> {
+    const theirs = body.gold;
+    this.data = { ...this.data, gold: theirs };
+    if (!theirs) return;
+    this.saved = fromSpans(theirs.segments);
+    this.history = push(this.history, this.saved);
+    this.refresh();
+    await dialog("The gold version changed meanwhile", [
+      h("p", {}, `${theirs.adjudicator ?? "Someone"} saved gold version ${theirs.version} while you were editing. It is shown now.`),
+      h("p", {}, "Your draft was not saved. Undo (Z) brings it back; saving it then replaces their version."),
+    ]);
+  }
+
+  // ---- playback and keys ---------------------------------------------------------------
+
+  private seekTo(frame: number): void {
+    this.playback = { ...seek(this.playback, Math.min(Math.max(frame, 0), this.n - 1)), playing: this.playback.playing };
+    this.refresh();
+  }
+
+  private tick = (now: number): void => {
+    this.playback = advance(this.playback, (now - this.lastTick) / 1000);
+    this.lastTick = now;
+    this.refresh();
+    if (this.playback.playing) this.raf = requestAnimationFrame(this.tick);
+  };
+
+  private toggleHelp(): void {
+    const open = document.querySelector(".adj-help");
+    if (open) return open.remove();
+    const rows = ADJ_HELP.map(([keys, what]) => h("tr", {}, h("th", {}, h("kbd", {}, keys)), h("td", {}, what)));
+    const box = h("div", { class: "modal-backdrop help adj-help", "data-testid": "help", onclick: () => box.remove() }, h("div", { class: "modal" }, h("h2", {}, "Keyboard"), h("table", { class: "keys" }, ...rows)));
+    document.body.append(box);
+  }
+
+  private handleKey(e: KeyboardEvent): void {
+    if (isTypingTarget(e.target) || document.querySelector(".modal-backdrop:not(.help)")) return;
+    const c = commandFor(e);
+    if (!c) return;
+    e.preventDefault();
+    this.command(c);
+  }
+
+  private command(c: Command): void {
+    const frame = this.frame();
+    const all = [...new Set([...this.draft.cuts, ...this.reviews.flatMap((r) => r.cuts)])].sort((a, b) => a - b);
+    switch (c.kind) {
+      case "play":
+        this.playback = togglePlay(this.playback);
+        this.lastTick = performance.now();
+        if (this.playback.playing) this.raf = requestAnimationFrame(this.tick);
+        break;
+      case "step":
+        return this.seekTo(frame + c.frames);
+      case "home":
+        return this.seekTo(0);
+      case "end":
+        return this.seekTo(this.n - 1);
+      case "jump": {
+        const target = c.direction > 0 ? all.find((f) => f > frame) : [...all].reverse().find((f) => f < frame);
+        if (target !== undefined) this.seekTo(target);
+        return;
+      }
+      case "zoom":
+        this.tiers.zoom(c.factor, frame);
+        return;
+      case "undo":
+        this.history = back(this.history);
+        break;
+      case "redo":
+        this.history = forward(this.history);
+        break;
+      case "insert":
+        return this.edit(addCut(this.draft, frame, this.n), `a gold cut is already at ${frame}`);
+      case "delete":
+        if (this.selectedCut === null) toast("Select a gold cut first: click it on the gold tier.");
+        else {
+          const index = this.selectedCut;
+          this.selectedCut = null;
+          this.edit(removeCut(this.draft, index), "no such cut");
+        }
+        return;
+      case "label": {
+        const label = this.labels.find((l) => l.hotkey === c.hotkey) ?? (this.labels.some((l) => l.hotkey) ? undefined : this.labels[Number(c.hotkey) - 1]);
+        if (label) this.labelUnderPlayhead(label.name);
+        else toast(`No label has hotkey ${c.hotkey}.`);
+        return;
+      }
+      case "clearLabel":
+        return this.labelUnderPlayhead(null);
+      case "palette":
+        openPalette(this.labels, (name) => this.labelUnderPlayhead(name));
+        return;
+      case "help":
+        this.toggleHelp();
+        return;
+      case "escape":
+        if (document.querySelector(".adj-help")) this.toggleHelp();
+        this.selectedCut = null;
+        break;
+      default:
+        return;
+    }
+    this.refresh();
+  }
+}

@@ -1,0 +1,27 @@
+// A modal asking for one line or paragraph of text; resolves with it, or null if cancelled.
+
+import { h } from "./dom";
+
+export function promptDialog(title: string, intro: string, ok: string, placeholder = ""): Promise<string | null> {
+  return new Promise((resolve) => {
+    const text = h("textarea", { class: "input prompt-text", rows: 4, placeholder, "data-testid": "prompt-text" });
+    const close = (answer: string | null) => {
+      backdrop.remove();
+      document.removeEventListener("keydown", onKey, true);
+      resolve(answer);
+    };
+    const onKey = (e: KeyboardEvent) => {
+      if (e.key === "Escape") close(null);
+    };
+    const yes = h("button", { class: "btn btn-primary", "data-testid": "prompt-ok", onclick: () => text.value.trim() && close(text.value.trim()) }, ok);
+    const no = h("button", { class: "btn", "data-testid": "prompt-cancel", onclick: () => close(null) }, "Cancel");
+    const backdrop = h(
+      "div",
+      { class: "modal-backdrop", role: "dialog", "aria-modal": "true", "aria-label": title },
+      h("div", { class: "modal" }, h("h2", {}, title), h("div", { class: "modal-body" }, h("p", {}, intro), text), h("div", { class: "modal-actions" }, no, yes)),
+    );
+    document.addEventListener("keydown", onKey, true);
+    document.body.append(backdrop);
+    text.focus();
+  });
+}
