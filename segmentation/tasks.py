@@ -11,7 +11,7 @@ import uuid
 from celery import shared_task
 from celery.signals import worker_ready
 
-from segmentation import services
+from segmentation import services, suggestions
 from segmentation.models import Capture, DetectionRun
 from segmentation.services.captures import exhausted, give_up
 
@@ -42,6 +42,13 @@ def detect(self, run_id):
     run = _claim(DetectionRun, run_id, self)
     if run is not None:
         services.detect_run(run)
+
+
+@shared_task(acks_late=True, reject_on_worker_lost=True)
+def suggest(capture_id, annotator_id):
+    """Compute and store the label suggestions an annotator's review of a capture lacks
+    (idempotent: a second delivery finds them stored)."""
+    return suggestions.fill_by_id(capture_id, annotator_id)
 
 
 @shared_task

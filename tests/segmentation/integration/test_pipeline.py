@@ -53,7 +53,7 @@ def test_it_takes_an_upload_to_a_submitted_review(running_workers, people):
     capture = bob_client.get(f"/api/captures/{capture_id}/").json()
     assert capture["status"] == "ready", capture["error"]
     assert capture["latest_run"]["status"] == "ready", capture["latest_run"]["error"]
-    review = bob_client.get(f"/api/captures/{capture_id}/review/").json()
+    review = bob_client.post(f"/api/captures/{capture_id}/review/").json()
     assert len(review["cuts"]) == len(capture["latest_run"]["candidates"]) > 0
     cut = review["cuts"][0]
     review = bob_client.patch(
