@@ -1,8 +1,9 @@
 """Stored label suggestions, shared by every web and worker process.
 
-- ``LabelSuggestion``: the suggested label of one span of a capture for one annotator,
-  computed against one state of the library segments that annotator may see (``pool``).
-  A row of another pool state is stale and never read.
+- ``LabelSuggestion``: the suggested label of one span of a capture, computed against
+  one state of one pool of library segments (``suggestions.pool_key``: everything, gold
+  only, or gold plus one annotator's own). Annotators whose pools are the same share the
+  rows; a row of an older state of a pool is stale and never read.
 - ``SuggestionRequest``: one per (capture, annotator): when suggestions were last asked
   of a worker and when that worker finished, so that twenty page loads send one job.
 
@@ -18,9 +19,8 @@ from segmentation.models import Capture
 
 class LabelSuggestion(models.Model):
     capture = models.ForeignKey(Capture, models.CASCADE, related_name="+")
-    annotator = models.ForeignKey(settings.AUTH_USER_MODEL, models.CASCADE, related_name="+")
-    # ``suggestions.pool_state``: the size and newest row of the pool the label came from.
-    pool = models.CharField(max_length=64)
+    # ``suggestions.pool_key``: which segments the label came from, and their state.
+    pool = models.CharField(max_length=100)
     start = models.PositiveIntegerField()
     stop = models.PositiveIntegerField()
     # "" when nothing in the pool can name the span (no descriptor, empty pool).
@@ -28,7 +28,7 @@ class LabelSuggestion(models.Model):
 
     class Meta:
         constraints = [
-            models.UniqueConstraint(fields=["capture", "annotator", "pool", "start", "stop"],
+            models.UniqueConstraint(fields=["capture", "pool", "start", "stop"],
                                     name="one_suggestion_per_span")
         ]
 

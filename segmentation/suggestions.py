@@ -11,12 +11,14 @@ One suggestion costs a DTW ranking; a one-hour take has thousands of segments. S
 review request computes them: ``…/review/suggestions/`` reads stored ``LabelSuggestion``
 rows and, for the spans that have none, sends the ``suggest`` job once
 (``SuggestionRequest``); the worker stores them in batches, and the page polls. A row is
-keyed by its span and by the state of the annotator's pool (``pool_state``), so an edit
-needs new suggestions only for the spans it creates, and a change to the pool makes the
-old rows stale without any request deleting them.
+keyed by its span and by the pool and its state (``pool_key``), so an edit needs new
+suggestions only for the spans it creates, a change to the pool makes the old rows stale
+without any request deleting them, and annotators with the same pool (every annotator
+who has no segment of their own in the library sees gold only) share the rows.
 """
 
 import logging
+import random
 from collections import Counter
 from datetime import timedelta
 
@@ -54,14 +56,23 @@ def pool(capture, annotator):
             .exclude(capture_id=capture.pk))
 
 
-def pool_state(capture, annotator):
-    """``"<rows>:<newest id>"`` of the pool, or None when it is empty.
+def pool_key(capture, annotator):
+    """``"<pool>:<rows>:<newest id>"`` naming the pool and its state, or None when it is
+    empty. The pool is ``all`` (a reviewer or admin), ``gold`` (an annotator with no
+    segment of their own in it) or ``own<user id>``; annotators with the same key draw on
+    the very same segments.
 
     The library replaces a capture's rows when a review is submitted or gold saved (new
-    ids) and deletes them with their capture (fewer rows), so either part changes.
+    ids) and deletes them with their capture (fewer rows), so the state changes.
     """
-    found = pool(capture, annotator).aggregate(n=Count("id"), newest=Max("id"))
-    return f"{found['n']}:{found['newest']}" if found["n"] else None
+    if not capture.project.can_see_all_reviews(annotator):
+        found = pool(capture, annotator).aggregate(
+            n=Count("id"), newest=Max("id"), own=Count("id", filter=Q(annotator=annotator)))
+        name = f"own{annotator.pk}" if found["own"] else "gold"
+    else:
+        found = pool(capture, annotator).aggregate(n=Count("id"), newest=Max("id"))
+        name = "all"
+    return f"{name}:{found['n']}:{found['newest']}" if found["n"] else None
 
 
 def unlabelled_spans(capture, annotator):
@@ -78,11 +89,11 @@ def unlabelled_spans(capture, annotator):
     return [(start, stop) for _, start, stop, label in rows if label is None and stop > start]
 
 
-def stored(capture, annotator, state, spans=None):
-    """{(start, stop): label name or None} stored for the pool state ``state``."""
-    rows = LabelSuggestion.objects.filter(capture=capture, annotator=annotator, pool=state)
+def stored(capture, key, spans):
+    """{(start, stop): label name or None} of ``spans`` stored for the pool ``key``."""
+    rows = LabelSuggestion.objects.filter(capture=capture, pool=key)
     found = {(s, e): name or None for s, e, name in rows.values_list("start", "stop", "label_name")}
-    return found if spans is None else {span: found[span] for span in spans if span in found}
+    return {span: found[span] for span in spans if span in found}
 
 
 def for_review(capture, annotator):
@@ -92,9 +103,9 @@ def for_review(capture, annotator):
     ``pending`` is true while some span still waits for the worker.
     """
     spans = unlabelled_spans(capture, annotator)
-    state = pool_state(capture, annotator) if spans else None
-    found = stored(capture, annotator, state, spans) if state else {}
-    pending = bool(state) and len(found) < len(spans)
+    key = pool_key(capture, annotator) if spans else None
+    found = stored(capture, key, spans) if key else {}
+    pending = bool(key) and len(found) < len(spans)
     if pending:
         ask(capture, annotator)
     return {
@@ -129,28 +140,36 @@ def _send(capture_id, annotator_id):
 def fill(capture, annotator):
     """Compute and store the suggestions the annotator's review is missing (the job).
 
-    Rows of an older pool state are deleted first. Returns the number of spans computed.
+    Rows of an older state of the same pool are deleted first. Jobs of annotators who
+    share a pool may run at once: each takes the spans in its own order and skips those
+    another job has stored meanwhile. Returns the number of spans computed.
     """
-    state = pool_state(capture, annotator)
-    (LabelSuggestion.objects.filter(capture=capture, annotator=annotator)
-     .exclude(pool=state or "").delete())
-    spans = unlabelled_spans(capture, annotator) if state else []
-    have = stored(capture, annotator, state, spans) if state else {}
+    key = pool_key(capture, annotator)
+    if key is not None:
+        name = key.split(":")[0]
+        (LabelSuggestion.objects.filter(capture=capture, pool__startswith=f"{name}:")
+         .exclude(pool=key).delete())
+    spans = unlabelled_spans(capture, annotator) if key else []
+    have = stored(capture, key, spans) if key else {}
     missing = [span for span in spans if span not in have]
+    random.Random(annotator.pk).shuffle(missing)
     request = SuggestionRequest.objects.filter(capture=capture, annotator=annotator)
-    if missing:
-        suggester = Suggester(capture, annotator)
-        for i in range(0, len(missing), BATCH):
-            batch = missing[i:i + BATCH]
-            LabelSuggestion.objects.bulk_create(
-                [LabelSuggestion(capture=capture, annotator=annotator, pool=state, start=s, stop=e,
-                                 label_name=label or "")
-                 for (s, e), label in zip(batch, suggester.labels(batch), strict=True)],
-                ignore_conflicts=True)
-            # Progress: a job still working is not taken as lost.
-            request.update(asked_at=timezone.now())
+    suggester, computed = None, 0
+    for i in range(0, len(missing), BATCH):
+        done = stored(capture, key, missing[i:i + BATCH]) if i else {}
+        batch = sorted(span for span in missing[i:i + BATCH] if span not in done)
+        if not batch:
+            continue
+        suggester = suggester or Suggester(capture, annotator)
+        LabelSuggestion.objects.bulk_create(
+            [LabelSuggestion(capture=capture, pool=key, start=s, stop=e, label_name=label or "")
+             for (s, e), label in zip(batch, suggester.labels(batch), strict=True)],
+            ignore_conflicts=True)
+        computed += len(batch)
+        # Progress: a job still working is not taken as lost.
+        request.update(asked_at=timezone.now())
     request.update(done_at=timezone.now())
-    return len(missing)
+    return computed
 
 
 def fill_by_id(capture_id, annotator_id):

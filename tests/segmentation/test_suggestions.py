@@ -94,6 +94,18 @@ class SuggestionPoolTest(SuggestionsTestCase):
         self.review_take_b(self.bob)
         assert None not in self.suggested(self.bob).values()
 
+    def test_annotators_who_see_the_same_segments_share_the_stored_suggestions(self):
+        self.submit_take_a(self.dana)
+        library.do_save_gold(self.take_a, self.rachel, [start for start, _, _ in self.truth_a[1:]],
+                             [label for _, _, label in self.truth_a], version=0)
+        # Bob and charlie (now an annotator) have no segment of their own: gold only.
+        services.do_set_member(self.project, "charlie", "annotator")
+        self.review_take_b(self.bob)
+        self.review_take_b(self.charlie)
+        assert tasks.suggest(self.take_b.pk, self.bob.pk) == len(self.truth_b)
+        assert tasks.suggest(self.take_b.pk, self.charlie.pk) == 0
+        assert self.suggested(self.charlie) == self.suggested(self.bob)
+
     def test_a_reviewer_gets_suggestions_from_every_segment_they_may_see(self):
         self.submit_take_a(self.dana)
         self.review_take_b(self.rachel)

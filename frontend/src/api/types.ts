@@ -125,8 +125,15 @@ export interface Segment {
   start: number;
   stop: number;
   label: string | null;
-  /** Label of the most alike library segments, for an unlabelled segment (server-side). */
+  /** Label of the most alike library segments, for an unlabelled segment: not sent with
+   * the review; the page fills it in from `Suggestions`. */
   suggested_label?: string | null;
+}
+
+/** `GET /api/captures/{id}/review/suggestions/`: computed by a worker, `pending` until all are. */
+export interface Suggestions {
+  pending: boolean;
+  suggestions: { start: number; stop: number; label: string | null }[];
 }
 
 export interface Review {

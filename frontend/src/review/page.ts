@@ -3,7 +3,7 @@
 // the API straight away (saver.ts); undo/redo are edits too, so the audit log is complete.
 
 import { get, post } from "../api/client";
-import type { Capture, Cut, Label, Me, Project, Review, ReviewEvent, Segment, Signal, SignalResponse } from "../api/types";
+import type { Capture, Cut, Label, Me, Project, Review, ReviewEvent, Segment, Signal, SignalResponse, Suggestions } from "../api/types";
 import { advance, frameOf, nextSpeed, seek, togglePlay, type Playback } from "../player/clock";
 import { SkeletonView } from "../player/skeletonView";
 import { clear, confirmDialog, dialog, h, toast } from "../ui/dom";
@@ -94,6 +94,9 @@ class ReviewPage {
   private shownFrame = -1;
   private floorSet = false;
   private panelSegment: Segment | undefined;
+  /** Suggested labels of the own review's unlabelled segments by "start-stop" (a worker computes them). */
+  private readonly suggested = new Map<string, string | null>();
+  private suggestionTimer = 0;
   private readonly saver: Saver;
   private readonly store: FrameStore;
   private readonly player: SkeletonView | null;
@@ -154,10 +157,12 @@ class ReviewPage {
     this.refresh();
     void this.loadEvents();
     void this.loadOtherReviews();
+    void this.loadSuggestions();
   }
 
   dispose(): void {
     this.abort.abort();
+    clearTimeout(this.suggestionTimer);
     cancelAnimationFrame(this.raf);
     document.removeEventListener("keydown", this.onKey);
     this.player?.dispose();
@@ -228,7 +233,7 @@ class ReviewPage {
   }
 
   private renderSide(): void {
-    const segment = segmentAt(this.review.segments, this.frame());
+    const segment = this.withSuggestion(segmentAt(this.review.segments, this.frame()));
     this.panelSegment = segment;
     renderLabels(this.el.labels, this.labels, segment?.label ?? null, this.locked() !== null, (name) => this.labelCurrent(name));
     renderSelection(this.el.selection, this.selectedCut(), segment, this.capture.fps);
@@ -355,6 +360,8 @@ class ReviewPage {
       this.review = review;
       this.refresh();
       void this.loadEvents();
+      // An edit makes new segments; their suggestions are asked for once the edits settle.
+      if (review.segments.some((s) => !s.label && !this.suggested.has(`${s.start}-${s.stop}`))) this.askSuggestions(800);
     }
   }
 
@@ -491,7 +498,7 @@ class ReviewPage {
 
   /** Commands that change the review; false if `c` is not one of them. */
   private editCommand(c: Command): boolean {
-    const segment = segmentAt(this.review.segments, this.frame());
+    const segment = this.withSuggestion(segmentAt(this.review.segments, this.frame()));
     switch (c.kind) {
       case "accept":
       case "delete":
@@ -554,6 +561,28 @@ class ReviewPage {
       ),
     );
     document.body.append(this.helpOpen);
+  }
+
+  // ---- label suggestions ---------------------------------------------------------------
+
+  /** `segment` with the suggested label of the own review's segment of the same span. */
+  private withSuggestion(segment: Segment | undefined): Segment | undefined {
+    if (!segment || this.readOnly || segment.label) return segment;
+    return { ...segment, suggested_label: this.suggested.get(`${segment.start}-${segment.stop}`) ?? null };
+  }
+
+  private askSuggestions(delayMs: number): void {
+    clearTimeout(this.suggestionTimer);
+    this.suggestionTimer = window.setTimeout(() => void this.loadSuggestions(), delayMs);
+  }
+
+  /** Suggestions are computed by a worker after the page opens; ask until none is pending. */
+  private async loadSuggestions(): Promise<void> {
+    const body = await get<Suggestions>(`/api/captures/${this.capture.id}/review/suggestions/`).catch(() => null);
+    if (!body || this.abort.signal.aborted) return;
+    for (const s of body.suggestions) this.suggested.set(`${s.start}-${s.stop}`, s.label);
+    this.renderSide();
+    if (body.pending) this.askSuggestions(2000);
   }
 
   // ---- activity and other annotators ---------------------------------------------------
