@@ -137,11 +137,12 @@ export interface Suggestions {
 }
 
 export interface Review {
-  id: number;
+  /** null: the caller has not started a review; this is the one the first write starts. */
+  id: number | null;
   capture: number;
   annotator: { id: number; username: string };
   run: number | null;
-  status: "in_progress" | "submitted";
+  status: "in_progress" | "submitted" | "not_started";
   version: number;
   cuts: Cut[];
   segments: Segment[];

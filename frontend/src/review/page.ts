@@ -12,7 +12,7 @@ import { FrameStore, loadFrames } from "./frames";
 import { changeFor, emptyHistory, record, redo, undo, type Change, type History } from "./history";
 import { commandFor, HELP, isTypingTarget, type Command } from "./keymap";
 import { Saver } from "./saver";
-import { applyEdit, clampFrame, describeDifferences, EditError, neighbourCut, segmentAt, type Edit } from "./state";
+import { applyEdit, clampFrame, describeDifferences, EditError, neighbourCut, segmentAt, withTempIds, type Edit } from "./state";
 import { buildLayout, type Elements } from "./layout";
 import { renderEvents, renderLabels, renderSelection, renderStats } from "./panels";
 import { Timeline } from "./timeline";
@@ -31,7 +31,8 @@ export async function renderReview(root: HTMLElement, captureId: number): Promis
   const frames = new FrameFeed(capture);
   try {
     const [review, signal] = await Promise.all([
-      post<Review>(`/api/captures/${captureId}/review/`),
+      // Reading does not start a review: the first edit does (saver.ts).
+      get<Review>(`/api/captures/${captureId}/review/`).then(withTempIds),
       get<SignalResponse>(`/api/captures/${captureId}/signal/?max_points=4000`).catch(() => null),
     ]);
     const page = new ReviewPage(root, capture, me, project ?? null, review, signal?.signals ?? [], frames);
@@ -117,6 +118,8 @@ class ReviewPage {
   ) {
     this.review = review;
     this.own = review;
+    // Below the temporary ids an unstarted review's candidates carry.
+    this.nextTempId = Math.min(0, ...review.cuts.map((c) => c.id)) - 1;
     this.labels = project?.labels ?? [];
     this.playback = { position: frameFromUrl(capture.n_frames), playing: false, speed: 1, fps: capture.fps, nFrames: capture.n_frames, loop: null };
     this.saver = new Saver(capture.id, review, {
