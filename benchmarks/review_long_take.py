@@ -19,14 +19,15 @@ Measured, over HTTP with a token (wall-clock ms on the client):
    cache (the per-process cache that never hit) — timed in this process.
 2. The new path: review GET and edits (insert, label, move, delete a cut) p50/p95, and
    how long the worker takes until every suggestion of the review is stored.
-3. Twenty annotators opening the long take at once (each page load: capture, me,
-   projects, POST review, signal, suggestions, first frames chunk; repeated while the
-   small review is measured; stored suggestions are deleted first, so the worker computes
-   them during the load) against the small capture's requests (review GET, label edit,
-   capture GET) measured alone first.
+3. Twenty annotators opening the long take at the same moment, in ``--waves`` rounds
+   (a page load: capture, me, projects, review, signal, suggestions and the first
+   chunk of frames — the page streams the rest while the review is already usable;
+   stored suggestions are deleted first, so the worker computes them during the first
+   round), against the small capture's requests (review GET, label edit, capture GET)
+   made one after another throughout, and alone before.
 
     .venv/bin/python benchmarks/review_long_take.py [--minutes 60] [--library-minutes 60]
-        [--repeats 40] [--pages 20]
+        [--repeats 40] [--pages 20] [--waves 3]
 
 Targets: review GET and edit p95 <= 100 ms; the small capture's p50 and p95 under the
 load <= 2x alone.
@@ -61,6 +62,7 @@ def parse_args():
     parser.add_argument("--library-minutes", type=float, default=60.0)
     parser.add_argument("--repeats", type=int, default=40, help="requests of each kind")
     parser.add_argument("--pages", type=int, default=20, help="concurrent page loads")
+    parser.add_argument("--waves", type=int, default=3, help="rounds of concurrent page loads")
     parser.add_argument("--old-repeats", type=int, default=3)
     return parser.parse_args()
 
@@ -274,18 +276,18 @@ def wait_for_suggestions(client, capture, timeout=1800):
     raise SystemExit(f"suggestions still pending after {timeout} s")
 
 
+PAGE_REQUESTS = ("capture", "me", "projects", "review", "signal", "suggestions", "frames")
+
+
 def page_load(client, capture):
-    """The requests the review page makes before it shows the review."""
+    """The requests the review page makes before it shows the review: {name: ms}."""
     base = f"/api/captures/{capture.pk}/"
+    paths = (base, "/api/me/", "/api/projects/", base + "review/", base + "signal/?max_points=4000",
+             base + "review/suggestions/", base + "frames/?start=0&stop=5000&step=1")
     started = time.perf_counter()
-    client.call("GET", base)
-    client.call("GET", "/api/me/")
-    client.call("GET", "/api/projects/")
-    client.call("POST", base + "review/")
-    client.call("GET", base + "signal/?max_points=4000")
-    client.call("GET", base + "review/suggestions/")
-    client.call("GET", base + "frames/?start=0&stop=5000&step=1")
-    return (time.perf_counter() - started) * 1000
+    times = {name: client.call("GET", path)[0] for name, path in zip(PAGE_REQUESTS, paths, strict=True)}
+    times["page"] = (time.perf_counter() - started) * 1000
+    return times
 
 
 def small_round(client, capture, state):
@@ -302,7 +304,9 @@ def small_round(client, capture, state):
     return out
 
 
-def time_under_load(port, data, repeats):
+def time_under_load(port, data, repeats, waves):
+    """The small capture's request times alone, then during ``waves`` rounds of every viewer
+    opening the long take at the same moment; and the page load times."""
     from segmentation.models_suggestions import LabelSuggestion, SuggestionRequest
 
     small = Client(port, data.tokens["small"])
@@ -310,25 +314,27 @@ def time_under_load(port, data, repeats):
     alone = [ms for _ in range(repeats) for ms in small_round(small, data.small, state)]
     LabelSuggestion.objects.filter(capture=data.long).delete()
     SuggestionRequest.objects.filter(capture=data.long).delete()
-    stop_at = threading.Event()
-    pages, errors = [], []
+    viewers = {name: Client(port, token) for name, token in data.tokens.items() if name.startswith("viewer")}
+    loaded, pages, errors = [], [], []  # loaded: one list per wave
 
-    def viewer(name):
-        client = Client(port, data.tokens[name])
+    def viewer(client, go):
+        go.wait()
         try:
-            while not stop_at.is_set():
-                pages.append(page_load(client, data.long))
+            pages.append(page_load(client, data.long))
         except Exception as exc:  # reported below, never hidden
-            errors.append(f"{name}: {exc}")
+            errors.append(str(exc))
 
-    threads = [threading.Thread(target=viewer, args=(name,)) for name in data.tokens if name.startswith("viewer")]
-    for thread in threads:
-        thread.start()
-    time.sleep(1.0)  # every viewer has its first page load under way
-    loaded = [ms for _ in range(repeats) for ms in small_round(small, data.small, state)]
-    stop_at.set()
-    for thread in threads:
-        thread.join()
+    for _ in range(waves):
+        go = threading.Barrier(len(viewers) + 1)
+        threads = [threading.Thread(target=viewer, args=(client, go)) for client in viewers.values()]
+        for thread in threads:
+            thread.start()
+        go.wait()
+        loaded.append([])
+        while any(thread.is_alive() for thread in threads):
+            loaded[-1].extend(small_round(small, data.small, state))
+        for thread in threads:
+            thread.join()
     return alone, loaded, pages, errors
 
 
@@ -398,7 +404,7 @@ def main():
         ann.call("GET", "/api/me/")  # warm both connections' first request
         ready_s, n_suggested, asks = wait_for_suggestions(ann, data.long)
         new = time_new_path(ann, data.long, args.repeats)
-        alone, loaded, pages, errors = time_under_load(port, data, args.repeats)
+        alone, loaded, pages, errors = time_under_load(port, data, args.repeats, args.waves)
 
         print(f"\n{'request (ms, client wall clock)':<34} {'n':>5} {'p50':>9} {'p95':>9} {'max':>9}")
         if old is None:
@@ -409,11 +415,16 @@ def main():
             row(f"NEW {kind}", values, TARGET_MS)
         row("NEW GET suggestions (polling)", asks)
         print(f"worker stored all {n_suggested} suggestions {ready_s:.1f} s after the page first asked")
-        print(f"\n{args.pages} concurrent page loads of the long take ({len(pages)} loads done, "
-              f"{len(errors)} errors) vs the small capture's requests:")
-        row("long take page load (7 requests)", pages)
+        print(f"\n{args.waves} x {args.pages} page loads of the long take started at once "
+              f"({len(pages)} done, {len(errors)} errors) vs the small capture's requests:")
+        row("long take page load (7 requests)", [p["page"] for p in pages])
+        for name in PAGE_REQUESTS:
+            row(f"  of which GET {name}", [p[name] for p in pages])
         row("small capture, alone", alone)
-        row("small capture, under the load", loaded)
+        for wave, values in enumerate(loaded, 1):
+            row(f"small capture, during wave {wave}", values)
+        loaded = [ms for values in loaded for ms in values]
+        row("small capture, during all waves", loaded)
         for q in (50, 95):
             ratio = pct(loaded, q) / pct(alone, q)
             print(f"small capture p{q} slowdown: {ratio:.2f}x  "

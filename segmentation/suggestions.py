@@ -120,10 +120,10 @@ def ask(capture, annotator):
     request, _ = SuggestionRequest.objects.get_or_create(capture=capture, annotator=annotator)
     now = timezone.now()
     idle = Q(asked_at__isnull=True) | Q(done_at__gte=F("asked_at")) | Q(asked_at__lt=now - ASK_AGAIN_AFTER)
-    with transaction.atomic():
-        claimed = SuggestionRequest.objects.filter(idle, pk=request.pk).update(asked_at=now, done_at=None)
-        if claimed:
-            transaction.on_commit(lambda: _send(capture.pk, annotator.pk))
+    # One conditional UPDATE claims the ask: 0 rows means a job is on its way.
+    claimed = SuggestionRequest.objects.filter(idle, pk=request.pk).update(asked_at=now, done_at=None)
+    if claimed:
+        transaction.on_commit(lambda: _send(capture.pk, annotator.pk))
     return bool(claimed)
 
 

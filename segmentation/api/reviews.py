@@ -18,6 +18,7 @@ from segmentation.api.serializers import (
     SuggestionsSerializer,
     VersionSerializer,
 )
+from segmentation.services.reviews import reload
 
 
 class OwnReviewView(APIView):
@@ -32,7 +33,7 @@ class OwnReviewView(APIView):
         return serializer.validated_data
 
     def reply(self, review, status=200):
-        review.refresh_from_db()
+        reload(review)
         return Response(ReviewSerializer(review).data, status=status)
 
 

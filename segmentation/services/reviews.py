@@ -23,7 +23,15 @@ def own_review(capture, user):
         raise NotReady(
             f"capture {capture.pk} is {capture.status}; it can be reviewed once it is ready"
         )
+    if review is not None:
+        review.capture, review.annotator = capture, user
     return review
+
+
+def reload(review):
+    """Read the review's own columns again, keeping its capture and annotator (a review
+    of a long take is written and read on every edit: no query that is not needed)."""
+    review.refresh_from_db(fields=["run", "status", "version", "updated_at", "submitted_at"])
 
 
 def get_or_create_review(capture, user):
@@ -90,7 +98,7 @@ def take_in_candidates(review, run):
     taken = set(review.cuts.exclude(fate="deleted").values_list("frame", flat=True))
     added = _add_candidates(review, run.candidates, taken)
     _log(review, None, "candidates", after={"run": run.pk, "candidates": len(added)})
-    review.refresh_from_db()
+    reload(review)
     return True
 
 
@@ -110,7 +118,7 @@ def _write(review, version):
     updated = Review.objects.filter(pk=review.pk, version=version, status="in_progress").update(
         version=F("version") + 1, updated_at=timezone.now()
     )
-    review.refresh_from_db()
+    reload(review)
     if updated:
         return
     if review.version != version:
