@@ -19,12 +19,13 @@ Measured, over HTTP with a token (wall-clock ms on the client):
    cache (the per-process cache that never hit) — timed in this process.
 2. The new path: review GET and edits (insert, label, move, delete a cut) p50/p95, and
    how long the worker takes until every suggestion of the review is stored.
-3. Twenty annotators opening the long take at the same moment, in ``--waves`` rounds
+3. Twenty annotators (threads of this process) opening the long take at the same
+   moment, in ``--waves`` rounds
    (a page load: capture, me, projects, review, signal, suggestions and the first
    chunk of frames — the page streams the rest while the review is already usable;
    stored suggestions are deleted first, so the worker computes them during the first
    round), against the small capture's requests (review GET, label edit, capture GET)
-   made one after another throughout, and alone before.
+   made one after another throughout by a process of its own, and alone before.
 
     .venv/bin/python benchmarks/review_long_take.py [--minutes 60] [--library-minutes 60]
         [--repeats 40] [--pages 20] [--waves 3]
@@ -36,6 +37,7 @@ load <= 2x alone.
 import argparse
 import http.client
 import json
+import multiprocessing
 import os
 import shutil
 import socket
@@ -213,7 +215,7 @@ class Client:
         self.port, self.token = port, token
         self.conn = http.client.HTTPConnection("127.0.0.1", port, timeout=300)
 
-    def call(self, method, path, body=None):
+    def call(self, method, path, body=None, parse=True):
         headers = {"Authorization": f"Token {self.token}"}
         data = None
         if body is not None:
@@ -234,7 +236,7 @@ class Client:
         elapsed = (time.perf_counter() - started) * 1000
         if response.status >= 400:
             raise RuntimeError(f"{method} {path} -> {response.status}: {content[:300]!r}")
-        return elapsed, json.loads(content) if content else None
+        return elapsed, json.loads(content) if content and parse else None
 
 
 def time_new_path(client, capture, repeats):
@@ -285,7 +287,8 @@ def page_load(client, capture):
     paths = (base, "/api/me/", "/api/projects/", base + "review/", base + "signal/?max_points=4000",
              base + "review/suggestions/", base + "frames/?start=0&stop=5000&step=1")
     started = time.perf_counter()
-    times = {name: client.call("GET", path)[0] for name, path in zip(PAGE_REQUESTS, paths, strict=True)}
+    times = {name: client.call("GET", path, parse=False)[0]
+             for name, path in zip(PAGE_REQUESTS, paths, strict=True)}
     times["page"] = (time.perf_counter() - started) * 1000
     return times
 
@@ -304,14 +307,38 @@ def small_round(client, capture, state):
     return out
 
 
+def small_client(port, token, capture_id, rounds, begin, stop_at, out):
+    """The small capture's requests, one after another, in a process of its own (so the
+    viewers' threads in this process never hold its clock): ``rounds`` rounds, or until
+    ``stop_at`` is set. Sends its list of ms to ``out``."""
+    client, state, times = Client(port, token), {}, []
+    capture = types.SimpleNamespace(pk=capture_id)
+    begin.wait()
+    while (len(times) < 3 * rounds) if rounds else not stop_at.is_set():
+        times.extend(small_round(client, capture, state))
+    out.send(times)
+
+
+def run_small(port, data, begin, rounds=0, stop_at=None):
+    reader, writer = multiprocessing.Pipe(duplex=False)
+    proc = multiprocessing.get_context("fork").Process(
+        target=small_client,
+        args=(port, data.tokens["small"], data.small.pk, rounds, begin, stop_at, writer))
+    proc.start()
+    return proc, reader
+
+
 def time_under_load(port, data, repeats, waves):
     """The small capture's request times alone, then during ``waves`` rounds of every viewer
     opening the long take at the same moment; and the page load times."""
     from segmentation.models_suggestions import LabelSuggestion, SuggestionRequest
 
-    small = Client(port, data.tokens["small"])
-    state = {}
-    alone = [ms for _ in range(repeats) for ms in small_round(small, data.small, state)]
+    fork = multiprocessing.get_context("fork")
+    begin = fork.Event()
+    proc, reader = run_small(port, data, begin, rounds=repeats)
+    begin.set()
+    alone = reader.recv()
+    proc.join()
     LabelSuggestion.objects.filter(capture=data.long).delete()
     SuggestionRequest.objects.filter(capture=data.long).delete()
     viewers = {name: Client(port, token) for name, token in data.tokens.items() if name.startswith("viewer")}
@@ -329,12 +356,15 @@ def time_under_load(port, data, repeats, waves):
         threads = [threading.Thread(target=viewer, args=(client, go)) for client in viewers.values()]
         for thread in threads:
             thread.start()
+        begin, stop_at = fork.Event(), fork.Event()
+        proc, reader = run_small(port, data, begin, stop_at=stop_at)
         go.wait()
-        loaded.append([])
-        while any(thread.is_alive() for thread in threads):
-            loaded[-1].extend(small_round(small, data.small, state))
+        begin.set()
         for thread in threads:
             thread.join()
+        stop_at.set()
+        loaded.append(reader.recv())
+        proc.join()
     return alone, loaded, pages, errors
 
 
