@@ -98,6 +98,7 @@ class ReviewPage {
   /** Suggested labels of the own review's unlabelled segments by "start-stop" (a worker computes them). */
   private readonly suggested = new Map<string, string | null>();
   private suggestionTimer = 0;
+  private suggestionDelay = 2000;
   private readonly saver: Saver;
   private readonly store: FrameStore;
   private readonly player: SkeletonView | null;
@@ -585,7 +586,13 @@ class ReviewPage {
     if (!body || this.abort.signal.aborted) return;
     for (const s of body.suggestions) this.suggested.set(`${s.start}-${s.stop}`, s.label);
     this.renderSide();
-    if (body.pending) this.askSuggestions(2000);
+    // Poll while the worker computes; less often the longer it takes (a busy or stopped worker).
+    if (!body.pending) {
+      this.suggestionDelay = 2000;
+      return;
+    }
+    this.askSuggestions(this.suggestionDelay);
+    this.suggestionDelay = Math.min(this.suggestionDelay * 1.5, 15000);
   }
 
   // ---- activity and other annotators ---------------------------------------------------
