@@ -18,12 +18,15 @@ who has no segment of their own in the library sees gold only) share the rows.
 """
 
 import logging
+import os
 import random
+import sys
+import threading
 from collections import Counter
 from datetime import timedelta
 
 import numpy as np
-from django.db import transaction
+from django.db import connection, transaction
 from django.db.models import Count, F, Max, Q
 from django.utils import timezone
 
@@ -47,6 +50,9 @@ NEIGHBOURS = 5
 BATCH = 100
 # A job that has neither finished nor reported progress for this long is taken as lost.
 ASK_AGAIN_AFTER = timedelta(minutes=2)
+# Nice value added to the thread computing suggestions: the worker shares the machine
+# with the web server (the embedded default), and a page request should come first.
+LOW_PRIORITY = 10
 
 
 def pool(capture, annotator):
@@ -173,13 +179,44 @@ def fill(capture, annotator):
 
 
 def fill_by_id(capture_id, annotator_id):
+    """``fill`` for the job (ids in, at low CPU priority); 0 if either row is gone."""
     from django.contrib.auth import get_user_model
 
     capture = Capture.objects.filter(pk=capture_id).first()
     annotator = get_user_model().objects.filter(pk=annotator_id).first()
     if capture is None or annotator is None:
         return 0  # deleted since the job was sent
-    return fill(capture, annotator)
+    return at_low_priority(lambda: fill(capture, annotator))
+
+
+def at_low_priority(work):
+    """``work()`` run in a thread whose nice value is ``LOW_PRIORITY`` higher.
+
+    Linux keeps a nice value per thread, so the priority ends with the thread and the
+    worker's next job (ingest, detection) runs at its usual priority; a process cannot
+    lower its nice value again without privileges. Elsewhere, or inside a transaction
+    (which another thread's connection could not see, e.g. in tests), it runs here.
+    """
+    if sys.platform != "linux" or connection.in_atomic_block:
+        return work()
+    outcome = {}
+
+    def run():
+        tid = threading.get_native_id()
+        try:
+            os.setpriority(os.PRIO_PROCESS, tid, os.getpriority(os.PRIO_PROCESS, tid) + LOW_PRIORITY)
+            outcome["value"] = work()
+        except BaseException as exc:  # handed to the job's own thread below
+            outcome["error"] = exc
+        finally:
+            connection.close()  # this thread's own connection
+
+    thread = threading.Thread(target=run, name="suggest", daemon=True)
+    thread.start()
+    thread.join()
+    if "error" in outcome:
+        raise outcome["error"]
+    return outcome["value"]
 
 
 class Suggester:

@@ -2,9 +2,15 @@
 drawn only from what the review's annotator may see (gold and their own segments for an
 annotator), never from another annotator's labels."""
 
+import os
+import sys
+import threading
+
 import numpy as np
+import pytest
 from django.core.files.base import ContentFile
 from django.db import connection
+from django.test import TransactionTestCase
 from django.test.utils import CaptureQueriesContext
 
 import motionlib
@@ -168,3 +174,21 @@ class SuggestionStoreTest(SuggestionsTestCase):
         assert suggestions.for_review(self.take_b, self.bob)["pending"] is True
         assert tasks.suggest(self.take_b.pk, self.bob.pk) == len(self.truth_b)
         assert LabelSuggestion.objects.count() == len(self.truth_b)
+
+
+class LowPriorityTest(TransactionTestCase):
+    """The job computes at a raised nice value, in a thread, so the priority of the
+    worker process (and of its next job) stays as it was."""
+
+    def test_it_computes_at_a_lower_priority_and_leaves_the_workers_own_priority_alone(self):
+        if sys.platform != "linux":
+            pytest.skip("nice values per thread are a Linux feature")
+        before = os.getpriority(os.PRIO_PROCESS, 0)
+        seen = suggestions.at_low_priority(
+            lambda: os.getpriority(os.PRIO_PROCESS, threading.get_native_id()))
+        assert seen == min(before + suggestions.LOW_PRIORITY, 19)
+        assert os.getpriority(os.PRIO_PROCESS, 0) == before
+
+    def test_it_hands_the_jobs_error_back(self):
+        with pytest.raises(ValueError, match="bad span"):
+            suggestions.at_low_priority(lambda: (_ for _ in ()).throw(ValueError("bad span")))
