@@ -166,10 +166,13 @@ def fill(capture, annotator):
         batch = sorted(span for span in missing[i:i + BATCH] if span not in done)
         if not batch:
             continue
-        suggester = suggester or Suggester(capture, annotator)
+        # Computing reads only; the writes stay at normal priority, so a low-priority
+        # thread never holds the database's write lock (SQLite) while others wait on it.
+        suggester = suggester or at_low_priority(Suggester, capture, annotator)
+        labels = at_low_priority(suggester.labels, batch)
         LabelSuggestion.objects.bulk_create(
             [LabelSuggestion(capture=capture, pool=key, start=s, stop=e, label_name=label or "")
-             for (s, e), label in zip(batch, suggester.labels(batch), strict=True)],
+             for (s, e), label in zip(batch, labels, strict=True)],
             ignore_conflicts=True)
         computed += len(batch)
         # Progress: a job still working is not taken as lost.
@@ -179,18 +182,18 @@ def fill(capture, annotator):
 
 
 def fill_by_id(capture_id, annotator_id):
-    """``fill`` for the job (ids in, at low CPU priority); 0 if either row is gone."""
+    """``fill`` for the job (ids in); 0 if either row is gone."""
     from django.contrib.auth import get_user_model
 
     capture = Capture.objects.filter(pk=capture_id).first()
     annotator = get_user_model().objects.filter(pk=annotator_id).first()
     if capture is None or annotator is None:
         return 0  # deleted since the job was sent
-    return at_low_priority(lambda: fill(capture, annotator))
+    return fill(capture, annotator)
 
 
-def at_low_priority(work):
-    """``work()`` run in a thread whose nice value is ``LOW_PRIORITY`` higher.
+def at_low_priority(work, *args):
+    """``work(*args)`` run in a thread whose nice value is ``LOW_PRIORITY`` higher.
 
     Linux keeps a nice value per thread, so the priority ends with the thread and the
     worker's next job (ingest, detection) runs at its usual priority; a process cannot
@@ -198,14 +201,14 @@ def at_low_priority(work):
     (which another thread's connection could not see, e.g. in tests), it runs here.
     """
     if sys.platform != "linux" or connection.in_atomic_block:
-        return work()
+        return work(*args)
     outcome = {}
 
     def run():
         tid = threading.get_native_id()
         try:
             os.setpriority(os.PRIO_PROCESS, tid, os.getpriority(os.PRIO_PROCESS, tid) + LOW_PRIORITY)
-            outcome["value"] = work()
+            outcome["value"] = work(*args)
         except BaseException as exc:  # handed to the job's own thread below
             outcome["error"] = exc
         finally:

@@ -178,14 +178,13 @@ class SuggestionStoreTest(SuggestionsTestCase):
 
 class LowPriorityTest(TransactionTestCase):
     """The job computes at a raised nice value, in a thread, so the priority of the
-    worker process (and of its next job) stays as it was."""
+    worker process (and of its next job) stays as it was; it writes at its own."""
 
     def test_it_computes_at_a_lower_priority_and_leaves_the_workers_own_priority_alone(self):
         if sys.platform != "linux":
             pytest.skip("nice values per thread are a Linux feature")
         before = os.getpriority(os.PRIO_PROCESS, 0)
-        seen = suggestions.at_low_priority(
-            lambda: os.getpriority(os.PRIO_PROCESS, threading.get_native_id()))
+        seen = suggestions.at_low_priority(lambda: os.getpriority(os.PRIO_PROCESS, threading.get_native_id()))
         assert seen == min(before + suggestions.LOW_PRIORITY, 19)
         assert os.getpriority(os.PRIO_PROCESS, 0) == before
 
