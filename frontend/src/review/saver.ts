@@ -6,10 +6,11 @@ import { api, ApiError, get } from "../api/client";
 import type { Review } from "../api/types";
 import { editRequest, findInsertedId, labelRequest, startedIds, type Edit } from "./state";
 
-/** The review was started elsewhere (another tab) after this page read it unstarted. */
+/** The review started differently from how this page showed it unstarted: another tab
+ * started and edited it, or a newer detection run finished in between. */
 class StartedElsewhere extends Error {
   constructor(readonly review: Review) {
-    super("This review was started in another window since this page opened.");
+    super("This review was started in another window, or new candidates arrived, since this page opened.");
   }
 }
 
@@ -80,8 +81,8 @@ export class Saver {
     const renamed = startedIds(this.server, started);
     for (const [temp, id] of renamed) this.ids.set(temp, id);
     this.events.saved(started, false, renamed);
-    // Started and edited in another window: show what changed there, send nothing.
-    if (started.version !== this.server.version) throw new StartedElsewhere(started);
+    // Not what the page showed: show what changed, send nothing.
+    if (started.version !== this.server.version || started.run !== this.server.run) throw new StartedElsewhere(started);
     this.server = started;
   }
 
