@@ -66,6 +66,8 @@ def parse_args():
     parser.add_argument("--pages", type=int, default=20, help="concurrent page loads")
     parser.add_argument("--waves", type=int, default=3, help="rounds of concurrent page loads")
     parser.add_argument("--old-repeats", type=int, default=3)
+    parser.add_argument("--keep-suggestions", action="store_true",
+                        help="leave stored suggestions in place: the worker stays idle during the loads")
     return parser.parse_args()
 
 
@@ -328,7 +330,7 @@ def run_small(port, data, begin, rounds=0, stop_at=None):
     return proc, reader
 
 
-def time_under_load(port, data, repeats, waves):
+def time_under_load(port, data, repeats, waves, keep_suggestions=False):
     """The small capture's request times alone, then during ``waves`` rounds of every viewer
     opening the long take at the same moment; and the page load times."""
     from segmentation.models_suggestions import LabelSuggestion, SuggestionRequest
@@ -339,8 +341,9 @@ def time_under_load(port, data, repeats, waves):
     begin.set()
     alone = reader.recv()
     proc.join()
-    LabelSuggestion.objects.filter(capture=data.long).delete()
-    SuggestionRequest.objects.filter(capture=data.long).delete()
+    if not keep_suggestions:
+        LabelSuggestion.objects.filter(capture=data.long).delete()
+        SuggestionRequest.objects.filter(capture=data.long).delete()
     viewers = {name: Client(port, token) for name, token in data.tokens.items() if name.startswith("viewer")}
     loaded, pages, errors = [], [], []  # loaded: one list per wave
 
@@ -434,7 +437,8 @@ def main():
         ann.call("GET", "/api/me/")  # warm both connections' first request
         ready_s, n_suggested, asks = wait_for_suggestions(ann, data.long)
         new = time_new_path(ann, data.long, args.repeats)
-        alone, loaded, pages, errors = time_under_load(port, data, args.repeats, args.waves)
+        alone, loaded, pages, errors = time_under_load(port, data, args.repeats, args.waves,
+                                                       args.keep_suggestions)
 
         print(f"\n{'request (ms, client wall clock)':<34} {'n':>5} {'p50':>9} {'p95':>9} {'max':>9}")
         if old is None:
@@ -446,7 +450,8 @@ def main():
         row("NEW GET suggestions (polling)", asks)
         print(f"worker stored all {n_suggested} suggestions {ready_s:.1f} s after the page first asked")
         print(f"\n{args.waves} x {args.pages} page loads of the long take started at once "
-              f"({len(pages)} done, {len(errors)} errors) vs the small capture's requests:")
+              f"({len(pages)} done, {len(errors)} errors; stored suggestions "
+              f"{'kept' if args.keep_suggestions else 'deleted first'}) vs the small capture's requests:")
         row("long take page load (7 requests)", [p["page"] for p in pages])
         for name in PAGE_REQUESTS:
             row(f"  of which GET {name}", [p[name] for p in pages])
