@@ -1,5 +1,5 @@
-"""The clip library: materialised segments, gold versions, exports, similar clips and
-label suggestions.
+"""The clip library: materialised segments, gold versions, exports and similar clips
+(label suggestions, which draw on the same rows, are ``segmentation.suggestions``).
 
 Segments become ``LibrarySegment`` rows when a review is submitted or a gold version is
 saved (``refresh_capture_library`` rebuilds one capture's rows: agreement values change
@@ -14,13 +14,10 @@ import json
 import logging
 import re
 import zipfile
-from collections import Counter
-from functools import lru_cache
 from pathlib import PurePath
 from types import SimpleNamespace
 
 import numpy as np
-from django.core.cache import cache
 from django.db import transaction
 from django.utils import timezone
 
@@ -35,7 +32,6 @@ log = logging.getLogger(__name__)
 
 # Similar clips and suggestions search at most this many of a project's recent segments.
 SIMILAR_POOL = 20000
-SUGGEST_NEIGHBOURS = 5
 # Profile-nearest segments whose full descriptors are compared (DTW) in both searches.
 SHORTLIST = 20
 MAX_EXPORT_SEGMENTS = 5000
@@ -356,80 +352,3 @@ def similar(segment, visible, k=10):
                                                shortlist=len(short))
     rows = LibrarySegment.objects.select_related("capture", "annotator").in_bulk([short[i] for i in order])
     return [(rows[short[i]], float(d)) for i, d in zip(order, distances, strict=True)]
-
-
-def suggest_labels(review, segments):
-    """A suggested label for each unlabelled segment of a review (None where there is none).
-
-    The label with the most votes among the nearest ``SUGGEST_NEIGHBOURS`` labelled
-    segments of the project's other captures, each vote weighted by 1 / distance^2 (gold
-    preferred when the pool is capped). Cached per span and library state, so editing one
-    segment does not recompute the others.
-    """
-    capture = review.capture
-    pending = [(s, e) for _, s, e, label in segments if label is None and e > s]
-    if not pending:
-        return [None] * len(segments)
-    latest = (LibrarySegment.objects.filter(project_id=capture.project_id).order_by("-id")
-              .values_list("id", "created_at").first())
-    if latest is None:
-        return [None] * len(segments)
-    # The newest row's id and time identify the library's state (ids alone can be reused
-    # after a rollback).
-    state = f"{latest[0]}@{latest[1].timestamp()}"
-    key = f"cutroom:suggest:{capture.pk}:{state}:"
-    found = cache.get_many([f"{key}{s}-{e}" for s, e in pending])
-    missing = [(s, e) for s, e in pending if f"{key}{s}-{e}" not in found]
-    if missing:
-        computed = _suggest(capture, missing, state)
-        fresh = {f"{key}{s}-{e}": v for (s, e), v in zip(missing, computed, strict=True)}
-        cache.set_many(fresh, timeout=3600)
-        found.update(fresh)
-    return [found.get(f"{key}{s}-{e}") if label is None else None for _, s, e, label in segments]
-
-
-def _suggest(capture, spans, latest):
-    queries = descriptors(capture, spans)
-    if queries[0] is None:
-        return [None] * len(spans)
-    ids, profiles, names = suggestion_pool(capture.project_id, capture.pk, latest,
-                                           queries[0].shape[1])
-    if not ids:
-        return [None] * len(spans)
-    shortlists = [[ids[i] for i in similarity.shortlist_by_profile(q, profiles, SHORTLIST)]
-                  for q in queries]
-    union = sorted({pk for short in shortlists for pk in short})
-    full = dict(zip(union, load_descriptors(union), strict=True))
-    return [_vote(q, short, full, names) for q, short in zip(queries, shortlists, strict=True)]
-
-
-@lru_cache(maxsize=4)
-def suggestion_pool(project_id, capture_id, latest, n_features):
-    """(ids, profiles, {id: label}) of the labelled segments suggestions draw on.
-
-    Kept per process for the library state ``latest`` (see ``suggest_labels``), because
-    every edit of a review asks again and the pool is up to ``SIMILAR_POOL`` rows.
-    """
-    pool = (
-        LibrarySegment.objects.preferred()
-        .filter(project_id=project_id, profile__isnull=False)
-        # Other annotators' labels of the same take would make reviews depend on each other.
-        .exclude(capture_id=capture_id)
-        .order_by("-is_gold", "-id").values_list("id", "profile", "label_name")
-    )[:SIMILAR_POOL]
-    names = {pk: name for pk, _, name in pool}
-    ids, profiles = profile_pool([(pk, blob) for pk, blob, _ in pool], n_features)
-    return ids, profiles, names
-
-
-def _vote(query, short, full, names):
-    """The label with most votes among the nearest neighbours, a vote weighing 1 / d^2:
-    with a small library a plain majority would name whichever label is most common
-    rather than the one that moves alike."""
-    order, distances = similarity.rank_similar(
-        query, np.stack([full[pk] for pk in short]), k=min(SUGGEST_NEIGHBOURS, len(short)),
-        shortlist=len(short))
-    votes = Counter()
-    for i, d in zip(order, distances, strict=True):
-        votes[names[short[i]]] += 1.0 / (d * d + 1e-9)
-    return votes.most_common(1)[0][0]

@@ -339,17 +339,21 @@ class Review(models.Model):
         """Cuts that split the take (everything not deleted), in frame order."""
         return [c for c in self.cuts.all() if c.fate != "deleted"]
 
+    def kept_frames(self):
+        """``[(cut id, frame)]`` of the kept cuts in frame order, read as plain values: a
+        one-hour take has thousands of cuts, and every edit asks."""
+        return list(self.cuts.exclude(fate="deleted").order_by("frame", "id").values_list("id", "frame"))
+
     def segments(self):
         """Intervals between kept cuts: list of (index, start, stop, label name or None).
 
         A segment's label is stored against the cut that starts it (no cut for the
         first segment), so labels follow their cut when it is moved.
         """
-        kept = sorted(self.kept_cuts(), key=lambda c: c.frame)
-        rows = self.segment_labels.select_related("label")
-        labels = {s.cut_id: s.label.name for s in rows if s.label_id}
-        starts = [(None, 0)] + [(c.id, c.frame) for c in kept]
-        stops = [c.frame for c in kept] + [self.capture.n_frames or 0]
+        kept = self.kept_frames()
+        labels = dict(self.segment_labels.filter(label__isnull=False).values_list("cut_id", "label__name"))
+        starts = [(None, 0)] + kept
+        stops = [frame for _, frame in kept] + [self.capture.n_frames or 0]
         return [
             (index, start, stop, labels.get(cut_id))
             for index, ((cut_id, start), stop) in enumerate(zip(starts, stops, strict=True))
@@ -357,10 +361,10 @@ class Review(models.Model):
 
     def segment_start_cut(self, index):
         """The cut that starts segment ``index`` (None for the first); IndexError if none."""
-        kept = sorted(self.kept_cuts(), key=lambda c: c.frame)
+        kept = self.kept_frames()
         if index < 0 or index > len(kept):
             raise IndexError(index)
-        return kept[index - 1] if index else None
+        return self.cuts.get(pk=kept[index - 1][0]) if index else None
 
 
 class Cut(models.Model):
@@ -487,3 +491,4 @@ from segmentation.models_library import (  # noqa: E402, F401
     CaptureAgreement,
     LibrarySegment,
 )
+from segmentation.models_suggestions import LabelSuggestion, SuggestionRequest  # noqa: E402, F401

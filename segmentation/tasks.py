@@ -15,7 +15,7 @@ from celery import shared_task
 from celery.signals import worker_process_init, worker_ready
 from django.conf import settings
 
-from segmentation import services
+from segmentation import services, suggestions
 from segmentation.models import Capture, DetectionRun
 from segmentation.services import adaptation
 from segmentation.services.captures import exhausted, give_up
@@ -91,6 +91,13 @@ def retrain(self, model_id):
     job = adaptation.claim_training(model_id, self.request.id or uuid.uuid4().hex)
     if job is not None:
         adaptation.train_project_model(job)
+
+
+@shared_task(acks_late=True, reject_on_worker_lost=True)
+def suggest(capture_id, annotator_id):
+    """Compute and store the label suggestions an annotator's review of a capture lacks
+    (idempotent: a second delivery finds them stored)."""
+    return suggestions.fill_by_id(capture_id, annotator_id)
 
 
 @shared_task

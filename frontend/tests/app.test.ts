@@ -92,5 +92,6 @@ describe("audit log lines", () => {
     expect(eventDetail({ action: "move", before: { frame: 700, fate: "pending" }, after: { frame: 760, fate: "moved" } })).toBe("frame 700 → 760");
     expect(eventDetail({ action: "insert", before: null, after: { frame: 3018, fate: "accepted" } })).toBe("at frame 3018");
     expect(eventDetail({ action: "label", before: { index: 0, label: null }, after: { index: 0, label: "walk" } })).toBe("segment 1: — → walk");
+    expect(eventDetail({ action: "candidates", before: null, after: { run: 4, candidates: 9 } })).toBe("9 candidates arrived");
   });
 });

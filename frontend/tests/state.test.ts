@@ -1,5 +1,6 @@
 import { describe, expect, it } from "vitest";
-import { applyEdit, deriveSegments, labelsByStartCut, describeDifferences, editRequest, EditError, findInsertedId, labelRequest, neighbourCut, segmentAt } from "../src/review/state";
+import type { Review } from "../src/api/types";
+import { applyEdit, deriveSegments, labelsByStartCut, describeDifferences, editRequest, EditError, findInsertedId, labelRequest, neighbourCut, segmentAt, startedIds, withTempIds } from "../src/review/state";
 import { cut, review } from "./fixtures";
 
 const N = 1000;
@@ -159,5 +160,19 @@ describe("describeDifferences", () => {
 
   it("test_it_says_nothing_when_nothing_changed", () => {
     expect(describeDifferences(review(), review())).toEqual([]);
+  });
+});
+
+describe("an unstarted review", () => {
+  const unstarted = (): Review => ({ ...review(), id: null, status: "not_started", version: 1, cuts: review().cuts.map((c) => ({ ...c, id: null as unknown as number })) });
+
+  it("test_it_gives_the_candidates_of_an_unstarted_review_temporary_ids", () => {
+    expect(withTempIds(unstarted()).cuts.map((c) => c.id)).toEqual([-1, -2, -3]);
+    expect(withTempIds(review())).toEqual(review());
+  });
+
+  it("test_it_maps_temporary_ids_onto_the_started_reviews_cuts_by_candidate_frame", () => {
+    const started = { ...review([cut(41, 800), cut(42, 200), cut(43, 500)]), id: 7 };
+    expect([...startedIds(withTempIds(unstarted()), started).entries()]).toEqual([[-1, 42], [-2, 43], [-3, 41]]);
   });
 });

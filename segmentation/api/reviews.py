@@ -7,7 +7,7 @@ from rest_framework.exceptions import PermissionDenied
 from rest_framework.response import Response
 from rest_framework.views import APIView
 
-from segmentation import services
+from segmentation import services, suggestions
 from segmentation.api.captures import capture_for
 from segmentation.api.serializers import (
     ChangeCutSerializer,
@@ -15,12 +15,14 @@ from segmentation.api.serializers import (
     InsertCutSerializer,
     LabelSegmentSerializer,
     ReviewSerializer,
+    SuggestionsSerializer,
     VersionSerializer,
 )
+from segmentation.services.reviews import reload
 
 
 class OwnReviewView(APIView):
-    """Base: the caller's own review of capture ``pk`` (created on first use)."""
+    """Base: the caller's own review of capture ``pk`` (a write starts it on first use)."""
 
     def review(self, pk):
         return services.get_or_create_review(capture_for(self.request.user, pk), self.request.user)
@@ -31,18 +33,50 @@ class OwnReviewView(APIView):
         return serializer.validated_data
 
     def reply(self, review, status=200):
-        review.refresh_from_db()
+        reload(review)
         return Response(ReviewSerializer(review).data, status=status)
 
 
 class ReviewView(OwnReviewView):
     @extend_schema(responses=ReviewSerializer)
     def get(self, request, pk):
-        return self.reply(self.review(pk))
+        """The caller's review; before they start one, the review they would start
+        (``id`` null; its cuts have no ids yet), which is not stored: reading never writes.
+        A write based on it sends version 1, the version the review starts at."""
+        capture = capture_for(request.user, pk)
+        review = services.own_review(capture, request.user)
+        if review is None:
+            return Response(unstarted_review(capture, request.user))
+        return Response(ReviewSerializer(review).data)
 
     @extend_schema(request=None, responses=ReviewSerializer)
     def post(self, request, pk):
+        """Start the caller's review (or return it if started)."""
         return self.reply(self.review(pk))
+
+
+def unstarted_review(capture, user):
+    """A review as ``user`` would start it now: the latest finished run's candidates."""
+    run = capture.latest_finished_run()
+    candidates = sorted(run.candidates, key=lambda c: c["frame"]) if run else []
+    cuts = [{"id": None, "origin": "candidate", "fate": "pending", "candidate_frame": c["frame"],
+             "frame": c["frame"], "confidence": c["confidence"]} for c in candidates]
+    bounds = [0, *[c["frame"] for c in candidates], capture.n_frames or 0]
+    return {
+        "id": None, "capture": capture.pk, "annotator": {"id": user.pk, "username": user.username},
+        "run": run.pk if run else None, "status": "not_started", "version": 1, "cuts": cuts,
+        "segments": [{"index": i, "start": a, "stop": b, "label": None}
+                     for i, (a, b) in enumerate(zip(bounds[:-1], bounds[1:], strict=True))],
+    }
+
+
+class SuggestionsView(APIView):
+    @extend_schema(responses=SuggestionsSerializer)
+    def get(self, request, pk):
+        """Suggested labels of the caller's unlabelled segments, as far as computed."""
+        capture = capture_for(request.user, pk)
+        services.own_review(capture, request.user)  # NotReady before ingest finished
+        return Response(suggestions.for_review(capture, request.user))
 
 
 class CutsView(OwnReviewView):
@@ -83,7 +117,8 @@ class SubmitView(OwnReviewView):
 class EventsView(OwnReviewView):
     @extend_schema(responses=EventSerializer(many=True))
     def get(self, request, pk):
-        events = self.review(pk).events.select_related("user")
+        review = services.own_review(capture_for(request.user, pk), request.user)
+        events = review.events.select_related("user") if review else []
         return Response(EventSerializer(events, many=True).data)
 
 

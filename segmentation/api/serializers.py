@@ -182,19 +182,27 @@ class ReviewSerializer(serializers.ModelSerializer):
         return {"id": review.annotator_id, "username": review.annotator.username}
 
     def get_cuts(self, review) -> list[dict]:
-        return CutSerializer(review.cuts.order_by("frame", "id"), many=True).data
+        # Plain values, not a nested serializer per cut: a one-hour take has thousands.
+        fields = list(CutSerializer().fields)
+        return [dict(zip(fields, row, strict=True))
+                for row in review.cuts.order_by("frame", "id").values_list(*fields)]
 
     def get_segments(self, review) -> list[dict]:
-        from segmentation.library import suggest_labels
+        # Label suggestions are not part of a review: they are computed by a worker and
+        # read from …/review/suggestions/ (segmentation.suggestions).
+        return [{"index": index, "start": start, "stop": stop, "label": label}
+                for index, start, stop, label in review.segments()]
 
-        segments = review.segments()
-        # Unlabelled segments get the label of the most alike segments in the library.
-        suggested = suggest_labels(review, segments)
-        return [
-            {"index": index, "start": start, "stop": stop, "label": label,
-             "suggested_label": suggestion}
-            for (index, start, stop, label), suggestion in zip(segments, suggested, strict=True)
-        ]
+
+class SuggestionSerializer(serializers.Serializer):
+    start = serializers.IntegerField()
+    stop = serializers.IntegerField()
+    label = serializers.CharField(allow_null=True)
+
+
+class SuggestionsSerializer(serializers.Serializer):
+    pending = serializers.BooleanField()
+    suggestions = SuggestionSerializer(many=True)
 
 
 class VersionSerializer(serializers.Serializer):

@@ -25,6 +25,7 @@ urlpatterns = [
     path(review + "segments/<int:index>/", reviews.SegmentView.as_view(), name="api-review-segment"),
     path(review + "submit/", reviews.SubmitView.as_view(), name="api-review-submit"),
     path(review + "events/", reviews.EventsView.as_view(), name="api-review-events"),
+    path(review + "suggestions/", reviews.SuggestionsView.as_view(), name="api-review-suggestions"),
     path("captures/<int:pk>/reviews/", reviews.AllReviewsView.as_view(), name="api-reviews"),
     *library.urlpatterns,
     *invitations.urlpatterns,

@@ -31,6 +31,7 @@ from segmentation.services.reviews import (
     do_label_segment,
     do_submit_review,
     get_or_create_review,
+    own_review,
 )
 
 __all__ = [
@@ -53,5 +54,6 @@ __all__ = [
     "do_upload_capture",
     "get_or_create_review",
     "ingest_capture",
+    "own_review",
     "sweep_stale_claims",
 ]

@@ -20,6 +20,7 @@ from motionlib.take import Limits
 from segmentation import storage
 from segmentation.errors import NotReady, UploadError, UploadTooLarge
 from segmentation.models import Capture, DetectionRun
+from segmentation.services.reviews import do_take_in_candidates
 
 log = logging.getLogger(__name__)
 
@@ -317,13 +318,16 @@ def _detect(run, take=None):
     ]
     signals = {name: np.asarray(v, dtype="<f4") for name, v in result.signals.items()}
     storage.save_npz(run.signals, "signals.npz", signals)
-    run.finish(
+    finished = run.finish(
         candidates=candidates,
         timings={k: round(float(v), 4) for k, v in result.timings.items()},
         signals=run.signals.name,
         finished_at=timezone.now(),
         **model_fields,
     )
+    if finished:
+        # Reviews opened while this run was computing start from its candidates now.
+        do_take_in_candidates(run)
 
 
 def exhausted(job):

@@ -16,18 +16,39 @@ from segmentation.models import Cut, Review, ReviewEvent, SegmentLabel
 FATE_ACTIONS = {"accepted": "accept", "deleted": "delete", "pending": "reset"}
 
 
-def get_or_create_review(capture, user):
-    """The user's review of a capture, created from the latest finished run if new."""
+def own_review(capture, user):
+    """The user's review of a capture, or None if they have not started one (no write)."""
     review = Review.objects.filter(capture=capture, annotator=user).first()
-    if review:
-        return review
-    if capture.status != "ready":
+    if review is None and capture.status != "ready":
         raise NotReady(
             f"capture {capture.pk} is {capture.status}; it can be reviewed once it is ready"
         )
-    from segmentation.services.assignments import check_may_start
+    if review is None:
+        # An annotator who may not pick this capture (not assigned to them, in a project
+        # that does not allow picking) may not start, so may not open, its review.
+        from segmentation.services.assignments import check_may_start
 
-    check_may_start(capture, user)
+        check_may_start(capture, user)
+    if review is not None:
+        review.capture, review.annotator = capture, user
+    return review
+
+
+def reload(review):
+    """Read the review's own columns again, keeping its capture and annotator (a review
+    of a long take is written and read on every edit: no query that is not needed)."""
+    review.refresh_from_db(fields=["run", "status", "version", "updated_at", "submitted_at"])
+
+
+def get_or_create_review(capture, user):
+    """The user's review of a capture, started from the latest finished run if new.
+
+    Only writes call this: reading a review never creates one (see ``own_review``).
+    """
+    review = own_review(capture, user)
+    if review:
+        _catch_up(review)
+        return review
     try:
         with transaction.atomic():
             return _create_review(capture, user)
@@ -40,19 +61,62 @@ def _create_review(capture, user):
     run = capture.latest_finished_run()
     review = Review.objects.create(capture=capture, annotator=user, run=run)
     candidates = run.candidates if run else []
-    Cut.objects.bulk_create(
-        Cut(
-            review=review,
-            origin="candidate",
-            candidate_frame=c["frame"],
-            frame=c["frame"],
-            confidence=c["confidence"],
-        )
-        for c in candidates
-    )
+    _add_candidates(review, candidates)
     after = {"run": run.pk if run else None, "candidates": len(candidates)}
     ReviewEvent.objects.create(review=review, user=user, action="create", after=after)
     return review
+
+
+def _add_candidates(review, candidates, taken=()):
+    """Candidate cuts of ``review``, leaving out frames in ``taken`` (kept cuts)."""
+    return Cut.objects.bulk_create(
+        Cut(review=review, origin="candidate", candidate_frame=c["frame"], frame=c["frame"],
+            confidence=c["confidence"])
+        for c in candidates if c["frame"] not in taken
+    )
+
+
+def _catch_up(review):
+    """A review started before detection finished, whose run has finished since but
+    missed the hand-over (``do_take_in_candidates``; e.g. both committed at once), takes
+    the candidates in before the write. Its version goes up, so the write itself is
+    refused as stale and its client reloads: the segment indexes it meant have moved."""
+    if review.run_id is None and review.status == "in_progress":
+        run = review.capture.latest_finished_run()
+        if run is not None:
+            with transaction.atomic():
+                take_in_candidates(review, run)
+
+
+def take_in_candidates(review, run):
+    """Give a review started before detection finished the candidates of ``run``.
+
+    Runs inside the caller's transaction. The review keeps everything its annotator did
+    (a candidate on a frame they already cut is left out) and its version goes up, so a
+    page holding the old version reloads instead of overwriting. Returns True if the
+    review took them (False if it already had a run or was submitted).
+    """
+    updated = Review.objects.filter(pk=review.pk, run__isnull=True, status="in_progress").update(
+        run=run, version=F("version") + 1, updated_at=timezone.now()
+    )
+    if not updated:
+        return False
+    taken = set(review.cuts.exclude(fate="deleted").values_list("frame", flat=True))
+    added = _add_candidates(review, run.candidates, taken)
+    _log(review, None, "candidates", after={"run": run.pk, "candidates": len(added)})
+    reload(review)
+    return True
+
+
+def do_take_in_candidates(run):
+    """Called when ``run`` finished: every review of its capture still waiting for
+    candidates takes them in. Returns how many did."""
+    count = 0
+    for review in Review.objects.filter(capture_id=run.capture_id, run__isnull=True,
+                                        status="in_progress"):
+        with transaction.atomic():
+            count += take_in_candidates(review, run)
+    return count
 
 
 def _write(review, version):
@@ -60,7 +124,7 @@ def _write(review, version):
     updated = Review.objects.filter(pk=review.pk, version=version, status__in=Review.EDITABLE).update(
         version=F("version") + 1, updated_at=timezone.now()
     )
-    review.refresh_from_db()
+    reload(review)
     if updated:
         return
     if review.version != version:

@@ -66,15 +66,18 @@ def test_it_saves_every_edit_and_restores_the_review_exactly_after_reload(live_s
     screen.wait_ready()
     expect(page.get_by_test_id("hud-time")).to_contain_text("· 120 fps")
 
+    # Opening the page starts no review: the server shows the one the first edit starts.
     start = screen.review()
+    assert (start["id"], start["status"]) == (None, "not_started")
     assert {c["fate"] for c in start["cuts"]} == {"pending"}
-    c0, c1, c2, c3 = sorted(start["cuts"], key=lambda c: c["frame"])[:4]
     frames_per_px = ingested_capture.n_frames / screen.box()["width"]
 
-    # Accept: click the dashed candidate line.
-    page.mouse.click(screen.x(c0["frame"]), screen.signal_y())
+    # Accept: click the dashed candidate line. The first edit starts the review.
+    page.mouse.click(screen.x(min(c["frame"] for c in start["cuts"])), screen.signal_y())
     screen.saved()
-    assert cut_by_id(screen.review(), c0["id"])["fate"] == "accepted"
+    start = screen.review()
+    c0, c1, c2, c3 = sorted(start["cuts"], key=lambda c: c["frame"])[:4]
+    assert start["status"] == "in_progress" and c0["fate"] == "accepted"
 
     # Move: drag a candidate right, less than halfway to the next one.
     shift_px = min(20.0, (c2["frame"] - c1["frame"]) / 3 / frames_per_px)
@@ -206,15 +209,13 @@ def test_it_shows_what_changed_when_the_review_was_edited_elsewhere(live_server,
     page = new_page("ann")
     screen = ReviewScreen(page, live_server.url, ingested_capture)
     screen.open()
+    # The same annotator, in another tab, starts the review and deletes the first cut.
+    from segmentation import services
+
+    review = services.get_or_create_review(ingested_capture, studio["ann"])
     start = screen.review()
     first, second = sorted(start["cuts"], key=lambda c: c["frame"])[:2]
-
-    # The same annotator, in another tab, deletes the first cut.
-    from segmentation import services
-    from segmentation.models import Cut, Review
-
-    review = Review.objects.get(pk=start["id"])
-    services.do_change_cut(review, studio["ann"], Cut.objects.get(pk=first["id"]), start["version"], fate="deleted")
+    services.do_change_cut(review, studio["ann"], review.cuts.get(pk=first["id"]), start["version"], fate="deleted")
 
     page.mouse.click(screen.x(second["frame"]), screen.signal_y())
     dialog = page.get_by_role("dialog")
@@ -278,7 +279,8 @@ def test_it_lists_the_shortcuts_and_locks_the_review_once_submitted(live_server,
     page.get_by_test_id("submit").click()
     expect(page.get_by_role("dialog")).to_contain_text("pending candidates")
     page.get_by_test_id("confirm-cancel").click()
-    assert screen.review()["status"] == "in_progress"
+    # Nothing was edited yet, so not even the review is started.
+    assert screen.review()["status"] == "not_started"
     page.get_by_test_id("submit").click()
     page.get_by_test_id("confirm-ok").click()
     expect(page.get_by_test_id("readonly-banner")).to_contain_text("You submitted this review")
@@ -299,7 +301,6 @@ def test_it_undoes_and_redoes_moves_inserts_and_deletes_on_the_server(live_serve
     screen.open()
     start = screen.review()
     c0, c1 = sorted(start["cuts"], key=lambda c: c["frame"])[:2]
-    as_left = {c["id"]: (c["fate"], c["frame"]) for c in start["cuts"]}
 
     # Move c0 with the mouse, delete c1 with the keyboard, insert a cut between them.
     page.mouse.move(screen.x(c0["frame"]), screen.signal_y())
@@ -307,6 +308,10 @@ def test_it_undoes_and_redoes_moves_inserts_and_deletes_on_the_server(live_serve
     page.mouse.move(screen.x(c0["frame"]) + 12, screen.signal_y(), steps=4)
     page.mouse.up()
     screen.saved()
+    # The move started the review: its candidates have ids now.
+    ids = {c["candidate_frame"]: c["id"] for c in screen.review()["cuts"]}
+    c0, c1 = ({**c, "id": ids[c["frame"]]} for c in (c0, c1))
+    as_left = {ids[c["frame"]]: (c["fate"], c["frame"]) for c in start["cuts"]}
     page.keyboard.press("Home")
     page.keyboard.press("Shift+ArrowRight")
     page.keyboard.press("Shift+ArrowRight")

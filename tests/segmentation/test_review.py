@@ -10,7 +10,7 @@ class ReviewTestCase(BaseTestCase):
         self.login(self.bob)
 
     def start(self):
-        return self.client.get(self.url).json()
+        return self.client.post(self.url).json()
 
     def cut_at(self, review, frame):
         return next(c for c in review["cuts"] if c["frame"] == frame)

@@ -7,7 +7,7 @@ class ReviewBadInputTestCase(BaseTestCase):
         self.capture = self.ready_capture(candidates=(100, 200), n_frames=400)
         self.url = f"/api/captures/{self.capture.pk}/review/"
         self.login(self.bob)
-        self.review = self.client.get(self.url).json()
+        self.review = self.client.post(self.url).json()
 
     def assert_refused(self, response, field, text):
         self.assertEqual(response.status_code, 400, response.content)

@@ -9,7 +9,7 @@ class ReviewConcurrencyTestCase(BaseTestCase):
         capture = self.ready_capture(candidates=(100, 200), n_frames=400)
         url = f"/api/captures/{capture.pk}/review/"
         self.login(self.bob)
-        self.client.get(url)
+        self.client.post(url)
 
         first = self.client.post(url + "cuts/", {"frame": 150, "version": 1}, format="json")
         second = self.client.post(url + "cuts/", {"frame": 250, "version": 1}, format="json")
@@ -27,7 +27,7 @@ class ReviewConcurrencyTestCase(BaseTestCase):
         capture = self.ready_capture(candidates=(100, 200), n_frames=400)
         url = f"/api/captures/{capture.pk}/review/"
         self.login(self.bob)
-        self.client.get(url)
+        self.client.post(url)
         self.client.post(url + "cuts/", {"frame": 150, "version": 1}, format="json")
         current = self.client.post(url + "cuts/", {"frame": 250, "version": 1}, format="json").json()
         retry = self.client.post(

@@ -7,9 +7,9 @@ class ReviewPermissionsTestCase(BaseTestCase):
         self.capture = self.ready_capture(candidates=(100, 200), n_frames=400)
         self.url = f"/api/captures/{self.capture.pk}/review/"
         self.login(self.rachel)
-        self.rachels = self.client.get(self.url).json()
+        self.rachels = self.client.post(self.url).json()
         self.login(self.bob)
-        self.bobs = self.client.get(self.url).json()
+        self.bobs = self.client.post(self.url).json()
 
     def test_each_annotator_gets_their_own_review(self):
         self.assertNotEqual(self.bobs["id"], self.rachels["id"])

@@ -144,16 +144,24 @@ export interface Segment {
   start: number;
   stop: number;
   label: string | null;
-  /** Label of the most alike library segments, for an unlabelled segment (server-side). */
+  /** Label of the most alike library segments, for an unlabelled segment: not sent with
+   * the review; the page fills it in from `Suggestions`. */
   suggested_label?: string | null;
 }
 
+/** `GET /api/captures/{id}/review/suggestions/`: computed by a worker, `pending` until all are. */
+export interface Suggestions {
+  pending: boolean;
+  suggestions: { start: number; stop: number; label: string | null }[];
+}
+
 export interface Review {
-  id: number;
+  /** null: the caller has not started a review; this is the one the first write starts. */
+  id: number | null;
   capture: number;
   annotator: { id: number; username: string };
   run: number | null;
-  status: "in_progress" | "submitted" | "returned";
+  status: "in_progress" | "submitted" | "returned" | "not_started";
   version: number;
   return_comment?: string;
   cuts: Cut[];

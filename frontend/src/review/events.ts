@@ -7,6 +7,8 @@ export function eventDetail(e: Pick<ReviewEvent, "action" | "before" | "after">)
   const before = (e.before ?? {}) as Record<string, unknown>;
   const after = (e.after ?? {}) as Record<string, unknown>;
   if (e.action === "create") return `${after.candidates ?? 0} candidates`;
+  // A review opened before detection finished takes the run's candidates in afterwards.
+  if (e.action === "candidates") return `${after.candidates ?? 0} candidates arrived`;
   if ("index" in after || "index" in before) {
     const index = Number(after.index ?? before.index);
     return `segment ${index + 1}: ${before.label ?? "—"} → ${after.label ?? "—"}`;

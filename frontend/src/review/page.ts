@@ -3,7 +3,7 @@
 // the API straight away (saver.ts); undo/redo are edits too, so the audit log is complete.
 
 import { ApiError, get, post } from "../api/client";
-import type { Capture, Cut, Label, Me, Project, Review, ReviewEvent, Segment, Signal, SignalResponse } from "../api/types";
+import type { Capture, Cut, Label, Me, Project, Review, ReviewEvent, Segment, Signal, SignalResponse, Suggestions } from "../api/types";
 import { advance, frameOf, nextSpeed, seek, togglePlay, type Playback } from "../player/clock";
 import { MAX_JOINTS, SkeletonView, TooManyJoints } from "../player/skeletonView";
 import { clear, confirmDialog, dialog, h, toast } from "../ui/dom";
@@ -16,7 +16,7 @@ import { changeFor, emptyHistory, record, redo, undo, type Change, type History 
 import { commandFor, HELP, isTypingTarget, type Command } from "./keymap";
 import { openPalette } from "./palette";
 import { Saver } from "./saver";
-import { applyEdit, clampFrame, describeDifferences, EditError, neighbourCut, segmentAt, type Edit } from "./state";
+import { applyEdit, clampFrame, describeDifferences, EditError, neighbourCut, segmentAt, withTempIds, type Edit } from "./state";
 import { buildLayout, type Elements } from "./layout";
 import { renderAdaptation, renderEvents, renderLabels, renderSelection, renderStats } from "./panels";
 import { Timeline } from "./timeline";
@@ -35,7 +35,8 @@ export async function renderReview(root: HTMLElement, captureId: number): Promis
   const frames = new FrameFeed(capture, maxJoints(me));
   try {
     const [review, signal] = await Promise.all([
-      post<Review>(`/api/captures/${captureId}/review/`),
+      // Reading does not start a review: the first edit does (saver.ts).
+      get<Review>(`/api/captures/${captureId}/review/`).then(withTempIds),
       get<SignalResponse>(`/api/captures/${captureId}/signal/?max_points=4000`).catch(() => null),
     ]);
     const page = new ReviewPage(root, capture, me, project ?? null, review, signal?.signals ?? [], frames);
@@ -114,6 +115,10 @@ class ReviewPage {
   private shownFrame = -1;
   private floorSet = false;
   private panelSegment: Segment | undefined;
+  /** Suggested labels of the own review's unlabelled segments by "start-stop" (a worker computes them). */
+  private readonly suggested = new Map<string, string | null>();
+  private suggestionTimer = 0;
+  private suggestionDelay = 2000;
   private readonly saver: Saver;
   private readonly store: FrameStore;
   private readonly player: SkeletonView | null;
@@ -134,6 +139,8 @@ class ReviewPage {
   ) {
     this.review = review;
     this.own = review;
+    // Below the temporary ids an unstarted review's candidates carry.
+    this.nextTempId = Math.min(0, ...review.cuts.map((c) => c.id)) - 1;
     this.labels = project?.labels ?? [];
     this.playback = { position: frameFromUrl(capture.n_frames), playing: false, speed: 1, fps: capture.fps, nFrames: capture.n_frames, loop: null };
     this.saver = new Saver(capture.id, review, {
@@ -175,10 +182,12 @@ class ReviewPage {
     this.refresh();
     void this.loadEvents();
     void this.loadOtherReviews();
+    void this.loadSuggestions();
   }
 
   dispose(): void {
     this.abort.abort();
+    clearTimeout(this.suggestionTimer);
     cancelAnimationFrame(this.raf);
     document.removeEventListener("keydown", this.onKey);
     this.player?.dispose();
@@ -258,7 +267,7 @@ class ReviewPage {
   }
 
   private renderSide(): void {
-    const segment = segmentAt(this.review.segments, this.frame());
+    const segment = this.withSuggestion(segmentAt(this.review.segments, this.frame()));
     this.panelSegment = segment;
     renderLabels(this.el.labels, this.activeLabels(), segment?.label ?? null, this.locked() !== null, (name) => this.labelCurrent(name));
     renderSelection(this.el.selection, this.selectedCut(), segment, this.capture.fps);
@@ -403,6 +412,8 @@ class ReviewPage {
       this.review = review;
       this.refresh();
       void this.loadEvents();
+      // An edit makes new segments; their suggestions are asked for once the edits settle.
+      if (review.segments.some((s) => !s.label && !this.suggested.has(`${s.start}-${s.stop}`))) this.askSuggestions(800);
     }
   }
 
@@ -542,7 +553,7 @@ class ReviewPage {
 
   /** Commands that change the review; false if `c` is not one of them. */
   private editCommand(c: Command): boolean {
-    const segment = segmentAt(this.review.segments, this.frame());
+    const segment = this.withSuggestion(segmentAt(this.review.segments, this.frame()));
     switch (c.kind) {
       case "accept":
       case "delete":
@@ -611,6 +622,34 @@ class ReviewPage {
     document.body.append(this.helpOpen);
   }
 
+  // ---- label suggestions ---------------------------------------------------------------
+
+  /** `segment` with the suggested label of the own review's segment of the same span. */
+  private withSuggestion(segment: Segment | undefined): Segment | undefined {
+    if (!segment || this.readOnly || segment.label) return segment;
+    return { ...segment, suggested_label: this.suggested.get(`${segment.start}-${segment.stop}`) ?? null };
+  }
+
+  private askSuggestions(delayMs: number): void {
+    clearTimeout(this.suggestionTimer);
+    this.suggestionTimer = window.setTimeout(() => void this.loadSuggestions(), delayMs);
+  }
+
+  /** Suggestions are computed by a worker after the page opens; ask until none is pending. */
+  private async loadSuggestions(): Promise<void> {
+    const body = await get<Suggestions>(`/api/captures/${this.capture.id}/review/suggestions/`).catch(() => null);
+    if (!body || this.abort.signal.aborted) return;
+    for (const s of body.suggestions) this.suggested.set(`${s.start}-${s.stop}`, s.label);
+    this.renderSide();
+    // Poll while the worker computes; less often the longer it takes (a busy or stopped worker).
+    if (!body.pending) {
+      this.suggestionDelay = 2000;
+      return;
+    }
+    this.askSuggestions(this.suggestionDelay);
+    this.suggestionDelay = Math.min(this.suggestionDelay * 1.5, 15000);
+  }
+
   // ---- activity and other annotators ---------------------------------------------------
 
   private async loadEvents(): Promise<void> {
@@ -626,7 +665,7 @@ class ReviewPage {
     const comment = await promptDialog(`Return ${review.annotator.username}'s review`, "Say what should change; they see it in their queue, edit and resubmit. Until then the review leaves agreement and the library.", "Return");
     if (!comment) return;
     try {
-      await returnReview(this.capture.id, review.id, comment);
+      await returnReview(this.capture.id, review.id as number, comment);
       toast(`Returned to ${review.annotator.username}.`);
       select.value = "";
       select.dispatchEvent(new Event("change"));

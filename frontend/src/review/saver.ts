@@ -4,7 +4,15 @@
 
 import { api, ApiError, get } from "../api/client";
 import type { Review } from "../api/types";
-import { editRequest, findInsertedId, labelRequest, type Edit } from "./state";
+import { editRequest, findInsertedId, labelRequest, startedIds, type Edit } from "./state";
+
+/** The review started differently from how this page showed it unstarted: another tab
+ * started and edited it, or a newer detection run finished in between. */
+class StartedElsewhere extends Error {
+  constructor(readonly review: Review) {
+    super("This review was started in another window, or new candidates arrived, since this page opened.");
+  }
+}
 
 export interface SaverEvents {
   saved(review: Review, idle: boolean, renamed: Map<number, number>): void;
@@ -42,6 +50,7 @@ export class Saver {
     while (this.queue.length) {
       const { edit } = this.queue[0];
       try {
+        if (this.server.id === null) await this.start();
         const request =
           edit.kind === "label"
             ? labelRequest(this.captureId, this.server, edit, this.server.version)
@@ -66,10 +75,26 @@ export class Saver {
     this.events.busy(0);
   }
 
+  /** The first save starts the review (reading it did not); its candidates get real ids. */
+  private async start(): Promise<void> {
+    const started = await api<Review>("POST", `/api/captures/${this.captureId}/review/`);
+    const renamed = startedIds(this.server, started);
+    for (const [temp, id] of renamed) this.ids.set(temp, id);
+    this.events.saved(started, false, renamed);
+    // Not what the page showed: show what changed, send nothing.
+    if (started.version !== this.server.version || started.run !== this.server.run) throw new StartedElsewhere(started);
+    this.server = started;
+  }
+
   private async abandon(err: unknown): Promise<void> {
     const unsaved = [...new Set(this.queue.map((q) => q.title))];
     this.queue = [];
     const message = err instanceof Error ? err.message : String(err);
+    if (err instanceof StartedElsewhere) {
+      this.server = err.review;
+      this.events.conflict(err.review, unsaved, message);
+      return;
+    }
     const body = err instanceof ApiError ? (err.body as { review?: Review } | null) : null;
     if (err instanceof ApiError && err.status === 409 && body?.review) {
       this.server = body.review;

@@ -59,6 +59,27 @@ export function neighbourCut(cuts: readonly Cut[], frame: number, direction: -1 
   return [...sorted].reverse().find((c) => c.frame < frame);
 }
 
+/**
+ * An unstarted review (id null: reading never creates one) with temporary negative ids
+ * on its candidate cuts, so they can be selected and edited before the first save
+ * starts the review.
+ */
+export function withTempIds(review: Review): Review {
+  if (review.id !== null) return review;
+  return { ...review, cuts: review.cuts.map((c, i) => ({ ...c, id: -1 - i })) };
+}
+
+/** Temporary ids of an unstarted review's candidates -> the started review's cut ids (by candidate frame). */
+export function startedIds(unstarted: Review, started: Review): Map<number, number> {
+  const byFrame = new Map(started.cuts.filter((c) => c.origin === "candidate").map((c) => [c.candidate_frame, c.id]));
+  const ids = new Map<number, number>();
+  for (const cut of unstarted.cuts) {
+    const id = byFrame.get(cut.candidate_frame);
+    if (cut.id < 0 && id !== undefined) ids.set(cut.id, id);
+  }
+  return ids;
+}
+
 /** Predict the server's answer to `edit`; throws `EditError` for an edit it would refuse. */
 export function applyEdit(review: Review, edit: Edit, nFrames: number): Review {
   const cuts = review.cuts.map((c) => ({ ...c }));

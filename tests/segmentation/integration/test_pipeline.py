@@ -53,7 +53,7 @@ def test_it_takes_an_upload_to_a_submitted_review(running_workers, people):
     capture = bob_client.get(f"/api/captures/{capture_id}/").json()
     assert capture["status"] == "ready", capture["error"]
     assert capture["latest_run"]["status"] == "ready", capture["latest_run"]["error"]
-    review = bob_client.get(f"/api/captures/{capture_id}/review/").json()
+    review = bob_client.post(f"/api/captures/{capture_id}/review/").json()
     assert len(review["cuts"]) == len(capture["latest_run"]["candidates"]) > 0
     cut = review["cuts"][0]
     review = bob_client.patch(
@@ -98,3 +98,29 @@ def test_two_workers_given_the_same_job_process_it_once(running_workers, people)
     assert capture.status == "ready"
     assert capture.attempts == 1
     assert DetectionRun.objects.filter(capture=capture).count() == 1
+
+
+def test_a_worker_computes_the_suggestions_the_page_asks_for(running_workers, people):
+    """Bob's labelled first take is his library; the review of his second take asks for
+    suggestions, which a real worker computes and stores while the page polls."""
+    project, alice, bob = people
+    for name in ("punch", "squat", "jumping_jack", "arm_circles", "idle", "kick"):
+        services.do_add_label(project, name)
+    first = upload(client_for(alice), project, synthetic_bvh(seed=5, duration=30.0), name="one.bvh")
+    second = upload(client_for(alice), project, synthetic_bvh(seed=6, duration=30.0), name="two.bvh")
+    wait_for(lambda: settled(first) and settled(second), what="ingest and detection")
+    bob_client = client_for(bob)
+    review = bob_client.post(f"/api/captures/{first}/review/").json()
+    for index in range(len(review["segments"])):
+        review = bob_client.patch(f"/api/captures/{first}/review/segments/{index}/",
+                                  {"label": "squat", "version": review["version"]}, format="json").json()
+    bob_client.post(f"/api/captures/{first}/review/submit/", {"version": review["version"]}, format="json")
+
+    url = f"/api/captures/{second}/review/suggestions/"
+    assert bob_client.get(url).json()["pending"] is True
+    wait_for(lambda: bob_client.get(url).json()["pending"] is False, timeout=120, interval=0.5,
+             what="suggestions")
+    body = bob_client.get(url).json()
+    segments = bob_client.get(f"/api/captures/{second}/review/").json()["segments"]
+    assert [(s["start"], s["stop"]) for s in body["suggestions"]] == [(s["start"], s["stop"]) for s in segments]
+    assert {s["label"] for s in body["suggestions"]} == {"squat"}

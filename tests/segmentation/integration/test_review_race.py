@@ -27,7 +27,7 @@ def review_url(transactional_db, services_env):
     )
     client = APIClient()
     client.force_authenticate(alice)
-    client.get(f"/api/captures/{capture.pk}/review/")
+    client.post(f"/api/captures/{capture.pk}/review/")
     return alice, f"/api/captures/{capture.pk}/review/"
 
 
