@@ -18,6 +18,7 @@ from segmentation.api.serializers import (
     SuggestionsSerializer,
     VersionSerializer,
 )
+from segmentation.services.adaptation import adaptation_summary
 from segmentation.services.reviews import reload
 
 
@@ -64,9 +65,11 @@ def unstarted_review(capture, user):
     bounds = [0, *[c["frame"] for c in candidates], capture.n_frames or 0]
     return {
         "id": None, "capture": capture.pk, "annotator": {"id": user.pk, "username": user.username},
-        "run": run.pk if run else None, "status": "not_started", "version": 1, "cuts": cuts,
+        "run": run.pk if run else None, "status": "not_started", "version": 1,
+        "return_comment": "", "cuts": cuts,
         "segments": [{"index": i, "start": a, "stop": b, "label": None}
                      for i, (a, b) in enumerate(zip(bounds[:-1], bounds[1:], strict=True))],
+        "adaptation": adaptation_summary(run, capture.project_id),
     }
 
 

@@ -117,7 +117,7 @@ class ExportTest(CmuLibraryTestCase):
                                               "manifest.json"]
         (entry,) = json.loads(archive.read("manifest.json"))
         assert entry | {"segment": None} == {
-            "file": "13_29_Squat_3805-4593.bvh", "segment": None, "capture": "13_29.bvh",
+            "file": "13_29_Squat_3805-4593.bvh", "format": "bvh", "segment": None, "capture": "13_29.bvh",
             "capture_id": self.capture.pk, "start": 3805, "stop": 4593, "label": "Squat",
             "gold": False, "annotator": "bob", "agreement": None}
         rows = list(csv.DictReader(io.StringIO(archive.read("manifest.csv").decode())))
