@@ -10,6 +10,7 @@ import uuid
 
 from celery import shared_task
 from celery.signals import worker_ready
+from django.conf import settings
 
 from segmentation import services
 from segmentation.models import Capture, DetectionRun
@@ -28,7 +29,13 @@ def _claim(model, pk, task):
     return job
 
 
-@shared_task(bind=True, acks_late=True, reject_on_worker_lost=True)
+def limits(seconds):
+    """Soft limit (the job fails with a message), then a hard one (its process is killed)."""
+    return {"soft_time_limit": seconds, "time_limit": seconds + 30}
+
+
+@shared_task(bind=True, acks_late=True, reject_on_worker_lost=True,
+             **limits(settings.CUTROOM_INGEST_TIME_LIMIT))
 def ingest(self, capture_id):
     """Parse a capture, store its metadata and positions, then queue default detection."""
     capture = _claim(Capture, capture_id, self)
@@ -36,7 +43,8 @@ def ingest(self, capture_id):
         services.ingest_capture(capture)
 
 
-@shared_task(bind=True, acks_late=True, reject_on_worker_lost=True)
+@shared_task(bind=True, acks_late=True, reject_on_worker_lost=True,
+             **limits(settings.CUTROOM_DETECT_TIME_LIMIT))
 def detect(self, run_id):
     """Compute a run's candidate cuts."""
     run = _claim(DetectionRun, run_id, self)
@@ -44,7 +52,7 @@ def detect(self, run_id):
         services.detect_run(run)
 
 
-@shared_task
+@shared_task(**limits(60))
 def sweep():
     """Requeue (or fail) jobs whose claim went stale because their worker vanished."""
     return services.sweep_stale_claims()

@@ -1,7 +1,8 @@
 """The one translator from domain errors to HTTP responses.
 
 - ``StaleVersion`` -> 409 with the current review;
-- ``UploadTooLarge`` -> 413;
+- ``UploadTooLarge``, ``QuotaExceeded`` -> 413;
+- ``TooManyRequests`` (rate and concurrency limits) -> 429 with ``Retry-After``;
 - any other ``ValueError`` (motionlib's ``CaptureError``/``ParamError``, the service's
   own) -> 400 with its message, which names the field, file, line or value at fault;
 - DRF's own errors keep their status, and always carry a readable ``detail``.
@@ -14,7 +15,7 @@ from rest_framework.response import Response
 from rest_framework.views import exception_handler as drf_exception_handler
 
 from motionlib.segmenters import ParamError
-from segmentation.errors import StaleVersion, UploadTooLarge
+from segmentation.errors import QuotaExceeded, StaleVersion, TooManyRequests, UploadTooLarge
 
 FIELD = re.compile(r"^(\w+): (.+)$", re.DOTALL)
 
@@ -25,8 +26,11 @@ def exception_handler(exc, context):
 
         body = {"detail": str(exc), "review": ReviewSerializer(exc.review).data}
         return Response(body, status=status.HTTP_409_CONFLICT)
+    if isinstance(exc, TooManyRequests):
+        return Response(_value_error_body(exc), status=429,
+                        headers={"Retry-After": str(exc.retry_after)})
     if isinstance(exc, ValueError):
-        code = 413 if isinstance(exc, UploadTooLarge) else 400
+        code = 413 if isinstance(exc, UploadTooLarge | QuotaExceeded) else 400
         return Response(_value_error_body(exc), status=code)
     response = drf_exception_handler(exc, context)
     if response is not None and isinstance(response.data, dict) and "detail" not in response.data:
