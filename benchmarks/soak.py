@@ -147,19 +147,23 @@ def wchan(pid):
         return ""
 
 
-def busy_child(worker, var):
-    """A pool process running a job: one not waiting on the job pipe or its lock."""
+def busy_child(worker):
+    """A pool process running a job (on the CPU right now)."""
     for pid in pool(worker):
-        if "pipe_read" not in wchan(pid) and "futex" not in wchan(pid):
+        try:
+            state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+        except OSError:
+            continue
+        if state == "R":
             return pid
     return None
 
 
-def kill(kind, out, var):
+def kill(kind, out):
     """Kill one part of the worker; what was killed, or None if there was nothing to kill."""
     worker = worker_pid(out)
     if kind == "busy pool process":
-        target = busy_child(worker, var)
+        target = busy_child(worker)
     elif kind == "idle pool process holding the job-pipe lock":
         target = next((p for p in pool(worker) if "pipe_read" in wchan(p)), None)
     else:
@@ -252,13 +256,13 @@ def main():
                     refused[status] += 1
             if now >= next_kill:
                 next_kill = now + args.kill_every
-                # The busy kill waits for a job to be running (up to 20 s).
+                # The busy kill waits for a job to be running (up to 30 s).
                 kind = kinds[sum(kills.values()) % len(kinds)]
-                for _ in range(200):
-                    done = kill(kind, out, var)
+                for _ in range(600):
+                    done = kill(kind, out)
                     if done or kind != "busy pool process":
                         break
-                    time.sleep(0.1)
+                    time.sleep(0.05)
                 kills[done or f"{kind} (none found)"] += 1
             refresh(client, captures)
             review_step(client, rng, captures)

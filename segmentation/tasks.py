@@ -9,7 +9,7 @@ logged.
 import uuid
 
 from celery import shared_task
-from celery.signals import worker_ready
+from celery.signals import worker_init, worker_ready
 from django.conf import settings
 
 from segmentation import services
@@ -29,13 +29,7 @@ def _claim(model, pk, task):
     return job
 
 
-def limits(seconds):
-    """Soft limit (the job fails with a message), then a hard one (its process is killed)."""
-    return {"soft_time_limit": seconds, "time_limit": seconds + 30}
-
-
-@shared_task(bind=True, acks_late=True, reject_on_worker_lost=True,
-             **limits(settings.CUTROOM_INGEST_TIME_LIMIT))
+@shared_task(bind=True, acks_late=True, reject_on_worker_lost=True)
 def ingest(self, capture_id):
     """Parse a capture, store its metadata and positions, then queue default detection."""
     capture = _claim(Capture, capture_id, self)
@@ -43,8 +37,7 @@ def ingest(self, capture_id):
         services.ingest_capture(capture)
 
 
-@shared_task(bind=True, acks_late=True, reject_on_worker_lost=True,
-             **limits(settings.CUTROOM_DETECT_TIME_LIMIT))
+@shared_task(bind=True, acks_late=True, reject_on_worker_lost=True)
 def detect(self, run_id):
     """Compute a run's candidate cuts."""
     run = _claim(DetectionRun, run_id, self)
@@ -52,10 +45,25 @@ def detect(self, run_id):
         services.detect_run(run)
 
 
-@shared_task(**limits(60))
+@shared_task
 def sweep():
     """Requeue (or fail) jobs whose claim went stale because their worker vanished."""
     return services.sweep_stale_claims()
+
+
+@worker_init.connect
+def apply_time_limits(**kwargs):
+    """Per-task time limits from the worker's own settings: a soft limit (the job stops
+    and fails with a message), then a hard one 30 s later (its process is killed).
+
+    Set here rather than on the decorators, where the sending process would write its
+    own values into each message."""
+    for task, seconds in (
+        (ingest, settings.CUTROOM_INGEST_TIME_LIMIT),
+        (detect, settings.CUTROOM_DETECT_TIME_LIMIT),
+        (sweep, 60),
+    ):
+        task.soft_time_limit, task.time_limit = seconds, seconds + 30
 
 
 @worker_ready.connect
