@@ -69,6 +69,28 @@ def test_it_gives_a_rejected_message_back_at_once(tmp_path):
     assert again.payload == "one"
 
 
+def test_it_releases_every_reserved_message_when_asked_after_its_only_worker_was_killed(tmp_path):
+    from cutroom import broker
+
+    put(tmp_path / "b.sqlite3", "one", "two")
+    take(tmp_path / "b.sqlite3")
+    take(tmp_path / "b.sqlite3")
+    assert broker.release_all(tmp_path / "b.sqlite3") == 2
+    message, _ = take(tmp_path / "b.sqlite3", timeout=0.5)
+    assert message.payload == "one"
+
+
+def test_it_counts_messages_sent_and_acknowledged(tmp_path):
+    from cutroom import broker
+
+    put(tmp_path / "b.sqlite3", "one", "two")
+    message, _ = take(tmp_path / "b.sqlite3")
+    message.ack()
+    assert broker.statistics(tmp_path / "b.sqlite3") == {
+        "jobs": {"sent": 2, "acked": 1, "waiting": 1}
+    }
+
+
 CONSUMER = textwrap.dedent("""
     import sys
     from kombu import Connection
