@@ -1,7 +1,7 @@
 """Upload -> candidates on the embedded default: how long until a 5-minute take has cuts.
 
 Everything is real and runs as `make up` runs it: a temporary SQLite database, the
-filesystem broker, and a Celery worker subprocess. Each repeat uploads a different
+SQLite broker, and a Celery worker subprocess. Each repeat uploads a different
 synthetic 5-minute, 120 fps take (written as BVH) through the HTTP API (Django's test
 client, so no socket time is counted) and polls the database until the default
 detection run is ready. The clock starts before the POST and stops when the run row
@@ -126,7 +126,7 @@ def upload_and_wait(client, project, name, content, timeout=120):
 
 
 def report(rows, n_frames, args):
-    print(f"upload -> candidates, embedded default (SQLite + filesystem broker + 1 worker), "
+    print(f"upload -> candidates, embedded default (SQLite + SQLite broker + 1 worker), "
           f"{args.minutes:g} min at {args.fps:g} fps = {n_frames} frames, "
           f"{len(rows)} repeats after {'a 10 s warm-up upload' if args.warm_up else 'no warm-up'}"
           f"; machine: {os.cpu_count()} cores, load average "

@@ -1,6 +1,6 @@
 """Cutroom settings, read from environment variables only.
 
-With nothing set, Cutroom runs embedded: SQLite and a filesystem Celery broker under
+With nothing set, Cutroom runs embedded: SQLite and a SQLite-file Celery broker under
 ``var/``, originals under ``var/media/``. Production sets ``DATABASE_URL`` (PostgreSQL)
 and ``CELERY_BROKER_URL`` (Redis). ``.env.example`` lists every variable.
 """
@@ -189,8 +189,16 @@ CUTROOM_MAX_UPLOAD_MB = envint("CUTROOM_MAX_UPLOAD_MB", 200)
 # API can answer with its own clear 413 instead of a generic error.
 DATA_UPLOAD_MAX_MEMORY_SIZE = 10 * 1024 * 1024
 FILE_UPLOAD_MAX_MEMORY_SIZE = 10 * 1024 * 1024
-# A claim on a capture or run older than this (seconds) is treated as abandoned.
-CUTROOM_CLAIM_TIMEOUT = envint("CUTROOM_CLAIM_TIMEOUT", 15 * 60)
+# A running job renews its claim every CUTROOM_CLAIM_TIMEOUT / 6 seconds; a claim not
+# renewed for CUTROOM_CLAIM_TIMEOUT seconds means its process died, and the sweep (every
+# CUTROOM_SWEEP_SECONDS) requeues the job.
+CUTROOM_CLAIM_TIMEOUT = envint("CUTROOM_CLAIM_TIMEOUT", 30)
+CUTROOM_SWEEP_SECONDS = envint("CUTROOM_SWEEP_SECONDS", 15)
+# A job still queued this long after it was sent has its message sent again (the broker
+# was unreachable at upload time, a queue was purged).
+CUTROOM_RESEND_AFTER = envint("CUTROOM_RESEND_AFTER", 15 * 60)
+# Workers are restarted when a job waited this long while a worker process sat idle.
+CUTROOM_STALL_SECONDS = envint("CUTROOM_STALL_SECONDS", 60)
 # After this many claims a job that keeps killing its worker is marked failed.
 CUTROOM_MAX_ATTEMPTS = envint("CUTROOM_MAX_ATTEMPTS", 3)
 # FBX uploads are read by Blender on this queue, served by its own worker (`make up`, compose).
@@ -213,10 +221,23 @@ CUTROOM_JOINT_FRAMES_PER_REQUEST = 250_000
 # A project's model retrains this many seconds after a review submit or gold save;
 # submits made meanwhile join the same training.
 CUTROOM_RETRAIN_DELAY = envint("CUTROOM_RETRAIN_DELAY", 10)
+# Time limits per job (seconds): past the soft limit the job fails with a message; past
+# soft + 30 s its process is killed. Ingest includes the default detection run.
+CUTROOM_INGEST_TIME_LIMIT = envint("CUTROOM_INGEST_TIME_LIMIT", 600)
+CUTROOM_DETECT_TIME_LIMIT = envint("CUTROOM_DETECT_TIME_LIMIT", 300)
+CUTROOM_RETRAIN_TIME_LIMIT = envint("CUTROOM_RETRAIN_TIME_LIMIT", 600)
+CUTROOM_SUGGEST_TIME_LIMIT = envint("CUTROOM_SUGGEST_TIME_LIMIT", 900)
+# Quotas (0 = no limit): uploads per user per hour, stored MB per project and per user,
+# detection runs queued or running at once per project.
+CUTROOM_UPLOADS_PER_HOUR = envint("CUTROOM_UPLOADS_PER_HOUR", 120)
+CUTROOM_PROJECT_STORAGE_MB = envint("CUTROOM_PROJECT_STORAGE_MB", 20 * 1024)
+CUTROOM_USER_STORAGE_MB = envint("CUTROOM_USER_STORAGE_MB", 10 * 1024)
+CUTROOM_PROJECT_ACTIVE_RUNS = envint("CUTROOM_PROJECT_ACTIVE_RUNS", 4)
 
 # Celery. No result backend: a job's state is its row (status, error, timings).
-# (the host part only keeps kombu from warning that none was given)
-CELERY_BROKER_URL = os.environ.get("CELERY_BROKER_URL") or "filesystem://localhost//"
+# The embedded default's broker is one SQLite file (cutroom.broker): no server, and a
+# message is only deleted once its job is acknowledged.
+CELERY_BROKER_URL = os.environ.get("CELERY_BROKER_URL") or "sqlite://localhost//"
 CELERY_BROKER_DIR = Path(os.environ.get("CELERY_BROKER_DIR") or VAR_DIR / "broker")
 CELERY_TASK_IGNORE_RESULT = True
 # Separate deployments (or test sessions) can share one Redis by using their own queue.
@@ -227,16 +248,12 @@ CELERY_TASK_ACKS_LATE = True
 CELERY_TASK_REJECT_ON_WORKER_LOST = True
 CELERY_WORKER_PREFETCH_MULTIPLIER = 1
 CELERY_BROKER_CONNECTION_RETRY_ON_STARTUP = True
-if CELERY_BROKER_URL.startswith("filesystem"):
-    # A spool folder shared by the web process and the worker: no broker server needed.
-    # Short polling keeps upload -> candidates quick on the embedded default.
+if CELERY_BROKER_URL.startswith("sqlite"):
+    # A message held by a consumer that stopped renewing it (killed) is handed out
+    # again after this many seconds; a live consumer renews it however long its job runs.
     CELERY_BROKER_TRANSPORT_OPTIONS = {
-        "data_folder_in": str(CELERY_BROKER_DIR / "queue"),
-        "data_folder_out": str(CELERY_BROKER_DIR / "queue"),
-        "processed_folder": str(CELERY_BROKER_DIR / "processed"),
-        # kombu keeps its exchange table in ./control unless told otherwise.
-        "control_folder": str(CELERY_BROKER_DIR / "control"),
-        "store_processed": False,
+        "path": str(CELERY_BROKER_DIR / "broker.sqlite3"),
+        "visibility_timeout": envint("CELERY_VISIBILITY_TIMEOUT", 60),
         "polling_interval": float(os.environ.get("CELERY_BROKER_POLL_SECONDS") or 0.1),
     }
 else:
@@ -245,7 +262,7 @@ else:
         "visibility_timeout": envint("CELERY_VISIBILITY_TIMEOUT", 3600),
     }
 CELERY_BEAT_SCHEDULE = {
-    "sweep-stale-claims": {"task": "segmentation.tasks.sweep", "schedule": 60.0},
+    "sweep-stale-claims": {"task": "segmentation.tasks.sweep", "schedule": float(CUTROOM_SWEEP_SECONDS)},
 }
 
 REST_FRAMEWORK = {

@@ -5,8 +5,8 @@
     python scripts/up.py [--host 127.0.0.1] [--port 8000] [--concurrency 2] [--no-demo]
                          [--no-shared-data]
 
-With no environment set, everything lives under ``var/`` (SQLite, the filesystem broker's
-spool, uploaded originals, logs). The worker and gunicorn run as child processes with
+With no environment set, everything lives under ``var/`` (SQLite, the SQLite broker
+file, uploaded originals, logs). The worker and gunicorn run as child processes with
 their logs in ``var/log/``; a worker that dies is reported (with the end of its log),
 its jobs are requeued and it is restarted; Ctrl-C (or SIGTERM) stops both and waits for
 them. Running it again is safe: migrations and demo data are only added when missing.
@@ -25,7 +25,11 @@ from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[1]
 BIN = Path(sys.executable).parent
-MAX_WORKER_DEATHS = 3
+# Worker restarts beyond this many in the window wait, longer each time (up to the
+# longest pause), instead of looping fast on a worker that cannot start.
+RESTARTS_IN_WINDOW = 5
+RESTART_WINDOW = 600.0
+LONGEST_PAUSE = 300.0
 
 
 def parse_args(argv=None):
@@ -130,13 +134,10 @@ class Child:
 
 
 def worker(env, logs, concurrency):
-    var = var_dir()
     argv = [
         str(BIN / "celery"), "-A", "cutroom", "worker", "--loglevel", "INFO",
         "--concurrency", str(concurrency), "--hostname", "cutroom-up@%h",
         "--without-mingle", "--without-gossip",
-        # Embedded beat: the periodic sweep that requeues jobs of a killed worker.
-        "--beat", "--schedule", str(var / "celerybeat-schedule"),
     ]
     return Child("worker", argv, env, logs / "worker.log")
 
@@ -198,9 +199,70 @@ def on_signal(signum, frame):
     raise Stop(signal.Signals(signum).name)
 
 
-def supervise(worker_child, web_child, convert_child=None):
-    """Watch the children until a signal arrives; returns the exit code for up.py."""
-    deaths = 0
+class Restarts:
+    """Worker restarts, rate-limited rather than counted for life: the first
+    RESTARTS_IN_WINDOW within RESTART_WINDOW seconds happen at once, each further one
+    waits twice as long as the last (5 s, 10 s, ... up to LONGEST_PAUSE)."""
+
+    def __init__(self, clock=time.monotonic):
+        self.clock, self.times = clock, []
+
+    def pause(self):
+        """Record a restart; the seconds to wait before doing it."""
+        now = self.clock()
+        self.times = [t for t in self.times if now - t < RESTART_WINDOW] + [now]
+        extra = len(self.times) - RESTARTS_IN_WINDOW
+        return 0.0 if extra <= 0 else min(LONGEST_PAUSE, 5.0 * 2 ** (extra - 1))
+
+
+class Watchdog:
+    """The supervisor's own look at the jobs, independent of the worker it watches:
+    every CUTROOM_SWEEP_SECONDS it requeues the jobs of dead pool processes and asks
+    whether the worker is stuck (segmentation.services.health)."""
+
+    def __init__(self, env, concurrency):
+        os.environ.update(env)
+        sys.path.insert(0, str(REPO))
+        import django
+
+        django.setup()
+        from django.conf import settings
+
+        self.concurrency, self.interval = concurrency, settings.CUTROOM_SWEEP_SECONDS
+        self.grace = max(self.interval, settings.CUTROOM_STALL_SECONDS)
+        self.restarted()
+
+    def restarted(self):
+        """A (re)started worker gets CUTROOM_STALL_SECONDS to take its first job."""
+        self.due = time.monotonic() + self.grace
+
+    def check(self):
+        """Why the worker must be restarted, or None (also None until the next check)."""
+        if time.monotonic() < self.due:
+            return None
+        self.due = time.monotonic() + self.interval
+        from django.db import connection
+
+        from segmentation.services import health, sweep_stale_claims
+        from segmentation.services.adaptation import sweep_stale_trainings
+
+        try:
+            sweep_stale_claims()
+            sweep_stale_trainings()
+            return health.stalled(self.concurrency)
+        except Exception as exc:  # the database busy or gone: look again next time
+            say(f"could not check the jobs ({type(exc).__name__}: {exc})")
+            return None
+        finally:
+            connection.close()
+
+
+def supervise(worker_child, web_child, watchdog, convert_child=None):
+    """Watch the children until a signal arrives; returns the exit code for up.py.
+
+    The web server keeps serving whatever happens to the worker; a worker that died or
+    stalled is restarted (rate-limited by Restarts)."""
+    restarts = Restarts()
     while True:
         time.sleep(0.5)
         if convert_child is not None and convert_child.exited() is not None:
@@ -210,19 +272,31 @@ def supervise(worker_child, web_child, convert_child=None):
                 f"end of {web_child.log}:\n{web_child.tail()}")
             return 1
         code = worker_child.exited()
-        if code is None:
-            continue
-        deaths += 1
-        say(f"the worker died (exit code {code}); end of {worker_child.log}:\n"
-            f"{worker_child.tail()}")
-        if deaths >= MAX_WORKER_DEATHS:
-            say(f"the worker died {deaths} times; stopping (fix the cause above and rerun)")
-            return 1
-        worker_child.kill()  # pool processes the dead main process left behind
-        requeue_abandoned(worker_child.env)
-        say("restarting the worker")
-        worker_child.start()
-        say(f"worker restarted, pid {worker_child.proc.pid}")
+        if code is not None:
+            say(f"the worker died (exit code {code}); end of {worker_child.log}:\n"
+                f"{worker_child.tail()}")
+        else:
+            stuck = watchdog.check()
+            if stuck is None:
+                continue
+            say(f"the worker is stuck: {stuck}; end of {worker_child.log}:\n"
+                f"{worker_child.tail()}")
+        restart(worker_child, restarts.pause())
+        watchdog.restarted()
+
+
+def restart(worker_child, pause):
+    worker_child.kill()  # the main process and the pool processes it left behind
+    worker_child.proc.wait(10)
+    requeue_abandoned(worker_child.env)
+    if pause:
+        say(f"the worker was restarted {RESTARTS_IN_WINDOW} times within "
+            f"{RESTART_WINDOW:.0f} s; waiting {pause:.0f} s before restarting it "
+            "(the web server keeps serving)")
+        time.sleep(pause)
+    say("restarting the worker")
+    worker_child.start()
+    say(f"worker restarted, pid {worker_child.proc.pid}")
 
 
 def restart_convert_worker(child):
@@ -238,19 +312,19 @@ def restart_convert_worker(child):
 
 
 def requeue_abandoned(env):
-    """Send the jobs of a worker that died back to the queue, at once.
+    """Send the jobs of a worker that died (or was stopped, stuck) back to the queue, at once.
 
-    The filesystem broker hands a message over when a worker takes it, so a killed
-    worker's jobs live on only as rows marked processing. The worker up.py runs is the
-    only one, so every claim is abandoned: sweeping with a claim timeout of 0 s requeues
-    them (and fails a job that keeps killing workers, after CUTROOM_MAX_ATTEMPTS).
-    Redis gives unacknowledged jobs back by itself, so nothing is done there.
+    The worker up.py runs is the only one, so every claim is abandoned and every message
+    it held is free: sweeping with a claim timeout of 0 s requeues the claimed jobs (and
+    fails a job that keeps killing workers, after CUTROOM_MAX_ATTEMPTS), and the SQLite
+    broker's reservations are released. Redis gives unacknowledged jobs back by itself.
     """
-    if not (env.get("CELERY_BROKER_URL") or "filesystem").startswith("filesystem"):
+    if not (env.get("CELERY_BROKER_URL") or "sqlite").startswith("sqlite"):
         return
     done = subprocess.run(
-        [sys.executable, "manage.py", "sweep_claims"], cwd=REPO,
-        env={**env, "CUTROOM_CLAIM_TIMEOUT": "0"}, capture_output=True, text=True,
+        [sys.executable, "manage.py", "sweep_claims", "--release-broker"], cwd=REPO,
+        env={**env, "CUTROOM_CLAIM_TIMEOUT": "0", "CUTROOM_RESEND_AFTER": "0"},
+        capture_output=True, text=True,
     )
     lines = (done.stdout + done.stderr).strip().splitlines()
     if done.returncode:
@@ -297,7 +371,7 @@ def main(argv=None):
             banner(url, worker_child, web_child, logs, not args.no_demo)
             say(f"FBX convert worker pid {convert_child.proc.pid} (Blender), log "
                 f"{convert_child.log}")
-            code = supervise(worker_child, web_child, convert_child)
+            code = supervise(worker_child, web_child, Watchdog(env, args.concurrency), convert_child)
     except Stop as stop:
         say(f"{stop} received; stopping the web server and the worker")
         code = 0

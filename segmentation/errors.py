@@ -13,6 +13,18 @@ class UploadTooLarge(UploadError):
     """The upload exceeds ``CUTROOM_MAX_UPLOAD_MB``."""
 
 
+class QuotaExceeded(UploadError):
+    """The upload would take a project or user past a storage quota (a 413)."""
+
+
+class TooManyRequests(ValueError):
+    """A rate or concurrency limit (a 429); ``retry_after`` is in seconds."""
+
+    def __init__(self, message, retry_after):
+        super().__init__(message)
+        self.retry_after = retry_after
+
+
 class NotReady(ValueError):
     """The capture has no parsed data yet (queued, processing or failed)."""
 

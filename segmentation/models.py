@@ -126,7 +126,8 @@ class ClaimQuerySet(models.QuerySet):
         return updated == 1
 
     def stale(self):
-        """Rows still marked processing whose claim is older than the claim timeout."""
+        """Rows still marked processing whose claim was not renewed within the claim
+        timeout: the process running them died."""
         limit = timezone.now() - timezone.timedelta(seconds=settings.CUTROOM_CLAIM_TIMEOUT)
         return self.filter(status="processing", claimed_at__lt=limit)
 
@@ -138,9 +139,9 @@ class ClaimQuerySet(models.QuerySet):
         ) == 1
 
     def waiting_too_long(self):
-        """Queued rows nobody claimed within the claim timeout: their message may be lost
-        (broker down at upload time, queue purged), so they are sent again."""
-        limit = timezone.now() - timezone.timedelta(seconds=settings.CUTROOM_CLAIM_TIMEOUT)
+        """Queued rows nobody claimed within CUTROOM_RESEND_AFTER: their message may be
+        lost (broker down at upload time, queue purged), so they are sent again."""
+        limit = timezone.now() - timezone.timedelta(seconds=settings.CUTROOM_RESEND_AFTER)
         last_sent = Q(claimed_at__lt=limit) | Q(claimed_at__isnull=True, created_at__lt=limit)
         return self.filter(last_sent, status="queued")
 
@@ -226,6 +227,8 @@ class Capture(Job):
     rest_pose_frame = models.IntegerField(null=True, blank=True)
     skeleton = models.JSONField(null=True, blank=True)
     positions = models.FileField(upload_to=derived_path, max_length=500, blank=True)
+    # Bytes of the original (and its ASF) as uploaded, for the storage quotas.
+    stored_bytes = models.PositiveBigIntegerField(default=0)
     created_at = models.DateTimeField(default=timezone.now)
     # FBX: the take Blender read (a saved .npz), written by the convert worker; ingest reads
     # it instead of the original. A file with several animations gives one capture each, all

@@ -12,7 +12,7 @@ import time
 import uuid
 
 from celery import shared_task
-from celery.signals import worker_process_init, worker_ready
+from celery.signals import worker_init, worker_process_init, worker_ready
 from django.conf import settings
 
 from segmentation import services, suggestions
@@ -106,7 +106,25 @@ def sweep():
     return services.sweep_stale_claims() + adaptation.sweep_stale_trainings()
 
 
+@worker_init.connect
+def apply_time_limits(**kwargs):
+    """Per-task time limits from the worker's own settings: a soft limit (the job stops
+    and fails with a message), then a hard one 30 s later (its process is killed).
+
+    Set here rather than on the decorators, where the sending process would write its
+    own values into each message."""
+    for task, seconds in (
+        (ingest, settings.CUTROOM_INGEST_TIME_LIMIT),
+        (detect, settings.CUTROOM_DETECT_TIME_LIMIT),
+        (retrain, settings.CUTROOM_RETRAIN_TIME_LIMIT),
+        (suggest, settings.CUTROOM_SUGGEST_TIME_LIMIT),
+        (sweep, 60),
+    ):
+        task.soft_time_limit, task.time_limit = seconds, seconds + 30
+
+
 @worker_ready.connect
 def sweep_on_start(**kwargs):
     # A restarted worker first picks up whatever a killed worker left behind.
     services.sweep_stale_claims()
+    adaptation.sweep_stale_trainings()

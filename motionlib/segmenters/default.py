@@ -480,6 +480,9 @@ def empty_segmentation(take) -> Segmentation:
 # The split is searched on block means at this rate: finer than the 0.1 s that
 # annotators label at, and the cut then moves to a turning point at the native rate.
 SPLIT_RATE_HZ = 30.0
+# Poses in the longest comparison window (rate_hz * scale_max_s); the cost of a take
+# grows with its square.
+MAX_WINDOW_SAMPLES = 600
 
 
 class Default(Segmenter):
@@ -497,8 +500,10 @@ class Default(Segmenter):
             "Minimum mean MMD² (0 = same poses, 2 = disjoint) for a peak to become a cut.",
         ),
         "min_segment_s": Param("float", 1.5, 0.1, 60.0, "Minimum time between two cuts (s)."),
-        "scale_min_s": Param("float", 3.0, 0.2, 30.0, "Shortest comparison window (s)."),
-        "scale_max_s": Param("float", 6.0, 0.2, 60.0, "Longest comparison window (s)."),
+        # Cost grows with the square of the samples in a window (rate_hz * scale_max_s,
+        # at most MAX_WINDOW_SAMPLES): the bounds keep a one-hour take within minutes.
+        "scale_min_s": Param("float", 3.0, 0.2, 20.0, "Shortest comparison window (s)."),
+        "scale_max_s": Param("float", 6.0, 0.2, 20.0, "Longest comparison window (s)."),
         "bandwidth": Param(
             "float", 0.3, 0.01, 100.0,
             "Kernel width² as a multiple of the median squared pose distance.",
@@ -521,6 +526,16 @@ class Default(Segmenter):
             "Move a cut that falls in a pause to its end, the onset of the next activity.",
         ),
     }
+
+    @classmethod
+    def validate_params(cls, values):
+        p = super().validate_params(values)
+        if p["rate_hz"] * p["scale_max_s"] > MAX_WINDOW_SAMPLES:
+            raise ParamError(
+                f"rate_hz: rate_hz * scale_max_s must be at most {MAX_WINDOW_SAMPLES} poses "
+                f"per window, got {p['rate_hz']:g} * {p['scale_max_s']:g}"
+            )
+        return p
 
     def _segment(self, take, **p) -> Segmentation:
         analysis = self.analyse(take, p)

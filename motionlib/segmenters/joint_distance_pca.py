@@ -97,13 +97,14 @@ class JointDistancePCA(Segmenter):
         "extrema spaced at least gamma frames apart, refined by pose distance."
     )
     params = {
-        "span": Param("int", 31, 3, 100000, "LOWESS window (frames)."),
+        # Cost grows with span and alpha (frames); bounded to keep long takes cheap.
+        "span": Param("int", 31, 3, 2000, "LOWESS window (frames)."),
         "delta": Param(
             "float", 0.3, 0.0, 1.0,
             "Amplitude test: keep an extremum when min swing <= delta * max swing.",
         ),
         "gamma": Param("int", 200, 1, 1000000, "Minimum frames from the previous kept cut."),
-        "alpha": Param("int", 40, 0, 100000, "Refinement half window (frames)."),
+        "alpha": Param("int", 40, 0, 2000, "Refinement half window (frames)."),
         "beta": Param(
             "float", 8.0, 0.0, 1e6,
             "Refinement: RMS channel distance below which a window frame belongs to the "

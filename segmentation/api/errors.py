@@ -1,8 +1,9 @@
 """The one translator from domain errors to HTTP responses.
 
 - ``StaleVersion`` -> 409 with the current review;
-- ``UploadTooLarge`` -> 413;
+- ``UploadTooLarge``, ``QuotaExceeded`` -> 413;
 - ``NotAllowed`` (a role refusal on a project the caller sees) -> 403;
+- ``TooManyRequests`` (rate and concurrency limits) -> 429 with ``Retry-After``;
 - any other ``ValueError`` (motionlib's ``CaptureError``/``ParamError``, the service's
   own) -> 400 with its message, which names the field, file, line or value at fault;
 - DRF's own errors keep their status, and always carry a readable ``detail``.
@@ -17,7 +18,13 @@ from rest_framework.response import Response
 from rest_framework.views import exception_handler as drf_exception_handler
 
 from motionlib.segmenters import ParamError
-from segmentation.errors import NotAllowed, StaleVersion, UploadTooLarge
+from segmentation.errors import (
+    NotAllowed,
+    QuotaExceeded,
+    StaleVersion,
+    TooManyRequests,
+    UploadTooLarge,
+)
 
 FIELD = re.compile(r"^(\w+): (.+)$", re.DOTALL)
 NO_MATCH = re.compile(r"^No (\w+) matches the given query\.$")
@@ -31,8 +38,11 @@ def exception_handler(exc, context):
         return Response(body, status=status.HTTP_409_CONFLICT)
     if isinstance(exc, NotAllowed):
         return Response({"detail": str(exc)}, status=status.HTTP_403_FORBIDDEN)
+    if isinstance(exc, TooManyRequests):
+        return Response(_value_error_body(exc), status=429,
+                        headers={"Retry-After": str(exc.retry_after)})
     if isinstance(exc, ValueError):
-        code = 413 if isinstance(exc, UploadTooLarge) else 400
+        code = 413 if isinstance(exc, UploadTooLarge | QuotaExceeded) else 400
         return Response(_value_error_body(exc), status=code)
     if isinstance(exc, Http404):
         # Django's "No Cut matches the given query." names a model class, not a thing.

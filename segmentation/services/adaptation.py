@@ -24,7 +24,7 @@ from motionlib.segmenters import get_segmenter
 from segmentation import takecache
 from segmentation.errors import NotReady, ReviewStarted
 from segmentation.models import Capture, ProjectCutModel, Review
-from segmentation.services.captures import do_start_run, read_take
+from segmentation.services.captures import do_start_run, heartbeat, read_take
 
 log = logging.getLogger(__name__)
 
@@ -140,7 +140,8 @@ def train_project_model(job):
     """Train a claimed ProjectCutModel row from the project's current examples, store it
     as the next version (or the reason it failed), then start the training that waited."""
     try:
-        _train(job)
+        with heartbeat(job):  # a training outlives the claim timeout; a dead one must not
+            _train(job)
     except ValueError as exc:
         job.fail(f"training: {exc}", finished_at=timezone.now())
     except Exception as exc:

@@ -5,11 +5,14 @@ import io
 import logging
 import os
 import re
+import threading
 import uuid
+from contextlib import contextmanager
 
 import numpy as np
+from celery.exceptions import SoftTimeLimitExceeded
 from django.conf import settings
-from django.db import IntegrityError, transaction
+from django.db import IntegrityError, connection, transaction
 from django.utils import timezone
 
 import motionlib
@@ -20,6 +23,7 @@ from motionlib.take import Limits
 from segmentation import storage
 from segmentation.errors import NotReady, UploadError, UploadTooLarge
 from segmentation.models import Capture, DetectionRun
+from segmentation.services import quotas
 from segmentation.services.reviews import do_take_in_candidates
 
 log = logging.getLogger(__name__)
@@ -97,8 +101,11 @@ def do_upload_capture(project, user, upload, asf=None):
         if existing.status == "failed" and _requeue_failed(existing):
             existing.refresh_from_db()
         return existing, False
+    size = upload.size + (asf.size if asf is not None else 0)
+    quotas.check_upload_rate(user)
+    quotas.check_storage(project, user, size)
     capture = Capture(project=project, uploaded_by=user, name=upload.name, format=fmt)
-    capture.checksum = digest
+    capture.checksum, capture.stored_bytes = digest, size
     capture.original.save(stored_name(upload.name), upload, save=False)
     if asf is not None:
         capture.asf.save(stored_name(asf.name), asf, save=False)
@@ -149,6 +156,7 @@ def do_start_run(capture, user, method, params):
     if capture.status != "ready":
         raise NotReady(f"capture {capture.pk} is {capture.status}; detection needs a ready capture")
     method, params = validate_method(method, params)
+    quotas.check_active_runs(capture.project)
     with transaction.atomic():
         run = DetectionRun.objects.create(
             capture=capture, method=method, params=params, created_by=user
@@ -217,7 +225,16 @@ def _guarded(job, what, work, **fail_fields):
     else is ours and is logged with its traceback.
     """
     try:
-        work()
+        with heartbeat(job):
+            work()
+    except SoftTimeLimitExceeded:
+        job.fail(
+            f"{what} took too long and was stopped (time limits: ingest with its default "
+            f"detection {settings.CUTROOM_INGEST_TIME_LIMIT} s, CUTROOM_INGEST_TIME_LIMIT; "
+            f"detection {settings.CUTROOM_DETECT_TIME_LIMIT} s, CUTROOM_DETECT_TIME_LIMIT). "
+            "Try parameters that cost less, or ask the administrators to raise the limit.",
+            **fail_fields,
+        )
     except ValueError as exc:
         job.fail(_bounded(str(exc), 2000), **fail_fields)
     except Exception as exc:
@@ -233,6 +250,36 @@ def _guarded(job, what, work, **fail_fields):
 def _bounded(text, limit):
     """An error text for a job's row, cut to about ``limit`` characters."""
     return text if len(text) <= limit else text[:limit] + "..."
+
+
+@contextmanager
+def heartbeat(job):
+    """Renew ``job``'s claim while the block runs.
+
+    A claim not renewed for CUTROOM_CLAIM_TIMEOUT seconds means its process died (a pool
+    process killed, a worker lost with its machine); the sweep then requeues the job. So
+    a dead job is noticed within that timeout, however long a live job runs.
+    """
+    stop = threading.Event()
+    interval = max(settings.CUTROOM_CLAIM_TIMEOUT / 6, 0.2)
+    owned = type(job).objects.filter(pk=job.pk, status="processing", claim_token=job.claim_token)
+
+    def renew():
+        try:
+            while not stop.wait(interval):
+                owned.update(claimed_at=timezone.now())
+        except Exception:
+            log.exception("could not renew the claim on %s", job)
+        finally:
+            connection.close()
+
+    beating = threading.Thread(target=renew, name=f"heartbeat {job}", daemon=True)
+    beating.start()
+    try:
+        yield
+    finally:
+        stop.set()
+        beating.join()
 
 
 def ingest_capture(capture):

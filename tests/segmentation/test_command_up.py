@@ -31,9 +31,10 @@ def free_port():
 class Up:
     """One ``up.py`` process with its output in a file."""
 
-    def __init__(self, var, port, *args):
-        env = {k: v for k, v in os.environ.items()
-               if k not in ("DATABASE_URL", "CELERY_BROKER_URL", "CUTROOM_MEDIA_ROOT")}
+    def __init__(self, var, port, *args, env=None):
+        env = {**{k: v for k, v in os.environ.items()
+                  if k not in ("DATABASE_URL", "CELERY_BROKER_URL", "CUTROOM_MEDIA_ROOT")},
+               **(env or {})}
         env["CUTROOM_VAR_DIR"] = str(var)
         self.var, self.port, self.out = var, port, var.parent / f"up-{port}.out"
         self.proc = subprocess.Popen(
@@ -114,8 +115,8 @@ def _live_in_group(stat, pgid):
 def up(tmp_path):
     started = []
 
-    def start(*args, var=tmp_path / "var"):
-        started.append(Up(var, free_port(), *args))
+    def start(*args, var=tmp_path / "var", env=None):
+        started.append(Up(var, free_port(), *args, env=env))
         return started[-1]
 
     yield start

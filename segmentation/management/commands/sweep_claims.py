@@ -1,3 +1,4 @@
+from django.conf import settings
 from django.core.management.base import BaseCommand
 
 from segmentation.services import sweep_stale_claims
@@ -10,6 +11,19 @@ class Command(BaseCommand):
         "(claim older than CUTROOM_CLAIM_TIMEOUT); fail those retried too often."
     )
 
+    def add_arguments(self, parser):
+        parser.add_argument(
+            "--release-broker", action="store_true",
+            help="also hand out again every message the SQLite broker has reserved "
+                 "(only when no worker is running)",
+        )
+
     def handle(self, *args, **options):
         count = sweep_stale_claims() + sweep_stale_trainings()
-        self.stdout.write(f"{count} stale job(s) requeued or failed")
+        released = ""
+        if options["release_broker"] and settings.CELERY_BROKER_URL.startswith("sqlite"):
+            from cutroom import broker
+
+            path = settings.CELERY_BROKER_TRANSPORT_OPTIONS["path"]
+            released = f"; {broker.release_all(path)} broker message(s) released"
+        self.stdout.write(f"{count} stale job(s) requeued or failed{released}")

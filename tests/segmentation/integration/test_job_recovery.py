@@ -1,0 +1,126 @@
+"""Jobs whose process died are retried or failed within a minute, and jobs that run too
+long are stopped: real workers, with the claim timeout and time limits of production
+unless a test says otherwise."""
+
+import os
+import signal
+import time
+
+import pytest
+from django.contrib.auth import get_user_model
+from django.core.files.uploadedfile import SimpleUploadedFile
+from rest_framework.test import APIClient
+
+from segmentation import services
+from segmentation.models import Capture, DetectionRun
+from tests.segmentation.base import synthetic_bvh
+from tests.segmentation.integration.conftest import Workers, new_queue, sending_to, wait_for
+
+pytestmark = pytest.mark.integration
+
+
+@pytest.fixture
+def owner(transactional_db):
+    alice = get_user_model().objects.create_user("alice", password="alice-password")
+    services.do_create_project(alice, "Studio A")
+    return alice
+
+
+@pytest.fixture(scope="module")
+def long_take():
+    return synthetic_bvh(seed=7, duration=240.0)
+
+
+@pytest.fixture
+def production_workers(services_env, shared_media, tmp_path, transactional_db, settings):
+    """Workers with the default claim timeout (this test process sweeps like the
+    supervisor does: independently of the workers)."""
+    pool = Workers(new_queue(), shared_media, tmp_path, claim_timeout=settings.CUTROOM_CLAIM_TIMEOUT)
+    with sending_to(pool.queue):
+        yield pool
+    pool.stop_all()
+
+
+def api(user):
+    client = APIClient()
+    client.force_authenticate(user)
+    return client
+
+
+def project_of(user):
+    from segmentation.models import Project
+
+    return Project.objects.get(memberships__user=user)
+
+
+def sweeping_until(predicate, timeout):
+    """Run the sweep every second (as `make up`'s supervisor does) until ``predicate``."""
+    def swept():
+        services.sweep_stale_claims()
+        return predicate()
+    return wait_for(swept, timeout=timeout, interval=1.0, what="the job to finish")
+
+
+def test_it_retries_within_a_minute_a_run_whose_pool_process_died_during_detection(
+    production_workers, owner, long_take
+):
+    worker = production_workers.start()
+    client = api(owner)
+    data = {"project": project_of(owner).pk, "file": SimpleUploadedFile("long.bvh", long_take)}
+    capture_id = client.post("/api/captures/", data, format="multipart").json()["id"]
+    run = wait_for(
+        lambda: DetectionRun.objects.filter(capture_id=capture_id, status="processing").first(),
+        timeout=120, interval=0.01, what="the default detection to start",
+    )
+    [child] = production_workers.children(worker)
+    os.kill(child, signal.SIGKILL)
+    killed = time.monotonic()
+
+    sweeping_until(
+        lambda: DetectionRun.objects.get(pk=run.pk).status in ("ready", "failed"), timeout=90
+    )
+    assert time.monotonic() - killed < 60
+    assert DetectionRun.objects.get(pk=run.pk).status == "ready"
+
+
+def test_it_recovers_promptly_the_capture_a_killed_worker_was_ingesting(
+    production_workers, owner, long_take
+):
+    worker = production_workers.start()
+    client = api(owner)
+    data = {"project": project_of(owner).pk, "file": SimpleUploadedFile("long.bvh", long_take)}
+    capture_id = client.post("/api/captures/", data, format="multipart").json()["id"]
+    wait_for(lambda: Capture.objects.get(pk=capture_id).status == "processing",
+             interval=0.01, what="ingest to start")
+    production_workers.kill(worker)
+    killed = time.monotonic()
+    production_workers.start()
+
+    sweeping_until(lambda: Capture.objects.get(pk=capture_id).status in ("ready", "failed"),
+                   timeout=90)
+    assert time.monotonic() - killed < 60
+    assert Capture.objects.get(pk=capture_id).status == "ready"
+
+
+def test_it_stops_a_detection_run_at_its_time_limit_and_says_why(
+    production_workers, owner, long_take
+):
+    production_workers.env["CUTROOM_DETECT_TIME_LIMIT"] = "1"
+    production_workers.start()
+    client = api(owner)
+    data = {"project": project_of(owner).pk, "file": SimpleUploadedFile("long.bvh", long_take)}
+    capture_id = client.post("/api/captures/", data, format="multipart").json()["id"]
+    wait_for(lambda: Capture.objects.get(pk=capture_id).status == "ready", timeout=120,
+             what="ingest")
+    wait_for(lambda: not DetectionRun.objects.filter(capture_id=capture_id,
+                                                     status__in=("queued", "processing")).exists(),
+             timeout=120, what="the default run")
+    r = client.post(f"/api/captures/{capture_id}/runs/",
+                    {"method": "ppca", "params": {"step_s": 0.04}}, format="json")
+    assert r.status_code == 202, r.json()
+
+    wait_for(lambda: DetectionRun.objects.get(pk=r.json()["id"]).status == "failed",
+             timeout=120, what="the run to be stopped")
+    error = DetectionRun.objects.get(pk=r.json()["id"]).error
+    assert "took too long and was stopped" in error
+    assert "detection 1 s, CUTROOM_DETECT_TIME_LIMIT" in error
