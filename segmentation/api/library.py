@@ -1,6 +1,7 @@
 """The clip library, agreement, adjudication and the project dashboard.
 
-- ``GET /api/segments/?project=&label=&capture=&annotator=&min_duration=&max_duration=&min_agreement=&gold=&ordering=``
+- ``GET /api/segments/?project=&label=&capture=&annotator=&min_duration=&max_duration=&min_agreement=&gold=&ordering=&page=``
+  (``count`` exact up to 10,000 matches, else 10,000 with ``count_capped``)
 - ``GET /api/segments/{id}/``, ``…/export.bvh``, ``…/similar/?k=10``
 - ``GET /api/segments/export.zip?<same filters>`` (streamed)
 - ``GET /api/captures/{id}/agreement/?tolerance=0.25`` (reviewers and admins)
@@ -19,6 +20,7 @@ from rest_framework import serializers
 from rest_framework.exceptions import NotFound
 from rest_framework.pagination import PageNumberPagination
 from rest_framework.response import Response
+from rest_framework.utils.urls import remove_query_param, replace_query_param
 from rest_framework.views import APIView
 
 from segmentation import agreement, library
@@ -36,9 +38,62 @@ ORDERINGS = {
 
 
 class SegmentPagination(PageNumberPagination):
+    """Page numbers as before, without counting a million rows for each page.
+
+    A page reads one row more than it shows, which says whether there is a next page.
+    The count is exact up to ``count_cap`` matches (a count of at most that many rows,
+    or none at all on the last page); beyond it ``count`` is the cap and ``count_capped``
+    is true, so a page of a huge library costs as much as a page of a small one.
+    """
+
     page_size = 50
     page_size_query_param = "page_size"
     max_page_size = 500
+    count_cap = 10_000
+
+    def paginate_queryset(self, queryset, request, view=None):
+        self.request = request
+        size = self.get_page_size(request)
+        self.number = int_param(request, self.page_query_param, 1, 1, 1_000_000)
+        offset = (self.number - 1) * size
+        rows = list(queryset[offset:offset + size + 1])
+        self.has_next = len(rows) > size
+        rows = rows[:size]
+        if rows and not self.has_next:
+            self.count, self.capped = offset + len(rows), False
+        else:
+            cap = max(self.count_cap, offset + size + 1)
+            self.count = queryset.order_by()[:cap + 1].count()
+            self.capped = self.count > cap
+            self.count = min(self.count, cap)
+        if not rows and self.number > 1:
+            raise NotFound(f"page: there is no page {self.number}; the query matches "
+                           f"{self.count} segment(s)")
+        return rows
+
+    def get_next_link(self):
+        if not self.has_next:
+            return None
+        return replace_query_param(self.request.build_absolute_uri(), self.page_query_param,
+                                   self.number + 1)
+
+    def get_previous_link(self):
+        if self.number == 1:
+            return None
+        url = self.request.build_absolute_uri()
+        if self.number == 2:
+            return remove_query_param(url, self.page_query_param)
+        return replace_query_param(url, self.page_query_param, self.number - 1)
+
+    def get_paginated_response(self, data):
+        return Response({"count": self.count, "count_capped": self.capped,
+                         "next": self.get_next_link(), "previous": self.get_previous_link(),
+                         "results": data})
+
+    def get_paginated_response_schema(self, schema):
+        body = super().get_paginated_response_schema(schema)
+        body["properties"]["count_capped"] = {"type": "boolean"}
+        return body
 
 
 class SegmentSerializer(serializers.ModelSerializer):
