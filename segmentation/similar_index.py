@@ -11,13 +11,16 @@ database no longer has or one the caller may not see.
 Files, in ``settings.SIMILAR_INDEX_DIR`` (``$CUTROOM_SIMILAR_INDEX_DIR``, default
 ``var/similar``):
 
-- ``project_<id>.g<generation>.usearch``: a usearch HNSW graph (float16 vectors, keys =
-  segment ids). Web processes open it as a read-only memory map (``view``), so all of
-  them on a machine share one copy in the page cache.
+- ``project_<id>.g<generation>/``: an inverted-file index (``motionlib.vector_index``:
+  k-means centres, and the float16 vectors with their segment ids grouped by centre).
+  Web processes map ids and vectors read-only, so all of them on a machine share one
+  copy in the page cache (a million segments: about 220 MB).
 - ``project_<id>.json``: the manifest, replaced atomically last: format version, vector
   width, the index file's name and size, how many vectors it holds and the highest
   segment id it has seen. A crash while writing leaves the previous manifest and file in
-  force (a new generation is written beside the old one and only then named).
+  force (a new generation is written beside the old one and only then named; the old
+  one is deleted after, and processes that still map it keep reading it until they see
+  the new manifest).
 
 Staying in step with the database (which is the truth):
 
@@ -25,8 +28,10 @@ Staying in step with the database (which is the truth):
   (the *delta*, cached per process), so a search never waits for the index.
 - Deleted segments left in the file are dropped when candidates are read back.
 - ``update`` (a Celery task queued when library rows change, and run by
-  ``manage.py similar_index``) compares the file's keys with the database's ids, removes
-  and adds the difference and writes a new generation; ``build`` writes one from scratch.
+  ``manage.py similar_index``) compares the index's keys with the database's ids, removes
+  and adds the difference (added vectors join their nearest existing centre) and writes a
+  new generation; ``build`` trains new centres and writes one from scratch, which
+  ``update`` does itself when much was removed or the library has doubled.
 - ``open_index`` checks a manifest the first time a process sees it: a missing or
   unreadable file, another format or width, or a vector count that disagrees with the
   database all mean "not usable": the search falls back to the exact scan and a rebuild
@@ -37,6 +42,7 @@ import fcntl
 import json
 import logging
 import os
+import shutil
 import threading
 import time
 from contextlib import contextmanager
@@ -48,19 +54,19 @@ from django.conf import settings
 from django.db import transaction
 
 from motionlib import similarity
+from motionlib.vector_index import IvfIndex
 from segmentation.models_library import LibrarySegment
 
 log = logging.getLogger(__name__)
 
 FORMAT = 1
-# HNSW parameters: M = 16 links per node, ef = 256 while building, 128 while searching
-# (chosen on the million-segment benchmark: recall@10 >= 0.95 at a few ms per search).
-CONNECTIVITY = 16
-EXPANSION_ADD = 256
-EXPANSION_SEARCH = 128
-# An update that would remove more than this share of the vectors rebuilds instead: many
-# deletions leave holes in the HNSW graph.
+# A search scans at least this share of the index (nearest clusters first): chosen on the
+# million-segment benchmark for recall@10 >= 0.95 against the exact scan.
+PROBE_SHARE = 0.01
+# An update that would remove more than this share of the vectors, or grow the index past
+# GROWTH times the size its centres were trained on, retrains instead (clusters drift).
 REBUILD_SHARE = 0.25
+GROWTH = 2.0
 # When the delta (segments newer than the file) grows past this, an update is queued.
 DELTA_LIMIT = 5000
 READ_CHUNK = 20000
@@ -89,13 +95,6 @@ def as_vectors(blobs, n_features=None):
     return vectors
 
 
-def _new_index(ndim):
-    from usearch.index import Index
-
-    return Index(ndim=ndim, metric="l2sq", dtype="f16", connectivity=CONNECTIVITY,
-                 expansion_add=EXPANSION_ADD, expansion_search=EXPANSION_SEARCH)
-
-
 @contextmanager
 def _locked(project_id):
     """One writer per project and machine (an update and a rebuild never interleave)."""
@@ -120,13 +119,14 @@ def read_manifest(project_id):
     if not isinstance(manifest, dict) or manifest.get("format") != FORMAT:
         raise IndexUnusable(f"{path}: format {manifest.get('format') if isinstance(manifest, dict) else '?'}"
                             f", this version reads format {FORMAT}")
-    file = index_dir() / str(manifest.get("file"))
+    folder = index_dir() / str(manifest.get("file"))
     try:
-        size = file.stat().st_size
+        sizes = {p.name: p.stat().st_size for p in folder.glob("*.npy")}
     except OSError as exc:
-        raise IndexUnusable(f"{file}: missing ({exc.strerror})") from exc
-    if size != manifest.get("bytes"):
-        raise IndexUnusable(f"{file}: {size} bytes, the manifest says {manifest.get('bytes')}")
+        raise IndexUnusable(f"{folder}: unreadable ({exc.strerror})") from exc
+    if sizes != manifest.get("bytes_per_file"):
+        raise IndexUnusable(f"{folder}: files {sizes or 'missing'}, the manifest says "
+                            f"{manifest.get('bytes_per_file')}")
     return manifest
 
 
@@ -139,17 +139,20 @@ def _fingerprint(project_id):
     return [found["n"], found["top"] or 0, int(found["total"] or 0)]
 
 
-def _write_generation(project_id, index, ndim, max_id, fingerprint):
+def _write_generation(project_id, index, max_id, fingerprint, trained_on):
     """Save ``index`` as a new generation and name it in the manifest (atomically).
 
     ``fingerprint`` is the database's, read before the index was."""
     generation = time.time_ns()
-    name = f"project_{project_id}.g{generation}.usearch"
-    path = index_dir() / name
-    index.save(str(path))
-    _fsync(path)
-    manifest = {"format": FORMAT, "ndim": ndim, "file": name, "bytes": path.stat().st_size,
-                "count": len(index), "max_id": int(max_id), "generation": generation,
+    name = f"project_{project_id}.g{generation}"
+    folder = index_dir() / name
+    sizes = index.save(folder)
+    for path in folder.iterdir():
+        _fsync(path)
+    _fsync(folder)
+    manifest = {"format": FORMAT, "ndim": index.ndim, "file": name, "bytes": sum(sizes.values()),
+                "bytes_per_file": sizes, "count": len(index), "lists": len(index.centroids),
+                "trained_on": trained_on, "max_id": int(max_id), "generation": generation,
                 "fingerprint": fingerprint,
                 "built_at": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())}
     tmp = manifest_path(project_id).with_suffix(".json.tmp")
@@ -157,9 +160,10 @@ def _write_generation(project_id, index, ndim, max_id, fingerprint):
     _fsync(tmp)
     os.replace(tmp, manifest_path(project_id))
     _fsync(index_dir())
-    for old in index_dir().glob(f"project_{project_id}.g*.usearch"):
+    for old in index_dir().glob(f"project_{project_id}.g*"):
         if old.name != name:
-            old.unlink(missing_ok=True)  # open memory maps keep their inode alive
+            # Processes that map the old files keep them (unlinked inodes live on).
+            shutil.rmtree(old, ignore_errors=True)
     return manifest
 
 
@@ -180,7 +184,7 @@ def _chunks(queryset):
         if not rows:
             return
         last = rows[-1][0]
-        yield np.array([r[0] for r in rows], dtype=np.uint64), as_vectors([r[1] for r in rows])
+        yield np.array([r[0] for r in rows], dtype=np.int64), as_vectors([r[1] for r in rows])
 
 
 def build(project_id):
@@ -191,20 +195,19 @@ def build(project_id):
 
 def _build(project_id):
     fingerprint = _fingerprint(project_id)
-    index, ndim, max_id = None, 0, 0
-    for keys, vectors in _chunks(described(project_id)):
-        if index is None:
-            ndim = vectors.shape[1]
-            index = _new_index(ndim)
-        if vectors.shape[1] != ndim:
-            raise ValueError(f"project {project_id}: segment {int(keys[0])} has a profile of "
-                             f"{vectors.shape[1]} numbers, others {ndim}; rebuild the library")
-        index.add(keys, vectors)
-        max_id = int(keys[-1])
-    if index is None:
+    parts = list(_chunks(described(project_id)))
+    if not parts:
         manifest_path(project_id).unlink(missing_ok=True)
         return None
-    manifest = _write_generation(project_id, index, ndim, max_id, fingerprint)
+    widths = {v.shape[1] for _, v in parts}
+    if len(widths) > 1:
+        raise ValueError(f"project {project_id}: segment profiles have {sorted(widths)} "
+                         "numbers; rebuild the library's descriptors")
+    ids = np.concatenate([k for k, _ in parts])
+    vectors = np.concatenate([v for _, v in parts])
+    del parts
+    index = IvfIndex.build(ids, vectors, seed=project_id)
+    manifest = _write_generation(project_id, index, int(ids[-1]), fingerprint, len(ids))
     log.info("similar index of project %s built: %s vectors", project_id, manifest["count"])
     return manifest
 
@@ -212,40 +215,40 @@ def _build(project_id):
 def update(project_id):
     """Bring a project's index in step with the database: remove the vectors of deleted
     segments, add the missing ones, write a new generation. Builds when there is no usable
-    index or too much would be removed. Returns the manifest (unchanged when in step)."""
-    from usearch.index import Index
-
+    index, too much would be removed, or the library outgrew the index's centres.
+    Returns the manifest (unchanged when in step)."""
     with _locked(project_id):
         try:
             manifest = read_manifest(project_id)
-            index = Index.restore(str(index_dir() / manifest["file"]))
-        except (IndexUnusable, RuntimeError, ValueError) as exc:
+            index = IvfIndex.open(index_dir() / manifest["file"], mmap=False)
+        except (IndexUnusable, ValueError) as exc:
             log.info("similar index of project %s rebuilt: %s", project_id, exc)
-            return _build(project_id)
-        if index is None:
             return _build(project_id)
         fingerprint = _fingerprint(project_id)
         if fingerprint == manifest.get("fingerprint"):
             return manifest
-        keys = np.asarray(index.keys, dtype=np.int64)
+        keys = np.asarray(index.ids, dtype=np.int64)
         ids = np.fromiter(described(project_id).values_list("id", flat=True).iterator(chunk_size=20000),
                           dtype=np.int64)
         removed = np.setdiff1d(keys, ids, assume_unique=True)
         added = np.setdiff1d(ids, keys, assume_unique=True)
-        if not len(removed) and not len(added):
-            return manifest
-        if len(removed) > REBUILD_SHARE * max(len(keys), 1):
+        if (len(removed) > REBUILD_SHARE * max(len(keys), 1)
+                or len(ids) > GROWTH * manifest.get("trained_on", len(keys))):
             return _build(project_id)
-        if len(removed):
-            index.remove(removed.astype(np.uint64))
+        add_ids, add_vectors = [], []
         for first in range(0, len(added), READ_CHUNK):
             part = [int(i) for i in added[first:first + READ_CHUNK]]
             rows = dict(LibrarySegment.objects.filter(pk__in=part).values_list("id", "profile"))
             part = [pk for pk in part if pk in rows]  # deleted meanwhile
-            if part:
-                index.add(np.array(part, dtype=np.uint64), as_vectors([rows[pk] for pk in part]))
+            add_ids += part
+            add_vectors += [rows[pk] for pk in part]
+        vectors = as_vectors(add_vectors, index.ndim // similarity.PROFILE_ROWS)
+        if len(vectors) and vectors.shape[1] != index.ndim:
+            return _build(project_id)
+        index = index.changed(removed, np.array(add_ids, dtype=np.int64), vectors)
         max_id = max(int(ids.max()) if len(ids) else 0, manifest["max_id"])
-        return _write_generation(project_id, index, manifest["ndim"], max_id, fingerprint)
+        return _write_generation(project_id, index, max_id, fingerprint,
+                                 manifest.get("trained_on", len(keys)))
 
 
 def schedule_update(project_id):
@@ -292,8 +295,7 @@ class OpenIndex:
     def nearest(self, vector, count):
         """Up to ``count`` segment ids nearest to a profile vector (from the file and the
         delta), nearest first. Ids may include deleted segments."""
-        found = self.index.search(vector, count)
-        ids, dist = np.asarray(found.keys, dtype=np.int64), np.asarray(found.distances)
+        ids, dist = self.index.search(vector, count, probe_share=PROBE_SHARE)
         if self.delta_vectors is not None and len(self.delta_ids):
             diff = self.delta_vectors - vector[None, :]
             d = np.einsum("ij,ij->i", diff, diff)
@@ -333,14 +335,12 @@ def open_index(project_id):
 
 
 def _open_checked(project_id):
-    from usearch.index import Index
-
     try:
         manifest = read_manifest(project_id)
-        index = Index.restore(str(index_dir() / manifest["file"]), view=True)
-        if index is None or len(index) != manifest["count"]:
-            raise IndexUnusable(f"{manifest['file']}: holds {len(index) if index else 0} "
-                                f"vectors, the manifest says {manifest['count']}")
+        index = IvfIndex.open(index_dir() / manifest["file"])
+        if len(index) != manifest["count"]:
+            raise IndexUnusable(f"{manifest['file']}: holds {len(index)} vectors, the "
+                                f"manifest says {manifest['count']}")
         in_db = described(project_id).filter(id__lte=manifest["max_id"]).count()
         if in_db != manifest["count"]:
             # Rows changed since the file was written (a crash before the update, or
@@ -348,12 +348,11 @@ def _open_checked(project_id):
             log.info("similar index of project %s: %s vectors, %s segments in the database; "
                      "updating", project_id, manifest["count"], in_db)
             schedule_update(project_id)
-    except (IndexUnusable, RuntimeError, ValueError) as exc:
+    except (IndexUnusable, ValueError) as exc:
         if described(project_id).exists():
             log.warning("similar index of project %s not used: %s; rebuilding", project_id, exc)
             schedule_update(project_id)
         return None
-    index.expansion_search = EXPANSION_SEARCH
     return OpenIndex(project_id, manifest, index)
 
 

@@ -155,11 +155,13 @@ def segment_for(user, pk):
 
 
 class SegmentListView(APIView):
+    pagination_class = SegmentPagination
+
     @extend_schema(responses=SegmentSerializer(many=True))
     def get(self, request):
         segments = segment_query(request).select_related("capture", "annotator", "label").defer(
             "descriptor", "profile", "capture__skeleton")
-        paginator = SegmentPagination()
+        paginator = self.pagination_class()
         page = paginator.paginate_queryset(segments, request, view=self)
         return paginator.get_paginated_response(SegmentSerializer(page, many=True).data)
 

@@ -2,11 +2,14 @@
 after it was written, is brought in step when reviews are submitted, and is rebuilt when
 its file is lost."""
 
+from unittest import mock
+
 import numpy as np
 from django.core.management import call_command
 
 import motionlib
-from motionlib import similarity, synth
+from motionlib import similarity, synth, vector_index
+from motionlib.vector_index import IvfIndex
 from segmentation import library, similar_index, tasks
 from segmentation.models_library import LibrarySegment
 from tests.segmentation.base import BaseTestCase
@@ -31,6 +34,14 @@ def synth_descriptors(n, seed=3):
 
 class SimilarIndexTestCase(BaseTestCase):
     N = 300
+
+    def setUp(self):
+        super().setUp()
+        # Clusters of 16 (a million-segment library has 1024 per cluster), so a search
+        # scans only some of them here too.
+        patcher = mock.patch.object(vector_index, "LIST_SIZE", 16)
+        patcher.start()
+        self.addCleanup(patcher.stop)
 
     @classmethod
     def setUpTestData(cls):
@@ -106,13 +117,19 @@ class IncrementalTest(SimilarIndexTestCase):
         gone = list(LibrarySegment.objects.order_by("id").values_list("id", flat=True)[:5])
         LibrarySegment.objects.filter(pk__in=gone).delete()
         tasks.update_similar_index(self.project.pk)  # what the worker runs
-        from usearch.index import Index
-
         manifest = similar_index.read_manifest(self.project.pk)
-        index = Index.restore(str(similar_index.index_dir() / manifest["file"]), view=True)
+        index = IvfIndex.open(similar_index.index_dir() / manifest["file"])
         ids = set(similar_index.described(self.project.pk).values_list("id", flat=True))
-        assert set(int(k) for k in index.keys) == ids
+        assert set(index.ids.tolist()) == ids
         assert manifest["count"] == len(ids) == self.N - 5
+
+    def test_it_retrains_when_the_library_has_doubled(self):
+        self.add_segments(self.spans[:100], self.descs[:100])
+        first = similar_index.build(self.project.pk)
+        self.add_segments(self.spans[100:], self.descs[100:])
+        manifest = similar_index.update(self.project.pk)
+        assert (first["lists"], manifest["lists"]) == (6, 18)
+        assert manifest["count"] == manifest["trained_on"] == self.N
 
     def test_it_leaves_an_index_in_step_unchanged(self):
         self.add_segments(self.spans[:50], self.descs[:50])
@@ -125,7 +142,7 @@ class RebuildTest(SimilarIndexTestCase):
         rows = self.add_segments(self.spans, self.descs)
         expected = self.exact(rows[7])
         manifest = similar_index.build(self.project.pk)
-        (similar_index.index_dir() / manifest["file"]).unlink()
+        (similar_index.index_dir() / manifest["file"] / "vectors.npy").unlink()
         similar_index.forget()
         with self.captureOnCommitCallbacks() as callbacks:
             assert similar_index.open_index(self.project.pk) is None
