@@ -143,15 +143,15 @@ def main():
     segments = LibrarySegment.objects.in_bulk(picks)
     print(f"database {name}: {len(ids):,} described segments in project Archive "
           f"(descriptor 35 x 35 float32, profile 105 numbers)")
-    print(f"index: usearch HNSW, f16, M={similar_index.CONNECTIVITY}, "
-          f"ef_construction={similar_index.EXPANSION_ADD}, ef={similar_index.EXPANSION_SEARCH}; "
-          f"{manifest['count']:,} vectors, {manifest['bytes'] / 1e6:.0f} MB file; "
+    print(f"index: inverted file (motionlib.vector_index), {manifest['lists']:,} k-means lists, "
+          f"float16, scans >= {similar_index.PROBE_SHARE:.1%} per search; "
+          f"{manifest['count']:,} vectors, {manifest['bytes'] / 1e6:.0f} MB of files; "
           f"{'built' if fresh else 'brought in step (cached)'} in {built:.1f} s")
     print(f"machine: {platform.machine()}, {os.cpu_count()} cores shared with other work, load "
           f"{', '.join(f'{x:.1f}' for x in os.getloadavg())}; {args.queries} queries "
           f"(old path: first {args.old_queries}), k=10, reviewer, through SimilarView\n")
     similar_index.forget()
-    rss_before = mapped_rss(manifest["file"])
+    rss_before = mapped_rss("vectors.npy")
     rows = {"exact (oracle, numpy in memory)": [], "index": [], "old (20,000 recent)": []}
     recall = {"index": [], "old (20,000 recent)": []}
     user = ctx["reviewer"]
@@ -167,7 +167,7 @@ def main():
                 found, ms = call_view(user, pk)
             rows["old (20,000 recent)"].append(ms)
             recall["old (20,000 recent)"].append(len(set(found) & set(truth)) / len(truth))
-    rss, pss = mapped_rss(manifest["file"])
+    rss, pss = mapped_rss("vectors.npy")
     header = f"{'path':<34} {'queries':>7} {'median ms':>10} {'p95 ms':>8} {'recall@10':>10}"
     print(header)
     print("-" * len(header))
@@ -175,7 +175,8 @@ def main():
         r = recall.get(title)
         print(f"{title:<34} {len(times):>7} {statistics.median(times):>10.1f} {p95(times):>8.1f} "
               f"{np.mean(r) if r else 1.0:>10.3f}")
-    print(f"\nindex memory: file {manifest['bytes'] / 1e6:.0f} MB (shared read-only map); "
+    print(f"\nindex memory: files {manifest['bytes'] / 1e6:.0f} MB (ids + vectors mapped read-only, "
+          f"shared by every process); vectors.npy "
           f"resident in this process before the queries {rss_before[0] / 1e3:.0f} MB, after "
           f"{rss / 1e3:.0f} MB (Pss {pss / 1e3:.0f} MB)")
     print(f"worst: index p95 {p95(rows['index']):.1f} ms (target 50), recall@10 "

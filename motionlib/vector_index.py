@@ -23,6 +23,8 @@ import numpy as np
 FILES = ("centroids", "offsets", "ids", "vectors")
 # Share of the vectors a search scans at least (nearest clusters first).
 PROBE_SHARE = 0.01
+# Lists a search scans at least.
+MIN_LISTS = 8
 # Vectors per cluster the index aims for (n_lists = n / LIST_SIZE, at least 1).
 LIST_SIZE = 1024
 TRAIN_SAMPLE = 65536
@@ -135,11 +137,13 @@ class IvfIndex:
                                  if len(add_ids) else np.zeros(0, dtype=np.int32)])
         return self._grouped(self.centroids, ids, vectors, labels)
 
-    def search(self, query: np.ndarray, count: int, *, probe_share: float = PROBE_SHARE):
+    def search(self, query: np.ndarray, count: int, *, probe_share: float = PROBE_SHARE,
+               min_lists: int = MIN_LISTS):
         """The ``count`` stored vectors nearest to ``query`` among the scanned lists.
 
         Lists are scanned nearest centre first until ``probe_share`` of all vectors (and
-        at least ``count``) have been compared.
+        at least ``count``) have been compared, and at least ``min_lists`` lists (a
+        query near the border of its cluster has neighbours in the next ones).
 
         Returns
         -------
@@ -153,7 +157,7 @@ class IvfIndex:
         order = np.argsort(_sq_distances(q, self.centroids, self._norms)[0], kind="stable")
         need = max(count, int(np.ceil(probe_share * len(self))))
         scanned = np.cumsum(sizes[order])
-        lists = order[:int(np.searchsorted(scanned, need)) + 1]
+        lists = order[:max(int(np.searchsorted(scanned, need)) + 1, min_lists)]
         spans = [(self.offsets[i], self.offsets[i + 1]) for i in np.sort(lists) if sizes[i]]
         if not spans:
             return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.float32)

@@ -321,7 +321,8 @@ def similar(segment, visible, k=10):
         return []
     order, distances = similarity.rank_similar(query, load_descriptors(short), k=k,
                                                shortlist=len(short))
-    rows = LibrarySegment.objects.select_related("capture", "annotator").in_bulk([short[i] for i in order])
+    rows = (LibrarySegment.objects.select_related("capture", "annotator", "label")
+            .defer("descriptor", "profile", "capture__skeleton").in_bulk([short[i] for i in order]))
     return [(rows[short[i]], float(d)) for i, d in zip(order, distances, strict=True)]
 
 

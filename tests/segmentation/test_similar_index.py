@@ -6,6 +6,8 @@ from unittest import mock
 
 import numpy as np
 from django.core.management import call_command
+from django.db import connection
+from django.test.utils import CaptureQueriesContext
 
 import motionlib
 from motionlib import similarity, synth, vector_index
@@ -93,6 +95,21 @@ class SameResultsTest(SimilarIndexTestCase):
         found = library.similar(dana_rows[0], visible, k=10)
         assert len(found) == 10
         assert {s.pk for s, _ in found} <= {r.pk for r in bob_rows}
+
+
+class QueryCountTest(SimilarIndexTestCase):
+    def test_it_answers_with_the_same_number_of_queries_whatever_k(self):
+        rows = self.add_segments(self.spans[:100], self.descs[:100])
+        similar_index.build(self.project.pk)
+        self.login(self.rachel)
+        self.client.get(f"/api/segments/{rows[0].pk}/similar/")  # opens and checks the index
+        counts = []
+        for k in (2, 20):
+            with CaptureQueriesContext(connection) as queries:
+                response = self.client.get(f"/api/segments/{rows[0].pk}/similar/?k={k}")
+            assert response.status_code == 200 and len(response.json()["results"]) == k
+            counts.append(len(queries))
+        assert counts[0] == counts[1]
 
 
 class IncrementalTest(SimilarIndexTestCase):
