@@ -319,10 +319,11 @@ def similar(segment, visible, k=10):
         short = exact_shortlist(query, pool, n)
     if not short:
         return []
-    order, distances = similarity.rank_similar(query, load_descriptors(short), k=k,
-                                               shortlist=len(short))
+    # The shortlist's rows, with what the caller shows of them, in one query.
     rows = (LibrarySegment.objects.select_related("capture", "annotator", "label")
-            .defer("descriptor", "profile", "capture__skeleton").in_bulk([short[i] for i in order]))
+            .defer("profile", "capture__skeleton").in_bulk(short))
+    order, distances = similarity.rank_similar(
+        query, np.stack([rows[pk].descriptor_array() for pk in short]), k=k, shortlist=len(short))
     return [(rows[short[i]], float(d)) for i, d in zip(order, distances, strict=True)]
 
 

@@ -77,6 +77,10 @@ class LibrarySegment(models.Model):
             models.Index(fields=["project", "is_gold", "-id"], name="libseg_gold"),
             models.Index(fields=["project", "agreement"], name="libseg_agreement"),
             models.Index(fields=["project", "duration"], name="libseg_duration"),
+            # The similar-clip index reads a project's described segments by id (all of
+            # them, or those newer than the index file).
+            models.Index(fields=["project", "id"], name="libseg_described",
+                         condition=Q(profile__isnull=False)),
         ]
 
     def __str__(self):

@@ -206,7 +206,8 @@ class SimilarView(APIView):
         found = library.similar(segment, visible, k=k)
         return Response({
             "segment": segment.pk,
-            "results": [{**SegmentSerializer(s).data, "distance": round(d, 4)} for s, d in found],
+            "results": [{**data, "distance": round(d, 4)} for data, (_, d) in zip(
+                SegmentSerializer([s for s, _ in found], many=True).data, found, strict=True)],
         })
 
 
