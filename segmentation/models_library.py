@@ -77,6 +77,11 @@ class LibrarySegment(models.Model):
             models.Index(fields=["project", "is_gold", "-id"], name="libseg_gold"),
             models.Index(fields=["project", "agreement"], name="libseg_agreement"),
             models.Index(fields=["project", "duration"], name="libseg_duration"),
+            # The list's default view in its default order, with every filtered column, so
+            # that a page's ids and a capped count come from the index alone.
+            models.Index(fields=["project", "superseded", "-id"], name="libseg_list_recent",
+                         include=["label_name", "duration", "agreement", "annotator", "is_gold",
+                                  "capture"]),
             # The similar-clip index reads a project's described segments by id (all of
             # them, or those newer than the index file).
             models.Index(fields=["project", "id"], name="libseg_described",

@@ -40,7 +40,7 @@ ORDERINGS = {
 class SegmentPagination(PageNumberPagination):
     """Page numbers as before, without counting a million rows for each page.
 
-    A page reads one row more than it shows, which says whether there is a next page.
+    A page reads one id more than it shows, which says whether there is a next page.
     The count is exact up to ``count_cap`` matches (a count of at most that many rows,
     or none at all on the last page); beyond it ``count`` is the cap and ``count_capped``
     is true, so a page of a huge library costs as much as a page of a small one.
@@ -56,9 +56,12 @@ class SegmentPagination(PageNumberPagination):
         size = self.get_page_size(request)
         self.number = int_param(request, self.page_query_param, 1, 1, 1_000_000)
         offset = (self.number - 1) * size
-        rows = list(queryset[offset:offset + size + 1])
-        self.has_next = len(rows) > size
-        rows = rows[:size]
+        # The page's ids first (an index can answer that alone, however deep the page),
+        # then its rows by id.
+        ids = list(queryset.values_list("id", flat=True)[offset:offset + size + 1])
+        self.has_next = len(ids) > size
+        found = queryset.order_by().in_bulk(ids[:size])
+        rows = [found[pk] for pk in ids[:size] if pk in found]
         if rows and not self.has_next:
             self.count, self.capped = offset + len(rows), False
         else:
