@@ -82,6 +82,13 @@ class LibrarySegment(models.Model):
             models.Index(fields=["project", "superseded", "-id"], name="libseg_list_recent",
                          include=["label_name", "duration", "agreement", "annotator", "is_gold",
                                   "capture"]),
+            # The same for a label (its segments newest first, or every label in order) and
+            # for an annotator.
+            models.Index(fields=["project", "superseded", "label_name", "id"], name="libseg_list_label",
+                         include=["duration", "agreement", "annotator", "is_gold", "capture"]),
+            models.Index(fields=["project", "superseded", "annotator", "-id"],
+                         name="libseg_list_annotator",
+                         include=["label_name", "duration", "agreement", "is_gold", "capture"]),
             # The similar-clip index reads a project's described segments by id (all of
             # them, or those newer than the index file).
             models.Index(fields=["project", "id"], name="libseg_described",
