@@ -73,10 +73,24 @@ def run(n_workers, folder, paths, env, var):
             if runs.filter(status="failed").exists() or time.perf_counter() - started > 7200:
                 raise SystemExit(f"runs failed or timed out: {list(runs.values('status', 'error'))[:3]}")
             time.sleep(0.2)
-        return imported, time.perf_counter() - started
+        return imported, time.perf_counter() - started, sum(cpu_seconds(w.pid) for w in workers)
     finally:
         for worker in workers:
             stop(worker)
+
+
+def cpu_seconds(pid):
+    """User + system CPU seconds of a process and its children (the worker's pool)."""
+    tick = os.sysconf("SC_CLK_TCK")
+    total = 0.0
+    kids = subprocess.run(["pgrep", "-P", str(pid)], capture_output=True, text=True).stdout.split()
+    for p in [pid, *map(int, kids)]:
+        try:
+            fields = Path(f"/proc/{p}/stat").read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        total += (int(fields[11]) + int(fields[12])) / tick
+    return total
 
 
 def start_worker(env, var, name):
@@ -122,17 +136,21 @@ def main():
               f"workers of concurrency 1; machine: {os.cpu_count()} cores shared with other work, "
               f"load {os.getloadavg()[0]:.1f}\n", flush=True)
         header = (f"{'workers':>7} {'takes':>6} {'command s':>10} {'total s':>9} "
-                  f"{'h motion/min':>13} {'per worker':>11} {'speed-up':>9}")
+                  f"{'h motion/min':>13} {'per worker':>11} {'speed-up':>9} {'worker CPU s':>13} "
+                  f"{'CPU s/take':>11}")
         print(header)
         print("-" * len(header), flush=True)
         for n in args.workers:
-            imported, total = run(n, folder, paths, env, var)
+            imported, total, cpu = run(n, folder, paths, env, var)
             rate = hours / (total / 60)
             rows.append(rate)
             print(f"{n:>7} {args.takes:>6} {imported:>10.1f} {total:>9.1f} {rate:>13.2f} "
-                  f"{rate / n:>11.2f} {rate / rows[0]:>8.2f}x", flush=True)
+                  f"{rate / n:>11.2f} {rate / rows[0]:>8.2f}x {cpu:>13.1f} {cpu / args.takes:>11.2f}",
+                  flush=True)
         print("\n(command s: import_captures itself, which parses, stores and queues each file; "
-              "total s: until the last detection run is ready)")
+              "total s: until the last detection run is ready; worker CPU s: user + system time of "
+              "the workers and their pool processes, which says what the work costs whatever the "
+              "machine's load)")
     finally:
         from django.db import connections
 
