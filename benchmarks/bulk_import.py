@@ -49,7 +49,7 @@ def take_files(n, minutes, fps=120.0, seed=1000):
     return folder, paths
 
 
-def run(n_workers, folder, paths, env, var):
+def run(n_workers, folder, paths, env, var, check=True):
     """Seconds from the command's start to the last ready run."""
     from django.contrib.auth import get_user_model
 
@@ -63,7 +63,8 @@ def run(n_workers, folder, paths, env, var):
         started = time.perf_counter()
         command = subprocess.run(
             [sys.executable, "manage.py", "import_captures", str(folder), "--project",
-             str(project.pk), "--user", user.username], cwd=REPO, env=env,
+             str(project.pk), "--user", user.username, *([] if check else ["--no-check"])],
+            cwd=REPO, env=env,
             capture_output=True, text=True)
         imported = time.perf_counter() - started
         if command.returncode:
@@ -112,6 +113,9 @@ def main():
     parser.add_argument("--takes", type=int, default=1000)
     parser.add_argument("--minutes", type=float, default=5.0)
     parser.add_argument("--workers", type=int, nargs="+", default=[1, 2])
+    parser.add_argument("--no-check", action="store_true",
+                        help="import_captures --no-check: the command only stores and queues, "
+                             "the workers do all the parsing")
     parser.add_argument("--redis-db", type=int, default=int(os.environ.get("BENCH_REDIS_DB", 8)))
     parser.add_argument("--admin-url", default=os.environ.get(
         "DATABASE_ADMIN_URL", "postgres://postgres@127.0.0.1:5432/postgres"))
@@ -130,8 +134,8 @@ def main():
     try:
         start_django(**{k: env[k] for k in ("DATABASE_URL", "CUTROOM_MEDIA_ROOT",
                                             "CELERY_BROKER_URL", "CELERY_QUEUE", "CUTROOM_VAR_DIR")})
-        print(f"bulk import: {args.takes} synthetic takes of {args.minutes:g} min at 120 fps "
-              f"({hours:.1f} h of motion, {sum(p.stat().st_size for p in paths) / 2**30:.1f} GB BVH, "
+        print(f"bulk import: {args.takes} synthetic takes of {args.minutes:g} min at 120 fps"
+              f"{' (--no-check)' if args.no_check else ''} ({hours:.1f} h of motion, {sum(p.stat().st_size for p in paths) / 2**30:.1f} GB BVH, "
               f"{'written' if prepared > 1 else 'cached'} in {prepared:.0f} s); PostgreSQL + Redis, "
               f"workers of concurrency 1; machine: {os.cpu_count()} cores shared with other work, "
               f"load {os.getloadavg()[0]:.1f}\n", flush=True)
@@ -141,7 +145,7 @@ def main():
         print(header)
         print("-" * len(header), flush=True)
         for n in args.workers:
-            imported, total, cpu = run(n, folder, paths, env, var)
+            imported, total, cpu = run(n, folder, paths, env, var, check=not args.no_check)
             rate = hours / (total / 60)
             rows.append(rate)
             print(f"{n:>7} {args.takes:>6} {imported:>10.1f} {total:>9.1f} {rate:>13.2f} "

@@ -203,10 +203,13 @@ class SegmentZipView(APIView):
 class SimilarView(APIView):
     @extend_schema(responses=dict)
     def get(self, request, pk):
-        segment = segment_for(request.user, pk)
         k = int_param(request, "k", 10, 1, 100)
-        visible = LibrarySegment.objects.visible_to(request.user).preferred()
-        found = library.similar(segment, visible, k=k)
+        # One membership lookup for both the segment and the clips it may be compared with.
+        visible = LibrarySegment.objects.visible_to(request.user)
+        segment = visible.select_related("capture", "annotator", "label").filter(pk=pk).first()
+        if segment is None:
+            raise NotFound("No such segment.")
+        found = library.similar(segment, visible.preferred(), k=k)
         return Response({
             "segment": segment.pk,
             "results": [{**data, "distance": round(d, 4)} for data, (_, d) in zip(
