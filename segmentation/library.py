@@ -322,6 +322,9 @@ def similar(segment, visible, k=10):
     # The shortlist's rows, with what the caller shows of them, in one query.
     rows = (LibrarySegment.objects.select_related("capture", "annotator", "label")
             .defer("profile", "capture__skeleton").in_bulk(short))
+    short = [pk for pk in short if pk in rows]  # a capture's rows rebuilt meanwhile
+    if not short:
+        return []
     order, distances = similarity.rank_similar(
         query, np.stack([rows[pk].descriptor_array() for pk in short]), k=k, shortlist=len(short))
     return [(rows[short[i]], float(d)) for i, d in zip(order, distances, strict=True)]
