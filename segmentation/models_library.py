@@ -82,6 +82,11 @@ class LibrarySegment(models.Model):
             models.Index(fields=["project", "superseded", "-id"], name="libseg_list_recent",
                          include=["label_name", "duration", "agreement", "annotator", "is_gold",
                                   "capture"]),
+            # The same across projects (every project a reviewer sees, an annotator's own
+            # and gold segments).
+            models.Index(fields=["superseded", "-id"], name="libseg_list_all",
+                         include=["project", "label_name", "duration", "agreement", "annotator",
+                                  "is_gold", "capture"]),
             # The same for a label (its segments newest first, or every label in order) and
             # for an annotator.
             models.Index(fields=["project", "superseded", "label_name", "id"], name="libseg_list_label",
