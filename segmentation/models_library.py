@@ -94,6 +94,9 @@ class LibrarySegment(models.Model):
             models.Index(fields=["project", "superseded", "annotator", "-id"],
                          name="libseg_list_annotator",
                          include=["label_name", "duration", "agreement", "is_gold", "capture"]),
+            models.Index(fields=["project", "superseded", "-agreement", "-id"],
+                         name="libseg_list_agreement",
+                         include=["label_name", "duration", "annotator", "is_gold", "capture"]),
             # The similar-clip index reads a project's described segments by id (all of
             # them, or those newer than the index file).
             models.Index(fields=["project", "id"], name="libseg_described",
