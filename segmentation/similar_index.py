@@ -266,6 +266,20 @@ def schedule_update(project_id):
     transaction.on_commit(send)
 
 
+def newer_than(project_id, after):
+    """(id, profile) of a project's described segments with ids above ``after``, in id
+    order. Written as row comparisons on (project, id) so that the planner walks the
+    ``libseg_described`` index from ``(project, after)`` to the project's end: with a plain
+    ``project_id = p AND id > after`` PostgreSQL estimates the project's share of all newer
+    rows and often prefers the primary key, then filters every newer row of every project."""
+    table = LibrarySegment._meta.db_table
+    return (LibrarySegment.objects.filter(profile__isnull=False)
+            .extra(where=[f'("{table}"."project_id", "{table}"."id") > (%s, %s)',
+                          f'("{table}"."project_id", "{table}"."id") < (%s, 0)'],
+                   params=[project_id, after, project_id + 1])
+            .order_by("project_id", "id").values_list("id", "profile"))
+
+
 @dataclass
 class OpenIndex:
     """A project's index as this process sees it: the mapped file and the delta."""
@@ -279,8 +293,7 @@ class OpenIndex:
 
     def refresh_delta(self):
         """Read the segments added since the last look (one indexed query)."""
-        rows = list(described(self.project_id).filter(id__gt=max(self.seen_id, self.manifest["max_id"]))
-                    .order_by("id").values_list("id", "profile"))
+        rows = list(newer_than(self.project_id, max(self.seen_id, self.manifest["max_id"])))
         if not rows:
             return
         vectors = as_vectors([r[1] for r in rows])
