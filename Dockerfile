@@ -16,7 +16,8 @@ ENV PYTHONDONTWRITEBYTECODE=1 \
     PIP_NO_CACHE_DIR=1 \
     PIP_DISABLE_PIP_VERSION_CHECK=1 \
     CUTROOM_VAR_DIR=/data/var \
-    CUTROOM_MEDIA_ROOT=/data/media
+    CUTROOM_MEDIA_ROOT=/data/media \
+    CUTROOM_SIMILAR_INDEX_DIR=/data/media/similar
 RUN useradd --create-home --uid 1000 cutroom \
     && mkdir -p /data/var /data/media && chown -R cutroom:cutroom /data
 WORKDIR /app

@@ -175,6 +175,8 @@ SILENCED_SYSTEM_CHECKS = ["staticfiles.W004"]
 
 MEDIA_URL = "/media/"
 MEDIA_ROOT = Path(os.environ.get("CUTROOM_MEDIA_ROOT") or VAR_DIR / "media")
+# The similar-clip vector indexes (segmentation.similar_index); rebuilt from the database.
+SIMILAR_INDEX_DIR = Path(os.environ.get("CUTROOM_SIMILAR_INDEX_DIR") or VAR_DIR / "similar")
 STORAGES = {
     "default": {
         "BACKEND": os.environ.get(

@@ -24,7 +24,7 @@ from django.utils import timezone
 import motionlib
 from motionlib import similarity
 from motionlib.agreement import label_codes, segment_support
-from segmentation import agreement, storage
+from segmentation import agreement, similar_index, storage
 from segmentation.models_library import Adjudication, LibrarySegment
 from segmentation.services.captures import read_take
 
@@ -139,6 +139,7 @@ def refresh_capture_library(capture):
     with transaction.atomic():
         LibrarySegment.objects.filter(capture=capture).delete()
         LibrarySegment.objects.bulk_create(rows, batch_size=500)
+        similar_index.schedule_update(capture.project_id)
     return rows
 
 
@@ -326,29 +327,46 @@ def similar(segment, visible, k=10):
     """The ``k`` visible segments of the same project that move most like ``segment``.
 
     Segments overlapping it in the same capture are left out (other annotators' versions
-    of the same motion), and so are duplicates of one span. Two stages: profiles of up to
-    ``SIMILAR_POOL`` recent segments pick a shortlist, whose full descriptors are ranked.
+    of the same motion), and so are duplicates of one span. Two stages: the profiles
+    nearest to the query's pick a shortlist, whose full descriptors are ranked. The
+    shortlist comes from the project's vector index (``similar_index``) when it has a
+    usable one, else from the profiles of up to ``SIMILAR_POOL`` recent segments.
     Returns ``[(segment, distance)]``, most similar first.
     """
     query = segment.descriptor_array()
     if query is None:
         raise ValueError(f"segment {segment.pk}: its skeleton could not be mapped to body "
                          "parts, so it has no motion descriptor")
-    pool = (
-        visible.filter(project_id=segment.project_id, profile__isnull=False)
-        .exclude(capture_id=segment.capture_id, start__lt=segment.stop, stop__gt=segment.start)
-        .order_by("-id").values_list("id", "capture_id", "start", "stop", "profile")
-    )[:SIMILAR_POOL]
+    pool = (visible.filter(project_id=segment.project_id, profile__isnull=False)
+            .exclude(capture_id=segment.capture_id, start__lt=segment.stop, stop__gt=segment.start))
+    n = max(SHORTLIST, k)
+    index = similar_index.open_index(segment.project_id)
+    short = similar_index.shortlist(index, query, pool, n) if index else None
+    if short is None:
+        short = exact_shortlist(query, pool, n)
+    if not short:
+        return []
+    # The shortlist's rows, with what the caller shows of them, in one query.
+    rows = (LibrarySegment.objects.select_related("capture", "annotator", "label")
+            .defer("profile", "capture__skeleton").in_bulk(short))
+    short = [pk for pk in short if pk in rows]  # a capture's rows rebuilt meanwhile
+    if not short:
+        return []
+    order, distances = similarity.rank_similar(
+        query, np.stack([rows[pk].descriptor_array() for pk in short]), k=k, shortlist=len(short))
+    return [(rows[short[i]], float(d)) for i, d in zip(order, distances, strict=True)]
+
+
+def exact_shortlist(query, pool, n):
+    """Ids of the ``n`` profile-nearest segments among the ``SIMILAR_POOL`` most recent of
+    ``pool`` (one span counted once, its newest row kept), nearest first."""
+    rows = pool.order_by("-id").values_list("id", "capture_id", "start", "stop", "profile")
     seen, unique = set(), []
-    for pk, capture_id, start, stop, blob in pool:
+    for pk, capture_id, start, stop, blob in rows[:SIMILAR_POOL]:
         if (capture_id, start, stop) not in seen:
             seen.add((capture_id, start, stop))
             unique.append((pk, blob))
     ids, profiles = profile_pool(unique, query.shape[1])
     if not ids:
         return []
-    short = [ids[i] for i in similarity.shortlist_by_profile(query, profiles, max(SHORTLIST, k))]
-    order, distances = similarity.rank_similar(query, load_descriptors(short), k=k,
-                                               shortlist=len(short))
-    rows = LibrarySegment.objects.select_related("capture", "annotator").in_bulk([short[i] for i in order])
-    return [(rows[short[i]], float(d)) for i, d in zip(order, distances, strict=True)]
+    return [ids[i] for i in similarity.shortlist_by_profile(query, profiles, n)]

@@ -77,6 +77,30 @@ class LibrarySegment(models.Model):
             models.Index(fields=["project", "is_gold", "-id"], name="libseg_gold"),
             models.Index(fields=["project", "agreement"], name="libseg_agreement"),
             models.Index(fields=["project", "duration"], name="libseg_duration"),
+            # The list's default view in its default order, with every filtered column, so
+            # that a page's ids and a capped count come from the index alone.
+            models.Index(fields=["project", "superseded", "-id"], name="libseg_list_recent",
+                         include=["label_name", "duration", "agreement", "annotator", "is_gold",
+                                  "capture"]),
+            # The same across projects (every project a reviewer sees, an annotator's own
+            # and gold segments).
+            models.Index(fields=["superseded", "-id"], name="libseg_list_all",
+                         include=["project", "label_name", "duration", "agreement", "annotator",
+                                  "is_gold", "capture"]),
+            # The same for a label (its segments newest first, or every label in order) and
+            # for an annotator.
+            models.Index(fields=["project", "superseded", "label_name", "id"], name="libseg_list_label",
+                         include=["duration", "agreement", "annotator", "is_gold", "capture"]),
+            models.Index(fields=["project", "superseded", "annotator", "-id"],
+                         name="libseg_list_annotator",
+                         include=["label_name", "duration", "agreement", "is_gold", "capture"]),
+            models.Index(fields=["project", "superseded", "-agreement", "-id"],
+                         name="libseg_list_agreement",
+                         include=["label_name", "duration", "annotator", "is_gold", "capture"]),
+            # The similar-clip index reads a project's described segments by id (all of
+            # them, or those newer than the index file).
+            models.Index(fields=["project", "id"], name="libseg_described",
+                         condition=Q(profile__isnull=False)),
         ]
 
     def __str__(self):

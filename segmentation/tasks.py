@@ -101,6 +101,14 @@ def suggest(capture_id, annotator_id):
 
 
 @shared_task
+def update_similar_index(project_id):
+    """Bring a project's similar-clip index in step with its library rows."""
+    from segmentation import similar_index
+
+    similar_index.update(project_id)
+
+
+@shared_task
 def sweep():
     """Requeue (or fail) jobs whose claim went stale because their worker vanished."""
     return services.sweep_stale_claims() + adaptation.sweep_stale_trainings()

@@ -1,6 +1,6 @@
 import { describe, expect, it } from "vitest";
 import { addCut, fromSpans, moveCut, removeCut, segmentAt, setLabel, toSpans } from "../src/library/gold";
-import { libraryFiltersFrom, libraryQuery } from "../src/library/page";
+import { libraryFiltersFrom, libraryQuery, segmentCount } from "../src/library/page";
 import { previewStep } from "../src/library/preview";
 
 const spans = [
@@ -79,5 +79,13 @@ describe("opening a capture at a segment", () => {
     expect(frameFromUrl(1000, "?frame=-3")).toBe(0);
     expect(frameFromUrl(1000, "?frame=abc")).toBe(0);
     expect(frameFromUrl(1000, "")).toBe(0);
+  });
+});
+
+describe("segment count", () => {
+  it("says when the server capped the count", () => {
+    expect(segmentCount(1, false)).toBe("1 segment");
+    expect(segmentCount(7, false)).toBe("7 segments");
+    expect(segmentCount(10000, true)).toBe("10,000+ segments");
   });
 });

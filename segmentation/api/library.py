@@ -1,6 +1,7 @@
 """The clip library, agreement, adjudication and the project dashboard.
 
-- ``GET /api/segments/?project=&label=&capture=&annotator=&min_duration=&max_duration=&min_agreement=&gold=&ordering=``
+- ``GET /api/segments/?project=&label=&capture=&annotator=&min_duration=&max_duration=&min_agreement=&gold=&ordering=&page=``
+  (``count`` exact up to 10,000 matches, else 10,000 with ``count_capped``)
 - ``GET /api/segments/{id}/``, ``…/export.bvh``, ``…/export.fbx``, ``…/export.glb``,
   ``…/similar/?k=10``
 - ``GET /api/segments/export.zip?<same filters>&file_format=bvh|fbx|glb`` (streamed)
@@ -20,6 +21,7 @@ from rest_framework import serializers
 from rest_framework.exceptions import NotFound, PermissionDenied
 from rest_framework.pagination import PageNumberPagination
 from rest_framework.response import Response
+from rest_framework.utils.urls import remove_query_param, replace_query_param
 from rest_framework.views import APIView
 
 from segmentation import agreement, exports, library
@@ -37,9 +39,65 @@ ORDERINGS = {
 
 
 class SegmentPagination(PageNumberPagination):
+    """Page numbers as before, without counting a million rows for each page.
+
+    A page reads one id more than it shows, which says whether there is a next page.
+    The count is exact up to ``count_cap`` matches (a count of at most that many rows,
+    or none at all on the last page); beyond it ``count`` is the cap and ``count_capped``
+    is true, so a page of a huge library costs as much as a page of a small one.
+    """
+
     page_size = 50
     page_size_query_param = "page_size"
     max_page_size = 500
+    count_cap = 10_000
+
+    def paginate_queryset(self, queryset, request, view=None):
+        self.request = request
+        size = self.get_page_size(request)
+        self.number = int_param(request, self.page_query_param, 1, 1, 1_000_000)
+        offset = (self.number - 1) * size
+        # The page's ids first (an index can answer that alone, however deep the page),
+        # then its rows by id.
+        ids = list(queryset.values_list("id", flat=True)[offset:offset + size + 1])
+        self.has_next = len(ids) > size
+        found = queryset.order_by().in_bulk(ids[:size])
+        rows = [found[pk] for pk in ids[:size] if pk in found]
+        if rows and not self.has_next:
+            self.count, self.capped = offset + len(rows), False
+        else:
+            cap = max(self.count_cap, offset + size + 1)
+            self.count = queryset.order_by()[:cap + 1].count()
+            self.capped = self.count > cap
+            self.count = min(self.count, cap)
+        if not rows and self.number > 1:
+            raise NotFound(f"page: there is no page {self.number}; the query matches "
+                           f"{self.count} segment(s)")
+        return rows
+
+    def get_next_link(self):
+        if not self.has_next:
+            return None
+        return replace_query_param(self.request.build_absolute_uri(), self.page_query_param,
+                                   self.number + 1)
+
+    def get_previous_link(self):
+        if self.number == 1:
+            return None
+        url = self.request.build_absolute_uri()
+        if self.number == 2:
+            return remove_query_param(url, self.page_query_param)
+        return replace_query_param(url, self.page_query_param, self.number - 1)
+
+    def get_paginated_response(self, data):
+        return Response({"count": self.count, "count_capped": self.capped,
+                         "next": self.get_next_link(), "previous": self.get_previous_link(),
+                         "results": data})
+
+    def get_paginated_response_schema(self, schema):
+        body = super().get_paginated_response_schema(schema)
+        body["properties"]["count_capped"] = {"type": "boolean"}
+        return body
 
 
 class SegmentSerializer(serializers.ModelSerializer):
@@ -101,11 +159,13 @@ def segment_for(user, pk):
 
 
 class SegmentListView(APIView):
+    pagination_class = SegmentPagination
+
     @extend_schema(responses=SegmentSerializer(many=True))
     def get(self, request):
         segments = segment_query(request).select_related("capture", "annotator", "label").defer(
             "descriptor", "profile", "capture__skeleton")
-        paginator = SegmentPagination()
+        paginator = self.pagination_class()
         page = paginator.paginate_queryset(segments, request, view=self)
         return paginator.get_paginated_response(SegmentSerializer(page, many=True).data)
 
@@ -164,13 +224,17 @@ class SegmentZipView(APIView):
 class SimilarView(APIView):
     @extend_schema(responses=dict)
     def get(self, request, pk):
-        segment = segment_for(request.user, pk)
         k = int_param(request, "k", 10, 1, 100)
-        visible = LibrarySegment.objects.visible_to(request.user).preferred()
-        found = library.similar(segment, visible, k=k)
+        # One membership lookup for both the segment and the clips it may be compared with.
+        visible = LibrarySegment.objects.visible_to(request.user)
+        segment = visible.select_related("capture", "annotator", "label").filter(pk=pk).first()
+        if segment is None:
+            raise NotFound("No such segment.")
+        found = library.similar(segment, visible.preferred(), k=k)
         return Response({
             "segment": segment.pk,
-            "results": [{**SegmentSerializer(s).data, "distance": round(d, 4)} for s, d in found],
+            "results": [{**data, "distance": round(d, 4)} for data, (_, d) in zip(
+                SegmentSerializer([s for s, _ in found], many=True).data, found, strict=True)],
         })
 
 

@@ -12,6 +12,7 @@ from motionlib.similarity import (
     PROFILE_ROWS,
     body_scale,
     dtw_distance,
+    dtw_distances,
     rank_similar,
     resample,
     segment_descriptor,
@@ -75,6 +76,14 @@ def test_it_computes_dtw_like_the_textbook_recursion_when_the_band_is_wide():
     rng = np.random.default_rng(1)
     a, b = rng.normal(size=(12, 3)), rng.normal(size=(9, 3))
     assert dtw_distance(a, b, band=1.0) == pytest.approx(slow_dtw(a, b))
+
+
+@pytest.mark.parametrize("n, m, band", [(32, 32, 0.25), (12, 9, 0.25), (9, 12, 1.0), (5, 20, 0.1)])
+def test_it_computes_a_batch_of_dtw_distances_exactly_as_one_at_a_time(n, m, band):
+    rng = np.random.default_rng(n + m)
+    a, bs = rng.normal(size=(n, 4)), rng.normal(size=(6, m, 4))
+    expected = [dtw_distance(a, b, band=band) for b in bs]
+    assert dtw_distances(a, bs, band=band).tolist() == expected
 
 
 def test_it_warps_away_a_change_of_tempo():

@@ -23,3 +23,15 @@ def _media_root_on_testcase(request, media_root):
     # unittest-style test cases reach the per-test folder as self.media_root.
     if request.instance is not None:
         request.instance.media_root = media_root
+
+
+@pytest.fixture(autouse=True)
+def similar_index_dir(settings, tmp_path):
+    """Each test keeps its similar-clip indexes in its own folder, and no process cache
+    of an index outlives the test (ids are reused once a test's rows are rolled back)."""
+    from segmentation import similar_index
+
+    settings.SIMILAR_INDEX_DIR = tmp_path / "similar"
+    similar_index.forget()
+    yield settings.SIMILAR_INDEX_DIR
+    similar_index.forget()

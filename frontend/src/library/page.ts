@@ -38,6 +38,11 @@ export function libraryQuery(f: LibraryFilters, withPage = true): string {
   return q.toString();
 }
 
+/** "1 segment", "7 segments", or "10,000+ segments" when the server stopped counting. */
+export function segmentCount(count: number, capped: boolean): string {
+  return `${count.toLocaleString("en-US")}${capped ? "+" : ""} segment${count === 1 && !capped ? "" : "s"}`;
+}
+
 const pct = (v: number | null) => (v === null ? "—" : `${Math.round(v * 100)} %`);
 
 export async function renderLibrary(root: HTMLElement): Promise<() => void> {
@@ -133,7 +138,7 @@ export async function renderLibrary(root: HTMLElement): Promise<() => void> {
   async function load(): Promise<void> {
     const query = libraryQuery(filters);
     exportZip.setAttribute("href", zipHref());
-    const data = await get<Page<LibrarySegment>>(`/api/segments/?${query}`).catch((err: Error) => {
+    const data = await get<Page<LibrarySegment> & { count_capped?: boolean }>(`/api/segments/?${query}`).catch((err: Error) => {
       clear(rows, h("tr", {}, h("td", { colspan: 7, class: "error-text", "data-testid": "lib-error" }, err.message)));
       return null;
     });
@@ -143,7 +148,7 @@ export async function renderLibrary(root: HTMLElement): Promise<() => void> {
     if (!data.results.length) rows.append(h("tr", {}, h("td", { colspan: 7, class: "muted empty" }, "No segments match. Segments appear here when reviews are submitted.")));
     clear(
       pager,
-      h("span", { class: "muted", "data-testid": "segment-count" }, `${data.count} segment${data.count === 1 ? "" : "s"}`),
+      h("span", { class: "muted", "data-testid": "segment-count" }, segmentCount(data.count, data.count_capped ?? false)),
       data.previous ? h("button", { class: "btn", onclick: () => apply({ ...filters, page: filters.page - 1 }) }, "← Previous") : null,
       data.next ? h("button", { class: "btn", onclick: () => apply({ ...filters, page: filters.page + 1 }) }, "Next →") : null,
     );

@@ -108,6 +108,7 @@ class Workers:
             "CELERY_BROKER_URL": settings.CELERY_BROKER_URL,
             "CELERY_QUEUE": queue,
             "CUTROOM_MEDIA_ROOT": str(media),
+            "CUTROOM_SIMILAR_INDEX_DIR": str(media / "similar"),
             "CUTROOM_CLAIM_TIMEOUT": str(claim_timeout),
         }
         self.queue, self.logs, self.procs = queue, logs, []

@@ -1,0 +1,201 @@
+"""The similar-clip vector index: it finds what the exact scan finds, sees segments added
+after it was written, is brought in step when reviews are submitted, and is rebuilt when
+its file is lost."""
+
+from unittest import mock
+
+import numpy as np
+from django.core.management import call_command
+from django.db import connection
+from django.test.utils import CaptureQueriesContext
+
+import motionlib
+from motionlib import similarity, synth, vector_index
+from motionlib.vector_index import IvfIndex
+from segmentation import library, similar_index, tasks
+from segmentation.models_library import LibrarySegment
+from tests.segmentation.base import BaseTestCase
+from tests.segmentation.test_library import submit_review
+
+
+def synth_descriptors(n, seed=3):
+    """``n`` descriptors of random spans (0.3-3 s) of a seeded synthetic take."""
+    take, _ = synth.generate(seed=seed, duration=90)
+    positions = motionlib.forward_kinematics(take)
+    joints = motionlib.canonical_indices(take)
+    scale = similarity.body_scale(positions, joints)
+    rng = np.random.default_rng(seed)
+    spans = []
+    for _ in range(n):
+        length = int(rng.uniform(0.3, 3.0) * take.fps)
+        start = int(rng.integers(0, len(positions) - length))
+        spans.append((start, start + length))
+    return spans, [similarity.segment_descriptor(positions, joints, a, b, fps=take.fps, scale=scale)
+                   for a, b in spans]
+
+
+class SimilarIndexTestCase(BaseTestCase):
+    N = 300
+
+    def setUp(self):
+        super().setUp()
+        # Clusters of 16 (a million-segment library has 1024 per cluster), so a search
+        # scans only some of them here too.
+        patcher = mock.patch.object(vector_index, "LIST_SIZE", 16)
+        patcher.start()
+        self.addCleanup(patcher.stop)
+
+    @classmethod
+    def setUpTestData(cls):
+        super().setUpTestData()
+        cls.spans, cls.descs = synth_descriptors(cls.N)
+
+    def add_segments(self, spans, descs, annotator=None):
+        capture = self.ready_capture(name=f"c{LibrarySegment.objects.count()}.bvh", n_frames=20000)
+        rows = []
+        for (start, stop), desc in zip(spans, descs, strict=True):
+            row = LibrarySegment(project=self.project, capture=capture, annotator=annotator or self.bob,
+                                 label=self.walk, label_name="walk", start=start, stop=stop,
+                                 duration=(stop - start) / 120)
+            library.store_descriptor(row, desc)
+            rows.append(row)
+        return LibrarySegment.objects.bulk_create(rows)
+
+    def visible(self):
+        return LibrarySegment.objects.visible_to(self.rachel).preferred()
+
+    def exact(self, segment, k=10):
+        """The exact scan: ``similar`` while the project has no index."""
+        similar_index.manifest_path(self.project.pk).unlink(missing_ok=True)
+        similar_index.forget()
+        assert similar_index.open_index(self.project.pk) is None
+        return [(s.pk, round(d, 5)) for s, d in library.similar(segment, self.visible(), k=k)]
+
+    def indexed(self, segment, k=10):
+        assert similar_index.open_index(self.project.pk) is not None
+        return [(s.pk, round(d, 5)) for s, d in library.similar(segment, self.visible(), k=k)]
+
+
+class SameResultsTest(SimilarIndexTestCase):
+    def test_it_returns_the_same_clips_as_the_exact_scan(self):
+        rows = self.add_segments(self.spans, self.descs)
+        queries = rows[::30]
+        expected = [self.exact(q) for q in queries]
+        similar_index.build(self.project.pk)
+        similar_index.forget()
+        assert [self.indexed(q) for q in queries] == expected
+        assert all(len(found) == 10 for found in expected)
+
+    def test_it_leaves_out_segments_the_caller_may_not_see(self):
+        dana_rows = self.add_segments(self.spans[:150], self.descs[:150], annotator=self.alice)
+        bob_rows = self.add_segments(self.spans[150:], self.descs[150:])
+        similar_index.build(self.project.pk)
+        # bob (an annotator) sees his own segments only; alice's are nearer to her own query.
+        visible = LibrarySegment.objects.visible_to(self.bob).preferred()
+        found = library.similar(dana_rows[0], visible, k=10)
+        assert len(found) == 10
+        assert {s.pk for s, _ in found} <= {r.pk for r in bob_rows}
+
+
+class QueryCountTest(SimilarIndexTestCase):
+    def test_it_answers_with_the_same_number_of_queries_whatever_k(self):
+        rows = self.add_segments(self.spans[:100], self.descs[:100])
+        similar_index.build(self.project.pk)
+        self.login(self.rachel)
+        self.client.get(f"/api/segments/{rows[0].pk}/similar/")  # opens and checks the index
+        counts = []
+        for k in (2, 20):
+            with CaptureQueriesContext(connection) as queries:
+                response = self.client.get(f"/api/segments/{rows[0].pk}/similar/?k={k}")
+            assert response.status_code == 200 and len(response.json()["results"]) == k
+            counts.append(len(queries))
+        assert counts[0] == counts[1]
+
+
+class IncrementalTest(SimilarIndexTestCase):
+    def test_it_finds_segments_added_after_the_index_was_written(self):
+        rows = self.add_segments(self.spans[:200], self.descs[:200])
+        similar_index.build(self.project.pk)
+        assert self.indexed(rows[0])  # the process has seen this index generation
+        # The same motion again, in another capture, newer than the index file.
+        twin = self.add_segments([self.spans[0]], [self.descs[0]])[0]
+        found = self.indexed(rows[0], k=3)
+        assert found[0] == (twin.pk, 0.0)
+        assert similar_index.read_manifest(self.project.pk)["max_id"] < twin.pk
+
+    def test_it_reads_only_its_own_projects_newer_segments(self):
+        self.add_segments(self.spans[:50], self.descs[:50])
+        similar_index.build(self.project.pk)
+        mine = self.add_segments(self.spans[50:52], self.descs[50:52])
+        capture = self.ready_capture(name="theirs.bvh")
+        capture.project = self.other_project
+        capture.save()
+        theirs = LibrarySegment(project=self.other_project, capture=capture, label_name="x",
+                                start=0, stop=10, duration=0.1)
+        library.store_descriptor(theirs, self.descs[52])
+        theirs.save()
+        self.add_segments(self.spans[53:54], self.descs[53:54])
+        newest = LibrarySegment.objects.filter(project=self.project).latest("id")
+        opened = similar_index.open_index(self.project.pk)
+        assert opened.delta_ids.tolist() == [mine[0].pk, mine[1].pk, newest.pk]
+
+    def test_it_brings_the_index_in_step_when_a_review_is_submitted(self):
+        self.add_segments(self.spans, self.descs)
+        similar_index.build(self.project.pk)
+        capture = self.ready_capture(name="reviewed.bvh")
+        with self.captureOnCommitCallbacks() as callbacks:
+            submit_review(capture, self.bob, [100, 200], ["walk", "punch", "walk"])
+        assert callbacks, "submitting a review queues an index update"
+        LibrarySegment.objects.filter(pk=self.add_segments(self.spans[:1], self.descs[:1])[0].pk).delete()
+        gone = list(LibrarySegment.objects.order_by("id").values_list("id", flat=True)[:5])
+        LibrarySegment.objects.filter(pk__in=gone).delete()
+        tasks.update_similar_index(self.project.pk)  # what the worker runs
+        manifest = similar_index.read_manifest(self.project.pk)
+        index = IvfIndex.open(similar_index.index_dir() / manifest["file"])
+        ids = set(similar_index.described(self.project.pk).values_list("id", flat=True))
+        assert set(index.ids.tolist()) == ids
+        assert manifest["count"] == len(ids) == self.N - 5
+
+    def test_it_retrains_when_the_library_has_doubled(self):
+        self.add_segments(self.spans[:100], self.descs[:100])
+        first = similar_index.build(self.project.pk)
+        self.add_segments(self.spans[100:], self.descs[100:])
+        manifest = similar_index.update(self.project.pk)
+        assert (first["lists"], manifest["lists"]) == (6, 18)
+        assert manifest["count"] == manifest["trained_on"] == self.N
+
+    def test_it_leaves_an_index_in_step_unchanged(self):
+        self.add_segments(self.spans[:50], self.descs[:50])
+        first = similar_index.build(self.project.pk)
+        assert similar_index.update(self.project.pk) == first
+
+
+class RebuildTest(SimilarIndexTestCase):
+    def test_it_scans_exactly_and_queues_a_rebuild_when_the_index_file_is_deleted(self):
+        rows = self.add_segments(self.spans, self.descs)
+        expected = self.exact(rows[7])
+        manifest = similar_index.build(self.project.pk)
+        (similar_index.index_dir() / manifest["file"] / "vectors.npy").unlink()
+        similar_index.forget()
+        with self.captureOnCommitCallbacks() as callbacks:
+            assert similar_index.open_index(self.project.pk) is None
+            found = [(s.pk, round(d, 5)) for s, d in library.similar(rows[7], self.visible())]
+        assert found == expected
+        assert callbacks, "a rebuild is queued"
+        tasks.update_similar_index(self.project.pk)
+        assert self.indexed(rows[7]) == expected
+
+    def test_it_does_not_use_an_index_of_another_format(self):
+        self.add_segments(self.spans[:50], self.descs[:50])
+        similar_index.build(self.project.pk)
+        path = similar_index.manifest_path(self.project.pk)
+        path.write_text(path.read_text().replace('"format": 1', '"format": 0'))
+        similar_index.forget()
+        assert similar_index.open_index(self.project.pk) is None
+
+    def test_it_rebuilds_every_index_from_the_command(self):
+        self.add_segments(self.spans[:50], self.descs[:50])
+        call_command("similar_index", "--rebuild", verbosity=0)
+        manifest = similar_index.read_manifest(self.project.pk)
+        assert manifest["count"] == 50
+        assert not similar_index.manifest_path(self.other_project.pk).exists()
