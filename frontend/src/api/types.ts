@@ -61,3 +61,13 @@ export type ReviewEvent = Schemas["Event"];
 export function isReady(capture: Capture): capture is ReadyCapture {
   return capture.status === "ready" && capture.fps !== null && capture.n_frames !== null && capture.skeleton !== null;
 }
+
+// Assignments, queues, members and invitations.
+export type QueueState = Schemas["QueueStateEnum"];
+export type QueueItem = Schemas["QueueItem"];
+export type Assignment = Schemas["Assignment"];
+export type Member = Schemas["Member"];
+/** A pending invitation as the project's admins see it. */
+export type Invitation = Schemas["Invitation"];
+/** An invitation as the invitee sees it: which project, what role, from whom. */
+export type MyInvitation = Schemas["MyInvitation"];
