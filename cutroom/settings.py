@@ -286,10 +286,20 @@ SPECTACULAR_SETTINGS = {
     "SWAGGER_UI_DIST": "SIDECAR",
     "SWAGGER_UI_FAVICON_HREF": "SIDECAR",
     "REDOC_DIST": "SIDECAR",
+    # Request and answer components apart, so that an answer's fields are all required
+    # (frontend/src/api/schema.d.ts is generated from this schema).
+    "COMPONENT_SPLIT_REQUEST": True,
+    "POSTPROCESSING_HOOKS": [
+        "drf_spectacular.hooks.postprocess_schema_enums",
+        "segmentation.api.schema.answers_have_every_field",
+    ],
     "ENUM_NAME_OVERRIDES": {
         "JobStatusEnum": "segmentation.models.JOB_STATUSES",
         "ReviewStatusEnum": "segmentation.models.Review.STATUSES",
         "RoleEnum": "segmentation.models.ROLES",
+        "ReviewStateEnum": "segmentation.api.serializers.REVIEW_STATES",
+        "QueueStateEnum": "segmentation.api.assignments.QUEUE_STATES",
+        "CaptureStateEnum": "segmentation.api.library.CAPTURE_STATES",
     },
 }
 

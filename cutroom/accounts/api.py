@@ -25,6 +25,15 @@ class ApiTokenSerializer(serializers.ModelSerializer):
         return token == self.context["request"].auth
 
 
+class IssuedTokenSerializer(serializers.Serializer):
+    token = serializers.CharField(help_text="The key; shown only in this answer.")
+    expires_at = serializers.DateTimeField()
+
+
+class RevokedSerializer(serializers.Serializer):
+    revoked = serializers.IntegerField(help_text="How many tokens were revoked")
+
+
 class TokenView(APIView):
     """POST: a new token for a username and password. DELETE: revoke the token this
     request was made with."""
@@ -40,7 +49,7 @@ class TokenView(APIView):
     def get_permissions(self):
         return [AllowAny()] if self.obtaining() else super().get_permissions()
 
-    @extend_schema(request=AuthTokenSerializer, responses=dict)
+    @extend_schema(request=AuthTokenSerializer, responses=IssuedTokenSerializer)
     def post(self, request):
         wait = throttle.wait_seconds(request, throttle.username_of(request.data))
         if wait:
@@ -50,7 +59,7 @@ class TokenView(APIView):
         user = serializer.validated_data["user"]
         throttle.forget_failures(user.get_username())
         token, key = ApiToken.objects.issue(user)
-        return Response({"token": key, "expires_at": token.expires_at})
+        return Response(IssuedTokenSerializer({"token": key, "expires_at": token.expires_at}).data)
 
     @extend_schema(responses={204: None})
     def delete(self, request):
@@ -70,10 +79,10 @@ class TokensView(APIView):
         tokens = request.user.api_tokens.live().order_by("-created_at", "-id")
         return Response(ApiTokenSerializer(tokens, many=True, context={"request": request}).data)
 
-    @extend_schema(operation_id="auth_tokens_revoke_all", responses=dict)
+    @extend_schema(operation_id="auth_tokens_revoke_all", responses=RevokedSerializer)
     def delete(self, request):
         revoked, _ = request.user.api_tokens.all().delete()
-        return Response({"revoked": revoked})
+        return Response(RevokedSerializer({"revoked": revoked}).data)
 
 
 class OneTokenView(APIView):

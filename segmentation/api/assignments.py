@@ -4,7 +4,7 @@ and returning a submitted review to its annotator."""
 from django.contrib.auth import get_user_model
 from django.shortcuts import get_object_or_404
 from django.urls import path
-from drf_spectacular.utils import OpenApiParameter, extend_schema
+from drf_spectacular.utils import OpenApiParameter, extend_schema, extend_schema_field
 from rest_framework import serializers
 from rest_framework.exceptions import PermissionDenied
 from rest_framework.response import Response
@@ -13,11 +13,14 @@ from rest_framework.views import APIView
 from segmentation.api.captures import capture_for
 from segmentation.api.params import int_param
 from segmentation.api.projects import project_for
-from segmentation.api.serializers import ReviewSerializer
+from segmentation.api.serializers import NamedRefSerializer, ReviewSerializer
 from segmentation.models import Assignment, Project
 from segmentation.services import assignments as service
 from segmentation.services import queue as queues
 from segmentation.services import returns
+
+# The schema's QueueStateEnum (settings.SPECTACULAR_SETTINGS).
+QUEUE_STATES = queues.QUEUE_STATES
 
 
 class AssignmentSerializer(serializers.ModelSerializer):
@@ -30,10 +33,12 @@ class AssignmentSerializer(serializers.ModelSerializer):
         model = Assignment
         fields = ["id", "capture", "annotator", "assigned_by", "created_at", "state"]
 
-    def get_capture(self, a) -> dict:
+    @extend_schema_field(NamedRefSerializer)
+    def get_capture(self, a):
         return {"id": a.capture_id, "name": a.capture.name}
 
-    def get_state(self, a) -> str:
+    @extend_schema_field(serializers.ChoiceField(choices=QUEUE_STATES))
+    def get_state(self, a):
         """assigned (no review yet), in_progress, returned or submitted."""
         review = next((r for r in a.capture.reviews.all() if r.annotator_id == a.annotator_id), None)
         return review.status if review else "assigned"
@@ -55,12 +60,27 @@ class ReturnRequest(serializers.Serializer):
     comment = serializers.CharField(allow_blank=True)
 
 
+class QueueCaptureSerializer(NamedRefSerializer):
+    project = serializers.IntegerField()
+    duration = serializers.FloatField(allow_null=True)
+    n_frames = serializers.IntegerField(allow_null=True)
+    n_candidates = serializers.IntegerField(allow_null=True, help_text="null: no finished run")
+
+
+class QueueReviewSerializer(serializers.Serializer):
+    id = serializers.IntegerField()
+    version = serializers.IntegerField()
+    submitted_at = serializers.DateTimeField(allow_null=True)
+    return_comment = serializers.CharField(allow_null=True)
+    returned_at = serializers.DateTimeField(allow_null=True)
+
+
 class QueueItemSerializer(serializers.Serializer):
-    capture = serializers.DictField()
-    state = serializers.ChoiceField(choices=queues.QUEUE_STATES)
+    capture = QueueCaptureSerializer()
+    state = serializers.ChoiceField(choices=QUEUE_STATES)
     assigned = serializers.BooleanField()
     since = serializers.DateTimeField()
-    review = serializers.DictField(allow_null=True)
+    review = QueueReviewSerializer(allow_null=True)
 
 
 def assigning_project(request, pk):

@@ -20,8 +20,11 @@ from segmentation.api.projects import project_for
 from segmentation.api.serializers import (
     CaptureListSerializer,
     CaptureSerializer,
+    FramesSerializer,
     RunRequestSerializer,
     RunSerializer,
+    SignalsSerializer,
+    UploadedSerializer,
     UploadSerializer,
 )
 from segmentation.errors import NotReady, UploadTooLarge
@@ -69,7 +72,8 @@ class CaptureViewSet(
             captures = captures.filter(name__icontains=self.request.query_params["search"])
         return captures
 
-    @extend_schema(request={"multipart/form-data": UploadSerializer}, responses=CaptureSerializer)
+    @extend_schema(request={"multipart/form-data": UploadSerializer},
+                   responses={201: UploadedSerializer, 200: UploadedSerializer})
     def create(self, request, *args, **kwargs):
         # Refuse an oversized body before reading it.
         length = int(request.META.get("CONTENT_LENGTH") or 0)
@@ -86,10 +90,10 @@ class CaptureViewSet(
         capture, created = services.do_upload_capture(
             project, request.user, data["file"], data.get("asf")
         )
-        body = {**CaptureSerializer(capture).data, "duplicate": not created}
-        return Response(body, status=201 if created else 200)
+        capture.duplicate = not created
+        return Response(UploadedSerializer(capture).data, status=201 if created else 200)
 
-    @extend_schema(parameters=[OpenApiParameter("max_points", int)], responses=dict)
+    @extend_schema(parameters=[OpenApiParameter("max_points", int)], responses=SignalsSerializer)
     @action(detail=True)
     def signal(self, request, pk=None):
         capture = self.get_object()
@@ -98,10 +102,11 @@ class CaptureViewSet(
         body = {"run": run.pk if run else None, "fps": capture.fps, "n_frames": capture.n_frames}
         signals = storage.load_npz(run.signals) if run and run.signals else {}
         body["signals"] = [_sampled(name, values, max_points) for name, values in signals.items()]
-        return Response(body)
+        return Response(SignalsSerializer(body).data)
 
     @extend_schema(
-        parameters=[OpenApiParameter(p, int) for p in ("start", "stop", "step")], responses=dict
+        parameters=[OpenApiParameter(p, int) for p in ("start", "stop", "step")],
+        responses=FramesSerializer,
     )
     @action(detail=True)
     def frames(self, request, pk=None):
@@ -118,13 +123,13 @@ class CaptureViewSet(
                           settings.CUTROOM_JOINT_FRAMES_PER_REQUEST // max(capture.n_joints, 1))
         stop = min(stop, start + max(per_request, 1) * step)
         block = np.ascontiguousarray(storage.load_npy(capture.positions)[start:stop:step], "<f4")
-        return Response({
+        return Response(FramesSerializer({
             "start": start, "stop": stop, "step": step,
             "n_frames": int(block.shape[0]), "n_joints": int(block.shape[1]),
             "dtype": "float32", "data": base64.b64encode(block.tobytes()).decode("ascii"),
-        })
+        }).data)
 
-    @extend_schema(request=None, responses=CaptureSerializer)
+    @extend_schema(request=None, responses={202: CaptureSerializer})
     @action(detail=True, methods=["post"])
     def retry(self, request, pk=None):
         """Queue a failed capture's ingest again from its stored original."""
@@ -133,7 +138,7 @@ class CaptureViewSet(
         capture.refresh_from_db()
         return Response(CaptureSerializer(capture).data, status=202)
 
-    @extend_schema(request=None, responses=RunSerializer)
+    @extend_schema(request=None, responses={202: RunSerializer})
     @action(detail=True, methods=["post"])
     def redetect(self, request, pk=None):
         """Detect again with the project's method and newest model (reviewers, admins),
@@ -144,8 +149,11 @@ class CaptureViewSet(
         run = adaptation.do_redetect(capture, request.user)
         return Response(RunSerializer(run).data, status=202)
 
-    @extend_schema(request=RunRequestSerializer, responses=RunSerializer(many=True))
-    @action(detail=True, methods=["get", "post"], serializer_class=RunRequestSerializer)
+    @extend_schema(methods=["GET"], responses=RunSerializer(many=True))
+    @extend_schema(methods=["POST"], request=RunRequestSerializer, responses={202: RunSerializer})
+    # pagination_class: the runs are one list, not pages (it keeps the schema saying so).
+    @action(detail=True, methods=["get", "post"], serializer_class=RunRequestSerializer,
+            pagination_class=None)
     def runs(self, request, pk=None):
         capture = self.get_object()
         if request.method == "GET":

@@ -2,13 +2,13 @@
 
 from django.shortcuts import get_object_or_404
 from django.urls import path
-from drf_spectacular.utils import extend_schema
+from drf_spectacular.utils import extend_schema, extend_schema_field
 from rest_framework import serializers
 from rest_framework.response import Response
 from rest_framework.views import APIView
 
 from segmentation import services
-from segmentation.api.serializers import MemberSerializer
+from segmentation.api.serializers import DetailSerializer, MemberSerializer, NamedRefSerializer
 from segmentation.models import Invitation
 
 # What a project admin is told, whether or not an account has the username.
@@ -36,16 +36,29 @@ class MyInvitationSerializer(serializers.ModelSerializer):
         model = Invitation
         fields = ["id", "project", "role", "invited_by", "created_at", "expires_at"]
 
-    def get_project(self, invitation) -> dict:
+    @extend_schema_field(NamedRefSerializer)
+    def get_project(self, invitation):
         return {"id": invitation.project_id, "name": invitation.project.name}
+
+
+class InvitedSerializer(DetailSerializer):
+    """What a project admin is told on adding a member who is not one yet."""
+
+    invitation = InvitationSerializer()
+
+
+class AcceptedSerializer(MemberSerializer):
+    """The caller's new membership, and its project."""
+
+    project = NamedRefSerializer()
 
 
 def invited_response(invitation):
     body = {
         "detail": INVITED.format(username=invitation.username, role=invitation.role),
-        "invitation": InvitationSerializer(invitation).data,
+        "invitation": invitation,
     }
-    return Response(body, status=202)
+    return Response(InvitedSerializer(body).data, status=202)
 
 
 class MyInvitationsView(APIView):
@@ -56,24 +69,29 @@ class MyInvitationsView(APIView):
 
 
 class AnswerView(APIView):
-    """POST accepts (``accept``) or declines (``decline``) one of the caller's invitations;
-    anybody else's is a 404."""
+    """POST answers one of the caller's invitations; anybody else's is a 404."""
 
-    accept = True
+    def invitation(self, request, pk):
+        return get_object_or_404(Invitation.objects.for_user(request.user), pk=pk)
 
-    @extend_schema(request=None, responses=dict)
+
+class AcceptView(AnswerView):
+    @extend_schema(request=None, responses=AcceptedSerializer)
     def post(self, request, pk):
-        invitation = get_object_or_404(Invitation.objects.for_user(request.user), pk=pk)
-        if not self.accept:
-            services.do_decline_invitation(invitation, request.user)
-            return Response({"detail": f"Declined joining {invitation.project.name!r}."})
-        membership = services.do_accept_invitation(invitation, request.user)
-        project = {"id": invitation.project_id, "name": invitation.project.name}
-        return Response({"project": project, **MemberSerializer(membership).data})
+        membership = services.do_accept_invitation(self.invitation(request, pk), request.user)
+        return Response(AcceptedSerializer(membership).data)
+
+
+class DeclineView(AnswerView):
+    @extend_schema(request=None, responses=DetailSerializer)
+    def post(self, request, pk):
+        invitation = self.invitation(request, pk)
+        services.do_decline_invitation(invitation, request.user)
+        return Response(DetailSerializer({"detail": f"Declined joining {invitation.project.name!r}."}).data)
 
 
 urlpatterns = [
     path("invitations/", MyInvitationsView.as_view(), name="api-invitations"),
-    path("invitations/<int:pk>/accept/", AnswerView.as_view(accept=True), name="api-invitation-accept"),
-    path("invitations/<int:pk>/decline/", AnswerView.as_view(accept=False), name="api-invitation-decline"),
+    path("invitations/<int:pk>/accept/", AcceptView.as_view(), name="api-invitation-accept"),
+    path("invitations/<int:pk>/decline/", DeclineView.as_view(), name="api-invitation-decline"),
 ]

@@ -16,7 +16,7 @@ exist (404, like any object the caller may not see).
 
 from django.http import HttpResponse, StreamingHttpResponse
 from django.urls import path
-from drf_spectacular.utils import OpenApiParameter, extend_schema
+from drf_spectacular.utils import OpenApiParameter, extend_schema, extend_schema_field
 from rest_framework import serializers
 from rest_framework.exceptions import NotFound, PermissionDenied
 from rest_framework.pagination import PageNumberPagination
@@ -28,8 +28,16 @@ from segmentation import agreement, exports, library
 from segmentation.api.captures import capture_for
 from segmentation.api.params import bool_param, float_param, int_param
 from segmentation.api.projects import project_for
+from segmentation.api.serializers import (
+    DetailSerializer,
+    NamedRefSerializer,
+    UserRefSerializer,
+)
 from segmentation.models import Review
 from segmentation.models_library import Adjudication, LibrarySegment
+
+# The schema's CaptureStateEnum (settings.SPECTACULAR_SETTINGS).
+CAPTURE_STATES = agreement.STATES
 
 ORDERINGS = {
     "recent": ("-id",), "duration": ("duration", "id"), "-duration": ("-duration", "-id"),
@@ -113,14 +121,179 @@ class SegmentSerializer(serializers.ModelSerializer):
         fields = ["id", "project", "capture", "review", "annotator", "gold", "superseded",
                   "label", "color", "start", "stop", "fps", "duration", "agreement"]
 
-    def get_capture(self, s) -> dict:
+    @extend_schema_field(NamedRefSerializer)
+    def get_capture(self, s):
         return {"id": s.capture_id, "name": s.capture.name}
 
-    def get_annotator(self, s) -> dict | None:
+    @extend_schema_field(UserRefSerializer(allow_null=True))
+    def get_annotator(self, s):
         return {"id": s.annotator_id, "username": s.annotator.username} if s.annotator_id else None
 
     def get_color(self, s) -> str:
         return s.label.color if s.label_id else "#888888"
+
+
+class SimilarSegmentSerializer(SegmentSerializer):
+    distance = serializers.FloatField(read_only=True, help_text="Descriptor distance to the segment")
+
+    class Meta(SegmentSerializer.Meta):
+        fields = [*SegmentSerializer.Meta.fields, "distance"]
+
+
+class SimilarSerializer(serializers.Serializer):
+    segment = serializers.IntegerField()
+    results = SimilarSegmentSerializer(many=True, help_text="Nearest first")
+
+
+class SpanSerializer(serializers.Serializer):
+    start = serializers.IntegerField()
+    stop = serializers.IntegerField()
+    label = serializers.CharField(allow_null=True)
+
+
+class AgreementReviewSerializer(serializers.Serializer):
+    id = serializers.IntegerField()
+    annotator = UserRefSerializer()
+    cuts = serializers.IntegerField(help_text="How many cuts it keeps")
+    submitted_at = serializers.DateTimeField(allow_null=True)
+
+
+class PairSideSerializer(serializers.Serializer):
+    review = serializers.IntegerField()
+    annotator = serializers.CharField()
+
+
+class PairSerializer(serializers.Serializer):
+    a = PairSideSerializer()
+    b = PairSideSerializer()
+    precision = serializers.FloatField(allow_null=True)
+    recall = serializers.FloatField(allow_null=True)
+    f1 = serializers.FloatField(allow_null=True)
+    matched = serializers.IntegerField()
+    kappa = serializers.FloatField(allow_null=True)
+
+
+class LabelMeasureSerializer(serializers.Serializer):
+    method = serializers.ChoiceField(choices=["cohen_kappa", "krippendorff_alpha"], allow_null=True)
+    value = serializers.FloatField(allow_null=True)
+
+
+class LabelOverlapSerializer(serializers.Serializer):
+    label = serializers.CharField()
+    overlap = serializers.FloatField(allow_null=True)
+    frames = serializers.IntegerField()
+
+
+class AgreementSerializer(serializers.Serializer):
+    """Agreement of a capture's submitted reviews (measures null where undefined)."""
+
+    capture = serializers.IntegerField()
+    tolerance_s = serializers.FloatField()
+    n_reviews = serializers.IntegerField()
+    reviews = AgreementReviewSerializer(many=True)
+    pairs = PairSerializer(many=True)
+    boundary_f1 = serializers.FloatField(allow_null=True)
+    labels = LabelMeasureSerializer()
+    alpha = serializers.FloatField(allow_null=True)
+    per_label = LabelOverlapSerializer(many=True)
+
+
+class GoldBodySerializer(serializers.Serializer):
+    """The capture's gold version as stored."""
+
+    version = serializers.IntegerField()
+    cuts = serializers.ListField(child=serializers.IntegerField())
+    labels = serializers.ListField(child=serializers.CharField(allow_null=True))
+    segments = SpanSerializer(many=True)
+    adjudicator = serializers.CharField(allow_null=True)
+    source_review = serializers.IntegerField(allow_null=True)
+    updated_at = serializers.DateTimeField()
+
+
+class AdjudicationCaptureSerializer(NamedRefSerializer):
+    fps = serializers.FloatField(allow_null=True)
+    n_frames = serializers.IntegerField(allow_null=True)
+    project = serializers.IntegerField()
+
+
+class AdjudicationLabelSerializer(serializers.Serializer):
+    name = serializers.CharField()
+    color = serializers.CharField()
+    hotkey = serializers.CharField(allow_null=True)
+
+
+class AdjudicationReviewSerializer(serializers.Serializer):
+    id = serializers.IntegerField()
+    annotator = UserRefSerializer()
+    status = serializers.ChoiceField(choices=Review.STATUSES)
+    cuts = serializers.ListField(child=serializers.IntegerField())
+    segments = SpanSerializer(many=True)
+
+
+class AdjudicationSerializer(serializers.Serializer):
+    capture = AdjudicationCaptureSerializer()
+    labels = AdjudicationLabelSerializer(many=True)
+    reviews = AdjudicationReviewSerializer(many=True)
+    gold = GoldBodySerializer(allow_null=True)
+    agreement = AgreementSerializer()
+
+
+class StaleGoldSerializer(DetailSerializer):
+    """409: the gold version changed since the one the edit was based on."""
+
+    gold = GoldBodySerializer(allow_null=True)
+
+
+class CaptureStatesSerializer(serializers.Serializer):
+    unreviewed = serializers.IntegerField()
+    in_review = serializers.IntegerField()
+    agreed = serializers.IntegerField()
+    adjudicated = serializers.IntegerField()
+
+
+class DashboardReviewSerializer(serializers.Serializer):
+    id = serializers.IntegerField()
+    annotator = serializers.CharField()
+    status = serializers.ChoiceField(choices=Review.STATUSES)
+
+
+class DashboardCaptureSerializer(NamedRefSerializer):
+    state = serializers.ChoiceField(choices=CAPTURE_STATES)
+    reviews = serializers.IntegerField()
+    submitted = serializers.IntegerField()
+    boundary_f1 = serializers.FloatField(allow_null=True)
+    label_agreement = serializers.FloatField(allow_null=True)
+    assigned = serializers.ListField(child=serializers.CharField())
+    review_states = DashboardReviewSerializer(many=True)
+
+
+class AnnotatorSerializer(serializers.Serializer):
+    id = serializers.IntegerField()
+    username = serializers.CharField()
+    submitted = serializers.IntegerField()
+    in_progress = serializers.IntegerField()
+    edits = serializers.DictField(child=serializers.IntegerField(), help_text="By audit-log action")
+    edits_total = serializers.IntegerField()
+    edits_per_review = serializers.FloatField(allow_null=True)
+    median_minutes_per_review = serializers.FloatField(allow_null=True)
+
+
+class ProjectLabelSerializer(LabelOverlapSerializer):
+    captures = serializers.IntegerField()
+
+
+class LibraryCountsSerializer(serializers.Serializer):
+    total = serializers.IntegerField()
+    gold = serializers.IntegerField()
+
+
+class DashboardSerializer(serializers.Serializer):
+    project = serializers.IntegerField()
+    states = CaptureStatesSerializer()
+    captures = DashboardCaptureSerializer(many=True)
+    annotators = AnnotatorSerializer(many=True)
+    labels = ProjectLabelSerializer(many=True)
+    library = LibraryCountsSerializer()
 
 
 def segment_query(request):
@@ -222,7 +395,7 @@ class SegmentZipView(APIView):
 
 
 class SimilarView(APIView):
-    @extend_schema(responses=dict)
+    @extend_schema(responses=SimilarSerializer, parameters=[OpenApiParameter("k", int)])
     def get(self, request, pk):
         k = int_param(request, "k", 10, 1, 100)
         # One membership lookup for both the segment and the clips it may be compared with.
@@ -231,11 +404,9 @@ class SimilarView(APIView):
         if segment is None:
             raise NotFound("No such segment.")
         found = library.similar(segment, visible.preferred(), k=k)
-        return Response({
-            "segment": segment.pk,
-            "results": [{**data, "distance": round(d, 4)} for data, (_, d) in zip(
-                SegmentSerializer([s for s, _ in found], many=True).data, found, strict=True)],
-        })
+        for s, d in found:
+            s.distance = round(d, 4)
+        return Response(SimilarSerializer({"segment": segment.pk, "results": [s for s, _ in found]}).data)
 
 
 def staff_capture(user, pk):
@@ -249,12 +420,13 @@ def staff_capture(user, pk):
 
 
 class AgreementView(APIView):
-    @extend_schema(responses=dict)
+    @extend_schema(responses=AgreementSerializer,
+                   parameters=[OpenApiParameter("tolerance", float, description="seconds (default 0.25)")])
     def get(self, request, pk):
         capture = staff_capture(request.user, pk)
         tolerance = float_param(request, "tolerance", 0, 10)
         tolerance = agreement.DEFAULT_TOLERANCE_S if tolerance is None else tolerance
-        return Response(agreement.capture_agreement(capture, tolerance))
+        return Response(AgreementSerializer(agreement.capture_agreement(capture, tolerance)).data)
 
 
 class GoldSerializer(serializers.Serializer):
@@ -297,11 +469,11 @@ def adjudication_body(capture):
 
 
 class AdjudicationView(APIView):
-    @extend_schema(responses=dict)
+    @extend_schema(responses=AdjudicationSerializer)
     def get(self, request, pk):
-        return Response(adjudication_body(staff_capture(request.user, pk)))
+        return Response(AdjudicationSerializer(adjudication_body(staff_capture(request.user, pk))).data)
 
-    @extend_schema(request=GoldSerializer, responses=dict)
+    @extend_schema(request=GoldSerializer, responses={200: AdjudicationSerializer, 409: StaleGoldSerializer})
     def put(self, request, pk):
         capture = staff_capture(request.user, pk)
         body = GoldSerializer(data=request.data)
@@ -318,17 +490,18 @@ class AdjudicationView(APIView):
             library.do_save_gold(capture, request.user, data["cuts"], data["labels"],
                                  data["version"], source)
         except library.StaleGold as exc:
-            return Response({"detail": str(exc), "gold": gold_body(exc.adjudication)}, status=409)
-        return Response(adjudication_body(capture))
+            body = {"detail": str(exc), "gold": gold_body(exc.adjudication)}
+            return Response(StaleGoldSerializer(body).data, status=409)
+        return Response(AdjudicationSerializer(adjudication_body(capture)).data)
 
 
 class DashboardView(APIView):
-    @extend_schema(responses=dict)
+    @extend_schema(responses=DashboardSerializer)
     def get(self, request, pk):
         project = project_for(request.user, pk)
         if not project.can_see_all_reviews(request.user):
             raise PermissionDenied("Only the project's reviewers and admins see its dashboard.")
-        return Response(agreement.dashboard(project))
+        return Response(DashboardSerializer(agreement.dashboard(project)).data)
 
 
 urlpatterns = [

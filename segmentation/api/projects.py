@@ -10,11 +10,13 @@ from rest_framework.views import APIView
 
 from motionlib.segmenters import list_segmenters
 from segmentation import services
-from segmentation.api.invitations import InvitationSerializer, invited_response
+from segmentation.api.invitations import InvitationSerializer, InvitedSerializer, invited_response
 from segmentation.api.serializers import (
     CutModelSerializer,
     LabelSerializer,
     MemberSerializer,
+    MeSerializer,
+    MethodSerializer,
     ProjectSerializer,
 )
 from segmentation.models import Membership, Project
@@ -46,7 +48,8 @@ class ProjectViewSet(
             raise PermissionDenied("Only the project's admins can change it, its labels and members.")
         return project
 
-    @extend_schema(request=LabelSerializer, responses=LabelSerializer(many=True))
+    @extend_schema(methods=["GET"], responses=LabelSerializer(many=True))
+    @extend_schema(methods=["POST"], request=LabelSerializer, responses={201: LabelSerializer})
     @action(detail=True, methods=["get", "post"], serializer_class=LabelSerializer)
     def labels(self, request, pk=None):
         project = self._admin_project()
@@ -57,7 +60,9 @@ class ProjectViewSet(
         label = services.do_add_label(project, **serializer.validated_data)
         return Response(LabelSerializer(label).data, status=201)
 
-    @extend_schema(request=MemberSerializer, responses=MemberSerializer(many=True))
+    @extend_schema(methods=["GET"], responses=MemberSerializer(many=True))
+    @extend_schema(methods=["POST"], request=MemberSerializer,
+                   responses={200: MemberSerializer, 202: InvitedSerializer})
     @action(detail=True, methods=["get", "post"], serializer_class=MemberSerializer)
     def members(self, request, pk=None):
         project = self._admin_project()
@@ -104,7 +109,7 @@ class ProjectViewSet(
 
 
 class MeView(APIView):
-    @extend_schema(responses=dict)
+    @extend_schema(responses=MeSerializer)
     def get(self, request):
         projects = [
             {"id": m.project_id, "name": m.project.name, "role": m.role}
@@ -114,14 +119,15 @@ class MeView(APIView):
 
         # What the service admits, so the pages refuse the same (e.g. a skeleton too big to draw).
         limits = {"max_joints": services.captures.input_limits().max_joints}
-        return Response({"id": request.user.pk, "username": request.user.username, "projects": projects,
-                         "limits": limits, "can_create_accounts": can_create_accounts(request.user)})
+        return Response(MeSerializer({
+            "id": request.user.pk, "username": request.user.username, "projects": projects,
+            "limits": limits, "can_create_accounts": can_create_accounts(request.user)}).data)
 
 
 class MethodsView(APIView):
-    @extend_schema(responses=dict)
+    @extend_schema(responses=MethodSerializer(many=True))
     def get(self, request):
-        return Response([cls.schema() for cls in list_segmenters()])
+        return Response(MethodSerializer([cls.schema() for cls in list_segmenters()], many=True).data)
 
 
 def project_for(user, pk):

@@ -1,17 +1,39 @@
 """JSON shapes of docs/api.md. Output serializers mirror the records; input serializers
 check the request's shape, and the services check its meaning."""
 
+from drf_spectacular.utils import extend_schema_field
 from rest_framework import serializers
 
 from segmentation.models import (
     ROLES,
     Capture,
+    Cut,
     DetectionRun,
     Label,
     ProjectCutModel,
     Review,
     ReviewEvent,
 )
+
+
+class UserRefSerializer(serializers.Serializer):
+    """A person as other records name them."""
+
+    id = serializers.IntegerField()
+    username = serializers.CharField()
+
+
+class NamedRefSerializer(serializers.Serializer):
+    """A capture or project as other records name them."""
+
+    id = serializers.IntegerField()
+    name = serializers.CharField()
+
+
+class DetailSerializer(serializers.Serializer):
+    """An answer that is only a sentence for the user."""
+
+    detail = serializers.CharField()
 
 
 class LabelSerializer(serializers.ModelSerializer):
@@ -35,8 +57,49 @@ class ProjectSerializer(serializers.Serializer):
     annotators_pick_unassigned = serializers.BooleanField(required=False, default=True)
     labels = LabelSerializer(many=True, read_only=True)
 
-    def get_role(self, project) -> str | None:
+    # Never null: projects are listed to, and created by, their members only.
+    @extend_schema_field(serializers.ChoiceField(choices=ROLES))
+    def get_role(self, project):
         return project.role_of(self.context["request"].user)
+
+
+class MyProjectSerializer(serializers.Serializer):
+    id = serializers.IntegerField()
+    name = serializers.CharField()
+    role = serializers.ChoiceField(choices=ROLES)
+
+
+class LimitsSerializer(serializers.Serializer):
+    """What the service admits, so the pages refuse the same."""
+
+    max_joints = serializers.IntegerField()
+
+
+class MeSerializer(serializers.Serializer):
+    id = serializers.IntegerField()
+    username = serializers.CharField()
+    projects = MyProjectSerializer(many=True)
+    limits = LimitsSerializer()
+    can_create_accounts = serializers.BooleanField()
+
+
+class ParamSerializer(serializers.Serializer):
+    """One parameter of a segmentation method."""
+
+    type = serializers.CharField()
+    default = serializers.JSONField(allow_null=True)
+    min = serializers.FloatField(allow_null=True)
+    max = serializers.FloatField(allow_null=True)
+    description = serializers.CharField()
+
+
+class MethodSerializer(serializers.Serializer):
+    """A segmentation method of the catalogue and its parameters."""
+
+    name = serializers.CharField()
+    title = serializers.CharField()
+    description = serializers.CharField()
+    params = serializers.DictField(child=ParamSerializer())
 
 
 class ErrorField(serializers.CharField):
@@ -52,11 +115,24 @@ class ErrorField(serializers.CharField):
 class MemberSerializer(serializers.Serializer):
     id = serializers.IntegerField(source="user.id", read_only=True)
     username = serializers.CharField(source="user.username")
-    role = serializers.ChoiceField(choices=[r for r, _ in ROLES])
+    role = serializers.ChoiceField(choices=ROLES)
+
+
+class CandidateSerializer(serializers.Serializer):
+    frame = serializers.IntegerField()
+    confidence = serializers.FloatField()
+
+
+@extend_schema_field(CandidateSerializer(many=True))
+class CandidatesField(serializers.JSONField):
+    """A run's candidates as stored (a one-hour take has thousands: no serializer per item)."""
 
 
 class RunSerializer(serializers.ModelSerializer):
     error = ErrorField()
+    params = serializers.DictField(read_only=True)
+    timings = serializers.DictField(child=serializers.FloatField(), read_only=True)
+    candidates = CandidatesField(read_only=True)
 
     class Meta:
         model = DetectionRun
@@ -69,7 +145,7 @@ class RunSerializer(serializers.ModelSerializer):
 class CutModelSerializer(serializers.ModelSerializer):
     """One training of a project's cut model: a version, or why it failed."""
 
-    error = serializers.SerializerMethodField()
+    error = ErrorField()
 
     class Meta:
         model = ProjectCutModel
@@ -78,13 +154,17 @@ class CutModelSerializer(serializers.ModelSerializer):
             "finished_at",
         ]
 
-    def get_error(self, job) -> str | None:
-        return job.error or None
-
 
 class RunRequestSerializer(serializers.Serializer):
     method = serializers.CharField(required=False, allow_blank=True, default="")
     params = serializers.DictField(required=False, default=dict)
+
+
+class SkeletonSerializer(serializers.Serializer):
+    joints = serializers.ListField(child=serializers.CharField())
+    parents = serializers.ListField(child=serializers.IntegerField(), help_text="-1: the root")
+    height = serializers.FloatField()
+    up = serializers.CharField()
 
 
 class CaptureSerializer(serializers.ModelSerializer):
@@ -103,7 +183,8 @@ class CaptureSerializer(serializers.ModelSerializer):
             "latest_run", "skeleton", "animation", "source",
         ]
 
-    def get_skeleton(self, capture) -> dict | None:
+    @extend_schema_field(SkeletonSerializer(allow_null=True))
+    def get_skeleton(self, capture):
         return capture.skeleton if capture.status == "ready" else None
 
 
@@ -121,6 +202,19 @@ class RunSummarySerializer(serializers.ModelSerializer):
         ]
 
 
+class TeamReviewSerializer(serializers.Serializer):
+    id = serializers.IntegerField()
+    annotator = serializers.CharField()
+    status = serializers.ChoiceField(choices=Review.STATUSES)
+
+
+class TeamSerializer(serializers.Serializer):
+    """Who is assigned a capture, and each review's annotator and state."""
+
+    assigned = serializers.ListField(child=serializers.CharField())
+    reviews = TeamReviewSerializer(many=True)
+
+
 class CaptureListSerializer(CaptureSerializer):
     """A capture list row: a capture without its skeleton, its latest run summarised.
     Those two are most of a full capture's bytes and decoding time, and a list shows
@@ -134,7 +228,8 @@ class CaptureListSerializer(CaptureSerializer):
     class Meta(CaptureSerializer.Meta):
         fields = [f for f in CaptureSerializer.Meta.fields if f != "skeleton"] + ["review_started", "team"]
 
-    def get_team(self, capture) -> dict:
+    @extend_schema_field(TeamSerializer)
+    def get_team(self, capture):
         """Who is assigned, and each review's annotator and state (from the prefetch)."""
         return {
             "assigned": [a.annotator.username for a in capture.assignments.all()],
@@ -149,16 +244,90 @@ class UploadSerializer(serializers.Serializer):
     project = serializers.IntegerField(min_value=1, max_value=2**63 - 1)
 
 
+class UploadedSerializer(CaptureSerializer):
+    duplicate = serializers.BooleanField(
+        read_only=True, help_text="The project already had this file (same checksum): it is that capture.")
+
+    class Meta(CaptureSerializer.Meta):
+        fields = [*CaptureSerializer.Meta.fields, "duplicate"]
+
+
+@extend_schema_field({"type": "array", "items": {"type": "number"}})
+class FloatsField(serializers.JSONField):
+    """A long list of numbers passed through as it is (no field call per value)."""
+
+
+class SignalSerializer(serializers.Serializer):
+    """A feature signal, sampled: value i is at frame start + i * step."""
+
+    name = serializers.CharField()
+    start = serializers.IntegerField()
+    step = serializers.IntegerField()
+    values = FloatsField(read_only=True)
+
+
+class SignalsSerializer(serializers.Serializer):
+    run = serializers.IntegerField(allow_null=True, help_text="The run they came from; null: none finished.")
+    fps = serializers.FloatField(allow_null=True)
+    n_frames = serializers.IntegerField(allow_null=True)
+    signals = SignalSerializer(many=True)
+
+
+class FramesSerializer(serializers.Serializer):
+    """Joint positions of frames start, start + step, … before stop (base64 of little-endian
+    float32, shape (n_frames, n_joints, 3)); the client continues from stop."""
+
+    start = serializers.IntegerField()
+    stop = serializers.IntegerField()
+    step = serializers.IntegerField()
+    n_frames = serializers.IntegerField()
+    n_joints = serializers.IntegerField()
+    dtype = serializers.ChoiceField(choices=["float32"])
+    data = serializers.CharField()
+
+
 class CutSerializer(serializers.Serializer):
-    id = serializers.IntegerField()
-    origin = serializers.CharField()
-    fate = serializers.CharField()
+    id = serializers.IntegerField(allow_null=True, help_text="null in a review not started yet")
+    origin = serializers.ChoiceField(choices=Cut.ORIGINS)
+    fate = serializers.ChoiceField(choices=Cut.FATES)
     candidate_frame = serializers.IntegerField(allow_null=True)
     frame = serializers.IntegerField()
     confidence = serializers.FloatField(allow_null=True)
 
 
+class ReviewSegmentSerializer(serializers.Serializer):
+    index = serializers.IntegerField()
+    start = serializers.IntegerField()
+    stop = serializers.IntegerField()
+    label = serializers.CharField(allow_null=True)
+
+
+class ProjectModelSerializer(serializers.Serializer):
+    version = serializers.IntegerField()
+    n_takes = serializers.IntegerField()
+    n_cuts = serializers.IntegerField()
+
+
+class AdaptationSerializer(serializers.Serializer):
+    """Where a review's candidates came from, and the project's learnt model."""
+
+    model_version = serializers.IntegerField(allow_null=True,
+                                             help_text="The review's run; null: the zero-shot detector.")
+    n_takes = serializers.IntegerField(allow_null=True, help_text="Reviewed takes that model learnt from.")
+    project_model = ProjectModelSerializer(allow_null=True)
+    training = serializers.BooleanField(help_text="A training is queued or running.")
+    training_error = serializers.CharField(allow_null=True, help_text="Why the last training failed.")
+
+
+# A review's statuses, and that of the review a caller has not started yet (the schema's
+# ReviewStateEnum, settings.SPECTACULAR_SETTINGS).
+REVIEW_STATES = [*Review.STATUSES, ("not_started", "Not started")]
+
+
 class ReviewSerializer(serializers.ModelSerializer):
+    # null, and status not_started: the review the caller would start (GET …/review/).
+    id = serializers.IntegerField(read_only=True, allow_null=True)
+    status = serializers.ChoiceField(choices=REVIEW_STATES, read_only=True)
     annotator = serializers.SerializerMethodField()
     cuts = serializers.SerializerMethodField()
     segments = serializers.SerializerMethodField()
@@ -171,23 +340,27 @@ class ReviewSerializer(serializers.ModelSerializer):
             "adaptation",
         ]
 
-    def get_adaptation(self, review) -> dict:
+    @extend_schema_field(AdaptationSerializer)
+    def get_adaptation(self, review):
         """Which project model the review's candidates came from (model_version null:
         the zero-shot detector), the project's newest model and its last failed training."""
         from segmentation.services.adaptation import adaptation_summary
 
         return adaptation_summary(review.run, review.capture.project_id)
 
-    def get_annotator(self, review) -> dict:
+    @extend_schema_field(UserRefSerializer)
+    def get_annotator(self, review):
         return {"id": review.annotator_id, "username": review.annotator.username}
 
-    def get_cuts(self, review) -> list[dict]:
+    @extend_schema_field(CutSerializer(many=True))
+    def get_cuts(self, review):
         # Plain values, not a nested serializer per cut: a one-hour take has thousands.
         fields = list(CutSerializer().fields)
         return [dict(zip(fields, row, strict=True))
                 for row in review.cuts.order_by("frame", "id").values_list(*fields)]
 
-    def get_segments(self, review) -> list[dict]:
+    @extend_schema_field(ReviewSegmentSerializer(many=True))
+    def get_segments(self, review):
         # Label suggestions are not part of a review: they are computed by a worker and
         # read from …/review/suggestions/ (segmentation.suggestions).
         return [{"index": index, "start": start, "stop": stop, "label": label}

@@ -33,12 +33,12 @@ def body(request, serializer_class):
 
 
 class RoleRequest(serializers.Serializer):
-    role = serializers.ChoiceField(choices=[r for r, _ in ROLES])
+    role = serializers.ChoiceField(choices=ROLES)
 
 
 class NewAccountRequest(serializers.Serializer):
     username = serializers.CharField(max_length=150)
-    role = serializers.ChoiceField(choices=[r for r, _ in ROLES])
+    role = serializers.ChoiceField(choices=ROLES)
 
 
 class NewAccountResponse(MemberSerializer):

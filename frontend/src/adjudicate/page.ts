@@ -4,7 +4,7 @@
 // cuts (they snap to the tiers' cuts); undo/redo; saving refuses a stale version (409).
 
 import { ApiError, api, get } from "../api/client";
-import type { Capture, Label } from "../api/types";
+import type { Capture, LabelChoice } from "../api/types";
 import { addCut, fromSpans, moveCut, removeCut, sameDraft, segmentAt, setLabel, toSpans, type Draft } from "../library/gold";
 import { topbar } from "../library/nav";
 import type { Adjudication, Span } from "../library/types";
@@ -57,7 +57,7 @@ class AdjudicationPage {
   private raf = 0;
   private lastTick = 0;
   private readonly reviews: Review[];
-  private readonly labels: Label[];
+  private readonly labels: LabelChoice[];
   private readonly store: FrameStore;
   private readonly abort = new AbortController();
   private readonly player: SkeletonView | null = null;
@@ -73,7 +73,7 @@ class AdjudicationPage {
   ) {
     // Only submitted reviews are tiers: in-progress and returned ones are not final.
     this.reviews = data.reviews.filter((r) => r.status === "submitted");
-    this.labels = data.labels.map((l, i) => ({ id: i, ...l }));
+    this.labels = data.labels;
     const gold = data.gold ? fromSpans(data.gold.segments) : { cuts: [], labels: [null] };
     this.history = start(gold);
     this.saved = data.gold ? gold : null;

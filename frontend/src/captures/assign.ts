@@ -13,7 +13,7 @@ export function teamCell(team: CaptureSummary["team"]): (HTMLElement | string)[]
   const names = [...new Set([...team.assigned, ...team.reviews.map((r) => r.annotator)])];
   return names.map((name) => {
     const status = reviewed.get(name);
-    const state = status && status !== "not_started" ? status : "assigned";
+    const state = status ?? "assigned";
     return h("span", { class: "who", title: team.assigned.includes(name) ? "assigned" : "picked it up" }, `${name} `, h("span", { class: `badge badge-q-${state}` }, STATE_TEXT[state]));
   });
 }

@@ -2,16 +2,10 @@
 // capture list shows each pending invitation with who sent it, the role, and two buttons.
 
 import { get, post } from "../api/client";
+import type { MyInvitation } from "../api/types";
 import { h, toast } from "../ui/dom";
 
-export interface Invitation {
-  id: number;
-  project: { id: number; name: string };
-  role: string;
-  invited_by: string | null;
-  created_at: string;
-  expires_at: string;
-}
+export type Invitation = MyInvitation;
 
 export function invitationsBox(onJoined: () => void): HTMLElement {
   const box = h("section", { class: "invitations", "data-testid": "invitations", hidden: true });

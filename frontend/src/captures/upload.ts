@@ -1,7 +1,7 @@
 // Uploads with progress. fetch() cannot report upload progress, so this uses XHR.
 
 import { errorText, readCookie } from "../api/client";
-import type { Capture } from "../api/types";
+import type { Uploaded } from "../api/types";
 
 export interface UploadItem {
   file: File;
@@ -32,7 +32,7 @@ export function pairFiles(files: File[]): { items: UploadItem[]; problems: strin
   return { items, problems };
 }
 
-export function upload(item: UploadItem, project: number, onProgress: (share: number) => void): Promise<Capture> {
+export function upload(item: UploadItem, project: number, onProgress: (share: number) => void): Promise<Uploaded> {
   return new Promise((resolve, reject) => {
     const form = new FormData();
     form.append("file", item.file);
@@ -51,7 +51,7 @@ export function upload(item: UploadItem, project: number, onProgress: (share: nu
       } catch {
         // keep the text
       }
-      if (xhr.status >= 200 && xhr.status < 300) resolve(body as Capture);
+      if (xhr.status >= 200 && xhr.status < 300) resolve(body as Uploaded);
       else reject(new Error(errorText(xhr.status, body)));
     };
     xhr.onerror = () => reject(new Error("The upload was interrupted (network error)."));

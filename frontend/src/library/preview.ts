@@ -2,6 +2,7 @@
 // a small box. Used by the library (a segment) and the adjudication view (a span).
 
 import { get } from "../api/client";
+import { isReady } from "../api/types";
 import type { Capture, FramesResponse } from "../api/types";
 import { SkeletonView, TooManyJoints } from "../player/skeletonView";
 import { decodeFloat32 } from "../review/frames";
@@ -25,7 +26,7 @@ export class ClipPreview {
     this.stop();
     if (!this.captures.has(captureId)) this.captures.set(captureId, get<Capture>(`/api/captures/${captureId}/`));
     const capture = await this.captures.get(captureId)!;
-    if (!capture.skeleton) return toast("This capture has no skeleton yet.", "error");
+    if (!isReady(capture)) return toast("This capture has no skeleton yet.", "error");
     // One answer holds the whole clip: fewer poses for a skeleton of many joints.
     const step = previewStep(stop - start, Math.min(1500, Math.floor(JOINT_FRAMES_PER_ANSWER / Math.max(capture.skeleton.joints.length, 1))));
     const frames = await get<FramesResponse>(`/api/captures/${captureId}/frames/?start=${start}&stop=${stop}&step=${step}`);

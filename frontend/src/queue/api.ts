@@ -1,31 +1,9 @@
 // Shapes and calls of assignments, queues and returns (docs/api.md, "Assignments and queues").
 
 import { get, post } from "../api/client";
+import type { Assignment, Member, QueueItem, QueueState } from "../api/types";
 
-export type QueueState = "assigned" | "in_progress" | "returned" | "submitted";
-
-export interface QueueItem {
-  capture: { id: number; name: string; project: number; duration: number | null; n_frames: number | null; n_candidates: number | null };
-  state: QueueState;
-  assigned: boolean;
-  since: string;
-  review: { id: number; version: number; submitted_at: string | null; return_comment: string | null; returned_at: string | null } | null;
-}
-
-export interface Assignment {
-  id: number;
-  capture: { id: number; name: string };
-  annotator: string;
-  assigned_by: string | null;
-  created_at: string;
-  state: QueueState;
-}
-
-export interface Member {
-  id: number;
-  username: string;
-  role: "annotator" | "reviewer" | "admin";
-}
+export type { Assignment, Member, QueueItem, QueueState };
 
 export const STATE_TEXT: Record<QueueState, string> = {
   assigned: "assigned",

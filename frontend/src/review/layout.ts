@@ -1,7 +1,7 @@
 // The review page's frame: top bar, 3D stage with its read-outs, side panels, transport
 // bar and the timeline's container. Only structure lives here; page.ts fills it in.
 
-import type { Capture, Me } from "../api/types";
+import type { Me, ReadyCapture } from "../api/types";
 import { SPEEDS } from "../player/clock";
 import { formatDuration, h } from "../ui/dom";
 import { appLinks } from "../ui/appnav";
@@ -20,7 +20,7 @@ export interface LayoutActions {
 
 export type Elements = Record<string, HTMLElement>;
 
-export function buildLayout(capture: Capture, me: Me, actions: LayoutActions): { root: HTMLElement; el: Elements } {
+export function buildLayout(capture: ReadyCapture, me: Me, actions: LayoutActions): { root: HTMLElement; el: Elements } {
   const el: Elements = {};
   const button = buttonMaker(el);
   const root = h(
@@ -53,7 +53,7 @@ function buttonMaker(el: Elements): ButtonMaker {
     ));
 }
 
-function topbar(c: Capture, me: Me, el: Elements, button: ButtonMaker, actions: LayoutActions): HTMLElement {
+function topbar(c: ReadyCapture, me: Me, el: Elements, button: ButtonMaker, actions: LayoutActions): HTMLElement {
   const duration = formatDuration(c.duration ?? c.n_frames / c.fps);
   return h(
     "header",

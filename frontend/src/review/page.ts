@@ -3,7 +3,8 @@
 // the API straight away (saver.ts); undo/redo are edits too, so the audit log is complete.
 
 import { ApiError, get, post } from "../api/client";
-import type { Capture, Cut, Label, Me, Project, Review, ReviewEvent, Segment, Signal, SignalResponse, Suggestions } from "../api/types";
+import { isReady } from "../api/types";
+import type { ApiReview, Capture, Cut, ReadyCapture, Label, Me, Project, Review, ReviewEvent, Segment, Signal, SignalResponse, Suggestions } from "../api/types";
 import { advance, frameOf, nextSpeed, seek, togglePlay, type Playback } from "../player/clock";
 import { MAX_JOINTS, SkeletonView, TooManyJoints } from "../player/skeletonView";
 import { clear, confirmDialog, dialog, h, toast } from "../ui/dom";
@@ -30,13 +31,13 @@ export async function renderReview(root: HTMLElement, captureId: number): Promis
     get<Project[] | { results: Project[] }>("/api/projects/"),
   ]);
   const project = listOf(projects).find((p) => p.id === capture.project);
-  if (capture.status !== "ready" || !capture.skeleton) return renderNotReady(root, capture);
+  if (!isReady(capture)) return renderNotReady(root, capture);
   // Poses start streaming now, in parallel with the review and the signal.
   const frames = new FrameFeed(capture, maxJoints(me));
   try {
     const [review, signal] = await Promise.all([
       // Reading does not start a review: the first edit does (saver.ts).
-      get<Review>(`/api/captures/${captureId}/review/`).then(withTempIds),
+      get<ApiReview>(`/api/captures/${captureId}/review/`).then(withTempIds),
       get<SignalResponse>(`/api/captures/${captureId}/signal/?max_points=4000`).catch(() => null),
     ]);
     const page = new ReviewPage(root, capture, me, project ?? null, review, signal?.signals ?? [], frames);
@@ -61,7 +62,7 @@ class FrameFeed {
   readonly done: Promise<void>;
   onChunk: () => void = () => {};
 
-  constructor(capture: Capture, maxJoints: number) {
+  constructor(capture: ReadyCapture, maxJoints: number) {
     // Poses the player will not draw are not fetched (nor memory set aside for them).
     const drawable = jointCount(capture) <= maxJoints;
     this.store = new FrameStore(capture.n_frames, drawable ? jointCount(capture) : 0);
@@ -69,7 +70,7 @@ class FrameFeed {
   }
 }
 
-function jointCount(capture: Capture): number {
+function jointCount(capture: ReadyCapture): number {
   return Math.max(capture.n_joints ?? 0, capture.skeleton?.joints.length ?? 0);
 }
 
@@ -130,7 +131,7 @@ class ReviewPage {
 
   constructor(
     root: HTMLElement,
-    private readonly capture: Capture,
+    private readonly capture: ReadyCapture,
     private readonly me: Me,
     private readonly project: Project | null,
     review: Review,

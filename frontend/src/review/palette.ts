@@ -1,10 +1,10 @@
 // The label palette: with more labels than number keys, "/" opens a list filtered as you
 // type (by name start first, then anywhere); ↑/↓ move, Enter applies, Escape closes.
 
-import type { Label } from "../api/types";
+import type { LabelChoice } from "../api/types";
 import { clear, h } from "../ui/dom";
 
-export function filterLabels(labels: Label[], text: string): Label[] {
+export function filterLabels<L extends LabelChoice>(labels: L[], text: string): L[] {
   const q = text.trim().toLowerCase();
   if (!q) return labels;
   const starts = labels.filter((l) => l.name.toLowerCase().startsWith(q));
@@ -12,7 +12,7 @@ export function filterLabels(labels: Label[], text: string): Label[] {
   return [...starts, ...contains];
 }
 
-export function openPalette(labels: Label[], pick: (name: string) => void): void {
+export function openPalette(labels: LabelChoice[], pick: (name: string) => void): void {
   let shown = labels;
   let index = 0;
   const input = h("input", { class: "input palette-input", placeholder: "Type to filter labels…", "data-testid": "palette-input", "aria-label": "filter labels" });

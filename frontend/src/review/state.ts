@@ -2,7 +2,7 @@
 // The page applies an edit here at once (so the screen answers immediately) and sends the
 // same edit to the server; the server's answer then replaces the prediction.
 
-import type { Cut, Fate, Review, Segment } from "../api/types";
+import type { ApiReview, Cut, Fate, Review, Segment } from "../api/types";
 
 export type Edit =
   | { kind: "fate"; cutId: number; fate: "accepted" | "deleted" | "pending" }
@@ -64,9 +64,9 @@ export function neighbourCut(cuts: readonly Cut[], frame: number, direction: -1 
  * on its candidate cuts, so they can be selected and edited before the first save
  * starts the review.
  */
-export function withTempIds(review: Review): Review {
-  if (review.id !== null) return review;
-  return { ...review, cuts: review.cuts.map((c, i) => ({ ...c, id: -1 - i })) };
+export function withTempIds(review: ApiReview): Review {
+  // A started review's cuts all have ids; an unstarted one's have none.
+  return { ...review, cuts: review.cuts.map((c, i) => ({ ...c, id: c.id ?? -1 - i })) };
 }
 
 /** Temporary ids of an unstarted review's candidates -> the started review's cut ids (by candidate frame). */

@@ -3,7 +3,7 @@
 // see the members; annotators are told the page is not theirs (the API refuses them too).
 
 import { api, ApiError, get, patch, post } from "../api/client";
-import type { Label, Me, Project, Role } from "../api/types";
+import type { Invitation, Label, Me, Project, Role } from "../api/types";
 import type { Member } from "../queue/api";
 import { appLinks } from "../ui/appnav";
 import { clear, confirmDialog, dialog, h, toast } from "../ui/dom";
@@ -12,15 +12,6 @@ import { taxonomyEditor } from "./taxonomy";
 import "./team.css";
 
 const ROLES: Role[] = ["annotator", "reviewer", "admin"];
-
-interface Invitation {
-  id: number;
-  username: string;
-  role: Role;
-  invited_by: string | null;
-  created_at: string;
-  expires_at: string;
-}
 
 export async function renderTeam(root: HTMLElement, projectId: number): Promise<() => void> {
   const [me, project] = await Promise.all([get<Me>("/api/me/"), get<Project>(`/api/projects/${projectId}/`)]);
