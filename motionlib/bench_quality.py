@@ -168,9 +168,20 @@ def loo_rows(cache: list[tuning.TakeCache], selection: tuning.Selection) -> dict
 
 
 def _examples(cache, held_out) -> list[tuple]:
-    """The other takes of ``held_out``'s label source, with their best-estimate cuts."""
-    return [(c.take, c.labelled.truth[:, 1]) for c in cache
-            if c.labelled.source == held_out.labelled.source and c.key != held_out.key]
+    """The other takes of ``held_out``'s label source, with their best-estimate cuts.
+
+    A capture counts once, as a studio's reviewed take would: of its views (full skeleton,
+    four channels) the one of ``held_out``'s kind if it has one, else its first.
+    """
+    views: dict[str, list] = {}
+    for c in cache:
+        if c.labelled.source == held_out.labelled.source and c.key != held_out.key:
+            views.setdefault(c.key, []).append(c)
+    out = []
+    for same in views.values():
+        c = next((v for v in same if v.labelled.kind == held_out.labelled.kind), same[0])
+        out.append((c.take, c.labelled.truth[:, 1]))
+    return out
 
 
 RUPTURES_PENALTIES = (1.0, 2.0, 3.0, 5.0, 8.0)

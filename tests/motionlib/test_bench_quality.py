@@ -72,3 +72,21 @@ def test_it_reports_the_patent_run_beside_the_published_cuts():
         ours, published = np.array(lists[f"{stage} ours"]), lists[f"{stage} published"]
         assert difference == np.abs(ours - published).max(), stage
     assert differences[-1] <= 30
+
+
+def test_it_gives_the_adaptation_each_other_capture_once_in_the_scored_takes_kind():
+    from motionlib import tuning
+
+    def view(name, kind, source="kruger2017"):
+        truth = np.array([[90, 100, 110]])
+        take = benchdata.ChannelTake(name=f"{name}-{kind}", fps=120.0,
+                                     channels=np.zeros((300, 4)))
+        return tuning.TakeCache(benchdata.LabelledTake(name, None, None, truth, source, kind),
+                                take)
+
+    cache = [view("a", "skeleton"), view("a", "channels"), view("b", "channels"),
+             view("c", "skeleton"), view("d", "channels", source="mocap6")]
+    names = [take.name for take, _ in bench_quality._examples(cache, cache[2])]
+    assert names == ["a-channels", "c-skeleton"]
+    names = [take.name for take, _ in bench_quality._examples(cache, cache[3])]
+    assert names == ["a-skeleton", "b-channels"]

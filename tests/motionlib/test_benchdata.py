@@ -36,7 +36,16 @@ def test_it_reads_transition_windows_and_drops_the_trial_length(tmp_path):
         "segment,label,end_lo,end_mid,end_hi\n1,walk,500,550,600\n2,jump,3881,3840,4000\n"
         "3,walk,4579,4579,4579\n"
     )
-    assert benchdata.kruger_truth(path).tolist() == [[500, 550, 600], [3840, 3881, 4000]]
+    assert benchdata.kruger_truth(path).tolist()[0] == [500, 550, 600]
+
+
+def test_it_reads_a_best_estimate_outside_its_window_as_the_window_middle(tmp_path):
+    path = tmp_path / "k.csv"
+    path.write_text(
+        "segment,label,end_lo,end_mid,end_hi\n1,walk,3881,3840,4000\n2,jump,1540,1685,1628\n"
+        "3,walk,4579,4579,4579\n"
+    )
+    assert benchdata.kruger_truth(path).tolist() == [[3881, 3940, 4000], [1540, 1584, 1628]]
 
 
 @needs_data
