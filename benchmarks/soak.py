@@ -147,23 +147,22 @@ def wchan(pid):
         return ""
 
 
-def busy_child(worker):
-    """A pool process running a job (on the CPU right now)."""
+def busy_child(worker, var):
+    """A pool process running a job: a job is processing and this process is not
+    waiting for one (on the job pipe or its lock)."""
+    if not any(status == "processing" for _, status in job_states(var)):
+        return None
     for pid in pool(worker):
-        try:
-            state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
-        except OSError:
-            continue
-        if state == "R":
+        if not any(idle in wchan(pid) for idle in ("pipe_read", "futex")):
             return pid
     return None
 
 
-def kill(kind, out):
+def kill(kind, out, var):
     """Kill one part of the worker; what was killed, or None if there was nothing to kill."""
     worker = worker_pid(out)
     if kind == "busy pool process":
-        target = busy_child(worker)
+        target = busy_child(worker, var)
     elif kind == "idle pool process holding the job-pipe lock":
         target = next((p for p in pool(worker) if "pipe_read" in wchan(p)), None)
     else:
@@ -244,22 +243,23 @@ def main():
     next_upload = next_kill = time.monotonic() + 10
     try:
         while time.monotonic() < deadline:
-            now = time.monotonic()
+            now, uploaded = time.monotonic(), False
             if now >= next_upload:
                 next_upload = now + args.upload_every
                 content = synthetic_take(rng.randrange(10**6), rng.uniform(20, 90))
                 status, body = client.upload(f"soak-{uploads}.bvh", content)
-                uploads += 1
+                uploads, uploaded = uploads + 1, True
                 if status in (200, 201):
                     captures.append({"id": body["id"]})
                 else:
                     refused[status] += 1
-            if now >= next_kill:
+            if now >= next_kill and uploaded:
+                # Right after an upload, so that the busy kill finds a job running.
                 next_kill = now + args.kill_every
                 # The busy kill waits for a job to be running (up to 30 s).
                 kind = kinds[sum(kills.values()) % len(kinds)]
                 for _ in range(600):
-                    done = kill(kind, out)
+                    done = kill(kind, out, var)
                     if done or kind != "busy pool process":
                         break
                     time.sleep(0.05)

@@ -87,6 +87,8 @@ class CaptureViewSet(
         upload.is_valid(raise_exception=True)
         data = upload.validated_data
         project = project_for(request.user, data["project"])
+        # People uploading through the API are rate-limited; imports by command are not.
+        services.quotas.check_upload_rate(request.user)
         capture, created = services.do_upload_capture(
             project, request.user, data["file"], data.get("asf")
         )

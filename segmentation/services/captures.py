@@ -102,7 +102,6 @@ def do_upload_capture(project, user, upload, asf=None):
             existing.refresh_from_db()
         return existing, False
     size = upload.size + (asf.size if asf is not None else 0)
-    quotas.check_upload_rate(user)
     quotas.check_storage(project, user, size)
     capture = Capture(project=project, uploaded_by=user, name=upload.name, format=fmt)
     capture.checksum, capture.stored_bytes = digest, size
