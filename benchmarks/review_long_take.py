@@ -120,7 +120,7 @@ def populate(args):
 
     from motionlib import synth
     from segmentation import library, services
-    from segmentation.models_library import LibrarySegment
+    from segmentation.models import LibrarySegment
 
     users = get_user_model().objects
     admin = users.create_user("admin")
@@ -333,7 +333,7 @@ def run_small(port, data, begin, rounds=0, stop_at=None):
 def time_under_load(port, data, repeats, waves, keep_suggestions=False):
     """The small capture's request times alone, then during ``waves`` rounds of every viewer
     opening the long take at the same moment; and the page load times."""
-    from segmentation.models_suggestions import LabelSuggestion, SuggestionRequest
+    from segmentation.models import LabelSuggestion, SuggestionRequest
 
     fork = multiprocessing.get_context("fork")
     begin = fork.Event()

@@ -41,7 +41,7 @@ def oracle_arrays(out):
     """ids, profiles, capture, start, stop, superseded of the archive (cached as .npy)."""
     path = out / "spans.npy"
     if not path.exists():
-        from segmentation.models_library import LibrarySegment
+        from segmentation.models import LibrarySegment
 
         project = million.personas()["project"]
         rows = np.array(list(LibrarySegment.objects.filter(project=project).order_by("id")
@@ -146,7 +146,7 @@ def main():
     from django.conf import settings
 
     from segmentation import similar_index
-    from segmentation.models_library import LibrarySegment
+    from segmentation.models import LibrarySegment
 
     settings.SIMILAR_INDEX_DIR = out / "similar"
     ctx = million.personas()

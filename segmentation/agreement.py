@@ -11,8 +11,14 @@ from statistics import median
 from django.db.models import Count, Q
 
 from motionlib.agreement import take_agreement
-from segmentation.models import Capture, Review, ReviewEvent
-from segmentation.models_library import Adjudication, CaptureAgreement, LibrarySegment
+from segmentation.models import (
+    Adjudication,
+    Capture,
+    CaptureAgreement,
+    LibrarySegment,
+    Review,
+    ReviewEvent,
+)
 
 DEFAULT_TOLERANCE_S = 0.25
 EDIT_ACTIONS = ("accept", "delete", "reset", "move", "insert", "label")

@@ -25,7 +25,7 @@ import motionlib
 from motionlib import similarity
 from motionlib.agreement import label_codes, segment_support
 from segmentation import agreement, similar_index, storage
-from segmentation.models_library import Adjudication, LibrarySegment
+from segmentation.models import Adjudication, LibrarySegment
 from segmentation.services.captures import read_take
 
 log = logging.getLogger(__name__)

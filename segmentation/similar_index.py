@@ -55,7 +55,7 @@ from django.db import transaction
 
 from motionlib import similarity
 from motionlib.vector_index import IvfIndex
-from segmentation.models_library import LibrarySegment
+from segmentation.models import LibrarySegment
 
 log = logging.getLogger(__name__)
 

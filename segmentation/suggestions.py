@@ -39,9 +39,7 @@ from segmentation.library import (
     load_descriptors,
     profile_pool,
 )
-from segmentation.models import Capture, Review
-from segmentation.models_library import LibrarySegment
-from segmentation.models_suggestions import LabelSuggestion, SuggestionRequest
+from segmentation.models import Capture, LabelSuggestion, LibrarySegment, Review, SuggestionRequest
 
 log = logging.getLogger(__name__)
 

@@ -28,8 +28,7 @@ from segmentation import agreement, exports, library
 from segmentation.api.captures import capture_for
 from segmentation.api.params import bool_param, float_param, int_param
 from segmentation.api.projects import project_for
-from segmentation.models import Review
-from segmentation.models_library import Adjudication, LibrarySegment
+from segmentation.models import Adjudication, LibrarySegment, Review
 
 ORDERINGS = {
     "recent": ("-id",), "duration": ("duration", "id"), "-duration": ("-duration", "-id"),

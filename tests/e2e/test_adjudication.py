@@ -17,7 +17,7 @@ def two_reviews(capture, studio):
 
 
 def test_it_makes_a_gold_version_from_two_annotators_reviews(live_server, new_page, ingested_capture, studio, screenshots):
-    from segmentation.models_library import Adjudication, LibrarySegment
+    from segmentation.models import Adjudication, LibrarySegment
 
     ann_review, cuts = two_reviews(ingested_capture, studio)
     page = new_page("rachel")
@@ -150,7 +150,7 @@ def test_it_accepts_a_suggested_label_with_one_key(live_server, new_page, ingest
 
 def test_tiers_feed_the_gold_tier_with_undo_snap_and_the_409_rule(live_server, new_page, ingested_capture, studio):
     from segmentation.library import do_save_gold
-    from segmentation.models_library import Adjudication
+    from segmentation.models import Adjudication
 
     _ann, (c0, c1, c2) = two_reviews(ingested_capture, studio)
     n = ingested_capture.n_frames

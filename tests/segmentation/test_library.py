@@ -8,7 +8,7 @@ from django.db import connection
 from django.test.utils import CaptureQueriesContext
 
 from segmentation import services
-from segmentation.models_library import LibrarySegment
+from segmentation.models import LibrarySegment
 from tests.segmentation.base import BaseTestCase
 
 

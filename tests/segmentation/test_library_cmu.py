@@ -15,8 +15,7 @@ from numpy.testing import assert_allclose
 
 import motionlib
 from segmentation import library, services, storage, tasks
-from segmentation.models import Capture, DetectionRun
-from segmentation.models_library import LibrarySegment
+from segmentation.models import Capture, DetectionRun, LibrarySegment
 from tests.segmentation.base import SHARED_DATA
 from tests.segmentation.test_library import LibraryTestCase, submit_review
 

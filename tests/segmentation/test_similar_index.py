@@ -13,7 +13,7 @@ import motionlib
 from motionlib import similarity, synth, vector_index
 from motionlib.vector_index import IvfIndex
 from segmentation import library, similar_index, tasks
-from segmentation.models_library import LibrarySegment
+from segmentation.models import LibrarySegment
 from tests.segmentation.base import BaseTestCase
 from tests.segmentation.test_library import submit_review
 

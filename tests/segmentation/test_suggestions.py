@@ -16,8 +16,7 @@ from django.test.utils import CaptureQueriesContext
 import motionlib
 from motionlib import synth
 from segmentation import library, services, storage, suggestions, tasks
-from segmentation.models import Capture
-from segmentation.models_suggestions import LabelSuggestion
+from segmentation.models import Capture, LabelSuggestion
 from tests.segmentation.test_library import LibraryTestCase, submit_review
 
 

@@ -5,7 +5,7 @@ from django.contrib.auth import get_user_model
 
 from motionlib.vector_index import IvfIndex
 from segmentation import library, services, similar_index
-from segmentation.models_library import LibrarySegment
+from segmentation.models import LibrarySegment
 from tests.segmentation.base import synthetic_bvh
 from tests.segmentation.integration.conftest import wait_for
 from tests.segmentation.integration.test_pipeline import client_for, settled, upload
