@@ -7,6 +7,7 @@ from django.conf import settings
 from django.db import models
 from django.utils import timezone
 
+from segmentation.errors import Invalid
 from segmentation.models.jobs import ClaimQuerySet, Job
 from segmentation.models.projects import Project
 
@@ -86,6 +87,23 @@ class Capture(Job):
     def needs_conversion(self):
         """An FBX not yet read by Blender: its next job is ``convert``, not ``ingest``."""
         return self.format == "fbx" and not self.converted
+
+    def check_cut_frame(self, frame, field="frame", cut=None):
+        """``frame`` as a cut of this take: an integer strictly inside it (a cut at 0 or at
+        ``n_frames`` splits off nothing). ``Invalid`` names ``field`` and the value, and
+        ``cut`` when it is one of a list ("cuts: cut 2 at frame 0 is outside 1..399")."""
+        if isinstance(frame, bool) or not isinstance(frame, int):
+            raise Invalid(f"{field}: must be an integer, got {frame!r}")
+        if not 0 < frame < self.n_frames:
+            if cut is None:
+                raise Invalid(f"{field}: must be between 1 and {self.n_frames - 1}, got {frame}")
+            raise Invalid(f"{field}: {cut} at frame {frame} is outside 1..{self.n_frames - 1}")
+        return frame
+
+    def first_job(self):
+        """The task that starts processing an upload: ``convert`` for an FBX Blender has not
+        read yet (the convert queue), else ``ingest``."""
+        return "convert" if self.needs_conversion else "ingest"
 
     def latest_run(self):
         """The newest detection run (uses ``prefetch_related("runs")`` when present)."""

@@ -15,6 +15,12 @@ JOB_STATUSES = (
 )
 
 
+def claim_cutoff():
+    """Claims older than this (not renewed for ``CUTROOM_CLAIM_TIMEOUT`` seconds) belong to
+    a process that died."""
+    return timezone.now() - timezone.timedelta(seconds=settings.CUTROOM_CLAIM_TIMEOUT)
+
+
 class ClaimQuerySet(models.QuerySet):
     """Claiming background work with one conditional UPDATE.
 
@@ -24,9 +30,8 @@ class ClaimQuerySet(models.QuerySet):
     """
 
     def claim(self, pk, token):
-        stale = timezone.now() - timezone.timedelta(seconds=settings.CUTROOM_CLAIM_TIMEOUT)
         claimable = Q(status="queued") | Q(status="processing") & (
-            Q(claim_token=token) | Q(claimed_at__lt=stale)
+            Q(claim_token=token) | Q(claimed_at__lt=claim_cutoff())
         )
         updated = self.filter(claimable, pk=pk).update(
             status="processing",
@@ -39,8 +44,7 @@ class ClaimQuerySet(models.QuerySet):
     def stale(self):
         """Rows still marked processing whose claim was not renewed within the claim
         timeout: the process running them died."""
-        limit = timezone.now() - timezone.timedelta(seconds=settings.CUTROOM_CLAIM_TIMEOUT)
-        return self.filter(status="processing", claimed_at__lt=limit)
+        return self.filter(status="processing", claimed_at__lt=claim_cutoff())
 
     def requeue_failed(self, pk):
         """Put a failed job back in the queue with a fresh attempt count; 0 rows updated

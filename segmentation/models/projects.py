@@ -6,7 +6,7 @@ from django.db import models
 from django.db.models import Q
 from django.utils import timezone
 
-from segmentation.models.jobs import ClaimQuerySet, Job
+from segmentation.models.jobs import ClaimQuerySet, Job, claim_cutoff
 
 ROLES = (("annotator", "Annotator"), ("reviewer", "Reviewer"), ("admin", "Admin"))
 
@@ -162,9 +162,8 @@ class CutModelQuerySet(ClaimQuerySet):
         """Claim a training unless another training of the same project holds a live
         claim: one training at a time per project. Zero rows updated means it is not
         this job's turn (or another worker has it)."""
-        stale = timezone.now() - timezone.timedelta(seconds=settings.CUTROOM_CLAIM_TIMEOUT)
         busy = self.model.objects.filter(
-            project=models.OuterRef("project"), status="processing", claimed_at__gte=stale
+            project=models.OuterRef("project"), status="processing", claimed_at__gte=claim_cutoff()
         ).exclude(pk=models.OuterRef("pk"))
         return super(CutModelQuerySet, self.filter(~models.Exists(busy))).claim(pk, token)
 
