@@ -9,6 +9,11 @@ Anything that is the caller's fault is an :class:`Invalid` (a ``ValueError``) wh
 starts with the field at fault, ``"field: what is wrong, got value"``: a 400.
 """
 
+import logging
+import secrets
+
+log = logging.getLogger(__name__)
+
 
 class CutroomError(Exception):
     """Base of every error the service raises on purpose."""
@@ -81,3 +86,11 @@ class StaleGold(CutroomError):
 
 class NotAllowed(CutroomError, PermissionError):
     """The caller's role does not allow the action: a 403 whose text says who may."""
+
+
+def internal_error(what, logger=log):
+    """Log the exception being handled with its traceback and a short reference, and
+    return the reference: the user quotes it, the administrators find the traceback."""
+    reference = secrets.token_hex(4)
+    logger.exception("%s failed with an internal error (reference %s)", what, reference)
+    return reference

@@ -11,6 +11,7 @@ import csv
 import io
 import itertools
 import json
+import logging
 import os
 import re
 import tempfile
@@ -18,10 +19,13 @@ import zipfile
 from pathlib import PurePath
 
 import motionlib
+from motionlib.errors import MotionlibError
 from motionlib.io.export import write_clips
 from segmentation import storage
-from segmentation.errors import ExportFormatError
+from segmentation.errors import CutroomError, ExportFormatError, internal_error
 from segmentation.storage import read_take
+
+log = logging.getLogger(__name__)
 
 EXPORT_FORMATS = {"bvh": "BVH", "fbx": "FBX", "glb": "glTF binary"}
 CONTENT_TYPES = {"bvh": "application/octet-stream", "fbx": "application/octet-stream",
@@ -161,8 +165,13 @@ def stream_zip(segments, fmt="bvh"):
                     archive.writestr(name, data)
                     manifest.append(manifest_row(segment, name, fmt))
                     yield sink.drain()
-            except ValueError as exc:
+            except (MotionlibError, CutroomError) as exc:
                 errors.append(f"capture {capture.pk} ({capture.name}): {exc}")
+            except Exception:
+                # Not the take's fault: logged with its traceback, named by its reference.
+                reference = internal_error(f"export of capture {capture.pk}", log)
+                errors.append(f"capture {capture.pk} ({capture.name}): internal error "
+                              f"(reference {reference})")
         archive.writestr("manifest.json", json.dumps(manifest, indent=1))
         archive.writestr("manifest.csv", _csv(manifest))
         if errors:

@@ -33,8 +33,8 @@ from segmentation.errors import (
     StaleVersion,
     TooManyRequests,
     UploadTooLarge,
+    internal_error,
 )
-from segmentation.services.jobs import internal_error
 
 log = logging.getLogger(__name__)
 

@@ -23,7 +23,7 @@ from django.utils import timezone
 from motionlib.errors import MotionlibError
 from motionlib.segmenters import get_segmenter
 from segmentation import takecache
-from segmentation.errors import CutroomError, Invalid
+from segmentation.errors import CutroomError, Invalid, internal_error
 from segmentation.models import Capture, ProjectCutModel, Review
 from segmentation.services import jobs
 from segmentation.services.jobs import heartbeat
@@ -143,7 +143,7 @@ def train_project_model(job):
     except (MotionlibError, CutroomError) as exc:
         job.fail(f"training: {exc}", finished_at=timezone.now())
     except Exception:
-        reference = jobs.internal_error(f"training of project {job.project_id}", log)
+        reference = internal_error(f"training of project {job.project_id}", log)
         job.fail(
             f"training failed with an internal error (reference {reference}); "
             "report this reference to the service's administrators",

@@ -17,7 +17,14 @@ import motionlib
 from motionlib.errors import MotionlibError, shorten
 from motionlib.segmenters import ParamError, get_segmenter, list_segmenters
 from segmentation import storage
-from segmentation.errors import CutroomError, NotReady, ReviewStarted, UploadError, UploadTooLarge
+from segmentation.errors import (
+    CutroomError,
+    NotReady,
+    ReviewStarted,
+    UploadError,
+    UploadTooLarge,
+    internal_error,
+)
 from segmentation.models import Capture, DetectionRun
 from segmentation.services import adaptation, jobs, quotas
 from segmentation.services.jobs import enqueue
@@ -185,7 +192,7 @@ def _guarded(job, what, work, **fail_fields):
     except (MotionlibError, CutroomError) as exc:
         job.fail(_bounded(str(exc), 2000), **fail_fields)
     except Exception:
-        reference = jobs.internal_error(what, log)
+        reference = internal_error(what, log)
         job.fail(
             f"{what} failed with an internal error (reference {reference}). The original "
             "upload is kept; report this reference to the service's administrators.",

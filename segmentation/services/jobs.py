@@ -6,7 +6,6 @@ Tasks are sent by name (``segmentation.tasks.<name>``), so no service imports th
 """
 
 import logging
-import secrets
 import threading
 from contextlib import contextmanager
 
@@ -37,14 +36,6 @@ def enqueue(task_name, pk):
     # FBX conversion runs Blender: its own queue, served by its own worker.
     options = {"queue": settings.CUTROOM_CONVERT_QUEUE} if task_name == "convert" else {}
     transaction.on_commit(lambda: send(task_name, pk, **options))
-
-
-def internal_error(what, logger=log):
-    """Log the exception being handled with its traceback and a short reference, and
-    return the reference: the user quotes it, the administrators find the traceback."""
-    reference = secrets.token_hex(4)
-    logger.exception("%s failed with an internal error (reference %s)", what, reference)
-    return reference
 
 
 def claim(model, pk, token):
