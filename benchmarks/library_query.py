@@ -111,7 +111,7 @@ def main():
     args = parser.parse_args()
     name, _ = million.connect(args.admin_url, args.segments, args.seed)
     ctx = million.personas()
-    from segmentation.models_library import LibrarySegment
+    from segmentation.models import LibrarySegment
 
     ctx["capture"] = (LibrarySegment.objects.filter(project=ctx["project"]).order_by("id")
                       .values_list("capture_id", flat=True).first())

@@ -119,8 +119,9 @@ def populate(args):
     from rest_framework.authtoken.models import Token
 
     from motionlib import synth
-    from segmentation import library, services
-    from segmentation.models_library import LibrarySegment
+    from segmentation import services
+    from segmentation.models import LibrarySegment
+    from segmentation.services import gold
 
     users = get_user_model().objects
     admin = users.create_user("admin")
@@ -138,7 +139,7 @@ def populate(args):
         capture, truth = synth_capture(project, admin, 100 + i, args.library_minutes / n_takes)
         cuts, labels = [s for s, _, _ in truth[1:]], [label for _, _, label in truth]
         submit(capture, people["librarian"], cuts, labels)
-        library.do_save_gold(capture, people["rachel"], cuts, labels, version=0)
+        gold.do_save_gold(capture, people["rachel"], cuts, labels, version=0)
     print(f"library: {n_takes} takes, {LibrarySegment.objects.filter(is_gold=True).count()} gold "
           f"segments ({time.perf_counter() - started:.0f} s to build)")
     started = time.perf_counter()
@@ -333,7 +334,7 @@ def run_small(port, data, begin, rounds=0, stop_at=None):
 def time_under_load(port, data, repeats, waves, keep_suggestions=False):
     """The small capture's request times alone, then during ``waves`` rounds of every viewer
     opening the long take at the same moment; and the page load times."""
-    from segmentation.models_suggestions import LabelSuggestion, SuggestionRequest
+    from segmentation.models import LabelSuggestion, SuggestionRequest
 
     fork = multiprocessing.get_context("fork")
     begin = fork.Event()

@@ -41,7 +41,7 @@ def oracle_arrays(out):
     """ids, profiles, capture, start, stop, superseded of the archive (cached as .npy)."""
     path = out / "spans.npy"
     if not path.exists():
-        from segmentation.models_library import LibrarySegment
+        from segmentation.models import LibrarySegment
 
         project = million.personas()["project"]
         rows = np.array(list(LibrarySegment.objects.filter(project=project).order_by("id")
@@ -61,7 +61,7 @@ def exact_top(segment, ids, profiles, spans, k=10):
     (as |x|^2 - 2 x.q + |q|^2) pick the 2,000 nearest; those are measured again exactly as
     the service measures (float64 differences), far more than the 20 the ranking needs."""
     from motionlib import similarity
-    from segmentation import library
+    from segmentation import descriptors, search
 
     query = segment.descriptor_array()
     q = query[:similarity.PROFILE_ROWS].ravel()
@@ -81,9 +81,9 @@ def exact_top(segment, ids, profiles, spans, k=10):
         if span not in seen:
             seen.add(span)
             short.append(int(ids[i]))
-        if len(short) == max(library.SHORTLIST, k):
+        if len(short) == max(search.SHORTLIST, k):
             break
-    found, _ = similarity.rank_similar(query, library.load_descriptors(short), k=k,
+    found, _ = similarity.rank_similar(query, descriptors.load_descriptors(short), k=k,
                                        shortlist=len(short))
     return [short[i] for i in found]
 
@@ -146,7 +146,7 @@ def main():
     from django.conf import settings
 
     from segmentation import similar_index
-    from segmentation.models_library import LibrarySegment
+    from segmentation.models import LibrarySegment
 
     settings.SIMILAR_INDEX_DIR = out / "similar"
     ctx = million.personas()

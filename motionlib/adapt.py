@@ -58,6 +58,7 @@ from pathlib import Path
 import numpy as np
 
 from motionlib import metrics
+from motionlib.errors import InputError, MotionlibError
 from motionlib.segmenters.base import Segmentation, _checked
 from motionlib.segmenters.default import (
     PLACEMENTS,
@@ -81,7 +82,7 @@ PLACEMENT_GAIN = (0.2, 0.03)
 MATCH_S = 1.0
 
 
-class ExampleError(ValueError):
+class ExampleError(MotionlibError):
     """An example take or its cuts cannot be learnt from; the message names it."""
 
 
@@ -126,11 +127,11 @@ class CutModel:
         try:
             data = json.loads(text)
         except (TypeError, json.JSONDecodeError) as exc:
-            raise ValueError(f"cut model: not JSON: {exc}") from None
+            raise InputError(f"cut model: not JSON: {exc}") from None
         if not isinstance(data, dict):
-            raise ValueError(f"cut model: expected a JSON object, got {type(data).__name__}")
+            raise InputError(f"cut model: expected a JSON object, got {type(data).__name__}")
         if data.get("format") != FORMAT:
-            raise ValueError(f"cut model: unsupported format {data.get('format')!r} "
+            raise InputError(f"cut model: unsupported format {data.get('format')!r} "
                              f"(expected {FORMAT})")
         values = {}
         for name, kind in (("n_takes", int), ("n_cuts", int), ("threshold", float),
@@ -140,11 +141,11 @@ class CutModel:
             value = data.get(name, OPTIONAL_FIELDS.get(name))
             ok = isinstance(value, int | float) and not isinstance(value, bool)
             if not ok or not math.isfinite(value) or (kind is int and value != int(value)):
-                raise ValueError(f"cut model: {name} must be a finite "
+                raise InputError(f"cut model: {name} must be a finite "
                                  f"{'integer' if kind is int else 'number'}, got {value!r}")
             values[name] = kind(value)
         if data.get("placement") not in PLACEMENTS:
-            raise ValueError(f"cut model: placement must be one of {', '.join(PLACEMENTS)}, "
+            raise InputError(f"cut model: placement must be one of {', '.join(PLACEMENTS)}, "
                              f"got {data.get('placement')!r}")
         return cls(**values, placement=data["placement"])
 

@@ -22,6 +22,7 @@ from itertools import combinations
 
 import numpy as np
 
+from motionlib.errors import InputError
 from motionlib.metrics import boundary_scores
 
 MISSING = -1
@@ -42,9 +43,9 @@ def boundary_agreement(cuts_a, cuts_b, *, fps: float, tolerance_s: float = 0.25)
     ``f1`` and ``matched``. Two annotators who both made no cut agree fully (F1 = 1).
     """
     if fps <= 0:
-        raise ValueError(f"fps: must be positive, got {fps}")
+        raise InputError(f"fps: must be positive, got {fps}")
     if tolerance_s < 0:
-        raise ValueError(f"tolerance_s: must be >= 0, got {tolerance_s}")
+        raise InputError(f"tolerance_s: must be >= 0, got {tolerance_s}")
     # B's cuts play the truth: the same one-to-one matching and scores as a detector's.
     return boundary_scores(cuts_a, cuts_b, fps=fps, tolerance_s=tolerance_s)
 
@@ -69,7 +70,7 @@ def label_codes(segment_lists, n_frames: int) -> tuple[np.ndarray, list]:
     for row, segments in enumerate(segment_lists):
         for start, stop, label in segments:
             if not 0 <= start <= stop <= n_frames:
-                raise ValueError(
+                raise InputError(
                     f"segment [{start}, {stop}) of annotator {row} is outside the take's "
                     f"{n_frames} frames"
                 )
@@ -100,7 +101,7 @@ def cohen_kappa(a, b) -> float:
     """
     a, b = np.asarray(a), np.asarray(b)
     if a.shape != b.shape:
-        raise ValueError(f"label arrays differ in shape: {a.shape} and {b.shape}")
+        raise InputError(f"label arrays differ in shape: {a.shape} and {b.shape}")
     both = (a != MISSING) & (b != MISSING)
     if not both.any():
         return float("nan")
@@ -129,7 +130,7 @@ def krippendorff_alpha(codes) -> float:
 
     codes = np.asarray(codes)
     if codes.ndim != 2:
-        raise ValueError(f"codes: expected (n_annotators, n_frames), got shape {codes.shape}")
+        raise InputError(f"codes: expected (n_annotators, n_frames), got shape {codes.shape}")
     pairable = (codes != MISSING).sum(axis=0) >= 2
     if not pairable.any():
         return float("nan")
@@ -203,7 +204,7 @@ def take_agreement(segment_lists, cut_lists, *, n_frames: int, fps: float,
     inputs), ``mean_boundary_f1``, ``alpha``, ``per_label`` and ``label_names``.
     """
     if len(segment_lists) != len(cut_lists):
-        raise ValueError("segment_lists and cut_lists must have one entry per annotator")
+        raise InputError("segment_lists and cut_lists must have one entry per annotator")
     codes, names = label_codes(segment_lists, n_frames)
     pairs = []
     for i, j in combinations(range(len(cut_lists)), 2):

@@ -23,10 +23,12 @@ from pathlib import Path
 
 import numpy as np
 
+from motionlib.errors import MotionlibError
+
 DEFAULT_DATA_DIR = Path(__file__).resolve().parents[1] / ".." / "shared" / "data"
 
 
-class LabelError(ValueError):
+class LabelError(MotionlibError):
     """A label file is malformed; the message names the file, line and value."""
 
 

@@ -1,7 +1,13 @@
-"""Domain errors of motionlib.
+"""Domain errors of motionlib, all under :class:`MotionlibError` (a ``ValueError``).
 
-Every error a caller can act on is a :class:`CaptureError`, a ``ValueError`` whose message names
-the file, the line and what was wrong, e.g. ``13_29.bvh:190: expected 96 values, found 95``.
+- :class:`CaptureError`: a capture file (or a take built from one) cannot be used; its message
+  names the file, the line and what was wrong, e.g. ``13_29.bvh:190: expected 96 values, found 95``;
+- :class:`ParamError`: a segmenter name or parameter value is invalid;
+- :class:`InputError`: any other argument a caller passed that cannot be used (a frame range,
+  a tolerance, arrays of the wrong shape), naming the argument and its value.
+
+A ``ValueError`` that is not a ``MotionlibError`` (numpy's, say) is a bug, not the caller's
+fault: the service reports it as an internal error.
 """
 
 from __future__ import annotations
@@ -18,7 +24,19 @@ def shorten(value, limit: int = 40) -> str:
     return repr(text) if len(text) <= limit else repr(text[:limit]) + f"... ({len(text)} characters)"
 
 
-class CaptureError(ValueError):
+class MotionlibError(ValueError):
+    """Base of every error motionlib raises on purpose."""
+
+
+class InputError(MotionlibError):
+    """An argument that cannot be used; the message names it and its value."""
+
+
+class ParamError(MotionlibError):
+    """A segmenter name or parameter value is invalid; the message names it."""
+
+
+class CaptureError(MotionlibError):
     """A capture file (or a take built from one) cannot be used as it is.
 
     Parameters

@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from motionlib import _kinematics
+from motionlib.errors import InputError
 
 _AXIS = {"X": 0, "Y": 1, "Z": 2}
 # Columns mixed by a right-multiplied rotation about each axis: G @ R_axis(θ).
@@ -96,7 +97,7 @@ def _layout(skeleton):
         rots = [(_AXIS[a], col[f"{a}rotation"]) for a in skeleton.rotation_orders[j]
                 if f"{a}rotation" in col]
         if len(rots) > _MAX_ROTATIONS:
-            raise ValueError(f"joint {skeleton.names[j]!r} has {len(rots)} rotation channels; "
+            raise InputError(f"joint {skeleton.names[j]!r} has {len(rots)} rotation channels; "
                              f"at most {_MAX_ROTATIONS} are supported")
         if rots:
             rotation[j, :len(rots)] = rots
@@ -134,7 +135,7 @@ def forward_kinematics(take, channels: np.ndarray | None = None) -> np.ndarray:
     channels = np.ascontiguousarray(take.channels if channels is None else channels,
                                     dtype=np.float64)
     if channels.ndim != 2 or channels.shape[1] != skeleton.n_channels:
-        raise ValueError(f"channels must have shape (n_frames, {skeleton.n_channels}), got "
+        raise InputError(f"channels must have shape (n_frames, {skeleton.n_channels}), got "
                          f"{channels.shape}")
     out = np.empty((channels.shape[0], skeleton.n_joints, 3))
     _kinematics.positions(channels, channels.shape[0], skeleton.n_channels, *_layout(skeleton),
@@ -171,6 +172,6 @@ def skeleton_height(take_or_positions) -> float:
         return float(y.max() - y.min())
     positions = np.asarray(take_or_positions, dtype=np.float64)
     if positions.ndim != 3 or positions.shape[-1] != 3 or positions.shape[0] == 0:
-        raise ValueError(f"positions must have shape (n_frames, n_joints, 3), got {positions.shape}")
+        raise InputError(f"positions must have shape (n_frames, n_joints, 3), got {positions.shape}")
     y = positions[..., 1]
     return float(np.median(y.max(axis=1) - y.min(axis=1)))

@@ -15,6 +15,8 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 
+from motionlib.errors import InputError
+
 
 def as_windows(truth) -> np.ndarray:
     """True cuts as an ``(n, 3)`` int array of ``(lo, mid, hi)`` frames, sorted by mid.
@@ -26,7 +28,7 @@ def as_windows(truth) -> np.ndarray:
     if arr.ndim == 1:
         arr = np.repeat(arr[:, None], 3, axis=1)
     if arr.ndim != 2 or arr.shape[1] != 3:
-        raise ValueError(f"truth: expected (n,) cuts or (n, 3) windows, got shape {arr.shape}")
+        raise InputError(f"truth: expected (n,) cuts or (n, 3) windows, got shape {arr.shape}")
     arr = np.sort(arr, axis=1)
     return arr[np.argsort(arr[:, 1], kind="stable")]
 

@@ -25,6 +25,7 @@ from functools import lru_cache
 
 import numpy as np
 
+from motionlib.errors import InputError
 from motionlib.features import body_frame_positions, bone_angles
 
 N_SAMPLES = 32
@@ -49,7 +50,7 @@ def body_scale(positions: np.ndarray, joints: dict[str, int]) -> float:
     )
     scale = float(np.median(lengths))
     if not scale > 0:
-        raise ValueError(f"body scale: the skeleton's leg and trunk have zero length ({scale})")
+        raise InputError(f"body scale: the skeleton's leg and trunk have zero length ({scale})")
     return scale
 
 
@@ -85,7 +86,7 @@ def resample(x: np.ndarray, n_samples: int = N_SAMPLES) -> np.ndarray:
     """
     x = np.asarray(x, dtype=float)
     if len(x) == 0:
-        raise ValueError("resample: the clip has no frames")
+        raise InputError("resample: the clip has no frames")
     if len(x) == 1:
         return np.repeat(x, n_samples, axis=0)
     source = np.linspace(0.0, len(x) - 1, n_samples)
@@ -114,10 +115,10 @@ def segment_descriptor(positions: np.ndarray, joints: dict[str, int], start: int
     (change per ``SPEED_WINDOW_S``) of each feature, then the resampled trajectory.
     """
     if not 0 <= start < stop <= len(positions):
-        raise ValueError(f"segment [{start}, {stop}) is empty or outside the take's "
+        raise InputError(f"segment [{start}, {stop}) is empty or outside the take's "
                          f"{len(positions)} frames")
     if fps <= 0:
-        raise ValueError(f"fps: must be positive, got {fps}")
+        raise InputError(f"fps: must be positive, got {fps}")
     scale = body_scale(positions, joints) if scale is None else scale
     features = frame_features(positions[start:stop], joints, scale)
     step = np.abs(np.diff(features, axis=0)) if len(features) > 1 else np.zeros_like(features)
@@ -230,10 +231,10 @@ def rank_similar(query: np.ndarray, library: np.ndarray, *, k: int = 10,
     library = np.asarray(library, dtype=float)
     query = np.asarray(query, dtype=float)
     if library.ndim != 3 or library.shape[1:] != query.shape:
-        raise ValueError(f"library: expected (n, {', '.join(map(str, query.shape))}) "
+        raise InputError(f"library: expected (n, {', '.join(map(str, query.shape))}) "
                          f"descriptors, got shape {library.shape}")
     if k < 1:
-        raise ValueError(f"k: must be at least 1, got {k}")
+        raise InputError(f"k: must be at least 1, got {k}")
     keep = shortlist_by_profile(query, library, max(shortlist, k))
     profile = np.array([float(np.linalg.norm(query[:PROFILE_ROWS] - library[i, :PROFILE_ROWS]))
                         for i in keep])

@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from motionlib.errors import CaptureError
+from motionlib.errors import CaptureError, InputError
 
 POSITION_CHANNELS = ("Xposition", "Yposition", "Zposition")
 ROTATION_CHANNELS = ("Xrotation", "Yrotation", "Zrotation")
@@ -66,10 +66,10 @@ class Skeleton:
         n = len(self.names)
         if not (len(self.parents) == len(self.offsets) == len(self.channels)
                 == len(self.rotation_orders) == n):
-            raise ValueError("names, parents, offsets, channels and rotation_orders "
+            raise InputError("names, parents, offsets, channels and rotation_orders "
                              f"must all have one entry per joint ({n})")
         if n and not _is_preorder(self.parents):
-            raise ValueError("joints must be in depth-first order (as BVH nests them): root "
+            raise InputError("joints must be in depth-first order (as BVH nests them): root "
                              "first, each joint right after its parent or a sibling's subtree")
 
     @property

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from motionlib.errors import InputError
 from motionlib.skeleton import Skeleton
 from motionlib.take import Take
 
@@ -267,19 +268,19 @@ def _noise(rng, t, n_channels, amplitude):
 
 def _check(fps, duration, n_segments, actions, segment_seconds, transition_seconds):
     if not fps > 0:
-        raise ValueError(f"fps must be positive, got {fps}")
+        raise InputError(f"fps must be positive, got {fps}")
     if duration is not None and not duration > 0:
-        raise ValueError(f"duration must be positive seconds, got {duration}")
+        raise InputError(f"duration must be positive seconds, got {duration}")
     if duration is None and n_segments < 1:
-        raise ValueError(f"n_segments must be at least 1, got {n_segments}")
+        raise InputError(f"n_segments must be at least 1, got {n_segments}")
     unknown = sorted(set(actions) - set(ACTIONS))
     if unknown or len(set(actions)) < 2:
-        raise ValueError(f"actions must be at least two of {', '.join(ACTIONS)}; got "
+        raise InputError(f"actions must be at least two of {', '.join(ACTIONS)}; got "
                          f"{', '.join(map(str, actions))}")
     lo, hi = segment_seconds
     if not 0 < lo <= hi:
-        raise ValueError(f"segment_seconds must be (min, max) with 0 < min <= max, got "
+        raise InputError(f"segment_seconds must be (min, max) with 0 < min <= max, got "
                          f"{segment_seconds}")
     if not 0 <= transition_seconds < lo:
-        raise ValueError(f"transition_seconds must be in [0, {lo}) (shorter than a segment), "
+        raise InputError(f"transition_seconds must be in [0, {lo}) (shorter than a segment), "
                          f"got {transition_seconds}")

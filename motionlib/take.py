@@ -6,7 +6,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from motionlib.errors import CaptureError
+from motionlib.errors import CaptureError, InputError
 from motionlib.skeleton import Skeleton
 
 
@@ -71,7 +71,7 @@ def frame_range(n_frames: int, start: int | None, stop: int | None) -> tuple[int
     start = 0 if start is None else int(start)
     stop = n_frames if stop is None else int(stop)
     if not 0 <= start < stop <= n_frames:
-        raise ValueError(f"frame range [{start}, {stop}) is empty or outside the take's "
+        raise InputError(f"frame range [{start}, {stop}) is empty or outside the take's "
                          f"{n_frames} frames")
     return start, stop
 

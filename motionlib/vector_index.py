@@ -20,6 +20,8 @@ from pathlib import Path
 
 import numpy as np
 
+from motionlib.errors import InputError
+
 FILES = ("centroids", "offsets", "ids", "vectors")
 # Share of the vectors a search scans at least (nearest clusters first).
 PROBE_SHARE = 0.01
@@ -53,7 +55,7 @@ def train_centroids(vectors: np.ndarray, n_lists: int, *, seed: int = 0,
     """
     n = len(vectors)
     if not 1 <= n_lists <= n:
-        raise ValueError(f"n_lists: must be between 1 and the {n} vectors, got {n_lists}")
+        raise InputError(f"n_lists: must be between 1 and the {n} vectors, got {n_lists}")
     rng = np.random.default_rng(seed)
     pick = np.sort(rng.choice(n, size=min(n, max(sample, n_lists)), replace=False))
     x = np.asarray(vectors[pick], dtype=np.float32)
@@ -113,7 +115,7 @@ class IvfIndex:
         """Train centres on ``vectors`` (n, d) and group them; ``ids`` (n,) int keys."""
         ids = np.asarray(ids, dtype=np.int64)
         if vectors.ndim != 2 or len(vectors) != len(ids) or not len(ids):
-            raise ValueError(f"vectors: expected ({len(ids)}, d) with at least one row, got "
+            raise InputError(f"vectors: expected ({len(ids)}, d) with at least one row, got "
                              f"shape {vectors.shape}")
         n_lists = n_lists or max(1, len(ids) // LIST_SIZE)
         centres = train_centroids(vectors, n_lists, seed=seed)
@@ -152,7 +154,7 @@ class IvfIndex:
         """
         q = np.asarray(query, dtype=np.float32).reshape(1, -1)
         if q.shape[1] != self.ndim:
-            raise ValueError(f"query: expected {self.ndim} numbers, got {q.shape[1]}")
+            raise InputError(f"query: expected {self.ndim} numbers, got {q.shape[1]}")
         sizes = np.diff(self.offsets)
         order = np.argsort(_sq_distances(q, self.centroids, self._norms)[0], kind="stable")
         need = max(count, int(np.ceil(probe_share * len(self))))
@@ -192,11 +194,11 @@ class IvfIndex:
                 arrays[name] = np.load(path, mmap_mode="r" if mmap and name in ("ids", "vectors")
                                        else None)
             except (OSError, ValueError, EOFError) as exc:
-                raise ValueError(f"{path}: cannot be read ({exc})") from exc
+                raise InputError(f"{path}: cannot be read ({exc})") from exc
         centroids, offsets = arrays["centroids"], arrays["offsets"]
         if (offsets.shape != (len(centroids) + 1,) or offsets[-1] != len(arrays["ids"])
                 or arrays["vectors"].shape != (len(arrays["ids"]), centroids.shape[1])):
-            raise ValueError(f"{folder}: its arrays disagree (centroids {centroids.shape}, "
+            raise InputError(f"{folder}: its arrays disagree (centroids {centroids.shape}, "
                              f"offsets {offsets.shape}, ids {arrays['ids'].shape}, vectors "
                              f"{arrays['vectors'].shape})")
         return cls(**arrays)

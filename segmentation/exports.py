@@ -1,4 +1,5 @@
-"""Library clips as files: BVH (written here), FBX and glTF binary (written by Blender).
+"""Library clips as files: BVH (written here), FBX and glTF binary (written by Blender), and
+bulk export as a zip archive with a manifest.
 
 FBX and glTF run Blender in a child process of the calling process (``motionlib.io.blender``;
 nothing here imports it). A clip of a capture read from FBX is cut from its stored original, so
@@ -6,20 +7,31 @@ it keeps the original's armature and bone names; any other becomes a new armatur
 """
 
 import contextlib
+import csv
+import io
+import itertools
+import json
+import logging
 import os
+import re
 import tempfile
+import zipfile
 from pathlib import PurePath
 
+import motionlib
+from motionlib.errors import MotionlibError
 from motionlib.io.export import write_clips
 from segmentation import storage
+from segmentation.errors import CutroomError, ExportFormatError, internal_error
+from segmentation.storage import read_take
+
+log = logging.getLogger(__name__)
 
 EXPORT_FORMATS = {"bvh": "BVH", "fbx": "FBX", "glb": "glTF binary"}
 CONTENT_TYPES = {"bvh": "application/octet-stream", "fbx": "application/octet-stream",
                  "glb": "model/gltf-binary"}
 
-
-class ExportFormatError(ValueError):
-    """An export format the library does not write."""
+MAX_EXPORT_SEGMENTS = 5000
 
 
 def check_format(fmt):
@@ -32,8 +44,6 @@ def check_format(fmt):
 
 def file_stem(segment):
     """``capture_label_start-stop`` with safe characters only (``#animation`` kept readable)."""
-    from segmentation.library import slug
-
     stem = PurePath(segment.capture.name.replace("#", "_")).stem
     if "#" in segment.capture.name:  # "take.fbx#walk": the animation after the file stem
         base, animation = segment.capture.name.split("#", 1)
@@ -66,3 +76,120 @@ def _original(capture, take):
         return
     with storage.local_path(capture.original) as path:
         yield path
+
+
+def slug(text):
+    return re.sub(r"[^A-Za-z0-9_]+", "-", str(text)).strip("-") or "untitled"
+
+
+def file_name(segment):
+    """``capture_label_start-stop.bvh`` with safe characters only."""
+    stem = PurePath(segment.capture.name).stem
+    return f"{slug(stem)}_{slug(segment.label_name)}_{segment.start}-{segment.stop}.bvh"
+
+
+def bvh_text(take, segment):
+    """The segment's frames as BVH with the take's own hierarchy and frame time.
+
+    A cgspeed BVH's added T-pose frame (``take.rest_pose_frame``) is not part of the
+    performance, so a clip that starts on or before it starts just after it.
+    """
+    start = segment.start
+    if take.rest_pose_frame is not None and start <= take.rest_pose_frame < segment.stop - 1:
+        start = take.rest_pose_frame + 1
+    out = io.StringIO()
+    motionlib.write_bvh(take, out, start=start, stop=segment.stop)
+    return out.getvalue()
+
+
+def unique_name(name, segment, used):
+    """``name``, or with the annotator (then the segment id) added if the archive already
+    holds it: two annotators' versions of one range and label would share a name."""
+    if name in used:
+        stem, dot, ext = name.rpartition(".")
+        who = slug(segment.annotator.username) if segment.annotator else "gold"
+        name = f"{stem}_{who}{dot}{ext}"
+        if name in used:
+            name = f"{stem}_{who}_{segment.pk}{dot}{ext}"
+    used.add(name)
+    return name
+
+
+def manifest_row(segment, name, fmt="bvh"):
+    return {
+        "file": name, "format": fmt, "segment": segment.pk, "capture": segment.capture.name,
+        "capture_id": segment.capture_id, "start": segment.start, "stop": segment.stop,
+        "label": segment.label_name, "gold": segment.is_gold,
+        "annotator": segment.annotator.username if segment.annotator else None,
+        "agreement": segment.agreement,
+    }
+
+
+class _Sink:
+    """A write-only file for ``zipfile``: it collects bytes until ``drain`` hands them out."""
+
+    def __init__(self):
+        self.parts = []
+
+    def write(self, data):
+        self.parts.append(bytes(data))
+        return len(data)
+
+    def flush(self):
+        pass
+
+    def drain(self):
+        data, self.parts = b"".join(self.parts), []
+        return data
+
+
+def stream_zip(segments, fmt="bvh"):
+    """Yield a zip archive of one clip per segment (BVH, FBX or glTF binary: ``fmt``) plus
+    ``manifest.csv`` and ``manifest.json``.
+
+    ``segments`` should be ordered by capture so each take is read once; the archive is
+    written as it goes (at most one take and one capture's clips are in memory). A take that
+    cannot be read any more cannot turn into an error response once streaming has begun: its
+    segments are left out and ``errors.txt`` says why.
+    """
+    sink = _Sink()
+    manifest, errors, used = [], [], set()
+    with zipfile.ZipFile(sink, "w", compression=zipfile.ZIP_DEFLATED) as archive:
+        for _, group in itertools.groupby(segments, key=lambda s: s.capture_id):
+            group = list(group)
+            capture = group[0].capture
+            try:
+                take = read_take(capture)
+                for segment, name, data in _clips(capture, take, group, fmt):
+                    name = unique_name(name, segment, used)
+                    archive.writestr(name, data)
+                    manifest.append(manifest_row(segment, name, fmt))
+                    yield sink.drain()
+            except (MotionlibError, CutroomError) as exc:
+                errors.append(f"capture {capture.pk} ({capture.name}): {exc}")
+            except Exception:
+                # Not the take's fault: logged with its traceback, named by its reference.
+                reference = internal_error(f"export of capture {capture.pk}", log)
+                errors.append(f"capture {capture.pk} ({capture.name}): internal error "
+                              f"(reference {reference})")
+        archive.writestr("manifest.json", json.dumps(manifest, indent=1))
+        archive.writestr("manifest.csv", _csv(manifest))
+        if errors:
+            archive.writestr("errors.txt", "\n".join(errors) + "\n")
+    yield sink.drain()
+
+
+def _clips(capture, take, segments, fmt):
+    if fmt == "bvh":
+        return ((s, file_name(s), bvh_text(take, s)) for s in segments)
+    return clip_files(capture, take, segments, fmt)
+
+
+def _csv(rows):
+    out = io.StringIO()
+    fields = ["file", "format", "segment", "capture", "capture_id", "start", "stop", "label", "gold",
+              "annotator", "agreement"]
+    writer = csv.DictWriter(out, fieldnames=fields)
+    writer.writeheader()
+    writer.writerows(rows)
+    return out.getvalue()

@@ -14,13 +14,10 @@ from django.core.files import File
 
 import motionlib
 from motionlib.io.fbx import check_fbx_header
-from segmentation import services
+from segmentation import services, storage
+from segmentation.errors import ImportProblem
 
 CAPTURE_SUFFIXES = (".bvh", ".amc", ".fbx")
-
-
-class ImportProblem(ValueError):
-    """A file that cannot be imported; the message names the file and what is wrong."""
 
 
 @dataclass
@@ -104,7 +101,7 @@ def check_readable(path, asf=None):
     if Path(path).suffix.lower() == ".fbx":
         check_fbx_header(path)
         return
-    motionlib.read(path, asf=asf, limits=services.captures.input_limits())
+    motionlib.read(path, asf=asf, limits=storage.input_limits())
 
 
 def import_file(project, user, path, asf=None, check=True):

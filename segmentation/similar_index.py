@@ -55,7 +55,8 @@ from django.db import transaction
 
 from motionlib import similarity
 from motionlib.vector_index import IvfIndex
-from segmentation.models_library import LibrarySegment
+from segmentation.models import LibrarySegment
+from segmentation.services import jobs
 
 log = logging.getLogger(__name__)
 
@@ -201,8 +202,8 @@ def _build(project_id):
         return None
     widths = {v.shape[1] for _, v in parts}
     if len(widths) > 1:
-        raise ValueError(f"project {project_id}: segment profiles have {sorted(widths)} "
-                         "numbers; rebuild the library's descriptors")
+        raise IndexUnusable(f"project {project_id}: segment profiles have {sorted(widths)} "
+                            "numbers; rebuild the library's descriptors")
     ids = np.concatenate([k for k, _ in parts])
     vectors = np.concatenate([v for _, v in parts])
     del parts
@@ -255,15 +256,8 @@ def schedule_update(project_id):
     """Queue ``update`` for when the current transaction commits (a worker must see the
     rows). A broker that cannot be reached costs freshness of the file only: searches
     read newer segments from the database."""
-    from segmentation import tasks
-
-    def send():
-        try:
-            tasks.update_similar_index.delay(project_id)
-        except Exception:
-            log.exception("could not queue the similar index update of project %s", project_id)
-
-    transaction.on_commit(send)
+    transaction.on_commit(lambda: jobs.send(
+        "update_similar_index", project_id, then="searches read the newer segments from the database"))
 
 
 def newer_than(project_id, after):

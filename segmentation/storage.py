@@ -1,4 +1,5 @@
-"""Reading and writing capture files through Django's storage (filesystem or S3-like)."""
+"""Reading and writing capture files through Django's storage (filesystem or S3-like), and
+reading a capture's take from its stored original."""
 
 import contextlib
 import io
@@ -7,7 +8,13 @@ import shutil
 import tempfile
 
 import numpy as np
+from django.conf import settings
 from django.core.files.base import ContentFile
+
+import motionlib
+from motionlib.io.npz import load_take
+from motionlib.take import Limits
+from segmentation.errors import NotReady
 
 
 @contextlib.contextmanager
@@ -55,3 +62,32 @@ def load_npz(fieldfile):
     with fieldfile.storage.open(fieldfile.name, "rb") as handle:
         with np.load(io.BytesIO(handle.read()), allow_pickle=False) as data:
             return {key: data[key] for key in data.files}
+
+
+def input_limits():
+    """motionlib's limits on what a capture may hold, with those set in the settings, and
+    at least two frames (one pose has no motion to segment or review)."""
+    overrides = {
+        "max_joints": settings.CUTROOM_MAX_JOINTS,
+        "max_frames": settings.CUTROOM_MAX_FRAMES,
+        "max_values": settings.CUTROOM_MAX_FRAME_VALUES,
+        "max_joint_frames": settings.CUTROOM_MAX_JOINT_FRAMES,
+        "max_expansion": settings.CUTROOM_MAX_EXPANSION,
+    }
+    return Limits(min_frames=2, **{k: v for k, v in overrides.items() if v is not None})
+
+
+def read_take(capture):
+    """The parsed take of a capture's stored original (BVH, or AMC with its ASF), or of the
+    take the convert worker saved for an FBX."""
+    if capture.converted:
+        with capture.converted.open("rb") as handle:
+            return load_take(io.BytesIO(handle.read()), path=capture.name)
+    if capture.needs_conversion:
+        raise NotReady(f"capture {capture.pk} is an FBX not converted yet")
+    limits = input_limits()
+    with local_path(capture.original) as path:
+        if capture.asf:
+            with local_path(capture.asf) as asf_path:
+                return motionlib.read(path, asf=asf_path, limits=limits)
+        return motionlib.read(path, limits=limits)

@@ -32,16 +32,10 @@ from django.utils import timezone
 
 from motionlib import similarity
 from segmentation import storage
-from segmentation.library import (
-    SHORTLIST,
-    SIMILAR_POOL,
-    capture_joints,
-    load_descriptors,
-    profile_pool,
-)
-from segmentation.models import Capture, Review
-from segmentation.models_library import LibrarySegment
-from segmentation.models_suggestions import LabelSuggestion, SuggestionRequest
+from segmentation.descriptors import capture_joints, load_descriptors, profile_pool
+from segmentation.models import Capture, LabelSuggestion, LibrarySegment, Review, SuggestionRequest
+from segmentation.search import SHORTLIST, SIMILAR_POOL
+from segmentation.services import jobs
 
 log = logging.getLogger(__name__)
 
@@ -134,13 +128,8 @@ def ask(capture, annotator):
 
 
 def _send(capture_id, annotator_id):
-    from segmentation import tasks
-
-    try:
-        tasks.suggest.delay(capture_id, annotator_id)
-    except Exception:
-        # The next look at the page asks again once the request counts as lost.
-        log.exception("could not send suggest(%s, %s)", capture_id, annotator_id)
+    jobs.send("suggest", capture_id, annotator_id,
+              then="the next look at the page asks again once the request counts as lost")
 
 
 def fill(capture, annotator):

@@ -15,24 +15,17 @@ from celery import shared_task
 from celery.signals import worker_init, worker_process_init, worker_ready
 from django.conf import settings
 
-from segmentation import services, suggestions
+from segmentation import services, similar_index, suggestions
 from segmentation.models import Capture, DetectionRun
-from segmentation.services import adaptation
-from segmentation.services.captures import exhausted, give_up
+from segmentation.services import adaptation, jobs
+from segmentation.services.convert import convert_capture
 
 log = logging.getLogger(__name__)
 
 
 def _claim(model, pk, task):
     """The claimed row, or None if another worker has it or it is already done."""
-    token = task.request.id or uuid.uuid4().hex
-    if not model.objects.claim(pk, token):
-        return None
-    job = model.objects.get(pk=pk)
-    if exhausted(job):
-        give_up(job)
-        return None
-    return job
+    return jobs.claim(model, pk, task.request.id or uuid.uuid4().hex)
 
 
 @shared_task(bind=True, acks_late=True, reject_on_worker_lost=True)
@@ -47,8 +40,6 @@ def ingest(self, capture_id):
              time_limit=settings.CUTROOM_CONVERT_TIME_LIMIT)
 def convert(self, capture_id):
     """Read an FBX capture with Blender (convert queue), then queue each animation's ingest."""
-    from segmentation.services.convert import convert_capture
-
     capture = _claim(Capture, capture_id, self)
     if capture is not None:
         convert_capture(capture)
@@ -103,8 +94,6 @@ def suggest(capture_id, annotator_id):
 @shared_task
 def update_similar_index(project_id):
     """Bring a project's similar-clip index in step with its library rows."""
-    from segmentation import similar_index
-
     similar_index.update(project_id)
 
 

@@ -13,12 +13,10 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from motionlib.errors import ParamError
+
 _TRUE = {"true", "1", "yes", "on"}
 _FALSE = {"false", "0", "no", "off"}
-
-
-class ParamError(ValueError):
-    """A segmenter name or parameter value is invalid; the message names it."""
 
 
 @dataclass(frozen=True)

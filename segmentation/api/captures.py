@@ -29,7 +29,6 @@ from segmentation.api.serializers import (
 )
 from segmentation.errors import NotReady, UploadTooLarge
 from segmentation.models import Capture, DetectionRun, JSONArrayLength, Review
-from segmentation.services import adaptation
 
 
 class CapturePagination(PageNumberPagination):
@@ -148,7 +147,7 @@ class CaptureViewSet(
         capture = self.get_object()
         if not capture.project.can_see_all_reviews(request.user):
             raise PermissionDenied("Only the project's reviewers and admins can re-detect a capture.")
-        run = adaptation.do_redetect(capture, request.user)
+        run = services.do_redetect(capture, request.user)
         return Response(RunSerializer(run).data, status=202)
 
     @extend_schema(methods=["GET"], responses=RunSerializer(many=True))

@@ -1,14 +1,19 @@
 """The one translator from domain errors to HTTP responses.
 
-- ``StaleVersion`` -> 409 with the current review;
+- ``StaleVersion`` -> 409 with the current review, ``StaleGold`` -> 409 with the current
+  gold version;
 - ``UploadTooLarge``, ``QuotaExceeded`` -> 413;
 - ``NotAllowed`` (a role refusal on a project the caller sees) -> 403;
 - ``TooManyRequests`` (rate and concurrency limits) -> 429 with ``Retry-After``;
-- any other ``ValueError`` (motionlib's ``CaptureError``/``ParamError``, the service's
-  own) -> 400 with its message, which names the field, file, line or value at fault;
-- DRF's own errors keep their status, and always carry a readable ``detail``.
+- any other domain error (motionlib's ``MotionlibError``: ``CaptureError``, ``ParamError``…;
+  the service's ``Invalid``) -> 400 with its message, which names the field, file, line or
+  value at fault;
+- DRF's own errors keep their status, and always carry a readable ``detail``;
+- anything else is a bug, not the caller's fault (a bare ``ValueError`` from numpy too): it is
+  logged with its traceback and answered 500 with a reference to quote.
 """
 
+import logging
 import re
 
 from django.http import Http404
@@ -17,43 +22,64 @@ from rest_framework.exceptions import NotFound
 from rest_framework.response import Response
 from rest_framework.views import exception_handler as drf_exception_handler
 
-from motionlib.segmenters import ParamError
+from motionlib.errors import MotionlibError, ParamError
+from segmentation.api.library import StaleGoldSerializer, gold_body
+from segmentation.api.serializers import ReviewSerializer
 from segmentation.errors import (
+    CutroomError,
     NotAllowed,
     QuotaExceeded,
+    StaleGold,
     StaleVersion,
     TooManyRequests,
     UploadTooLarge,
+    internal_error,
 )
+
+log = logging.getLogger(__name__)
 
 FIELD = re.compile(r"^(\w+): (.+)$", re.DOTALL)
 NO_MATCH = re.compile(r"^No (\w+) matches the given query\.$")
 
 
 def exception_handler(exc, context):
-    if isinstance(exc, StaleVersion):
-        from segmentation.api.serializers import ReviewSerializer
+    if isinstance(exc, MotionlibError | CutroomError):
+        return _domain_response(exc)
+    if isinstance(exc, Http404):
+        # Django's "No Cut matches the given query." names a model class, not a thing.
+        found = NO_MATCH.match(str(exc))
+        exc = NotFound(f"No such {_words(found.group(1))}." if found else "Not found.")
+    response = drf_exception_handler(exc, context)
+    if response is None:
+        reference = internal_error(_what(context), log)
+        return Response({"detail": "internal error", "reference": reference},
+                        status=status.HTTP_500_INTERNAL_SERVER_ERROR)
+    if isinstance(response.data, dict) and "detail" not in response.data:
+        response.data = {"detail": _summary(response.data), **response.data}
+    elif isinstance(response.data, list):
+        response.data = {"detail": _summary(response.data), "errors": response.data}
+    return response
 
+
+def _domain_response(exc):
+    if isinstance(exc, StaleVersion):
         body = {"detail": str(exc), "review": ReviewSerializer(exc.review).data}
+        return Response(body, status=status.HTTP_409_CONFLICT)
+    if isinstance(exc, StaleGold):
+        body = StaleGoldSerializer({"detail": str(exc), "gold": gold_body(exc.adjudication)}).data
         return Response(body, status=status.HTTP_409_CONFLICT)
     if isinstance(exc, NotAllowed):
         return Response({"detail": str(exc)}, status=status.HTTP_403_FORBIDDEN)
     if isinstance(exc, TooManyRequests):
         return Response(_value_error_body(exc), status=429,
                         headers={"Retry-After": str(exc.retry_after)})
-    if isinstance(exc, ValueError):
-        code = 413 if isinstance(exc, UploadTooLarge | QuotaExceeded) else 400
-        return Response(_value_error_body(exc), status=code)
-    if isinstance(exc, Http404):
-        # Django's "No Cut matches the given query." names a model class, not a thing.
-        found = NO_MATCH.match(str(exc))
-        exc = NotFound(f"No such {_words(found.group(1))}." if found else "Not found.")
-    response = drf_exception_handler(exc, context)
-    if response is not None and isinstance(response.data, dict) and "detail" not in response.data:
-        response.data = {"detail": _summary(response.data), **response.data}
-    elif response is not None and isinstance(response.data, list):
-        response.data = {"detail": _summary(response.data), "errors": response.data}
-    return response
+    code = 413 if isinstance(exc, UploadTooLarge | QuotaExceeded) else 400
+    return Response(_value_error_body(exc), status=code)
+
+
+def _what(context):
+    request = context.get("request")
+    return f"{request.method} {request.path}" if request is not None else "a request"
 
 
 def _value_error_body(exc):

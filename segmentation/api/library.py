@@ -24,7 +24,7 @@ from rest_framework.response import Response
 from rest_framework.utils.urls import remove_query_param, replace_query_param
 from rest_framework.views import APIView
 
-from segmentation import agreement, exports, library
+from segmentation import agreement, dashboard, exports, search
 from segmentation.api.captures import capture_for
 from segmentation.api.params import bool_param, float_param, int_param
 from segmentation.api.projects import project_for
@@ -33,8 +33,10 @@ from segmentation.api.serializers import (
     NamedRefSerializer,
     UserRefSerializer,
 )
-from segmentation.models import Review
-from segmentation.models_library import Adjudication, LibrarySegment
+from segmentation.errors import Invalid
+from segmentation.models import Adjudication, LibrarySegment, Review
+from segmentation.services.gold import do_save_gold
+from segmentation.storage import read_take
 
 # The schema's CaptureStateEnum (settings.SPECTACULAR_SETTINGS).
 CAPTURE_STATES = agreement.STATES
@@ -319,7 +321,7 @@ def segment_query(request):
             segments = segments.filter(**{lookup: value})
     ordering = request.query_params.get("ordering") or "recent"
     if ordering not in ORDERINGS:
-        raise ValueError(f"ordering: must be one of {', '.join(ORDERINGS)}, got {ordering!r}")
+        raise Invalid(f"ordering: must be one of {', '.join(ORDERINGS)}, got {ordering!r}")
     return segments.order_by(*ORDERINGS[ordering])
 
 
@@ -353,9 +355,9 @@ class SegmentBvhView(APIView):
     @extend_schema(responses={(200, "text/plain"): str})
     def get(self, request, pk):
         segment = segment_for(request.user, pk)
-        text = library.bvh_text(library.read_take(segment.capture), segment)
+        text = exports.bvh_text(read_take(segment.capture), segment)
         response = HttpResponse(text, content_type="application/octet-stream")
-        response["Content-Disposition"] = f'attachment; filename="{library.file_name(segment)}"'
+        response["Content-Disposition"] = f'attachment; filename="{exports.file_name(segment)}"'
         return response
 
 
@@ -367,7 +369,7 @@ class SegmentClipView(APIView):
         fmt = exports.check_format(fmt)
         segment = segment_for(request.user, pk)
         capture = segment.capture
-        [(_, name, data)] = exports.clip_files(capture, library.read_take(capture), [segment], fmt)
+        [(_, name, data)] = exports.clip_files(capture, read_take(capture), [segment], fmt)
         response = HttpResponse(data, content_type=exports.CONTENT_TYPES[fmt])
         response["Content-Disposition"] = f'attachment; filename="{name}"'
         return response
@@ -383,12 +385,12 @@ class SegmentZipView(APIView):
         fmt = exports.check_format(request.query_params.get("file_format"))
         segments = segment_query(request)
         count = segments.count()
-        if count > library.MAX_EXPORT_SEGMENTS:
-            raise ValueError(f"export: the query matches {count} segments; export at most "
-                             f"{library.MAX_EXPORT_SEGMENTS} at a time (narrow the filters)")
+        if count > exports.MAX_EXPORT_SEGMENTS:
+            raise Invalid(f"export: the query matches {count} segments; export at most "
+                          f"{exports.MAX_EXPORT_SEGMENTS} at a time (narrow the filters)")
         rows = (segments.select_related("capture", "annotator").defer("descriptor", "profile")
                 .order_by("capture_id", "start", "id").iterator(chunk_size=200))
-        response = StreamingHttpResponse(library.stream_zip(rows, fmt),
+        response = StreamingHttpResponse(exports.stream_zip(rows, fmt),
                                          content_type="application/zip")
         response["Content-Disposition"] = f'attachment; filename="segments-{fmt}.zip"'
         return response
@@ -403,7 +405,7 @@ class SimilarView(APIView):
         segment = visible.select_related("capture", "annotator", "label").filter(pk=pk).first()
         if segment is None:
             raise NotFound("No such segment.")
-        found = library.similar(segment, visible.preferred(), k=k)
+        found = search.similar(segment, visible.preferred(), k=k)
         for s, d in found:
             s.distance = round(d, 4)
         return Response(SimilarSerializer({"segment": segment.pk, "results": [s for s, _ in found]}).data)
@@ -484,14 +486,9 @@ class AdjudicationView(APIView):
             source = Review.objects.filter(pk=data["source_review"], capture=capture,
                                            status="submitted").first()
             if source is None:
-                raise ValueError(f"source_review: review {data['source_review']} is not a "
-                                 "submitted review of this capture")
-        try:
-            library.do_save_gold(capture, request.user, data["cuts"], data["labels"],
-                                 data["version"], source)
-        except library.StaleGold as exc:
-            body = {"detail": str(exc), "gold": gold_body(exc.adjudication)}
-            return Response(StaleGoldSerializer(body).data, status=409)
+                raise Invalid(f"source_review: review {data['source_review']} is not a "
+                              "submitted review of this capture")
+        do_save_gold(capture, request.user, data["cuts"], data["labels"], data["version"], source)
         return Response(AdjudicationSerializer(adjudication_body(capture)).data)
 
 
@@ -501,7 +498,7 @@ class DashboardView(APIView):
         project = project_for(request.user, pk)
         if not project.can_see_all_reviews(request.user):
             raise PermissionDenied("Only the project's reviewers and admins see its dashboard.")
-        return Response(DashboardSerializer(agreement.dashboard(project)).data)
+        return Response(DashboardSerializer(dashboard.dashboard(project)).data)
 
 
 urlpatterns = [

@@ -1,9 +1,10 @@
-"""Query-string parameters. Each parser raises ``ValueError`` (a 400) whose message names
+"""Query-string parameters. Each parser raises ``Invalid`` (a 400) whose message names
 the parameter and the value at fault."""
 
 import math
 
 from motionlib.errors import shorten
+from segmentation.errors import Invalid
 
 
 def int_param(request, name, default, low=None, high=None):
@@ -25,7 +26,7 @@ def bool_param(request, name):
         return True
     if raw.lower() in ("false", "0", "no"):
         return False
-    raise ValueError(f"{name}: must be true or false, got {shorten(raw)}")
+    raise Invalid(f"{name}: must be true or false, got {shorten(raw)}")
 
 
 # What a database integer holds (SQLite and PostgreSQL bigint): a larger filter is refused
@@ -40,13 +41,13 @@ def _number(request, name, default, convert, kind, low, high):
     try:
         value = convert(raw)
     except ValueError:
-        raise ValueError(f"{name}: must be {kind}, got {shorten(raw)}") from None
+        raise Invalid(f"{name}: must be {kind}, got {shorten(raw)}") from None
     if convert is int:
         low = INT_RANGE[0] if low is None else low
         high = INT_RANGE[1] if high is None else high
     elif not math.isfinite(value):
-        raise ValueError(f"{name}: must be a finite number, got {shorten(raw)}")
+        raise Invalid(f"{name}: must be a finite number, got {shorten(raw)}")
     if low is not None and value < low or high is not None and value > high:
         shown = raw if len(raw) <= 40 else shorten(raw)
-        raise ValueError(f"{name}: must be between {low} and {high}, got {shown}")
+        raise Invalid(f"{name}: must be between {low} and {high}, got {shown}")
     return value

@@ -9,7 +9,7 @@ from rest_framework.response import Response
 from rest_framework.views import APIView
 
 from motionlib.segmenters import list_segmenters
-from segmentation import services
+from segmentation import services, storage
 from segmentation.api.invitations import InvitationSerializer, InvitedSerializer, invited_response
 from segmentation.api.serializers import (
     CutModelSerializer,
@@ -20,6 +20,7 @@ from segmentation.api.serializers import (
     ProjectSerializer,
 )
 from segmentation.models import Membership, Project
+from segmentation.services.team import can_create_accounts
 
 
 class ProjectViewSet(
@@ -115,10 +116,8 @@ class MeView(APIView):
             {"id": m.project_id, "name": m.project.name, "role": m.role}
             for m in request.user.memberships.select_related("project").order_by("project_id")
         ]
-        from segmentation.services.team import can_create_accounts
-
         # What the service admits, so the pages refuse the same (e.g. a skeleton too big to draw).
-        limits = {"max_joints": services.captures.input_limits().max_joints}
+        limits = {"max_joints": storage.input_limits().max_joints}
         return Response(MeSerializer({
             "id": request.user.pk, "username": request.user.username, "projects": projects,
             "limits": limits, "can_create_accounts": can_create_accounts(request.user)}).data)

@@ -7,11 +7,11 @@ once their transaction commits, so a worker never sees a row that is not there y
 from segmentation.services.captures import (
     default_method,
     detect_run,
+    do_redetect,
     do_retry_capture,
     do_start_run,
     do_upload_capture,
     ingest_capture,
-    sweep_stale_claims,
 )
 from segmentation.services.invitations import (
     do_accept_invitation,
@@ -19,6 +19,7 @@ from segmentation.services.invitations import (
     do_cancel_invitation,
     do_decline_invitation,
 )
+from segmentation.services.jobs import sweep_stale_claims
 from segmentation.services.projects import (
     do_add_label,
     do_create_project,
@@ -45,6 +46,7 @@ __all__ = [
     "do_create_project",
     "do_decline_invitation",
     "do_insert_cut",
+    "do_redetect",
     "do_label_segment",
     "do_retry_capture",
     "do_set_member",

@@ -20,11 +20,14 @@ from django.db import IntegrityError, transaction
 from django.db.models import Max
 from django.utils import timezone
 
+from motionlib.errors import MotionlibError
 from motionlib.segmenters import get_segmenter
 from segmentation import takecache
-from segmentation.errors import NotReady, ReviewStarted
+from segmentation.errors import CutroomError, Invalid, internal_error
 from segmentation.models import Capture, ProjectCutModel, Review
-from segmentation.services.captures import do_start_run, heartbeat, read_take
+from segmentation.services import jobs
+from segmentation.services.jobs import heartbeat
+from segmentation.storage import read_take
 
 log = logging.getLogger(__name__)
 
@@ -65,13 +68,8 @@ def request_training(project_id):
 
 
 def _send_training(pk, countdown=0):
-    from segmentation import tasks
-
-    try:
-        tasks.retrain.apply_async((pk,), countdown=countdown)
-    except Exception:
-        # The row stays queued; the sweep sends it again later.
-        log.exception("could not send retrain(%s); the sweep will retry", pk)
+    # The row stays queued if the broker is down; the sweep sends it again later.
+    jobs.send("retrain", pk, countdown=countdown)
 
 
 # ---- training ----------------------------------------------------------------------------
@@ -106,8 +104,8 @@ def example_take(capture):
     so that an error names it."""
     try:
         take = takecache.read_cached(capture, read_take)
-    except (ValueError, OSError) as exc:
-        raise ValueError(f"reviewed capture {capture.pk} ({capture.name!r}) cannot be read: {exc}") from exc
+    except (MotionlibError, CutroomError, OSError) as exc:
+        raise Invalid(f"reviewed capture {capture.pk} ({capture.name!r}) cannot be read: {exc}") from exc
     # motionlib names a take by its path when it has one: the stored file's name is a
     # random folder away from what the studio knows, so name the capture instead.
     return dataclasses.replace(take, name=f"capture {capture.pk} ({capture.name})", path=None)
@@ -142,13 +140,13 @@ def train_project_model(job):
     try:
         with heartbeat(job):  # a training outlives the claim timeout; a dead one must not
             _train(job)
-    except ValueError as exc:
+    except (MotionlibError, CutroomError) as exc:
         job.fail(f"training: {exc}", finished_at=timezone.now())
-    except Exception as exc:
-        log.exception("training of project %s failed", job.project_id)
+    except Exception:
+        reference = internal_error(f"training of project {job.project_id}", log)
         job.fail(
-            f"training failed with an internal error ({type(exc).__name__}: {exc}); "
-            "report this to the service's administrators",
+            f"training failed with an internal error (reference {reference}); "
+            "report this reference to the service's administrators",
             finished_at=timezone.now(),
         )
     finally:
@@ -159,7 +157,7 @@ def _train(job):
     started = time.perf_counter()
     examples = project_examples(job.project_id)
     if not examples:
-        raise ValueError("the project has no submitted review or gold version to learn from")
+        raise Invalid("the project has no submitted review or gold version to learn from")
     takes = [(example_take(capture), cuts) for capture, cuts in examples]
     from motionlib import adapt
 
@@ -252,34 +250,6 @@ def _loaded(pk, version):
     except ValueError:
         log.exception("cut model v%s (row %s) cannot be read; detecting zero-shot", version, pk)
         return None
-
-
-# ---- re-detecting ------------------------------------------------------------------------
-
-
-def do_redetect(capture, user):
-    """Queue a new detection of ``capture`` with the project's method, parameters and
-    newest model, for a capture nobody has started reviewing.
-
-    A review is started as soon as someone opens the capture for review (its candidates
-    are copied into the review then); new candidates would not reach that review, so
-    re-detection is refused with the annotators' names.
-    """
-    if capture.status != "ready":
-        raise NotReady(f"capture {capture.pk} is {capture.status}; detection needs a ready capture")
-    project = capture.project
-    with transaction.atomic():
-        # One re-detection or review start at a time per capture.
-        Capture.objects.select_for_update().filter(pk=capture.pk).first()
-        names = sorted(capture.reviews.values_list("annotator__username", flat=True))
-        if names:
-            raise ReviewStarted(
-                f"capture: {', '.join(names)} started reviewing {capture.name!r}; "
-                "re-detection would change the candidates under their review"
-            )
-        if capture.runs.filter(status__in=("queued", "processing")).exists():
-            raise NotReady(f"capture {capture.pk} already has a detection queued or running")
-        return do_start_run(capture, user, project.default_method, project.default_params)
 
 
 # ---- what the review page shows ----------------------------------------------------------

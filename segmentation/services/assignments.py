@@ -9,7 +9,7 @@ already assigned to someone in the pool counts towards its N.
 from django.db import transaction
 from django.utils import timezone
 
-from segmentation.errors import NotAllowed
+from segmentation.errors import Invalid, NotAllowed
 from segmentation.models import Assignment, Capture, Membership, Review
 
 
@@ -17,24 +17,24 @@ def members_by_username(project, usernames):
     """The project's members with these usernames, in the given order; ValueError names
     anyone who is not a member."""
     if not isinstance(usernames, list) or not usernames:
-        raise ValueError("annotators: give a non-empty list of usernames")
+        raise Invalid("annotators: give a non-empty list of usernames")
     found = {
         m.user.username: m.user
         for m in Membership.objects.filter(project=project, user__username__in=usernames).select_related("user")
     }
     missing = [u for u in usernames if u not in found]
     if missing:
-        raise ValueError(f"annotators: not members of this project: {', '.join(map(str, missing))}")
+        raise Invalid(f"annotators: not members of this project: {', '.join(map(str, missing))}")
     return [found[u] for u in dict.fromkeys(usernames)]
 
 
 def project_captures(project, capture_ids):
     if not isinstance(capture_ids, list) or not capture_ids:
-        raise ValueError("captures: give a non-empty list of capture ids")
+        raise Invalid("captures: give a non-empty list of capture ids")
     captures = {c.pk: c for c in Capture.objects.filter(project=project, pk__in=capture_ids)}
     missing = [pk for pk in capture_ids if pk not in captures]
     if missing:
-        raise ValueError(f"captures: not captures of this project: {', '.join(map(str, missing))}")
+        raise Invalid(f"captures: not captures of this project: {', '.join(map(str, missing))}")
     return [captures[pk] for pk in dict.fromkeys(capture_ids)]
 
 
@@ -60,8 +60,8 @@ def do_assign(project, actor, capture_ids, usernames, per_capture=None):
     if per_capture is None:
         per_capture = len(pool)
     if isinstance(per_capture, bool) or not isinstance(per_capture, int) or not 1 <= per_capture <= len(pool):
-        raise ValueError(f"per_capture: must be between 1 and {len(pool)} (the annotators given), "
-                         f"got {per_capture!r}")
+        raise Invalid(f"per_capture: must be between 1 and {len(pool)} (the annotators given), "
+                      f"got {per_capture!r}")
     made = []
     with transaction.atomic():
         # One assignment run at a time per project, so two spreads do not both pick the
@@ -88,7 +88,7 @@ def do_reassign(assignment, actor, username):
     (user,) = members_by_username(assignment.capture.project, [username])
     with transaction.atomic():
         if Assignment.objects.filter(capture=assignment.capture, annotator=user).exists():
-            raise ValueError(f"annotator: {username!r} is already assigned to {assignment.capture.name!r}")
+            raise Invalid(f"annotator: {username!r} is already assigned to {assignment.capture.name!r}")
         assignment.annotator, assignment.assigned_by = user, actor
         assignment.created_at = timezone.now()
         assignment.save(update_fields=["annotator", "assigned_by", "created_at"])

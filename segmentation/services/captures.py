@@ -1,30 +1,35 @@
-"""Captures and detection runs: upload, ingest, detect, and recovery of abandoned jobs."""
+"""Captures and detection runs: upload, ingest, detect (recovery of abandoned jobs is
+``services.jobs``)."""
 
 import hashlib
-import io
 import logging
 import os
 import re
-import threading
 import uuid
-from contextlib import contextmanager
 
 import numpy as np
 from celery.exceptions import SoftTimeLimitExceeded
 from django.conf import settings
-from django.db import IntegrityError, connection, transaction
+from django.db import IntegrityError, transaction
 from django.utils import timezone
 
 import motionlib
-from motionlib.errors import shorten
-from motionlib.io.npz import load_take
+from motionlib.errors import MotionlibError, shorten
 from motionlib.segmenters import ParamError, get_segmenter, list_segmenters
-from motionlib.take import Limits
 from segmentation import storage
-from segmentation.errors import NotReady, UploadError, UploadTooLarge
+from segmentation.errors import (
+    CutroomError,
+    NotReady,
+    ReviewStarted,
+    UploadError,
+    UploadTooLarge,
+    internal_error,
+)
 from segmentation.models import Capture, DetectionRun
-from segmentation.services import quotas
+from segmentation.services import adaptation, jobs, quotas
+from segmentation.services.jobs import enqueue
 from segmentation.services.reviews import do_take_in_candidates
+from segmentation.storage import read_take
 
 log = logging.getLogger(__name__)
 
@@ -111,7 +116,7 @@ def do_upload_capture(project, user, upload, asf=None):
     try:
         with transaction.atomic():
             capture.save()
-            _enqueue(first_job(capture), capture.pk)
+            enqueue(capture.first_job(), capture.pk)
     except IntegrityError:
         # The same file arrived twice at once; the other request stored it.
         return Capture.objects.get(project=project, checksum=digest), False
@@ -146,7 +151,7 @@ def _requeue_failed(capture):
     with transaction.atomic():
         if not Capture.objects.requeue_failed(capture.pk):
             return False
-        _enqueue(first_job(capture), capture.pk)
+        enqueue(capture.first_job(), capture.pk)
     return True
 
 
@@ -160,71 +165,20 @@ def do_start_run(capture, user, method, params):
         run = DetectionRun.objects.create(
             capture=capture, method=method, params=params, created_by=user
         )
-        _enqueue("detect", run.pk)
+        enqueue("detect", run.pk)
     return run
 
 
-def first_job(capture):
-    """``convert`` for an FBX Blender has not read yet (the convert queue), else ``ingest``."""
-    return "convert" if capture.needs_conversion else "ingest"
-
-
-def _enqueue(task_name, pk):
-    """Send the job once the row is committed (a worker must be able to see it)."""
-    from segmentation import tasks
-
-    # FBX conversion runs Blender: its own queue, served by its own worker.
-    options = {"queue": settings.CUTROOM_CONVERT_QUEUE} if task_name == "convert" else {}
-    transaction.on_commit(lambda: _send(getattr(tasks, task_name), pk, options))
-
-
-def _send(task, pk, options=None):
-    try:
-        task.apply_async((pk,), **(options or {}))
-    except Exception:
-        # The row is stored and stays queued; the sweep sends it again later, so an
-        # unreachable broker costs a delay, never the upload.
-        log.exception("could not send %s(%s); the sweep will retry", task.name, pk)
-
-
-def input_limits():
-    """motionlib's limits on what a capture may hold, with those set in the settings, and
-    at least two frames (one pose has no motion to segment or review)."""
-    overrides = {
-        "max_joints": settings.CUTROOM_MAX_JOINTS,
-        "max_frames": settings.CUTROOM_MAX_FRAMES,
-        "max_values": settings.CUTROOM_MAX_FRAME_VALUES,
-        "max_joint_frames": settings.CUTROOM_MAX_JOINT_FRAMES,
-        "max_expansion": settings.CUTROOM_MAX_EXPANSION,
-    }
-    return Limits(min_frames=2, **{k: v for k, v in overrides.items() if v is not None})
-
-
-def read_take(capture):
-    """The parsed take of a capture's stored original (BVH, or AMC with its ASF), or of the
-    take the convert worker saved for an FBX."""
-    if capture.converted:
-        with capture.converted.open("rb") as handle:
-            return load_take(io.BytesIO(handle.read()), path=capture.name)
-    if capture.needs_conversion:
-        raise NotReady(f"capture {capture.pk} is an FBX not converted yet")
-    limits = input_limits()
-    with storage.local_path(capture.original) as path:
-        if capture.asf:
-            with storage.local_path(capture.asf) as asf_path:
-                return motionlib.read(path, asf=asf_path, limits=limits)
-        return motionlib.read(path, limits=limits)
-
-
 def _guarded(job, what, work, **fail_fields):
-    """Run ``work()``; any error fails the job with a message a person can act on, so a
-    job never stays "processing" because of its input or a bug.
+    """Run ``work()``; any error fails the job, so a job never stays "processing" because
+    of its input or a bug.
 
-    A ValueError is the input's fault (motionlib names file, line and value); anything
-    else is ours and is logged with its traceback.
+    A domain error (motionlib's, naming file, line and value, or the service's own) is the
+    input's fault and its message is stored as it is; anything else is ours: it is logged
+    with its traceback and the job stores an internal error with a reference to quote.
     """
     try:
-        with heartbeat(job):
+        with jobs.heartbeat(job):
             work()
     except SoftTimeLimitExceeded:
         job.fail(
@@ -234,14 +188,13 @@ def _guarded(job, what, work, **fail_fields):
             "Try parameters that cost less, or ask the administrators to raise the limit.",
             **fail_fields,
         )
-    except ValueError as exc:
+    except (MotionlibError, CutroomError) as exc:
         job.fail(_bounded(str(exc), 2000), **fail_fields)
-    except Exception as exc:
-        log.exception("%s failed", what)
+    except Exception:
+        reference = internal_error(what, log)
         job.fail(
-            f"{what} failed with an internal error ({type(exc).__name__}: "
-            f"{_bounded(str(exc), 300)}). "
-            "The original upload is kept; report this to the service's administrators.",
+            f"{what} failed with an internal error (reference {reference}). The original "
+            "upload is kept; report this reference to the service's administrators.",
             **fail_fields,
         )
 
@@ -249,36 +202,6 @@ def _guarded(job, what, work, **fail_fields):
 def _bounded(text, limit):
     """An error text for a job's row, cut to about ``limit`` characters."""
     return text if len(text) <= limit else text[:limit] + "..."
-
-
-@contextmanager
-def heartbeat(job):
-    """Renew ``job``'s claim while the block runs.
-
-    A claim not renewed for CUTROOM_CLAIM_TIMEOUT seconds means its process died (a pool
-    process killed, a worker lost with its machine); the sweep then requeues the job. So
-    a dead job is noticed within that timeout, however long a live job runs.
-    """
-    stop = threading.Event()
-    interval = max(settings.CUTROOM_CLAIM_TIMEOUT / 6, 0.2)
-    owned = type(job).objects.filter(pk=job.pk, status="processing", claim_token=job.claim_token)
-
-    def renew():
-        try:
-            while not stop.wait(interval):
-                owned.update(claimed_at=timezone.now())
-        except Exception:
-            log.exception("could not renew the claim on %s", job)
-        finally:
-            connection.close()
-
-    beating = threading.Thread(target=renew, name=f"heartbeat {job}", daemon=True)
-    beating.start()
-    try:
-        yield
-    finally:
-        stop.set()
-        beating.join()
 
 
 def ingest_capture(capture):
@@ -343,7 +266,7 @@ def _start_default_run(capture):
         )
         return None
     run = DetectionRun.objects.create(capture=capture, method=method, params=params)
-    _enqueue("detect", run.pk)
+    enqueue("detect", run.pk)
     return run
 
 
@@ -353,8 +276,6 @@ def detect_run(run):
 
 
 def _detect(run, take=None):
-    from segmentation.services import adaptation
-
     take = read_take(run.capture) if take is None else take
     # Runs of the default method detect with the project's newest learnt model.
     result, model_fields = adaptation.detect(run, take)
@@ -376,59 +297,26 @@ def _detect(run, take=None):
         do_take_in_candidates(run)
 
 
-def exhausted(job):
-    """A job claimed more than CUTROOM_MAX_ATTEMPTS times: its input keeps killing workers."""
-    return job.attempts > settings.CUTROOM_MAX_ATTEMPTS
+def do_redetect(capture, user):
+    """Queue a new detection of ``capture`` with the project's method, parameters and
+    newest model, for a capture nobody has started reviewing.
 
-
-def give_up(job):
-    """Mark a job that never finished as failed, saying why."""
-    extra = {"finished_at": timezone.now()} if isinstance(job, DetectionRun) else {}
-    return job.fail(
-        f"processing started {job.attempts} times and never finished (the worker was killed "
-        "or lost each time); giving up. The original upload is kept.",
-        **extra,
-    )
-
-
-def sweep_stale_claims():
-    """Requeue jobs whose worker vanished mid-way (failing those retried too often) and
-    resend jobs queued for longer than the claim timeout.
-
-    Returns the number of jobs requeued, failed or resent.
+    A review is started as soon as someone opens the capture for review (its candidates
+    are copied into the review then); new candidates would not reach that review, so
+    re-detection is refused with the annotators' names.
     """
-    count = 0
-    for model, task_name in ((Capture, first_job), (DetectionRun, "detect")):
-        count += _resend_waiting(model, task_name)
-        count += _rescue_stale(model, task_name)
-    return count
-
-
-def _resend_waiting(model, task_name):
-    count = 0
-    for job in model.objects.waiting_too_long():
-        with transaction.atomic():
-            model.objects.filter(pk=job.pk, status="queued").update(claimed_at=timezone.now())
-            _enqueue(_job_name(task_name, job), job.pk)
-        count += 1
-    return count
-
-
-def _job_name(task_name, job):
-    return task_name(job) if callable(task_name) else task_name
-
-
-def _rescue_stale(model, task_name):
-    count = 0
-    for job in model.objects.stale():
-        if job.attempts >= settings.CUTROOM_MAX_ATTEMPTS:
-            count += give_up(job)
-            continue
-        with transaction.atomic():
-            requeued = model.objects.filter(
-                pk=job.pk, status="processing", claim_token=job.claim_token
-            ).update(status="queued", claim_token="", claimed_at=timezone.now())
-            if requeued:
-                _enqueue(_job_name(task_name, job), job.pk)
-        count += requeued
-    return count
+    if capture.status != "ready":
+        raise NotReady(f"capture {capture.pk} is {capture.status}; detection needs a ready capture")
+    project = capture.project
+    with transaction.atomic():
+        # One re-detection or review start at a time per capture.
+        Capture.objects.select_for_update().filter(pk=capture.pk).first()
+        names = sorted(capture.reviews.values_list("annotator__username", flat=True))
+        if names:
+            raise ReviewStarted(
+                f"capture: {', '.join(names)} started reviewing {capture.name!r}; "
+                "re-detection would change the candidates under their review"
+            )
+        if capture.runs.filter(status__in=("queued", "processing")).exists():
+            raise NotReady(f"capture {capture.pk} already has a detection queued or running")
+        return do_start_run(capture, user, project.default_method, project.default_params)

@@ -16,7 +16,8 @@ from motionlib.io.fbx import read_fbx_all
 from motionlib.io.npz import take_bytes
 from segmentation import storage
 from segmentation.models import Capture
-from segmentation.services.captures import _enqueue, _guarded
+from segmentation.services.captures import _guarded
+from segmentation.services.jobs import enqueue
 
 log = logging.getLogger(__name__)
 
@@ -46,7 +47,7 @@ def _convert(capture):
         )
         if not handed_over:
             return  # another worker took this capture over; it converts it itself
-        _enqueue("ingest", capture.pk)
+        enqueue("ingest", capture.pk)
     for take in rest:
         add_animation(capture, take)
 
@@ -74,6 +75,6 @@ def add_animation(capture, take):
     try:
         with transaction.atomic():
             sibling.save()
-            _enqueue("ingest", sibling.pk)
+            enqueue("ingest", sibling.pk)
     except IntegrityError:
         log.info("animation %s of capture %s already added", take.animation, capture.pk)

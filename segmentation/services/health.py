@@ -7,6 +7,7 @@ from django.db.models.functions import Coalesce
 from django.utils import timezone
 
 from segmentation.models import Capture, DetectionRun
+from segmentation.models.jobs import claim_cutoff
 
 JOBS = (Capture, DetectionRun)
 
@@ -28,9 +29,9 @@ def stalled(concurrency, after=None):
     taken = _latest(model.objects.exclude(status="queued") for model in JOBS)
     if taken is not None and taken > limit:
         return None
-    fresh = now - timezone.timedelta(seconds=settings.CUTROOM_CLAIM_TIMEOUT)
     running = sum(
-        model.objects.filter(status="processing", claimed_at__gte=fresh).count() for model in JOBS
+        model.objects.filter(status="processing", claimed_at__gte=claim_cutoff()).count()
+        for model in JOBS
     )
     if running >= concurrency:
         return None

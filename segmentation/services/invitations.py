@@ -14,6 +14,7 @@ from django.contrib.auth import get_user_model
 from django.db import transaction
 from django.utils import timezone
 
+from segmentation.errors import Invalid
 from segmentation.models import Invitation
 from segmentation.services.projects import do_set_member
 
@@ -33,13 +34,13 @@ def do_add_member(project, actor, username, role):
     Inviting a username again replaces its pending invitation.
     """
     if not username or len(username) > USERNAME_MAX:
-        raise ValueError(f"username: must be 1 to {USERNAME_MAX} characters, got {len(username)}")
+        raise Invalid(f"username: must be 1 to {USERNAME_MAX} characters, got {len(username)}")
     with transaction.atomic():
         if project.memberships.filter(user__username=username).exists():
             return do_set_member(project, username, role)
         users = get_user_model().objects
         if can_see_accounts(actor) and not users.filter(username=username).exists():
-            raise ValueError(f"username: no user named {username!r}")
+            raise Invalid(f"username: no user named {username!r}")
         now = timezone.now()
         invitation, _ = Invitation.objects.update_or_create(
             project=project, username=username, status="pending",
@@ -70,7 +71,7 @@ def do_cancel_invitation(invitation, admin):
     with transaction.atomic():
         invitation = Invitation.objects.select_for_update().get(pk=invitation.pk)
         if invitation.status != "pending":
-            raise ValueError(f"status: the invitation is already {invitation.status}")
+            raise Invalid(f"status: the invitation is already {invitation.status}")
         _answer(invitation, admin, "cancelled")
     return invitation
 
@@ -79,7 +80,7 @@ def _still_pending(invitation, user):
     """The invitation re-read under a row lock, if it is still the user's to answer."""
     locked = Invitation.objects.select_for_update().for_user(user).filter(pk=invitation.pk).first()
     if locked is None:
-        raise ValueError("status: this invitation was already answered, cancelled or has expired")
+        raise Invalid("status: this invitation was already answered, cancelled or has expired")
     return locked
 
 

@@ -3,8 +3,9 @@
 import re
 
 from django.contrib.auth import get_user_model
-from django.db import transaction
+from django.db import IntegrityError, transaction
 
+from segmentation.errors import Invalid
 from segmentation.models import Label, Membership, Project
 from segmentation.services.captures import validate_method
 
@@ -25,15 +26,27 @@ def do_create_project(user, name, default_method="", default_params=None,
 
 
 def do_update_project(project, **fields):
-    """Rename a project or change its default method and parameters."""
-    method = fields.get("default_method", project.default_method)
-    if "default_method" in fields or "default_params" in fields:
-        params = fields.get("default_params", project.default_params)
-        fields["default_params"] = checked_defaults(method, params)
-    for name, value in fields.items():
-        setattr(project, name, value)
-    project.save(update_fields=list(fields))
+    """Rename a project or change its default method and parameters.
+
+    The project row is locked and read again first, so new parameters are checked against
+    the method as stored by a concurrent change, not as this request last saw it.
+    """
+    with transaction.atomic():
+        current = _locked(project)
+        method = fields.get("default_method", current.default_method)
+        if "default_method" in fields or "default_params" in fields:
+            params = fields.get("default_params", current.default_params)
+            fields["default_params"] = checked_defaults(method, params)
+        for name, value in fields.items():
+            setattr(project, name, value)
+        project.save(update_fields=list(fields))
     return project
+
+
+def _locked(project):
+    """The project row, locked until the transaction ends: the changes of its members, its
+    settings and its taxonomy run one after the other (see also ``services.team``)."""
+    return Project.objects.select_for_update().get(pk=project.pk)
 
 
 def checked_defaults(method, params):
@@ -47,13 +60,13 @@ def do_set_member(project, username, role):
     """Add a user to the project, or change their role; a project keeps one admin."""
     user = get_user_model().objects.filter(username=username).first()
     if user is None:
-        raise ValueError(f"username: no user named {username!r}")
+        raise Invalid(f"username: no user named {username!r}")
     with transaction.atomic():
         # The project row lock serialises role changes (see services.team).
-        Project.objects.select_for_update().get(pk=project.pk)
+        _locked(project)
         demoted = project.role_of(user) == "admin" and role != "admin"
         if demoted and project.memberships.filter(role="admin").count() == 1:
-            raise ValueError(f"role: {username!r} is the project's only admin; add another admin first")
+            raise Invalid(f"role: {username!r} is the project's only admin; add another admin first")
         membership, _ = Membership.objects.update_or_create(
             project=project, user=user, defaults={"role": role}
         )
@@ -64,15 +77,26 @@ def do_add_label(project, name, color="#888888", hotkey=None):
     """Add a label to the taxonomy; names and hotkeys are unique within a project."""
     name = name.strip()
     if not name:
-        raise ValueError("name: a label needs a name")
+        raise Invalid("name: a label needs a name")
     if not COLOR.match(color or ""):
-        raise ValueError(f"color: must look like #rrggbb, got {color!r}")
+        raise Invalid(f"color: must look like #rrggbb, got {color!r}")
     if hotkey is not None and (len(hotkey) != 1 or hotkey not in "123456789"):
-        raise ValueError(f"hotkey: must be one of 1..9 or null, got {hotkey!r}")
-    if project.labels.filter(name=name).exists():
-        raise ValueError(f"name: the project already has a label {name!r}")
-    if hotkey and project.labels.filter(hotkey=hotkey).exists():
-        raise ValueError(f"hotkey: {hotkey!r} is already used by another label")
-    position = project.labels.count()  # new labels go to the end of the taxonomy
-    return Label.objects.create(project=project, name=name, color=color.lower(), hotkey=hotkey,
-                                position=position)
+        raise Invalid(f"hotkey: must be one of 1..9 or null, got {hotkey!r}")
+    with transaction.atomic():
+        # Concurrent adds run one after the other: the second sees the first's label.
+        _locked(project)
+        if project.labels.filter(name=name).exists():
+            raise Invalid(f"name: the project already has a label {name!r}")
+        if hotkey and project.labels.filter(hotkey=hotkey).exists():
+            raise Invalid(f"hotkey: {hotkey!r} is already used by another label")
+        position = project.labels.count()  # new labels go to the end of the taxonomy
+        try:
+            with transaction.atomic():
+                return Label.objects.create(project=project, name=name, color=color.lower(),
+                                            hotkey=hotkey, position=position)
+        except IntegrityError:
+            # Where the database cannot lock the row (SQLite), a concurrent add still
+            # loses to the unique constraints: say which, as the checks above would.
+            if hotkey is None or project.labels.filter(name=name).exists():
+                raise Invalid(f"name: the project already has a label {name!r}") from None
+            raise Invalid(f"hotkey: {hotkey!r} is already used by another label") from None

@@ -4,8 +4,9 @@ from django.db import transaction
 from django.db.models import F
 from django.utils import timezone
 
-from segmentation.errors import ReviewClosed
+from segmentation.errors import Invalid, ReviewClosed
 from segmentation.models import Review, ReviewEvent
+from segmentation.services.library import on_review_submitted
 
 
 def do_return_review(review, reviewer, comment):
@@ -16,10 +17,7 @@ def do_return_review(review, reviewer, comment):
     """
     comment = (comment or "").strip()
     if not comment:
-        raise ValueError("comment: say what the annotator should change")
-    # Rebuilds the capture's agreement and library rows from its submitted reviews.
-    from segmentation.library import on_review_submitted
-
+        raise Invalid("comment: say what the annotator should change")
     with transaction.atomic():
         now = timezone.now()
         updated = Review.objects.filter(pk=review.pk, status="submitted").update(
@@ -32,5 +30,6 @@ def do_return_review(review, reviewer, comment):
         ReviewEvent.objects.create(review=review, user=reviewer, action="return",
                                    before={"status": "submitted"},
                                    after={"status": "returned", "comment": comment})
+        # Rebuilds the capture's agreement and library rows from its submitted reviews.
         on_review_submitted(review)
     return review

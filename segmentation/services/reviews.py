@@ -10,8 +10,11 @@ from django.db import IntegrityError, transaction
 from django.db.models import F
 from django.utils import timezone
 
-from segmentation.errors import NotReady, ReviewClosed, StaleVersion
+from segmentation.errors import Invalid, NotReady, ReviewClosed, StaleVersion
 from segmentation.models import Cut, Review, ReviewEvent, SegmentLabel
+from segmentation.services.adaptation import on_examples_changed
+from segmentation.services.assignments import check_may_start
+from segmentation.services.library import on_review_submitted
 
 FATE_ACTIONS = {"accepted": "accept", "deleted": "delete", "pending": "reset"}
 
@@ -26,8 +29,6 @@ def own_review(capture, user):
     if review is None:
         # An annotator who may not pick this capture (not assigned to them, in a project
         # that does not allow picking) may not start, so may not open, its review.
-        from segmentation.services.assignments import check_may_start
-
         check_may_start(capture, user)
     if review is not None:
         review.capture, review.annotator = capture, user
@@ -134,16 +135,12 @@ def _write(review, version):
 
 def _check_frame(review, frame, moving=None):
     """A cut frame must be inside the take and not on another kept cut."""
-    n_frames = review.capture.n_frames
-    if isinstance(frame, bool) or not isinstance(frame, int):
-        raise ValueError(f"frame: must be an integer, got {frame!r}")
-    if not 0 < frame < n_frames:
-        raise ValueError(f"frame: must be between 1 and {n_frames - 1}, got {frame}")
+    review.capture.check_cut_frame(frame)
     taken = review.cuts.exclude(fate="deleted").filter(frame=frame)
     if moving is not None:
         taken = taken.exclude(pk=moving.pk)
     if taken.exists():
-        raise ValueError(f"frame: there is already a cut at frame {frame}")
+        raise Invalid(f"frame: there is already a cut at frame {frame}")
 
 
 def _log(review, user, action, cut=None, before=None, after=None):
@@ -175,7 +172,7 @@ def do_change_cut(review, user, cut, version, fate=None, frame=None):
             action = "move"
         else:
             if fate not in FATE_ACTIONS:
-                raise ValueError(f"fate: must be accepted, deleted or pending, got {fate!r}")
+                raise Invalid(f"fate: must be accepted, deleted or pending, got {fate!r}")
             if cut.fate == "deleted" and fate != "deleted":
                 _check_frame(review, cut.frame, moving=cut)
             cut.fate = fate
@@ -192,15 +189,15 @@ def do_label_segment(review, user, index, label_name, version):
         try:
             start_cut = review.segment_start_cut(index)
         except IndexError:
-            raise ValueError(f"index: the review has no segment {index}") from None
+            raise Invalid(f"index: the review has no segment {index}") from None
         label = None
         if label_name is not None:
             label = review.capture.project.labels.filter(name=label_name).first()
             if label is not None and label.retired:
-                raise ValueError(f"label: {label_name!r} is retired; pick a label in use")
+                raise Invalid(f"label: {label_name!r} is retired; pick a label in use")
             if label is None:
                 names = ", ".join(review.capture.project.labels.values_list("name", flat=True))
-                raise ValueError(f"label: {label_name!r} is not a label of this project ({names})")
+                raise Invalid(f"label: {label_name!r} is not a label of this project ({names})")
         row, _ = SegmentLabel.objects.get_or_create(review=review, cut=start_cut)
         before = {"index": index, "label": row.label.name if row.label else None}
         row.label = label
@@ -220,11 +217,7 @@ def do_submit_review(review, user, version):
         action = "resubmit" if was == "returned" else "submit"
         _log(review, user, action, before={"status": was}, after={"status": "submitted"})
         # Materialise the capture's library rows and agreement with the submit itself.
-        from segmentation.library import on_review_submitted
-
         on_review_submitted(review)
         # The project's cut model learns from the new example once this commits.
-        from segmentation.services.adaptation import on_examples_changed
-
         on_examples_changed(review.capture.project_id)
     return review

@@ -6,6 +6,7 @@ stays on the segments that carry it but is no longer offered for new ones.
 
 from django.db import transaction
 
+from segmentation.errors import Invalid
 from segmentation.models import Label
 from segmentation.services.projects import COLOR
 
@@ -19,21 +20,21 @@ def do_change_label(label, **fields):
     if "name" in fields:
         name = (fields["name"] or "").strip()
         if not name:
-            raise ValueError("name: a label needs a name")
+            raise Invalid("name: a label needs a name")
         if project.labels.filter(name=name).exclude(pk=label.pk).exists():
-            raise ValueError(f"name: the project already has a label {name!r}")
+            raise Invalid(f"name: the project already has a label {name!r}")
         label.name = name
     if "color" in fields:
         if not COLOR.match(fields["color"] or ""):
-            raise ValueError(f"color: must look like #rrggbb, got {fields['color']!r}")
+            raise Invalid(f"color: must look like #rrggbb, got {fields['color']!r}")
         label.color = fields["color"].lower()
     if "hotkey" in fields:
         hotkey = fields["hotkey"] or None
         if hotkey is not None and (len(hotkey) != 1 or hotkey not in HOTKEYS):
-            raise ValueError(f"hotkey: must be one of 1..9 or null, got {hotkey!r}")
+            raise Invalid(f"hotkey: must be one of 1..9 or null, got {hotkey!r}")
         other = project.labels.filter(hotkey=hotkey).exclude(pk=label.pk).first() if hotkey else None
         if other:
-            raise ValueError(f"hotkey: {hotkey!r} is already used by {other.name!r}")
+            raise Invalid(f"hotkey: {hotkey!r} is already used by {other.name!r}")
         label.hotkey = hotkey
     if "retired" in fields:
         label.retired = bool(fields["retired"])
@@ -47,8 +48,8 @@ def do_reorder_labels(project, ids):
     """Put the taxonomy in the order of ``ids`` (every label of the project, once)."""
     labels = {label.pk: label for label in project.labels.all()}
     if not isinstance(ids, list) or sorted(ids) != sorted(labels):
-        raise ValueError(f"order: must list each of the project's label ids once ({sorted(labels)}), "
-                         f"got {ids!r}")
+        raise Invalid(f"order: must list each of the project's label ids once ({sorted(labels)}), "
+                      f"got {ids!r}")
     with transaction.atomic():
         for position, pk in enumerate(ids):
             labels[pk].position = position

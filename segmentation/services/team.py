@@ -10,7 +10,7 @@ import secrets
 from django.contrib.auth import get_user_model
 from django.db import IntegrityError, transaction
 
-from segmentation.errors import NotAllowed
+from segmentation.errors import Invalid, NotAllowed
 from segmentation.models import Membership, Project
 
 ROLES = ("annotator", "reviewer", "admin")
@@ -25,13 +25,13 @@ def _keep_an_admin(project, membership, new_role):
         return
     others = project.memberships.filter(role="admin").exclude(pk=membership.pk)
     if not others.exists():
-        raise ValueError(f"role: {membership.user.username!r} is the project's last admin; "
-                         "make someone else admin first")
+        raise Invalid(f"role: {membership.user.username!r} is the project's last admin; "
+                      "make someone else admin first")
 
 
 def do_change_role(project, membership, role):
     if role not in ROLES:
-        raise ValueError(f"role: must be one of {', '.join(ROLES)}, got {role!r}")
+        raise Invalid(f"role: must be one of {', '.join(ROLES)}, got {role!r}")
     with transaction.atomic():
         _locked(project)
         membership = Membership.objects.select_related("user").get(pk=membership.pk)
@@ -66,15 +66,15 @@ def do_create_account(project, actor, username, role):
     if not can_create_accounts(actor):
         raise NotAllowed("Only site admins create accounts; invite an existing user instead.")
     if role not in ROLES:
-        raise ValueError(f"role: must be one of {', '.join(ROLES)}, got {role!r}")
+        raise Invalid(f"role: must be one of {', '.join(ROLES)}, got {role!r}")
     username = (username or "").strip()
     if not username or len(username) > 150:
-        raise ValueError("username: must be 1 to 150 characters")
+        raise Invalid("username: must be 1 to 150 characters")
     password = secrets.token_urlsafe(12)
     try:
         with transaction.atomic():
             user = get_user_model().objects.create_user(username, password=password)
             membership = Membership.objects.create(project=project, user=user, role=role)
     except IntegrityError:
-        raise ValueError(f"username: an account named {username!r} already exists; invite it") from None
+        raise Invalid(f"username: an account named {username!r} already exists; invite it") from None
     return membership, password

@@ -17,7 +17,7 @@ def two_reviews(capture, studio):
 
 
 def test_it_makes_a_gold_version_from_two_annotators_reviews(live_server, new_page, ingested_capture, studio, screenshots):
-    from segmentation.models_library import Adjudication, LibrarySegment
+    from segmentation.models import Adjudication, LibrarySegment
 
     ann_review, cuts = two_reviews(ingested_capture, studio)
     page = new_page("rachel")
@@ -109,8 +109,9 @@ def test_it_accepts_a_suggested_label_with_one_key(live_server, new_page, ingest
     come with suggested labels; S on the review page accepts the one under the playhead."""
     from django.core.files.uploadedfile import SimpleUploadedFile
 
-    from segmentation import library, services, tasks
+    from segmentation import services, tasks
     from segmentation.models import Capture, DetectionRun
+    from segmentation.services import gold
     from tests.e2e.conftest import synthetic_bvh
 
     # Take one (seed 5): punch | arm circles | squat | walk | punch | jumping jack | idle.
@@ -118,7 +119,7 @@ def test_it_accepts_a_suggested_label_with_one_key(live_server, new_page, ingest
                     ["punch", None, "squat", "walk", "punch", "jumping_jack", None])
     submit_review(ingested_capture, studio["ann"], cuts, labels)
     # Bob may not see ann's labels, only gold: rachel makes ann's review the gold version.
-    library.do_save_gold(ingested_capture, studio["rachel"], cuts, labels, version=0)
+    gold.do_save_gold(ingested_capture, studio["rachel"], cuts, labels, version=0)
     # Take two (seed 6): squat | punch | squat | jumping jack | squat, cut but not labelled.
     upload = SimpleUploadedFile("second_session.bvh", synthetic_bvh(seed=6, duration=30.0))
     capture, _ = services.do_upload_capture(studio["project"], studio["alice"], upload)
@@ -149,8 +150,8 @@ def test_it_accepts_a_suggested_label_with_one_key(live_server, new_page, ingest
 
 
 def test_tiers_feed_the_gold_tier_with_undo_snap_and_the_409_rule(live_server, new_page, ingested_capture, studio):
-    from segmentation.library import do_save_gold
-    from segmentation.models_library import Adjudication
+    from segmentation.models import Adjudication
+    from segmentation.services.gold import do_save_gold
 
     _ann, (c0, c1, c2) = two_reviews(ingested_capture, studio)
     n = ingested_capture.n_frames

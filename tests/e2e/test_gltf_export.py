@@ -14,8 +14,7 @@ def fbx_segments(studio):
     from django.core.files.uploadedfile import SimpleUploadedFile
 
     from segmentation import services, tasks
-    from segmentation.models import Capture, DetectionRun
-    from segmentation.models_library import LibrarySegment
+    from segmentation.models import Capture, DetectionRun, LibrarySegment
 
     upload = SimpleUploadedFile("samba.fbx", shared_fbx("samba_dancing.fbx").read_bytes())
     capture, _ = services.do_upload_capture(studio["project"], studio["alice"], upload)

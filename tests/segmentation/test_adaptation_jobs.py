@@ -5,9 +5,9 @@ tests/segmentation/integration/test_adaptation_flow.py.)"""
 from django.test import override_settings
 from django.utils import timezone
 
-from segmentation import library, tasks
+from segmentation import tasks
 from segmentation.models import ProjectCutModel
-from segmentation.services import adaptation
+from segmentation.services import adaptation, gold
 from tests.segmentation.base import BaseTestCase
 
 
@@ -57,7 +57,7 @@ class TrainingRequestTestCase(AdaptationTestCase):
         commit(self.submit_review(capture, self.bob))
         ProjectCutModel.objects.all().delete()
         with self.captureOnCommitCallbacks() as callbacks:
-            library.do_save_gold(capture, self.rachel, [150], ["walk", "punch"], 0)
+            gold.do_save_gold(capture, self.rachel, [150], ["walk", "punch"], 0)
         self.assertFalse(ProjectCutModel.objects.exists())
         commit(callbacks)
         self.assertEqual(ProjectCutModel.objects.get().status, "queued")
@@ -164,7 +164,7 @@ class ExamplesTestCase(AdaptationTestCase):
     def test_the_gold_version_wins_over_the_reviews(self):
         capture = self.ready_capture(candidates=(100, 200, 300))
         self.submit_review(capture, self.bob)
-        library.do_save_gold(capture, self.rachel, [120, 250], ["walk", "punch", None], 0)
+        gold.do_save_gold(capture, self.rachel, [120, 250], ["walk", "punch", None], 0)
         self.assertEqual(adaptation.project_examples(self.project.pk), [(capture, [120, 250])])
 
     def test_a_take_reviewed_twice_is_one_example_the_latest_submitted(self):

@@ -16,8 +16,7 @@ The two reviews of ``LibraryTestCase.two_reviews`` on a 400-frame take at 120 fp
 
 import pytest
 
-from segmentation.models import ReviewEvent
-from segmentation.models_library import Adjudication, LibrarySegment
+from segmentation.models import Adjudication, LibrarySegment, ReviewEvent
 from tests.segmentation.test_library import LibraryTestCase, submit_review
 
 

@@ -126,7 +126,7 @@ class LostMessageTestCase(BaseTestCase):
         reset_connections()
         app.conf.update(unreachable)
         self.login(self.bob)
-        with self.assertLogs("segmentation.services.captures", "ERROR") as logs:
+        with self.assertLogs("segmentation.services.jobs", "ERROR") as logs:
             with self.captureOnCommitCallbacks(execute=True):
                 r = self.upload(b"HIERARCHY\n", name="offline.bvh")
         self.assertEqual(r.status_code, 201)

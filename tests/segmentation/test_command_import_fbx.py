@@ -9,7 +9,6 @@ from pathlib import Path
 from django.core.management import call_command
 
 from segmentation.models import Capture
-from segmentation.services.captures import first_job
 from tests.fbx.files import shared_fbx
 from tests.segmentation.base import BaseTestCase
 
@@ -33,7 +32,7 @@ class ImportFbxTestCase(BaseTestCase):
         capture = Capture.objects.get()
         self.assertEqual((capture.name, capture.format, capture.status),
                          ("flair.fbx", "fbx", "queued"))
-        self.assertEqual(first_job(capture), "convert")
+        self.assertEqual(capture.first_job(), "convert")
 
     def test_it_reports_an_ascii_fbx_by_name_without_importing_it(self):
         (self.folder / "old.fbx").write_text("; FBX 7.4.0 project file\nFBXHeaderExtension: {\n}\n")

@@ -5,7 +5,6 @@ import pytest
 
 from segmentation import tasks
 from segmentation.models import Capture, DetectionRun
-from segmentation.services.captures import first_job
 from tests.fbx.files import shared_fbx
 from tests.segmentation.base import BaseTestCase
 
@@ -84,4 +83,4 @@ class ConvertTestCase(BaseTestCase):
     def test_it_queues_an_fbx_upload_for_conversion_not_ingest(self):
         capture = Capture.objects.get(pk=self.upload_file(shared_fbx("flair.fbx")))
         self.assertTrue(capture.needs_conversion)
-        self.assertEqual(first_job(capture), "convert")
+        self.assertEqual(capture.first_job(), "convert")

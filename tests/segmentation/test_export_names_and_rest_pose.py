@@ -9,7 +9,7 @@ from django.contrib.auth import get_user_model
 from numpy.testing import assert_allclose
 
 from segmentation import services
-from segmentation.models_library import LibrarySegment
+from segmentation.models import LibrarySegment
 from tests.segmentation.test_library import submit_review
 from tests.segmentation.test_library_cmu import CmuLibraryTestCase, data_file
 

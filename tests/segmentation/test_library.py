@@ -8,7 +8,7 @@ from django.db import connection
 from django.test.utils import CaptureQueriesContext
 
 from segmentation import services
-from segmentation.models_library import LibrarySegment
+from segmentation.models import LibrarySegment
 from tests.segmentation.base import BaseTestCase
 
 
@@ -192,13 +192,13 @@ class UnreadableTakeTest(LibraryTestCase):
         assert "could not be mapped to body parts" in response.json()["detail"]
 
     def test_it_refuses_an_export_of_more_than_the_limit(self):
-        from segmentation import library
+        from segmentation import exports
 
-        saved, library.MAX_EXPORT_SEGMENTS = library.MAX_EXPORT_SEGMENTS, 3
+        saved, exports.MAX_EXPORT_SEGMENTS = exports.MAX_EXPORT_SEGMENTS, 3
         try:
             response = self.client.get("/api/segments/export.zip")
         finally:
-            library.MAX_EXPORT_SEGMENTS = saved
+            exports.MAX_EXPORT_SEGMENTS = saved
         assert response.status_code == 400
         assert response.json()["detail"].startswith("export: the query matches 7 segments")
 

@@ -14,9 +14,9 @@ from django.core.files.base import ContentFile
 from numpy.testing import assert_allclose
 
 import motionlib
-from segmentation import library, services, storage, tasks
-from segmentation.models import Capture, DetectionRun
-from segmentation.models_library import LibrarySegment
+from segmentation import services, storage, tasks
+from segmentation.models import Capture, DetectionRun, LibrarySegment
+from segmentation.services import gold
 from tests.segmentation.base import SHARED_DATA
 from tests.segmentation.test_library import LibraryTestCase, submit_review
 
@@ -198,7 +198,7 @@ class SimilarAndSuggestionsTest(CmuLibraryTestCase):
         for frame in cuts:
             review = services.do_insert_cut(review, self.dana, frame, review.version)
         # dana may see gold and her own segments only: bob's 13_29 becomes gold.
-        library.do_save_gold(self.library_capture, self.rachel, *self.library_cuts, version=0)
+        gold.do_save_gold(self.library_capture, self.rachel, *self.library_cuts, version=0)
         tasks.suggest(capture.pk, self.dana.pk)
         url = f"/api/captures/{capture.pk}/review/suggestions/"
         suggested = {s["start"]: s["label"] for s in self.client.get(url).json()["suggestions"]}

@@ -10,8 +10,7 @@ import pytest
 
 import motionlib
 from segmentation import storage, tasks
-from segmentation.models import Capture, DetectionRun
-from segmentation.models_library import LibrarySegment
+from segmentation.models import Capture, DetectionRun, LibrarySegment
 from tests.fbx.files import shared_fbx
 from tests.segmentation.base import BaseTestCase, synthetic_bvh
 from tests.segmentation.test_library import submit_review

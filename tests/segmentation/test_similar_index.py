@@ -12,8 +12,8 @@ from django.test.utils import CaptureQueriesContext
 import motionlib
 from motionlib import similarity, synth, vector_index
 from motionlib.vector_index import IvfIndex
-from segmentation import library, similar_index, tasks
-from segmentation.models_library import LibrarySegment
+from segmentation import descriptors, search, similar_index, tasks
+from segmentation.models import LibrarySegment
 from tests.segmentation.base import BaseTestCase
 from tests.segmentation.test_library import submit_review
 
@@ -57,7 +57,7 @@ class SimilarIndexTestCase(BaseTestCase):
             row = LibrarySegment(project=self.project, capture=capture, annotator=annotator or self.bob,
                                  label=self.walk, label_name="walk", start=start, stop=stop,
                                  duration=(stop - start) / 120)
-            library.store_descriptor(row, desc)
+            descriptors.store_descriptor(row, desc)
             rows.append(row)
         return LibrarySegment.objects.bulk_create(rows)
 
@@ -69,11 +69,11 @@ class SimilarIndexTestCase(BaseTestCase):
         similar_index.manifest_path(self.project.pk).unlink(missing_ok=True)
         similar_index.forget()
         assert similar_index.open_index(self.project.pk) is None
-        return [(s.pk, round(d, 5)) for s, d in library.similar(segment, self.visible(), k=k)]
+        return [(s.pk, round(d, 5)) for s, d in search.similar(segment, self.visible(), k=k)]
 
     def indexed(self, segment, k=10):
         assert similar_index.open_index(self.project.pk) is not None
-        return [(s.pk, round(d, 5)) for s, d in library.similar(segment, self.visible(), k=k)]
+        return [(s.pk, round(d, 5)) for s, d in search.similar(segment, self.visible(), k=k)]
 
 
 class SameResultsTest(SimilarIndexTestCase):
@@ -92,7 +92,7 @@ class SameResultsTest(SimilarIndexTestCase):
         similar_index.build(self.project.pk)
         # bob (an annotator) sees his own segments only; alice's are nearer to her own query.
         visible = LibrarySegment.objects.visible_to(self.bob).preferred()
-        found = library.similar(dana_rows[0], visible, k=10)
+        found = search.similar(dana_rows[0], visible, k=10)
         assert len(found) == 10
         assert {s.pk for s, _ in found} <= {r.pk for r in bob_rows}
 
@@ -132,7 +132,7 @@ class IncrementalTest(SimilarIndexTestCase):
         capture.save()
         theirs = LibrarySegment(project=self.other_project, capture=capture, label_name="x",
                                 start=0, stop=10, duration=0.1)
-        library.store_descriptor(theirs, self.descs[52])
+        descriptors.store_descriptor(theirs, self.descs[52])
         theirs.save()
         self.add_segments(self.spans[53:54], self.descs[53:54])
         newest = LibrarySegment.objects.filter(project=self.project).latest("id")
@@ -179,7 +179,7 @@ class RebuildTest(SimilarIndexTestCase):
         similar_index.forget()
         with self.captureOnCommitCallbacks() as callbacks:
             assert similar_index.open_index(self.project.pk) is None
-            found = [(s.pk, round(d, 5)) for s, d in library.similar(rows[7], self.visible())]
+            found = [(s.pk, round(d, 5)) for s, d in search.similar(rows[7], self.visible())]
         assert found == expected
         assert callbacks, "a rebuild is queued"
         tasks.update_similar_index(self.project.pk)

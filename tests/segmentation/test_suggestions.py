@@ -15,9 +15,9 @@ from django.test.utils import CaptureQueriesContext
 
 import motionlib
 from motionlib import synth
-from segmentation import library, services, storage, suggestions, tasks
-from segmentation.models import Capture
-from segmentation.models_suggestions import LabelSuggestion
+from segmentation import services, storage, suggestions, tasks
+from segmentation.models import Capture, LabelSuggestion
+from segmentation.services import gold
 from tests.segmentation.test_library import LibraryTestCase, submit_review
 
 
@@ -95,14 +95,14 @@ class SuggestionPoolTest(SuggestionsTestCase):
 
     def test_it_suggests_gold_segments_to_an_annotator(self):
         self.submit_take_a(self.dana)
-        library.do_save_gold(self.take_a, self.rachel, [start for start, _, _ in self.truth_a[1:]],
+        gold.do_save_gold(self.take_a, self.rachel, [start for start, _, _ in self.truth_a[1:]],
                              [label for _, _, label in self.truth_a], version=0)
         self.review_take_b(self.bob)
         assert None not in self.suggested(self.bob).values()
 
     def test_annotators_who_see_the_same_segments_share_the_stored_suggestions(self):
         self.submit_take_a(self.dana)
-        library.do_save_gold(self.take_a, self.rachel, [start for start, _, _ in self.truth_a[1:]],
+        gold.do_save_gold(self.take_a, self.rachel, [start for start, _, _ in self.truth_a[1:]],
                              [label for _, _, label in self.truth_a], version=0)
         # Bob and charlie (now an annotator) have no segment of their own: gold only.
         services.do_set_member(self.project, "charlie", "annotator")

@@ -7,7 +7,7 @@ import numpy as np
 
 from motionlib import adapt, synth
 from segmentation import takecache
-from segmentation.services.captures import read_take
+from segmentation.storage import read_take
 from tests.segmentation.base import BaseTestCase, synthetic_bvh
 
 

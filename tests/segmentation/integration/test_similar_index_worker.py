@@ -4,8 +4,8 @@ import pytest
 from django.contrib.auth import get_user_model
 
 from motionlib.vector_index import IvfIndex
-from segmentation import library, services, similar_index
-from segmentation.models_library import LibrarySegment
+from segmentation import search, services, similar_index
+from segmentation.models import LibrarySegment
 from tests.segmentation.base import synthetic_bvh
 from tests.segmentation.integration.conftest import wait_for
 from tests.segmentation.integration.test_pipeline import client_for, settled, upload
@@ -56,6 +56,6 @@ def test_it_indexes_the_segments_of_a_submitted_review_on_a_worker(running_worke
     query = LibrarySegment.objects.get(capture=captures[1], start=0)
     visible = LibrarySegment.objects.visible_to(bob).preferred()
     assert similar_index.open_index(project.pk) is not None
-    found = [s.pk for s, _ in library.similar(query, visible, k=10)]
+    found = [s.pk for s, _ in search.similar(query, visible, k=10)]
     # Every other segment, the query's own span left out.
     assert sorted(found) == sorted(every - {query.pk})

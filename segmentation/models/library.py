@@ -7,6 +7,8 @@
 - ``Adjudication``: the gold version of a capture, made by a reviewer.
 - ``CaptureAgreement``: the agreement summary of a capture's submitted reviews at the
   default tolerance, kept for the project dashboard.
+- ``LabelSuggestion``, ``SuggestionRequest``: label suggestions computed from the library
+  (see below and ``segmentation.suggestions``).
 """
 
 import numpy as np
@@ -15,7 +17,9 @@ from django.db import models
 from django.db.models import Q
 from django.utils import timezone
 
-from segmentation.models import Capture, Label, Membership, Project, Review
+from segmentation.models.captures import Capture
+from segmentation.models.projects import Label, Membership, Project
+from segmentation.models.reviews import Review
 
 # A capture whose annotators agree this well needs no adjudication.
 AGREED_BOUNDARY_F1 = 0.8
@@ -163,3 +167,50 @@ class CaptureAgreement(models.Model):
             and (self.boundary_f1 or 0) >= AGREED_BOUNDARY_F1
             and (self.label_agreement or 0) >= AGREED_LABELS
         )
+
+
+# Stored label suggestions, shared by every web and worker process.
+#
+# - ``LabelSuggestion``: the suggested label of one span of a capture, computed against
+#   one state of one pool of library segments (``suggestions.pool_key``: everything, gold
+#   only, or gold plus one annotator's own). Annotators whose pools are the same share the
+#   rows; a row of an older state of a pool is stale and never read.
+# - ``SuggestionRequest``: one per (capture, annotator): when suggestions were last asked
+#   of a worker and when that worker finished, so that twenty page loads send one job.
+#
+# See ``segmentation.suggestions``.
+
+
+class LabelSuggestion(models.Model):
+    capture = models.ForeignKey(Capture, models.CASCADE, related_name="+")
+    # ``suggestions.pool_key``: which segments the label came from, and their state.
+    pool = models.CharField(max_length=100)
+    start = models.PositiveIntegerField()
+    stop = models.PositiveIntegerField()
+    # "" when nothing in the pool can name the span (no descriptor, empty pool).
+    label_name = models.CharField(max_length=100, blank=True)
+
+    class Meta:
+        constraints = [
+            models.UniqueConstraint(fields=["capture", "pool", "start", "stop"],
+                                    name="one_suggestion_per_span")
+        ]
+
+    def __str__(self):
+        return f"{self.label_name or '-'} for {self.start}-{self.stop} of {self.capture_id}"
+
+
+class SuggestionRequest(models.Model):
+    capture = models.ForeignKey(Capture, models.CASCADE, related_name="+")
+    annotator = models.ForeignKey(settings.AUTH_USER_MODEL, models.CASCADE, related_name="+")
+    asked_at = models.DateTimeField(null=True, blank=True)
+    done_at = models.DateTimeField(null=True, blank=True)
+    created_at = models.DateTimeField(default=timezone.now)
+
+    class Meta:
+        constraints = [
+            models.UniqueConstraint(fields=["capture", "annotator"], name="one_suggestion_request")
+        ]
+
+    def __str__(self):
+        return f"suggestions for {self.annotator_id} on {self.capture_id}"

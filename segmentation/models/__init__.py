@@ -1,0 +1,70 @@
+"""Cutroom's records, one module per noun (same app label, same migrations).
+
+- ``jobs``: the claimable background-work row shared by captures, runs and trainings;
+- ``projects``: projects, members, labels, invitations, the project's cut model;
+- ``captures``: captures, detection runs, assignments;
+- ``reviews``: reviews, cuts, segment labels, the review audit log;
+- ``library``: library segments, gold versions, agreement, label suggestions.
+
+Rules about one record live on the models; lookups live on the managers
+(``Capture.objects.visible_to(user)``). Workflows that touch several records are the
+``do_*`` functions in ``segmentation.services``.
+"""
+
+from segmentation.models.captures import (
+    Assignment,
+    Capture,
+    CaptureQuerySet,
+    DetectionRun,
+    derived_path,
+    original_path,
+)
+from segmentation.models.jobs import JOB_STATUSES, ClaimQuerySet, Job, JSONArrayLength
+from segmentation.models.library import (
+    AGREED_BOUNDARY_F1,
+    AGREED_LABELS,
+    Adjudication,
+    CaptureAgreement,
+    LabelSuggestion,
+    LibrarySegment,
+    SuggestionRequest,
+)
+from segmentation.models.projects import (
+    ROLES,
+    Invitation,
+    Label,
+    Membership,
+    Project,
+    ProjectCutModel,
+)
+from segmentation.models.reviews import Cut, Review, ReviewEvent, SegmentLabel
+
+__all__ = [
+    "AGREED_BOUNDARY_F1",
+    "AGREED_LABELS",
+    "JOB_STATUSES",
+    "ROLES",
+    "Adjudication",
+    "Assignment",
+    "Capture",
+    "CaptureAgreement",
+    "CaptureQuerySet",
+    "ClaimQuerySet",
+    "Cut",
+    "DetectionRun",
+    "Invitation",
+    "JSONArrayLength",
+    "Job",
+    "Label",
+    "LabelSuggestion",
+    "LibrarySegment",
+    "Membership",
+    "Project",
+    "ProjectCutModel",
+    "Review",
+    "ReviewEvent",
+    "SegmentLabel",
+    "SuggestionRequest",
+    "derived_path",
+    "original_path",
+]

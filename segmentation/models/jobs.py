@@ -1,0 +1,104 @@
+"""Background work shared by captures, detection runs and cut-model trainings: a row
+that a worker claims with one conditional UPDATE, renews while it works, and closes with
+its result or the error a person can act on."""
+
+from django.conf import settings
+from django.db import models
+from django.db.models import F, Q
+from django.utils import timezone
+
+JOB_STATUSES = (
+    ("queued", "Queued"),
+    ("processing", "Processing"),
+    ("ready", "Ready"),
+    ("failed", "Failed"),
+)
+
+
+def claim_cutoff():
+    """Claims older than this (not renewed for ``CUTROOM_CLAIM_TIMEOUT`` seconds) belong to
+    a process that died."""
+    return timezone.now() - timezone.timedelta(seconds=settings.CUTROOM_CLAIM_TIMEOUT)
+
+
+class ClaimQuerySet(models.QuerySet):
+    """Claiming background work with one conditional UPDATE.
+
+    A row can be claimed when it is queued, when the same job message comes back after
+    its worker died (same ``claim_token``), or when another claim is older than
+    ``CUTROOM_CLAIM_TIMEOUT``. Zero rows updated means another worker has the job.
+    """
+
+    def claim(self, pk, token):
+        claimable = Q(status="queued") | Q(status="processing") & (
+            Q(claim_token=token) | Q(claimed_at__lt=claim_cutoff())
+        )
+        updated = self.filter(claimable, pk=pk).update(
+            status="processing",
+            claim_token=token,
+            claimed_at=timezone.now(),
+            attempts=F("attempts") + 1,
+        )
+        return updated == 1
+
+    def stale(self):
+        """Rows still marked processing whose claim was not renewed within the claim
+        timeout: the process running them died."""
+        return self.filter(status="processing", claimed_at__lt=claim_cutoff())
+
+    def requeue_failed(self, pk):
+        """Put a failed job back in the queue with a fresh attempt count; 0 rows updated
+        means it was not failed (a concurrent retry, or nothing to retry)."""
+        return self.filter(pk=pk, status="failed").update(
+            status="queued", error="", claim_token="", claimed_at=timezone.now(), attempts=0
+        ) == 1
+
+    def waiting_too_long(self):
+        """Queued rows nobody claimed within CUTROOM_RESEND_AFTER: their message may be
+        lost (broker down at upload time, queue purged), so they are sent again."""
+        limit = timezone.now() - timezone.timedelta(seconds=settings.CUTROOM_RESEND_AFTER)
+        last_sent = Q(claimed_at__lt=limit) | Q(claimed_at__isnull=True, created_at__lt=limit)
+        return self.filter(last_sent, status="queued")
+
+
+class JSONArrayLength(models.Func):
+    """Length of a JSON array column, counted by the database (SQLite and PostgreSQL)."""
+
+    function = "JSON_ARRAY_LENGTH"
+    output_field = models.IntegerField()
+
+    def as_postgresql(self, compiler, connection, **extra):
+        return self.as_sql(compiler, connection, function="JSONB_ARRAY_LENGTH", **extra)
+
+
+class Job(models.Model):
+    """State shared by the two kinds of background work (ingest, detect)."""
+
+    status = models.CharField(max_length=20, choices=JOB_STATUSES, default="queued")
+    error = models.TextField(blank=True)
+    claim_token = models.CharField(max_length=64, blank=True)
+    # Time of the last claim, or of the last requeue while queued.
+    claimed_at = models.DateTimeField(null=True, blank=True)
+    attempts = models.PositiveIntegerField(default=0)
+
+    class Meta:
+        abstract = True
+
+    def finish(self, **fields):
+        """Store the result, but only if this job's claim still holds."""
+        return self._close("ready", "", fields)
+
+    def fail(self, error, **fields):
+        return self._close("failed", error, fields)
+
+    def _close(self, status, error, fields):
+        fields.update(status=status, error=error)
+        updated = (
+            type(self)
+            .objects.filter(pk=self.pk, status="processing", claim_token=self.claim_token)
+            .update(**fields)
+        )
+        if updated:
+            for name, value in fields.items():
+                setattr(self, name, value)
+        return updated == 1

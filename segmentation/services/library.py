@@ -1,0 +1,69 @@
+"""The clip library's rows: labelled segments of submitted reviews and gold versions.
+
+Segments become ``LibrarySegment`` rows when a review is submitted or a gold version is
+saved (``refresh_capture_library`` rebuilds one capture's rows: agreement values change
+whenever another review of the capture comes in). Each row carries its motion descriptor
+(``segmentation.descriptors``), so "find similar" and label suggestions never re-read takes.
+"""
+
+import numpy as np
+from django.db import transaction
+
+from motionlib.agreement import label_codes, segment_support
+from segmentation import agreement, similar_index
+from segmentation.descriptors import descriptors, store_descriptor
+from segmentation.models import Adjudication, LibrarySegment
+
+
+def refresh_capture_library(capture):
+    """Rebuild a capture's library rows from its submitted reviews and gold version.
+
+    Only labelled segments enter the library. An annotator's segment carries the share of
+    the other annotators' frames that agree with its label; a gold segment the share of
+    all annotators' frames. Annotators' segments of a capture with gold are superseded.
+    """
+    reviews = agreement.submitted_reviews(capture)
+    gold = Adjudication.objects.filter(capture=capture).first()
+    lists = [agreement.review_segments(r) for r in reviews]
+    if gold:
+        lists.append(gold.segments())
+    codes, _ = label_codes(lists, capture.n_frames)
+    labels = {label.name: label for label in capture.project.labels.all()}
+    n = len(reviews)
+    rows = []
+    for row, segments in enumerate(lists):
+        review = reviews[row] if row < n else None
+        for start, stop, name in segments:
+            if name is None or stop <= start:
+                continue
+            support = (segment_support(codes[:n], row, start, stop) if review
+                       else _gold_support(codes, n, start, stop))
+            rows.append(LibrarySegment(
+                project_id=capture.project_id, capture=capture, review=review,
+                annotator_id=review.annotator_id if review else None, is_gold=review is None,
+                superseded=bool(gold) and review is not None, label=labels.get(name),
+                label_name=name, start=start, stop=stop, duration=(stop - start) / capture.fps,
+                agreement=agreement.finite(support)))
+    for segment, descriptor in zip(rows, descriptors(capture, [(r.start, r.stop) for r in rows]),
+                                   strict=True):
+        store_descriptor(segment, descriptor)
+    with transaction.atomic():
+        LibrarySegment.objects.filter(capture=capture).delete()
+        LibrarySegment.objects.bulk_create(rows, batch_size=500)
+        similar_index.schedule_update(capture.project_id)
+    return rows
+
+
+def _gold_support(codes, n_reviews, start, stop):
+    """Share of all annotators' frames in [start, stop) that carry the gold label."""
+    if n_reviews == 0:
+        return float("nan")
+    gold = codes[n_reviews, start:stop]
+    return float(np.mean(codes[:n_reviews, start:stop] == gold[None, :]))
+
+
+def on_review_submitted(review):
+    """Called by the submit workflow, inside its transaction."""
+    capture = review.capture
+    agreement.refresh_capture_agreement(capture)
+    refresh_capture_library(capture)
