@@ -39,7 +39,7 @@ from segmentation.services.gold import do_save_gold
 from segmentation.storage import read_take
 
 # The schema's CaptureStateEnum (settings.SPECTACULAR_SETTINGS).
-CAPTURE_STATES = agreement.STATES
+CAPTURE_STATES = dashboard.STATES
 
 ORDERINGS = {
     "recent": ("-id",), "duration": ("duration", "id"), "-duration": ("-duration", "-id"),
