@@ -122,8 +122,8 @@ def synth_capture(project, user, seed, minutes, detect=False):
 
 def populate(args):
     from django.contrib.auth import get_user_model
-    from rest_framework.authtoken.models import Token
 
+    from cutroom.accounts.models import ApiToken
     from motionlib import synth
     from segmentation import library, services
     from segmentation.models_library import LibrarySegment
@@ -155,7 +155,7 @@ def populate(args):
     small, _ = synth_capture(project, admin, 12, 40 / 60, detect=True)
     services.get_or_create_review(long_take, people["ann"])
     services.get_or_create_review(small, people["small"])
-    tokens = {name: Token.objects.create(user=user).key for name, user in people.items()}
+    tokens = {name: ApiToken.objects.issue(user)[1] for name, user in people.items()}
     return types.SimpleNamespace(long=long_take, small=small, tokens=tokens, people=people)
 
 
