@@ -1,8 +1,11 @@
 """Review requests on a one-hour take: reads and edits stay fast, suggestions come from the worker.
 
 Everything runs as `make up` runs it: a temporary SQLite database, the filesystem broker,
-a Celery worker (2 processes) and gunicorn (2 workers x 4 threads) as subprocesses. The
-data is seeded (``motionlib.synth``):
+a Celery worker (2 processes) and gunicorn as subprocesses, started with the command lines
+of ``scripts/up.py`` (its gunicorn sizing, its worker nice value). ``--old-serving``
+starts them as they were before frames and signals answers were cached and bounded:
+gunicorn 2 workers x 4 threads, the worker not niced, ``CUTROOM_HEAVY_REQUESTS=0`` and
+``CUTROOM_ANSWER_CACHE_MB=0``. The data is seeded (``motionlib.synth``):
 
 - a library of gold-labelled takes (``--library-minutes``, cut into 10-minute takes at
   their true boundaries, submitted by one annotator and adjudicated by a reviewer);
@@ -28,7 +31,7 @@ Measured, over HTTP with a token (wall-clock ms on the client):
    made one after another throughout by a process of its own, and alone before.
 
     .venv/bin/python benchmarks/review_long_take.py [--minutes 60] [--library-minutes 60]
-        [--repeats 40] [--pages 20] [--waves 3]
+        [--repeats 40] [--pages 20] [--waves 3] [--old-serving]
 
 Targets: review GET and edit p95 <= 100 ms; the small capture's p50 and p95 under the
 load <= 2x alone.
@@ -36,6 +39,7 @@ load <= 2x alone.
 
 import argparse
 import http.client
+import importlib.util
 import json
 import multiprocessing
 import os
@@ -68,6 +72,8 @@ def parse_args():
     parser.add_argument("--old-repeats", type=int, default=3)
     parser.add_argument("--keep-suggestions", action="store_true",
                         help="leave stored suggestions in place: the worker stays idle during the loads")
+    parser.add_argument("--old-serving", action="store_true",
+                        help="gunicorn 2x4, worker not niced, no answer cache, no heavy-request bound")
     return parser.parse_args()
 
 
@@ -116,8 +122,8 @@ def synth_capture(project, user, seed, minutes, detect=False):
 
 def populate(args):
     from django.contrib.auth import get_user_model
-    from rest_framework.authtoken.models import Token
 
+    from cutroom.accounts.models import ApiToken
     from motionlib import synth
     from segmentation import services
     from segmentation.models import LibrarySegment
@@ -150,7 +156,7 @@ def populate(args):
     small, _ = synth_capture(project, admin, 12, 40 / 60, detect=True)
     services.get_or_create_review(long_take, people["ann"])
     services.get_or_create_review(small, people["small"])
-    tokens = {name: Token.objects.create(user=user).key for name, user in people.items()}
+    tokens = {name: ApiToken.objects.issue(user)[1] for name, user in people.items()}
     return types.SimpleNamespace(long=long_take, small=small, tokens=tokens, people=people)
 
 
@@ -401,6 +407,33 @@ def answers(port):
         return False
 
 
+def up_script():
+    spec = importlib.util.spec_from_file_location("up", REPO / "scripts" / "up.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def serving(old, var, port):
+    """(worker argv, gunicorn argv, description) as `make up` starts them, or as before."""
+    up, env = up_script(), os.environ.copy()
+    worker_argv = up.worker(env, var, 2).argv
+    web_argv = up.web(env, var, "127.0.0.1", port).argv
+    if old:
+        os.environ.update(CUTROOM_HEAVY_REQUESTS="0", CUTROOM_ANSWER_CACHE_MB="0")
+        worker_argv = worker_argv[worker_argv.index(str(Path(sys.executable).parent / "celery")):]
+        web_argv[web_argv.index("--workers") + 1], web_argv[web_argv.index("--threads") + 1] = "2", "4"
+    from django.conf import settings
+
+    heavy = os.environ.get("CUTROOM_HEAVY_REQUESTS", settings.CUTROOM_HEAVY_REQUESTS)
+    cache_mb = os.environ.get("CUTROOM_ANSWER_CACHE_MB", settings.CUTROOM_ANSWER_CACHE_MB)
+    workers, threads = (web_argv[web_argv.index(f"--{k}") + 1] for k in ("workers", "threads"))
+    niced = f"nice {worker_argv[2]}" if worker_argv[0] == "nice" else "not niced"
+    return worker_argv, web_argv, (
+        f"{'OLD' if old else 'NEW'} serving: gunicorn {workers} workers x {threads} threads, "
+        f"worker {niced}, CUTROOM_HEAVY_REQUESTS={heavy}, CUTROOM_ANSWER_CACHE_MB={cache_mb}")
+
+
 # ---- report -------------------------------------------------------------------------------
 
 
@@ -425,15 +458,12 @@ def main():
         data = populate(args)
         old = time_old_path(data, args.old_repeats)
 
-        bin_dir = Path(sys.executable).parent
-        worker_log = var / "worker.log"
-        procs.append(start([str(bin_dir / "celery"), "-A", "cutroom", "worker", "--concurrency", "2",
-                            "--loglevel", "INFO", "--without-mingle", "--without-gossip"],
-                           worker_log, lambda: " ready." in worker_log.read_text()))
         port = free_port()
-        procs.append(start([str(bin_dir / "gunicorn"), "cutroom.wsgi:application", "--bind",
-                            f"127.0.0.1:{port}", "--workers", "2", "--threads", "4", "--timeout", "300"],
-                           var / "web.log", lambda: answers(port)))
+        worker_argv, web_argv, described = serving(args.old_serving, var, port)
+        print(described)
+        worker_log = var / "worker.log"
+        procs.append(start(worker_argv, worker_log, lambda: " ready." in worker_log.read_text()))
+        procs.append(start(web_argv, var / "web.log", lambda: answers(port)))
         ann = Client(port, data.tokens["ann"])
         ann.call("GET", "/api/me/")  # warm both connections' first request
         ready_s, n_suggested, asks = wait_for_suggestions(ann, data.long)

@@ -220,6 +220,12 @@ CUTROOM_MAX_JOINT_FRAMES = envint("CUTROOM_MAX_JOINT_FRAMES", None)
 CUTROOM_MAX_EXPANSION = envint("CUTROOM_MAX_EXPANSION", None)
 # One /frames/ answer carries at most this many joint positions (frames × joints).
 CUTROOM_JOINT_FRAMES_PER_REQUEST = 250_000
+# Frames and signals answers: at most this many built at once per web process (0: no
+# limit), a waiting request gives up after CUTROOM_HEAVY_WAIT s (429); built answers kept
+# per process up to CUTROOM_ANSWER_CACHE_MB (0: none). See segmentation/api/heavy.py.
+CUTROOM_HEAVY_REQUESTS = envint("CUTROOM_HEAVY_REQUESTS", 1)
+CUTROOM_HEAVY_WAIT = envint("CUTROOM_HEAVY_WAIT", 60)
+CUTROOM_ANSWER_CACHE_MB = envint("CUTROOM_ANSWER_CACHE_MB", 64)
 # A project's model retrains this many seconds after a review submit or gold save;
 # submits made meanwhile join the same training.
 CUTROOM_RETRAIN_DELAY = envint("CUTROOM_RETRAIN_DELAY", 10)

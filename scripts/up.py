@@ -30,6 +30,13 @@ BIN = Path(sys.executable).parent
 RESTARTS_IN_WINDOW = 5
 RESTART_WINDOW = 600.0
 LONGEST_PAUSE = 300.0
+# The workers run at this nice value, so on a small machine the web server's requests
+# win the CPU over detection and suggestion jobs.
+WORKER_NICE = 10
+# gunicorn: 2 processes of 16 threads. A thread waiting for one of its process's
+# CUTROOM_HEAVY_REQUESTS slots sleeps (no CPU, no GIL); with this many threads a light
+# request still finds a free one while 20 page loads of a long take are in progress.
+WEB_WORKERS, WEB_THREADS = 2, 16
 
 
 def parse_args(argv=None):
@@ -135,6 +142,7 @@ class Child:
 
 def worker(env, logs, concurrency):
     argv = [
+        "nice", "-n", str(WORKER_NICE),
         str(BIN / "celery"), "-A", "cutroom", "worker", "--loglevel", "INFO",
         "--concurrency", str(concurrency), "--hostname", "cutroom-up@%h",
         "--without-mingle", "--without-gossip",
@@ -146,6 +154,7 @@ def convert_worker(env, logs):
     """The worker of the FBX convert queue: Blender loaded once per pool process, which is
     replaced after some files (Blender's memory), each file under a time limit."""
     argv = [
+        "nice", "-n", str(WORKER_NICE),
         str(BIN / "celery"), "-A", "cutroom", "worker", "--loglevel", "INFO",
         "--queues", env.get("CUTROOM_CONVERT_QUEUE") or "convert", "--concurrency", "1",
         "--max-tasks-per-child", "50", "--hostname", "cutroom-convert@%h",
@@ -158,7 +167,7 @@ def convert_worker(env, logs):
 def web(env, logs, host, port):
     argv = [
         str(BIN / "gunicorn"), "cutroom.wsgi:application", "--bind", f"{host}:{port}",
-        "--workers", "2", "--threads", "4", "--timeout", "120",
+        "--workers", str(WEB_WORKERS), "--threads", str(WEB_THREADS), "--timeout", "120",
         "--access-logfile", "-", "--error-logfile", "-",
     ]
     return Child("web server", argv, env, logs / "web.log")

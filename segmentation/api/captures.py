@@ -15,6 +15,7 @@ from rest_framework.parsers import FormParser, JSONParser, MultiPartParser
 from rest_framework.response import Response
 
 from segmentation import services, storage
+from segmentation.api.heavy import immutable
 from segmentation.api.params import int_param
 from segmentation.api.projects import project_for
 from segmentation.api.serializers import (
@@ -96,6 +97,7 @@ class CaptureViewSet(
 
     @extend_schema(parameters=[OpenApiParameter("max_points", int)], responses=SignalsSerializer)
     @action(detail=True)
+    @immutable(lambda view, request: _signal_identity(view.get_object()))
     def signal(self, request, pk=None):
         capture = self.get_object()
         max_points = int_param(request, "max_points", 2000, 2, 1_000_000)
@@ -110,6 +112,7 @@ class CaptureViewSet(
         responses=FramesSerializer,
     )
     @action(detail=True)
+    @immutable(lambda view, request: _frames_identity(view.get_object()))
     def frames(self, request, pk=None):
         capture = self.get_object()
         if capture.status != "ready":
@@ -163,6 +166,17 @@ class CaptureViewSet(
         body.is_valid(raise_exception=True)
         run = services.do_start_run(capture, request.user, **body.validated_data)
         return Response(RunSerializer(run).data, status=202)
+
+
+def _signal_identity(capture):
+    # A finished run's signals are written once; a newer run is another answer.
+    run = capture.latest_finished_run()
+    return (run.pk, run.signals.name) if run and run.signals else None
+
+
+def _frames_identity(capture):
+    # Ingest writes a capture's positions once, before it is ready.
+    return (capture.pk, capture.positions.name) if capture.status == "ready" else None
 
 
 def _sampled(name, values, max_points):

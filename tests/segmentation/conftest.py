@@ -35,3 +35,14 @@ def similar_index_dir(settings, tmp_path):
     similar_index.forget()
     yield settings.SIMILAR_INDEX_DIR
     similar_index.forget()
+
+
+@pytest.fixture(autouse=True)
+def answer_cache():
+    """No built frames or signals answer outlives its test (ids and file names recur once a
+    test's rows and media folder are gone)."""
+    from segmentation.api import heavy
+
+    heavy.answer_cache().clear()
+    yield heavy.answer_cache()
+    heavy.answer_cache().clear()
