@@ -1,5 +1,7 @@
 import json
 import math
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -90,3 +92,10 @@ def test_it_gives_the_adaptation_each_other_capture_once_in_the_scored_takes_kin
     assert names == ["a-channels", "c-skeleton"]
     names = [take.name for take, _ in bench_quality._examples(cache, cache[3])]
     assert names == ["a-skeleton", "b-channels"]
+
+
+def test_it_answers_to_its_older_name_bench_too(tmp_path):
+    done = subprocess.run([sys.executable, "-m", "motionlib", "bench", "--data",
+                           str(tmp_path / "missing")], capture_output=True, text=True)
+    assert done.returncode == 2
+    assert "benchmark data folder not found" in done.stderr
