@@ -13,6 +13,7 @@ from pathlib import Path
 from django.core.files import File
 
 import motionlib
+from motionlib.io import check_bvh
 from motionlib.io.fbx import check_fbx_header
 from segmentation import services
 
@@ -96,15 +97,21 @@ def find_asf(amc, asf=None):
 
 
 def check_readable(path, asf=None):
-    """Parse the file with motionlib under the service's input limits; CaptureError names
-    the file, line and value at fault.
+    """Check the file's structure with motionlib under the service's input limits;
+    CaptureError names the file, line and value at fault.
 
-    An FBX is only checked to be binary FBX here: Blender reads it on the convert queue (its
-    problems then fail the capture, with the reason)."""
-    if Path(path).suffix.lower() == ".fbx":
+    A BVH's hierarchy and motion header are checked (``motionlib.io.check_bvh``: the head
+    of the file only, so that importing a folder costs little more than copying it); its
+    frames are read by the worker, which fails the capture naming a bad frame's line. An
+    FBX is only checked to be binary FBX: Blender reads it on the convert queue. A CMU
+    AMC (small files) is read in full."""
+    suffix = Path(path).suffix.lower()
+    if suffix == ".fbx":
         check_fbx_header(path)
-        return
-    motionlib.read(path, asf=asf, limits=services.captures.input_limits())
+    elif suffix == ".bvh":
+        check_bvh(path, limits=services.captures.input_limits())
+    else:
+        motionlib.read(path, asf=asf, limits=services.captures.input_limits())
 
 
 def import_file(project, user, path, asf=None, check=True):
@@ -120,8 +127,8 @@ def import_file(project, user, path, asf=None, check=True):
     asf : str or PathLike, optional
         The ASF to use for an AMC file instead of looking for one.
     check : bool
-        Parse the file first and refuse it if unreadable, instead of leaving the
-        worker to mark the capture failed.
+        Check the file's structure first (:func:`check_readable`) and refuse it if
+        broken, instead of leaving the worker to mark the capture failed.
 
     Returns
     -------

@@ -23,7 +23,7 @@ class Command(BaseCommand):
         )
         parser.add_argument(
             "--no-check", action="store_true",
-            help="do not parse files before storing them (the worker reports bad ones)",
+            help="do not check files before storing them (the worker reports bad ones)",
         )
 
     def handle(self, *args, **options):
