@@ -96,25 +96,27 @@ def find_asf(amc, asf=None):
     raise ImportProblem(f"{amc}: no ASF skeleton found (looked for {looked}); pass --asf PATH")
 
 
-def check_readable(path, asf=None):
+def check_readable(path, asf=None, full=False):
     """Check the file's structure with motionlib under the service's input limits;
     CaptureError names the file, line and value at fault.
 
     A BVH's hierarchy and motion header are checked (``motionlib.io.check_bvh``: the head
     of the file only, so that importing a folder costs little more than copying it); its
-    frames are read by the worker, which fails the capture naming a bad frame's line. An
-    FBX is only checked to be binary FBX: Blender reads it on the convert queue. A CMU
-    AMC (small files) is read in full."""
+    frames are read by the worker, which fails the capture naming a bad frame's line.
+    ``full`` reads every frame here too (the worker then reads the file again). An FBX is
+    only checked to be binary FBX: Blender reads it on the convert queue. A CMU AMC
+    (small files) is read in full."""
     suffix = Path(path).suffix.lower()
+    limits = services.captures.input_limits()
     if suffix == ".fbx":
         check_fbx_header(path)
-    elif suffix == ".bvh":
-        check_bvh(path, limits=services.captures.input_limits())
+    elif suffix == ".bvh" and not full:
+        check_bvh(path, limits=limits)
     else:
-        motionlib.read(path, asf=asf, limits=services.captures.input_limits())
+        motionlib.read(path, asf=asf, limits=limits)
 
 
-def import_file(project, user, path, asf=None, check=True):
+def import_file(project, user, path, asf=None, check=True, full_check=False):
     """Import one capture file into ``project`` as if ``user`` had uploaded it.
 
     Parameters
@@ -129,6 +131,8 @@ def import_file(project, user, path, asf=None, check=True):
     check : bool
         Check the file's structure first (:func:`check_readable`) and refuse it if
         broken, instead of leaving the worker to mark the capture failed.
+    full_check : bool
+        With ``check``: read every frame too.
 
     Returns
     -------
@@ -139,7 +143,7 @@ def import_file(project, user, path, asf=None, check=True):
     try:
         skeleton = find_asf(path, asf) if path.suffix.lower() == ".amc" else None
         if check:
-            check_readable(path, skeleton)
+            check_readable(path, skeleton, full=full_check)
         capture, created = _upload(project, user, path, skeleton)
     except (ValueError, OSError) as exc:
         return Outcome(path, "failed", _reason(path, exc))

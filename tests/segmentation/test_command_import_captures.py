@@ -94,6 +94,16 @@ class ImportCapturesTestCase(BaseTestCase):
         self.assertEqual(capture.status, "failed")
         self.assertRegex(capture.error, rf"bad_value\.bvh:{len(lines) - 2}: .*'nan-ish'")
 
+    def test_it_reads_every_frame_before_storing_with_full_check(self):
+        lines = synthetic_bvh(seed=6, duration=10.0).decode().splitlines()
+        tokens = lines[-3].split()
+        lines[-3] = " ".join(tokens[:2] + ["nan-ish"] + tokens[3:])
+        self.write("bad_value.bvh", "\n".join(lines).encode())
+        out, _ = self.run_import(self.folder / "bad_value.bvh", self.write(
+            "good.bvh", synthetic_bvh(seed=7, duration=10.0)), full_check=True)
+        self.assertIn("1 imported, 0 duplicate, 1 failed", out)
+        self.assertRegex(out, rf"bad_value\.bvh:{len(lines) - 2}: .*'nan-ish'")
+
     def test_it_reports_a_path_that_does_not_exist(self):
         good = self.write("good.bvh", synthetic_bvh(seed=7, duration=10.0))
         out, _ = self.run_import(self.folder / "missing.bvh", good)
