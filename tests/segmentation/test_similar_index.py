@@ -138,6 +138,18 @@ class IncrementalTest(SimilarIndexTestCase):
         assert found[0] == mine.pk
         assert theirs.pk not in found
 
+    def test_it_queues_one_update_when_many_segments_are_newer_than_the_index(self):
+        rows = self.add_segments(self.spans[:50], self.descs[:50])
+        similar_index.build(self.project.pk)
+        self.add_segments(self.spans[50:53], self.descs[50:53])
+        queued = []
+        with mock.patch.object(similar_index, "DELTA_LIMIT", 2):
+            for _ in range(2):
+                with self.captureOnCommitCallbacks() as callbacks:
+                    self.indexed(rows[0])
+                queued.append(len(callbacks))
+        assert queued == [1, 0], "the first search queues the update, the next one does not"
+
     def test_it_brings_the_index_in_step_when_a_review_is_submitted(self):
         self.add_segments(self.spans, self.descs)
         similar_index.build(self.project.pk)
