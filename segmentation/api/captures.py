@@ -89,15 +89,22 @@ class CaptureViewSet(
         body = {**CaptureSerializer(capture).data, "duplicate": not created}
         return Response(body, status=201 if created else 200)
 
-    @extend_schema(parameters=[OpenApiParameter("max_points", int)], responses=dict)
+    @extend_schema(parameters=[OpenApiParameter("max_points", int),
+                               OpenApiParameter("encoding", str, enum=["json", "float32"])],
+                   responses=dict)
     @action(detail=True)
     def signal(self, request, pk=None):
         capture = self.get_object()
         max_points = int_param(request, "max_points", 2000, 2, 1_000_000)
+        encoding = request.query_params.get("encoding", "json")
+        if encoding not in SIGNAL_ENCODINGS:
+            raise ValueError(f"encoding: must be one of {', '.join(SIGNAL_ENCODINGS)}, got "
+                             f"{encoding[:40]!r}")
         run = capture.latest_finished_run()
         body = {"run": run.pk if run else None, "fps": capture.fps, "n_frames": capture.n_frames}
         signals = storage.load_npz(run.signals) if run and run.signals else {}
-        body["signals"] = [_sampled(name, values, max_points) for name, values in signals.items()]
+        body["signals"] = [SIGNAL_ENCODINGS[encoding](name, values, max_points)
+                           for name, values in signals.items()]
         return Response(body)
 
     @extend_schema(
@@ -160,6 +167,19 @@ def _sampled(name, values, max_points):
     step = max(1, math.ceil(len(values) / max_points))
     sampled = np.asarray(values[::step], dtype=float)
     return {"name": name, "start": 0, "step": step, "values": np.round(sampled, 6).tolist()}
+
+
+def _sampled_float32(name, values, max_points):
+    """As ``_sampled``, the values as base64 little-endian float32 (``data``), as the
+    frames are sent: 5.3 bytes a value instead of about 9 as JSON, and nothing for the page
+    to parse (an hour at 120 fps, two signals: 4.4 MB instead of 7.7 MB)."""
+    step = max(1, math.ceil(len(values) / max_points))
+    sampled = np.ascontiguousarray(values[::step], dtype="<f4")
+    return {"name": name, "start": 0, "step": step, "dtype": "float32",
+            "data": base64.b64encode(sampled.tobytes()).decode("ascii")}
+
+
+SIGNAL_ENCODINGS = {"json": _sampled, "float32": _sampled_float32}
 
 
 def capture_for(user, pk):
