@@ -5,14 +5,19 @@ Production setup on one machine: a scratch PostgreSQL database, Redis as the bro
 ``--redis-db``, a queue of this run's own), and N Celery workers (separate processes,
 concurrency 1 each). The takes are seeded ``motionlib.synth`` takes of ``--minutes`` at
 120 fps written as BVH, cached in ``benchmarks/out/`` (written once). For each worker
-count the clock starts when ``import_captures`` starts (it parses and stores each file,
+count the clock starts when ``import_captures`` starts (it checks and stores each file,
 then queues it) and stops when every capture's default detection run is ready.
 
-Prints per worker count: takes, hours of motion, wall time, hours of motion per minute
-(per worker and in total), and the speed-up of two workers over one.
+Each worker count runs for each ``--checks`` mode of the command: ``full`` (every frame
+read before storing, what the command did before: the old path), ``header`` (the
+default now: the hierarchy and motion header only) and ``none`` (``--no-check``).
+
+Prints per mode and worker count: takes, hours of motion, wall time, hours of motion per
+minute (per worker and in total), and the speed-up over one worker.
 
     DATABASE_ADMIN_URL=postgres://postgres@127.0.0.1:5432/postgres \\
         .venv/bin/python benchmarks/bulk_import.py [--takes 1000] [--minutes 5] [--workers 1 2]
+        [--checks full header]
 """
 
 import argparse
@@ -49,26 +54,29 @@ def take_files(n, minutes, fps=120.0, seed=1000):
     return folder, paths
 
 
-def run(n_workers, folder, paths, env, var, check=True):
+CHECK_FLAGS = {"header": [], "full": ["--full-check"], "none": ["--no-check"]}
+
+
+def run(n_workers, folder, paths, env, var, check="header"):
     """Seconds from the command's start to the last ready run."""
     from django.contrib.auth import get_user_model
 
     from segmentation import services
     from segmentation.models import DetectionRun
 
-    user = get_user_model().objects.create_user(f"importer{n_workers}")
-    project = services.do_create_project(user, f"Bulk {n_workers}")
-    workers = [start_worker(env, var, f"bulk{n_workers}_{i}") for i in range(n_workers)]
+    user = get_user_model().objects.create_user(f"importer{n_workers}{check}")
+    project = services.do_create_project(user, f"Bulk {n_workers} {check}")
+    workers = [start_worker(env, var, f"bulk{n_workers}{check}_{i}") for i in range(n_workers)]
     try:
         started = time.perf_counter()
         command = subprocess.run(
             [sys.executable, "manage.py", "import_captures", str(folder), "--project",
-             str(project.pk), "--user", user.username, *([] if check else ["--no-check"])],
+             str(project.pk), "--user", user.username, *CHECK_FLAGS[check]],
             cwd=REPO, env=env,
             capture_output=True, text=True)
         imported = time.perf_counter() - started
-        if command.returncode:
-            raise SystemExit(f"import_captures failed:\n{command.stdout}\n{command.stderr}")
+        if command.returncode or f" {len(paths)} imported," not in command.stdout:
+            raise SystemExit(f"import_captures failed:\n{command.stdout[-2000:]}\n{command.stderr[-2000:]}")
         runs = DetectionRun.objects.filter(capture__project=project)
         while runs.filter(status="ready").count() < len(paths):
             if runs.filter(status="failed").exists() or time.perf_counter() - started > 7200:
@@ -113,9 +121,10 @@ def main():
     parser.add_argument("--takes", type=int, default=1000)
     parser.add_argument("--minutes", type=float, default=5.0)
     parser.add_argument("--workers", type=int, nargs="+", default=[1, 2])
-    parser.add_argument("--no-check", action="store_true",
-                        help="import_captures --no-check: the command only stores and queues, "
-                             "the workers do all the parsing")
+    parser.add_argument("--checks", nargs="+", choices=sorted(CHECK_FLAGS), default=["full", "header"],
+                        help="how import_captures checks files: full (--full-check, every frame "
+                             "read before storing: what it did before), header (the default: "
+                             "hierarchy and motion header), none (--no-check)")
     parser.add_argument("--redis-db", type=int, default=int(os.environ.get("BENCH_REDIS_DB", 8)))
     parser.add_argument("--admin-url", default=os.environ.get(
         "DATABASE_ADMIN_URL", "postgres://postgres@127.0.0.1:5432/postgres"))
@@ -128,30 +137,34 @@ def main():
     url = scratch_database(args.admin_url, name)
     env = {**os.environ, "DATABASE_URL": url, "CUTROOM_MEDIA_ROOT": str(var / "media"),
            "CELERY_BROKER_URL": f"redis://127.0.0.1:6379/{args.redis_db}",
-           "CELERY_QUEUE": name, "CUTROOM_VAR_DIR": str(var)}
+           "CELERY_QUEUE": name, "CUTROOM_VAR_DIR": str(var),
+           # An archive is imported by an operator: no hourly upload limit (120 by default).
+           "CUTROOM_UPLOADS_PER_HOUR": "0"}
     hours = args.takes * args.minutes / 60
-    rows = []
     try:
         start_django(**{k: env[k] for k in ("DATABASE_URL", "CUTROOM_MEDIA_ROOT",
                                             "CELERY_BROKER_URL", "CELERY_QUEUE", "CUTROOM_VAR_DIR")})
         print(f"bulk import: {args.takes} synthetic takes of {args.minutes:g} min at 120 fps"
-              f"{' (--no-check)' if args.no_check else ''} ({hours:.1f} h of motion, {sum(p.stat().st_size for p in paths) / 2**30:.1f} GB BVH, "
+              f" ({hours:.1f} h of motion, {sum(p.stat().st_size for p in paths) / 2**30:.1f} GB BVH, "
               f"{'written' if prepared > 1 else 'cached'} in {prepared:.0f} s); PostgreSQL + Redis, "
               f"workers of concurrency 1; machine: {os.cpu_count()} cores shared with other work, "
               f"load {os.getloadavg()[0]:.1f}\n", flush=True)
-        header = (f"{'workers':>7} {'takes':>6} {'command s':>10} {'total s':>9} "
+        header = (f"{'check':>6} {'workers':>7} {'takes':>6} {'command s':>10} {'total s':>9} "
                   f"{'h motion/min':>13} {'per worker':>11} {'speed-up':>9} {'worker CPU s':>13} "
                   f"{'CPU s/take':>11}")
         print(header)
         print("-" * len(header), flush=True)
-        for n in args.workers:
-            imported, total, cpu = run(n, folder, paths, env, var, check=not args.no_check)
-            rate = hours / (total / 60)
-            rows.append(rate)
-            print(f"{n:>7} {args.takes:>6} {imported:>10.1f} {total:>9.1f} {rate:>13.2f} "
-                  f"{rate / n:>11.2f} {rate / rows[0]:>8.2f}x {cpu:>13.1f} {cpu / args.takes:>11.2f}",
-                  flush=True)
-        print("\n(command s: import_captures itself, which parses, stores and queues each file; "
+        for check in args.checks:
+            one = None
+            for n in args.workers:
+                imported, total, cpu = run(n, folder, paths, env, var, check=check)
+                rate = hours / (total / 60)
+                one = one or rate
+                print(f"{check:>6} {n:>7} {args.takes:>6} {imported:>10.1f} {total:>9.1f} "
+                      f"{rate:>13.2f} {rate / n:>11.2f} {rate / one:>8.2f}x {cpu:>13.1f} "
+                      f"{cpu / args.takes:>11.2f}", flush=True)
+        print(f"\nload at the end {os.getloadavg()[0]:.1f}. (command s: import_captures itself, "
+              "which checks, stores and queues each file; "
               "total s: until the last detection run is ready; worker CPU s: user + system time of "
               "the workers and their pool processes, which says what the work costs whatever the "
               "machine's load)")

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -34,6 +34,10 @@ class Take:
         The file it was read from, if any (used in error messages).
     animation : str or None
         Which animation of a file holding several (FBX actions), else None.
+    positions : ndarray of float, shape (n_frames, n_joints, 3), or None
+        World joint positions (``forward_kinematics(take)``) when a caller has computed
+        them already; segmenters then use them instead of computing them again. Set them
+        read-only (``flags.writeable = False``): segmenters do not change them.
     """
 
     name: str
@@ -45,6 +49,7 @@ class Take:
     rest_pose_frame: int | None = None
     path: str | None = None
     animation: str | None = None
+    positions: np.ndarray | None = field(default=None, repr=False)
 
     @property
     def n_frames(self) -> int:
@@ -63,7 +68,9 @@ class Take:
         start, stop = frame_range(self.n_frames, start, stop)
         rest = self.rest_pose_frame
         rest = rest - start if rest is not None and start <= rest < stop else None
-        return replace(self, channels=self.channels[start:stop], rest_pose_frame=rest)
+        positions = None if self.positions is None else self.positions[start:stop]
+        return replace(self, channels=self.channels[start:stop], rest_pose_frame=rest,
+                       positions=positions)
 
 
 def frame_range(n_frames: int, start: int | None, stop: int | None) -> tuple[int, int]:

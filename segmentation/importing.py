@@ -13,6 +13,7 @@ from pathlib import Path
 from django.core.files import File
 
 import motionlib
+from motionlib.io import check_bvh
 from motionlib.io.fbx import check_fbx_header
 from segmentation import services, storage
 from segmentation.errors import ImportProblem
@@ -92,19 +93,27 @@ def find_asf(amc, asf=None):
     raise ImportProblem(f"{amc}: no ASF skeleton found (looked for {looked}); pass --asf PATH")
 
 
-def check_readable(path, asf=None):
-    """Parse the file with motionlib under the service's input limits; CaptureError names
-    the file, line and value at fault.
+def check_readable(path, asf=None, full=False):
+    """Check the file's structure with motionlib under the service's input limits;
+    CaptureError names the file, line and value at fault.
 
-    An FBX is only checked to be binary FBX here: Blender reads it on the convert queue (its
-    problems then fail the capture, with the reason)."""
-    if Path(path).suffix.lower() == ".fbx":
+    A BVH's hierarchy and motion header are checked (``motionlib.io.check_bvh``: the head
+    of the file only, so that importing a folder costs little more than copying it); its
+    frames are read by the worker, which fails the capture naming a bad frame's line.
+    ``full`` reads every frame here too (the worker then reads the file again). An FBX is
+    only checked to be binary FBX: Blender reads it on the convert queue. A CMU AMC
+    (small files) is read in full."""
+    suffix = Path(path).suffix.lower()
+    limits = storage.input_limits()
+    if suffix == ".fbx":
         check_fbx_header(path)
-        return
-    motionlib.read(path, asf=asf, limits=storage.input_limits())
+    elif suffix == ".bvh" and not full:
+        check_bvh(path, limits=limits)
+    else:
+        motionlib.read(path, asf=asf, limits=limits)
 
 
-def import_file(project, user, path, asf=None, check=True):
+def import_file(project, user, path, asf=None, check=True, full_check=False):
     """Import one capture file into ``project`` as if ``user`` had uploaded it.
 
     Parameters
@@ -117,8 +126,10 @@ def import_file(project, user, path, asf=None, check=True):
     asf : str or PathLike, optional
         The ASF to use for an AMC file instead of looking for one.
     check : bool
-        Parse the file first and refuse it if unreadable, instead of leaving the
-        worker to mark the capture failed.
+        Check the file's structure first (:func:`check_readable`) and refuse it if
+        broken, instead of leaving the worker to mark the capture failed.
+    full_check : bool
+        With ``check``: read every frame too.
 
     Returns
     -------
@@ -129,7 +140,7 @@ def import_file(project, user, path, asf=None, check=True):
     try:
         skeleton = find_asf(path, asf) if path.suffix.lower() == ".amc" else None
         if check:
-            check_readable(path, skeleton)
+            check_readable(path, skeleton, full=full_check)
         capture, created = _upload(project, user, path, skeleton)
     except (ValueError, OSError) as exc:
         return Outcome(path, "failed", _reason(path, exc))

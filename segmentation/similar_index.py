@@ -24,8 +24,9 @@ Files, in ``settings.SIMILAR_INDEX_DIR`` (``$CUTROOM_SIMILAR_INDEX_DIR``, defaul
 
 Staying in step with the database (which is the truth):
 
-- Segments newer than the manifest's ``max_id`` are searched exactly from the database
-  (the *delta*, cached per process), so a search never waits for the index.
+- Segments newer than the manifest's ``max_id`` (the *delta*) are read with each
+  search's candidates, in the same query, and measured exactly, so a search never waits
+  for the index.
 - Deleted segments left in the file are dropped when candidates are read back.
 - ``update`` (a Celery task queued when library rows change, and run by
   ``manage.py similar_index``) compares the index's keys with the database's ids, removes
@@ -46,12 +47,12 @@ import shutil
 import threading
 import time
 from contextlib import contextmanager
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 from django.conf import settings
-from django.db import transaction
+from django.db import connections, transaction
 
 from motionlib import similarity
 from motionlib.vector_index import IvfIndex
@@ -63,7 +64,7 @@ log = logging.getLogger(__name__)
 FORMAT = 1
 # A search scans at least this share of the index (nearest clusters first): chosen on the
 # million-segment benchmark for recall@10 >= 0.95 against the exact scan.
-PROBE_SHARE = 0.01
+PROBE_SHARE = 0.005
 # An update that would remove more than this share of the vectors, or grow the index past
 # GROWTH times the size its centres were trained on, retrains instead (clusters drift).
 REBUILD_SHARE = 0.25
@@ -260,58 +261,58 @@ def schedule_update(project_id):
         "update_similar_index", project_id, then="searches read the newer segments from the database"))
 
 
-def newer_than(project_id, after):
-    """(id, profile) of a project's described segments with ids above ``after``, in id
-    order. Written as row comparisons on (project, id) so that the planner walks the
-    ``libseg_described`` index from ``(project, after)`` to the project's end: with a plain
-    ``project_id = p AND id > after`` PostgreSQL estimates the project's share of all newer
-    rows and often prefers the primary key, then filters every newer row of every project."""
+def _candidates_or_newer(pool, ids, project_id, after):
+    """``pool``'s rows that are among ``ids`` or newer than the index file (the delta), in
+    one query: [(id, capture, start, stop, profile)].
+
+    The delta is found by row comparisons on (project, id), so that the database walks
+    the ``libseg_described`` index from ``(project, after)`` to the project's end: with a
+    plain ``project_id = p AND id > after`` PostgreSQL estimates the project's share of
+    all newer rows and often prefers the primary key, then filters every newer row of
+    every project. On PostgreSQL the delta's ids are an InitPlan joined to the candidates'
+    as one array, so the rows themselves are one scan of the primary key (an OR of the two
+    lets the planner pick a library-list index and scan the project: ~0.5 s at a million).
+    """
     table = LibrarySegment._meta.db_table
-    return (LibrarySegment.objects.filter(profile__isnull=False)
-            .extra(where=[f'("{table}"."project_id", "{table}"."id") > (%s, %s)',
-                          f'("{table}"."project_id", "{table}"."id") < (%s, 0)'],
-                   params=[project_id, after, project_id + 1])
-            .order_by("project_id", "id").values_list("id", "profile"))
+    newer = (f'SELECT u.id FROM "{table}" u WHERE u.profile IS NOT NULL AND '
+             '(u.project_id, u.id) > (%s, %s) AND (u.project_id, u.id) < (%s, 0)')
+    marks = ", ".join(["%s"] * len(ids))
+    if connections[pool.db].vendor == "postgresql":
+        where = f'"{table}"."id" = ANY(ARRAY[{marks}]::bigint[] || ARRAY({newer}))'
+    else:
+        where = f'("{table}"."id" IN ({marks or "NULL"}) OR "{table}"."id" IN ({newer}))'
+    return list(pool.extra(where=[where], params=[*ids, project_id, after, project_id + 1])
+                .values_list("id", "capture_id", "start", "stop", "profile"))
 
 
 @dataclass
 class OpenIndex:
-    """A project's index as this process sees it: the mapped file and the delta."""
+    """A project's index as this process sees it: its manifest and the mapped file.
+
+    Segments newer than the file (the *delta*) are not cached here: every search reads
+    them from the database in the same query as its candidates (``shortlist``), filtered
+    by what the caller may see, so a search costs no query of its own for freshness."""
 
     project_id: int
     manifest: dict
     index: object
-    delta_ids: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
-    delta_vectors: np.ndarray | None = None
-    seen_id: int = 0
-
-    def refresh_delta(self):
-        """Read the segments added since the last look (one indexed query)."""
-        rows = list(newer_than(self.project_id, max(self.seen_id, self.manifest["max_id"])))
-        if not rows:
-            return
-        vectors = as_vectors([r[1] for r in rows])
-        ids = np.array([r[0] for r in rows], dtype=np.int64)
-        old = self.delta_vectors if self.delta_vectors is not None else vectors[:0]
-        self.delta_ids = np.concatenate([self.delta_ids, ids])
-        self.delta_vectors = np.concatenate([old, vectors])
-        self.seen_id = int(ids[-1])
-        if len(self.delta_ids) > DELTA_LIMIT >= len(self.delta_ids) - len(ids):
-            schedule_update(self.project_id)
+    update_queued: bool = False
 
     def nearest(self, vector, count):
-        """Up to ``count`` segment ids nearest to a profile vector (from the file and the
-        delta), nearest first. Ids may include deleted segments."""
-        ids, dist = self.index.search(vector, count, probe_share=PROBE_SHARE)
-        if self.delta_vectors is not None and len(self.delta_ids):
-            diff = self.delta_vectors - vector[None, :]
-            d = np.einsum("ij,ij->i", diff, diff)
-            ids, dist = np.concatenate([ids, self.delta_ids]), np.concatenate([dist, d])
-        return ids[np.argsort(dist, kind="stable")[:count]]
+        """Up to ``count`` segment ids of the file nearest to a profile vector, nearest
+        first. Ids may include deleted segments."""
+        return self.index.search(vector, count, probe_share=PROBE_SHARE)[0]
+
+    def note_delta(self, newer):
+        """Queue an update (once per generation) when ``newer`` segments outnumber
+        ``DELTA_LIMIT``: every search reads them."""
+        if newer > DELTA_LIMIT and not self.update_queued:
+            self.update_queued = True
+            schedule_update(self.project_id)
 
     @property
     def size(self):
-        return len(self.index) + len(self.delta_ids)
+        return len(self.index)
 
 
 _open = {}
@@ -336,8 +337,6 @@ def open_index(project_id):
         else:
             opened = _open_checked(project_id)
             _open[project_id] = (stamp, opened)
-    if opened is not None:
-        opened.refresh_delta()
     return opened
 
 
@@ -380,10 +379,11 @@ def shortlist(index, query, pool, n):
     """
     vector = np.asarray(query[:similarity.PROFILE_ROWS], dtype=np.float32).ravel()
     count = max(OVERSAMPLE * n, 64)
+    after = index.manifest["max_id"]
     while True:
         candidates = index.nearest(vector, count)
-        rows = list(pool.filter(pk__in=[int(c) for c in candidates])
-                    .values_list("id", "capture_id", "start", "stop", "profile"))
+        rows = _candidates_or_newer(pool, [int(c) for c in candidates], index.project_id, after)
+        index.note_delta(sum(r[0] > after for r in rows))
         found = _nearest_unique(rows, query, n)
         exhausted = len(candidates) < count
         if len(found) >= n or exhausted:

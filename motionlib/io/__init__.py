@@ -7,10 +7,10 @@ from pathlib import Path
 
 from motionlib.errors import CaptureError
 from motionlib.io.asf_amc import read_amc, read_asf
-from motionlib.io.bvh import read_bvh, write_bvh
+from motionlib.io.bvh import check_bvh, read_bvh, write_bvh
 from motionlib.take import DEFAULT_LIMITS, Limits, Take
 
-__all__ = ["read", "read_amc", "read_asf", "read_bvh", "write_bvh"]
+__all__ = ["check_bvh", "read", "read_amc", "read_asf", "read_bvh", "write_bvh"]
 
 
 def read(path: str | os.PathLike, *, asf: str | os.PathLike | None = None,

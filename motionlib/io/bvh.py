@@ -18,7 +18,7 @@ import numpy as np
 
 from motionlib.errors import CaptureError, shorten
 from motionlib.io.numbers import finite_value, read_rows
-from motionlib.io.text import read_lines_bytes
+from motionlib.io.text import lone_cr_to_lf, read_lines_bytes
 from motionlib.skeleton import CHANNEL_NAMES, ROTATION_CHANNELS, Skeleton
 from motionlib.take import DEFAULT_LIMITS, Limits, Take, check_size, frame_range
 
@@ -338,6 +338,18 @@ def read_bvh(path: str | os.PathLike, *, limits: Limits = DEFAULT_LIMITS) -> Tak
     """
     path = os.fspath(path)
     data = read_lines_bytes(path)
+    skeleton, n_frames, frame_time, pos, line = _head(data, len(data), path, limits)
+    channels = _parse_motion(data, pos, line, n_frames, skeleton, path, limits)
+    del data
+    return Take(name=Path(path).stem, format="bvh", fps=_snap_fps(frame_time),
+                frame_time=frame_time, channels=channels, skeleton=skeleton,
+                rest_pose_frame=detect_rest_pose(skeleton, channels), path=path)
+
+
+def _head(data: bytes, file_bytes: int, path, limits: Limits):
+    """The HIERARCHY and the motion header at the start of ``data``, checked against
+    ``limits`` for a file of ``file_bytes``: (skeleton, n_frames, frame_time, body byte,
+    body line)."""
     if not data.strip():
         raise CaptureError("empty file", path=path, line=1)
     m = _MOTION.search(data)
@@ -349,13 +361,54 @@ def read_bvh(path: str | os.PathLike, *, limits: Limits = DEFAULT_LIMITS) -> Tak
     motion_line = header.count(b"\n") + 1
     n_frames, frame_time, pos, line, frames_line = _motion_header(data, m.end(), motion_line,
                                                                   path, limits)
-    check_size(n_frames, skeleton.n_joints, skeleton.n_channels, len(data), limits,
+    check_size(n_frames, skeleton.n_joints, skeleton.n_channels, file_bytes, limits,
                path=path, line=frames_line)
-    channels = _parse_motion(data, pos, line, n_frames, skeleton, path, limits)
-    del data
-    return Take(name=Path(path).stem, format="bvh", fps=_snap_fps(frame_time),
-                frame_time=frame_time, channels=channels, skeleton=skeleton,
-                rest_pose_frame=detect_rest_pose(skeleton, channels), path=path)
+    return skeleton, n_frames, frame_time, pos, line
+
+
+def _has_motion_header(data: bytes) -> bool:
+    """Whether ``data`` holds MOTION and, after it, three whole lines that are not blank
+    (``Frames:``, ``Frame Time:`` and the first frame)."""
+    m = _MOTION.search(data)
+    whole = data[m.end():].split(b"\n")[1:-1] if m else []
+    return sum(1 for line in whole if line.strip()) >= 3
+
+
+# A BVH's hierarchy and motion header fit in the first block of nearly every file.
+HEAD_BLOCK = 1 << 16
+
+
+def check_bvh(path: str | os.PathLike, *, limits: Limits = DEFAULT_LIMITS) -> tuple[Skeleton, int, float]:
+    """Check a BVH file's structure without reading its frames.
+
+    Reads the file up to the line after ``Frame Time:`` only (a few kilobytes of a file
+    of any size), and checks what ``read_bvh`` checks there: the HIERARCHY, the
+    ``Frames:`` and ``Frame Time:`` lines, and the frame count against ``limits`` for
+    the file's size. A bad frame value or a missing frame line is not seen: ``read_bvh``
+    finds it and names its line.
+
+    Returns
+    -------
+    skeleton : Skeleton
+    n_frames : int
+    frame_time : float, seconds
+
+    Raises
+    ------
+    CaptureError
+        Naming the file, the line and what was wrong, with ``read_bvh``'s messages.
+    """
+    path = os.fspath(path)
+    file_bytes = os.path.getsize(path)
+    with open(path, "rb") as fh:
+        data = b""
+        while True:
+            block = fh.read(HEAD_BLOCK)
+            data = lone_cr_to_lf(data + block)
+            if not block or _has_motion_header(data):
+                break
+    skeleton, n_frames, frame_time, _, _ = _head(data, file_bytes, path, limits)
+    return skeleton, n_frames, frame_time
 
 
 _ROOT_CHANNELS = ("Xposition", "Yposition", "Zposition", "Zrotation", "Yrotation", "Xrotation")

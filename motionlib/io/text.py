@@ -15,7 +15,11 @@ def read_lines_bytes(path) -> bytes:
     line, and its error messages would point at the wrong place for the wrong reason.
     CRLF is left as it is (the CR is whitespace to the readers).
     """
-    data = Path(path).read_bytes()
+    return lone_cr_to_lf(Path(path).read_bytes())
+
+
+def lone_cr_to_lf(data: bytes) -> bytes:
+    """``data`` with each CR not followed by LF turned into LF."""
     if b"\r" in data and data.count(b"\r") != data.count(b"\r\n"):
         data = _LONE_CR.sub(b"\n", data)
     return data

@@ -181,7 +181,8 @@ def take_positions(take: Any) -> tuple[np.ndarray, dict[str, int], int]:
     """World joint positions of the frames a segmenter should look at.
 
     A cgspeed BVH starts with an added T-pose frame (``take.rest_pose_frame``); it is
-    not part of the performance, so detection starts after it.
+    not part of the performance, so detection starts after it. ``take.positions`` are
+    used when set (a service that has just computed them for storage), else computed.
 
     Returns
     -------
@@ -192,7 +193,8 @@ def take_positions(take: Any) -> tuple[np.ndarray, dict[str, int], int]:
     import motionlib
 
     first = 0 if take.rest_pose_frame is None else int(take.rest_pose_frame) + 1
-    positions = motionlib.forward_kinematics(take)[first:]
+    known = getattr(take, "positions", None)
+    positions = (motionlib.forward_kinematics(take) if known is None else known)[first:]
     return positions, motionlib.canonical_indices(take), first
 
 

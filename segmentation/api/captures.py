@@ -6,7 +6,7 @@ import math
 import numpy as np
 from django.conf import settings
 from django.db.models import Exists, OuterRef, Prefetch
-from drf_spectacular.utils import OpenApiParameter, extend_schema
+from drf_spectacular.utils import OpenApiParameter, PolymorphicProxySerializer, extend_schema
 from rest_framework import mixins, viewsets
 from rest_framework.decorators import action
 from rest_framework.exceptions import NotFound, PermissionDenied
@@ -22,13 +22,14 @@ from segmentation.api.serializers import (
     CaptureListSerializer,
     CaptureSerializer,
     FramesSerializer,
+    PackedSignalsSerializer,
     RunRequestSerializer,
     RunSerializer,
     SignalsSerializer,
     UploadedSerializer,
     UploadSerializer,
 )
-from segmentation.errors import NotReady, UploadTooLarge
+from segmentation.errors import Invalid, NotReady, UploadTooLarge
 from segmentation.models import Capture, DetectionRun, JSONArrayLength, Review
 
 
@@ -95,17 +96,27 @@ class CaptureViewSet(
         capture.duplicate = not created
         return Response(UploadedSerializer(capture).data, status=201 if created else 200)
 
-    @extend_schema(parameters=[OpenApiParameter("max_points", int)], responses=SignalsSerializer)
+    @extend_schema(parameters=[OpenApiParameter("max_points", int),
+                               OpenApiParameter("encoding", str, enum=["json", "float32"])],
+                   responses=PolymorphicProxySerializer(
+                       component_name="SignalsAnswer", resource_type_field_name=None,
+                       serializers=[SignalsSerializer, PackedSignalsSerializer]))
     @action(detail=True)
     @immutable(lambda view, request: _signal_identity(view.get_object()))
     def signal(self, request, pk=None):
         capture = self.get_object()
         max_points = int_param(request, "max_points", 2000, 2, 1_000_000)
+        encoding = request.query_params.get("encoding", "json")
+        if encoding not in SIGNAL_ENCODINGS:
+            raise Invalid(f"encoding: must be one of {', '.join(SIGNAL_ENCODINGS)}, got "
+                          f"{encoding[:40]!r}")
         run = capture.latest_finished_run()
         body = {"run": run.pk if run else None, "fps": capture.fps, "n_frames": capture.n_frames}
         signals = storage.load_npz(run.signals) if run and run.signals else {}
-        body["signals"] = [_sampled(name, values, max_points) for name, values in signals.items()]
-        return Response(SignalsSerializer(body).data)
+        body["signals"] = [SIGNAL_ENCODINGS[encoding](name, values, max_points)
+                           for name, values in signals.items()]
+        answer = SignalsSerializer if encoding == "json" else PackedSignalsSerializer
+        return Response(answer(body).data)
 
     @extend_schema(
         parameters=[OpenApiParameter(p, int) for p in ("start", "stop", "step")],
@@ -183,6 +194,19 @@ def _sampled(name, values, max_points):
     step = max(1, math.ceil(len(values) / max_points))
     sampled = np.asarray(values[::step], dtype=float)
     return {"name": name, "start": 0, "step": step, "values": np.round(sampled, 6).tolist()}
+
+
+def _sampled_float32(name, values, max_points):
+    """As ``_sampled``, the values as base64 little-endian float32 (``data``), as the
+    frames are sent: 5.3 bytes a value instead of about 9 as JSON, and nothing for the page
+    to parse (an hour at 120 fps, two signals: 4.4 MB instead of 7.7 MB)."""
+    step = max(1, math.ceil(len(values) / max_points))
+    sampled = np.ascontiguousarray(values[::step], dtype="<f4")
+    return {"name": name, "start": 0, "step": step, "dtype": "float32",
+            "data": base64.b64encode(sampled.tobytes()).decode("ascii")}
+
+
+SIGNAL_ENCODINGS = {"json": _sampled, "float32": _sampled_float32}
 
 
 def capture_for(user, pk):

@@ -273,6 +273,21 @@ class SignalsSerializer(serializers.Serializer):
     signals = SignalSerializer(many=True)
 
 
+class PackedSignalSerializer(serializers.Serializer):
+    """A feature signal, sampled (``encoding=float32``): ``data`` is base64 of the values as
+    little-endian float32; value i is at frame start + i * step."""
+
+    name = serializers.CharField()
+    start = serializers.IntegerField()
+    step = serializers.IntegerField()
+    dtype = serializers.ChoiceField(choices=["float32"])
+    data = serializers.CharField()
+
+
+class PackedSignalsSerializer(SignalsSerializer):
+    signals = PackedSignalSerializer(many=True)
+
+
 class FramesSerializer(serializers.Serializer):
     """Joint positions of frames start, start + step, … before stop (base64 of little-endian
     float32, shape (n_frames, n_joints, 3)); the client continues from stop."""

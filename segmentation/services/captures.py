@@ -214,7 +214,10 @@ def ingest_capture(capture):
 
 def _ingest(capture):
     take = read_take(capture)
-    positions = np.asarray(motionlib.forward_kinematics(take), dtype="<f4")
+    # Detection below, in this process, reuses the world positions (they are read-only).
+    take.positions = motionlib.forward_kinematics(take)
+    take.positions.flags.writeable = False
+    positions = np.asarray(take.positions, dtype="<f4")
     height = float(motionlib.skeleton_height(take))
     storage.save_npy(capture.positions, "positions.npy", positions)
     run = None

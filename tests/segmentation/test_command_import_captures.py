@@ -71,17 +71,38 @@ class ImportCapturesTestCase(BaseTestCase):
     def test_it_reports_bad_files_by_name_and_line_and_goes_on(self):
         good = synthetic_bvh(seed=6, duration=10.0)
         lines = good.decode().splitlines()
-        tokens = lines[-3].split()
-        bad_line = " ".join(tokens[:2] + ["nan-ish"] + tokens[3:])
-        bad_value = lines[:-3] + [bad_line] + lines[-2:]
+        motion = lines.index("MOTION")
+        bad_header = lines[:motion + 1] + ["Frames: many"] + lines[motion + 2:]
         self.write("a_empty.bvh", b"")
-        self.write("b_bad_value.bvh", "\n".join(bad_value).encode())
+        self.write("b_bad_header.bvh", "\n".join(bad_header).encode())
         self.write("c_good.bvh", good)
         out, _ = self.run_import(self.folder)
         self.assertIn("1 imported, 0 duplicate, 2 failed", out)
         self.assertIn("a_empty.bvh:1: empty file", out)
-        self.assertRegex(out, rf"b_bad_value\.bvh:{len(lines) - 2}: .*'nan-ish'")
+        self.assertRegex(out, rf"b_bad_header\.bvh:{motion + 2}: frame count must be a whole "
+                              "number, found 'many'")
         self.assertEqual([c.name for c in Capture.objects.all()], ["c_good.bvh"])
+
+    def test_it_leaves_a_bad_frame_to_the_worker_which_names_its_line(self):
+        lines = synthetic_bvh(seed=6, duration=10.0).decode().splitlines()
+        tokens = lines[-3].split()
+        lines[-3] = " ".join(tokens[:2] + ["nan-ish"] + tokens[3:])
+        self.write("bad_value.bvh", "\n".join(lines).encode())
+        out, _ = self.run_import(self.folder)
+        self.assertIn("1 imported", out)
+        capture = self.ingest(Capture.objects.get().pk)
+        self.assertEqual(capture.status, "failed")
+        self.assertRegex(capture.error, rf"bad_value\.bvh:{len(lines) - 2}: .*'nan-ish'")
+
+    def test_it_reads_every_frame_before_storing_with_full_check(self):
+        lines = synthetic_bvh(seed=6, duration=10.0).decode().splitlines()
+        tokens = lines[-3].split()
+        lines[-3] = " ".join(tokens[:2] + ["nan-ish"] + tokens[3:])
+        self.write("bad_value.bvh", "\n".join(lines).encode())
+        out, _ = self.run_import(self.folder / "bad_value.bvh", self.write(
+            "good.bvh", synthetic_bvh(seed=7, duration=10.0)), full_check=True)
+        self.assertIn("1 imported, 0 duplicate, 1 failed", out)
+        self.assertRegex(out, rf"bad_value\.bvh:{len(lines) - 2}: .*'nan-ish'")
 
     def test_it_reports_a_path_that_does_not_exist(self):
         good = self.write("good.bvh", synthetic_bvh(seed=7, duration=10.0))

@@ -1,3 +1,5 @@
+import base64
+
 import numpy as np
 
 from tests.segmentation.base import BaseTestCase
@@ -33,3 +35,15 @@ class SignalTestCase(BaseTestCase):
         r = self.client.get(self.url, {"max_points": 1})
         self.assertEqual(r.status_code, 400)
         self.assertIn("max_points", r.json()["detail"])
+
+    def test_it_sends_the_values_as_float32_when_asked(self):
+        [plain] = self.client.get(self.url, {"max_points": 100}).json()["signals"]
+        [packed] = self.client.get(self.url, {"max_points": 100, "encoding": "float32"}).json()["signals"]
+        self.assertEqual((packed["step"], packed["dtype"]), (plain["step"], "float32"))
+        values = np.frombuffer(base64.b64decode(packed["data"]), dtype="<f4")
+        np.testing.assert_allclose(values, plain["values"], atol=1e-6)
+
+    def test_it_refuses_an_unknown_encoding(self):
+        r = self.client.get(self.url, {"encoding": "csv"})
+        self.assertEqual(r.status_code, 400)
+        self.assertIn("encoding", r.json()["detail"])

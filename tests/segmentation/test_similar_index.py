@@ -123,21 +123,32 @@ class IncrementalTest(SimilarIndexTestCase):
         assert found[0] == (twin.pk, 0.0)
         assert similar_index.read_manifest(self.project.pk)["max_id"] < twin.pk
 
-    def test_it_reads_only_its_own_projects_newer_segments(self):
-        self.add_segments(self.spans[:50], self.descs[:50])
+    def test_it_finds_newer_segments_of_its_own_project_only(self):
+        rows = self.add_segments(self.spans[:50], self.descs[:50])
         similar_index.build(self.project.pk)
-        mine = self.add_segments(self.spans[50:52], self.descs[50:52])
         capture = self.ready_capture(name="theirs.bvh")
         capture.project = self.other_project
         capture.save()
         theirs = LibrarySegment(project=self.other_project, capture=capture, label_name="x",
                                 start=0, stop=10, duration=0.1)
-        descriptors.store_descriptor(theirs, self.descs[52])
+        descriptors.store_descriptor(theirs, self.descs[0])
         theirs.save()
-        self.add_segments(self.spans[53:54], self.descs[53:54])
-        newest = LibrarySegment.objects.filter(project=self.project).latest("id")
-        opened = similar_index.open_index(self.project.pk)
-        assert opened.delta_ids.tolist() == [mine[0].pk, mine[1].pk, newest.pk]
+        mine = self.add_segments([self.spans[0]], [self.descs[0]])[0]
+        found = [pk for pk, _ in self.indexed(rows[0], k=5)]
+        assert found[0] == mine.pk
+        assert theirs.pk not in found
+
+    def test_it_queues_one_update_when_many_segments_are_newer_than_the_index(self):
+        rows = self.add_segments(self.spans[:50], self.descs[:50])
+        similar_index.build(self.project.pk)
+        self.add_segments(self.spans[50:53], self.descs[50:53])
+        queued = []
+        with mock.patch.object(similar_index, "DELTA_LIMIT", 2):
+            for _ in range(2):
+                with self.captureOnCommitCallbacks() as callbacks:
+                    self.indexed(rows[0])
+                queued.append(len(callbacks))
+        assert queued == [1, 0], "the first search queues the update, the next one does not"
 
     def test_it_brings_the_index_in_step_when_a_review_is_submitted(self):
         self.add_segments(self.spans, self.descs)

@@ -1263,6 +1263,25 @@ export interface components {
          * @enum {string}
          */
         OriginEnum: "candidate" | "inserted";
+        /**
+         * @description A feature signal, sampled (``encoding=float32``): ``data`` is base64 of the values as
+         *     little-endian float32; value i is at frame start + i * step.
+         */
+        PackedSignal: {
+            name: string;
+            start: number;
+            step: number;
+            dtype: components["schemas"]["DtypeEnum"];
+            data: string;
+        };
+        PackedSignals: {
+            /** @description The run they came from; null: none finished. */
+            run: number | null;
+            /** Format: double */
+            fps: number | null;
+            n_frames: number | null;
+            signals: components["schemas"]["PackedSignal"][];
+        };
         PaginatedCaptureListList: {
             /** @example 123 */
             count: number;
@@ -1547,6 +1566,7 @@ export interface components {
             n_frames: number | null;
             signals: components["schemas"]["Signal"][];
         };
+        SignalsAnswer: components["schemas"]["Signals"] | components["schemas"]["PackedSignals"];
         Similar: {
             segment: number;
             /** @description Nearest first */
@@ -2290,6 +2310,7 @@ export interface operations {
     captures_signal_retrieve: {
         parameters: {
             query?: {
+                encoding?: "float32" | "json";
                 max_points?: number;
             };
             header?: never;
@@ -2306,7 +2327,7 @@ export interface operations {
                     [name: string]: unknown;
                 };
                 content: {
-                    "application/json": components["schemas"]["Signals"];
+                    "application/json": components["schemas"]["SignalsAnswer"];
                 };
             };
         };

@@ -23,7 +23,13 @@ class Command(BaseCommand):
         )
         parser.add_argument(
             "--no-check", action="store_true",
-            help="do not parse files before storing them (the worker reports bad ones)",
+            help="do not check files before storing them (the worker reports bad ones)",
+        )
+        parser.add_argument(
+            "--full-check", action="store_true",
+            help="read every frame of each file before storing it (by default only a BVH's "
+                 "hierarchy and header are checked here; the worker reads the frames, and "
+                 "fails a capture with a bad one, naming its line)",
         )
 
     def handle(self, *args, **options):
@@ -34,7 +40,8 @@ class Command(BaseCommand):
         for path in files:
             progress.step(importing.relative(path))
             outcome = importing.import_file(
-                project, user, path, asf=options["asf"], check=not options["no_check"]
+                project, user, path, asf=options["asf"], check=not options["no_check"],
+                full_check=options["full_check"],
             )
             outcomes.append(outcome)
         progress.done()
