@@ -1,7 +1,7 @@
 """FBX: upload -> candidates through the convert worker, against the BVH of the same take, and
 FBX / glTF export of a 10 s clip.
 
-Everything runs as `make up` runs it: a temporary SQLite database, the filesystem broker, a
+Everything runs as `make up` runs it: a temporary SQLite database, the SQLite broker, a
 Celery worker for ingest and detection and a convert worker (Blender, loaded once as the
 worker starts: its start-up is measured apart and not paid per file). Each repeat uploads
 CMU 13_29 as the FBX Blender wrote (``../shared/data/fbx/13_29_blender.fbx``) and as the BVH
@@ -152,7 +152,7 @@ def report(args, startup_worker, rows, startup, exports):
     print(f"convert worker: Blender loaded {startup_worker:.2f} s after the worker started "
           "(once per worker process, not per file)")
     print()
-    print("upload -> candidates, embedded default (SQLite + filesystem broker, 1 ingest worker "
+    print("upload -> candidates, embedded default (SQLite + SQLite broker, 1 ingest worker "
           "+ 1 convert worker), CMU 13_29")
     print(f"{'repeat':>6} {'file':<20} {'frames':>6} {'converted s':>11} {'total s':>8} "
           f"{'cuts':>5}")

@@ -1,7 +1,7 @@
 """An hour-long take end to end: upload -> candidates, the review page's first pose and
 whole signal, and the worker's peak memory.
 
-Runs as ``make up`` does (a temporary SQLite database, the filesystem broker, one Celery
+Runs as ``make up`` does (a temporary SQLite database, the SQLite broker, one Celery
 worker subprocess with concurrency 1). The take is a seeded ``motionlib.synth`` take of
 ``--minutes`` (default 60) at 120 fps written as BVH, cached in ``benchmarks/out/``. It is
 uploaded through the HTTP API (Django's test client; the upload limit is raised to 2 GB
@@ -139,7 +139,7 @@ def main():
         print(f"hour-long take: {capture.n_frames:,} frames at {capture.fps:g} fps "
               f"({capture.n_frames / capture.fps / 60:.0f} min), {path.stat().st_size / 2**20:.0f} MB "
               f"BVH ({'written' if prepared > 1 else 'cached'} in {prepared:.0f} s); embedded default "
-              f"(SQLite, filesystem broker, 1 worker, concurrency 1); machine: {os.cpu_count()} cores "
+              f"(SQLite, SQLite broker, 1 worker, concurrency 1); machine: {os.cpu_count()} cores "
               f"shared with other work, load {os.getloadavg()[0]:.1f}\n")
         print(f"{'step':<32} {'seconds':>8} {'target':>7}")
         print("-" * 49)

@@ -1,6 +1,6 @@
 """Review requests on a one-hour take: reads and edits stay fast, suggestions come from the worker.
 
-Everything runs as `make up` runs it: a temporary SQLite database, the filesystem broker,
+Everything runs as `make up` runs it: a temporary SQLite database, the SQLite broker,
 a Celery worker (2 processes) and gunicorn as subprocesses, started with the command lines
 of ``scripts/up.py`` (its gunicorn sizing, its worker nice value). ``--old-serving``
 starts them as they were before frames and signals answers were cached and bounded:
@@ -454,7 +454,7 @@ def main():
     try:
         start_django(unset=("DATABASE_URL", "CELERY_BROKER_URL", "CUTROOM_MEDIA_ROOT", "CELERY_BROKER_DIR"),
                      CUTROOM_VAR_DIR=str(var))
-        print(f"embedded default (SQLite, filesystem broker) in {var}; {load()}")
+        print(f"embedded default (SQLite, SQLite broker) in {var}; {load()}")
         data = populate(args)
         old = time_old_path(data, args.old_repeats)
 
