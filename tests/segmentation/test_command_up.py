@@ -1,5 +1,5 @@
 """``scripts/up.py`` (``make up``) as a person runs it: a real gunicorn and a real Celery
-worker on the embedded default (SQLite + filesystem broker in a fresh var folder)."""
+worker on the embedded default (SQLite + SQLite broker in a fresh var folder)."""
 
 import json
 import os
