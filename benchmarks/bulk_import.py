@@ -32,6 +32,9 @@ from pathlib import Path
 
 from harness import REPO, drop_database, scratch_database, start_django, stop
 
+# The workers run as `make up` runs them: one core per pool process, no BLAS threads.
+SINGLE_THREADED = {"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
+
 OUT = REPO / "benchmarks" / "out"
 
 
@@ -107,7 +110,8 @@ def start_worker(env, var, name):
     proc = subprocess.Popen(
         [str(Path(sys.executable).with_name("celery")), "-A", "cutroom", "worker", "--concurrency",
          "1", "--loglevel", "INFO", "--without-mingle", "--without-gossip", "-n", f"{name}@%h"],
-        cwd=REPO, env=env, stdout=log.open("w"), stderr=subprocess.STDOUT, start_new_session=True)
+        cwd=REPO, env={**SINGLE_THREADED, **env}, stdout=log.open("w"), stderr=subprocess.STDOUT,
+        start_new_session=True)
     deadline = time.monotonic() + 60
     while " ready." not in log.read_text():
         if proc.poll() is not None or time.monotonic() > deadline:
