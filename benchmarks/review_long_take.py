@@ -188,6 +188,11 @@ def old_library():
                                 capture_output=True, text=True, check=True).stdout
     except (subprocess.CalledProcessError, IndexError, OSError):
         return None
+    # Modules it imports that have since moved: the models now live in one package.
+    import segmentation.models
+
+    for moved in ("models_library", "models_reviews", "models_captures", "models_jobs"):
+        sys.modules.setdefault(f"segmentation.{moved}", segmentation.models)
     module = types.ModuleType("old_library")
     exec(compile(source, "old segmentation/library.py", "exec"), module.__dict__)
     return module
