@@ -5,7 +5,8 @@ a Celery worker (2 processes) and gunicorn as subprocesses, started with the com
 of ``scripts/up.py`` (its gunicorn sizing, its worker nice value). ``--old-serving``
 starts them as they were before frames and signals answers were cached and bounded:
 gunicorn 2 workers x 4 threads, the worker not niced, ``CUTROOM_HEAVY_REQUESTS=0`` and
-``CUTROOM_ANSWER_CACHE_MB=0``. The data is seeded (``motionlib.synth``):
+``CUTROOM_ANSWER_CACHE_MB=0``, no bulk lane (``cutroom/lanes.py``; the new serving starts
+its niced server as ``make up`` does). The data is seeded (``motionlib.synth``):
 
 - a library of gold-labelled takes (``--library-minutes``, cut into 10-minute takes at
   their true boundaries, submitted by one annotator and adjudicated by a reviewer);
@@ -392,9 +393,9 @@ def free_port():
         return sock.getsockname()[1]
 
 
-def start(argv, log, ready):
+def start(argv, log, ready, **extra_env):
     handle = log.open("w")
-    proc = subprocess.Popen(argv, cwd=REPO, env=os.environ.copy(), stdout=handle,
+    proc = subprocess.Popen(argv, cwd=REPO, env={**os.environ, **extra_env}, stdout=handle,
                             stderr=subprocess.STDOUT, start_new_session=True)
     deadline = time.monotonic() + 90
     while not ready():
@@ -420,23 +421,33 @@ def up_script():
 
 
 def serving(old, var, port):
-    """(worker argv, gunicorn argv, description) as `make up` starts them, or as before."""
+    """(worker argv, gunicorn argv, bulk lane server argv or None, description) as
+    `make up` starts them, or as before. Sets the environment the processes get."""
     up, env = up_script(), os.environ.copy()
+    env["CUTROOM_VAR_DIR"] = str(var)
     worker_argv = up.worker(env, var, 2).argv
+    bulk = None if old else up.bulk_web(env, var)
+    bulk_argv = bulk.argv if bulk else None
     web_argv = up.web(env, var, "127.0.0.1", port).argv
     if old:
-        os.environ.update(CUTROOM_HEAVY_REQUESTS="0", CUTROOM_ANSWER_CACHE_MB="0")
+        os.environ.update(CUTROOM_HEAVY_REQUESTS="0", CUTROOM_ANSWER_CACHE_MB="0",
+                          CUTROOM_BULK_REQUESTS="0", CUTROOM_BULK_SOCKET="")
         worker_argv = worker_argv[worker_argv.index(str(Path(sys.executable).parent / "celery")):]
         web_argv[web_argv.index("--workers") + 1], web_argv[web_argv.index("--threads") + 1] = "2", "4"
+    else:
+        os.environ["CUTROOM_BULK_SOCKET"] = env["CUTROOM_BULK_SOCKET"]
     from django.conf import settings
 
     heavy = os.environ.get("CUTROOM_HEAVY_REQUESTS", settings.CUTROOM_HEAVY_REQUESTS)
     cache_mb = os.environ.get("CUTROOM_ANSWER_CACHE_MB", settings.CUTROOM_ANSWER_CACHE_MB)
     workers, threads = (web_argv[web_argv.index(f"--{k}") + 1] for k in ("workers", "threads"))
     niced = f"nice {worker_argv[2]}" if worker_argv[0] == "nice" else "not niced"
-    return worker_argv, web_argv, (
+    lane = ("no bulk lane" if old else
+            f"bulk lane (CUTROOM_BULK_REQUESTS={settings.CUTROOM_BULK_REQUESTS}) on its own server, "
+            f"nice {bulk_argv[2]}" if bulk_argv else "bulk lane in the web server's processes")
+    return worker_argv, web_argv, bulk_argv, (
         f"{'OLD' if old else 'NEW'} serving: gunicorn {workers} workers x {threads} threads, "
-        f"worker {niced}, CUTROOM_HEAVY_REQUESTS={heavy}, CUTROOM_ANSWER_CACHE_MB={cache_mb}")
+        f"worker {niced}, CUTROOM_HEAVY_REQUESTS={heavy}, CUTROOM_ANSWER_CACHE_MB={cache_mb}, {lane}")
 
 
 # ---- report -------------------------------------------------------------------------------
@@ -464,10 +475,13 @@ def main():
         old = time_old_path(data, args.old_repeats)
 
         port = free_port()
-        worker_argv, web_argv, described = serving(args.old_serving, var, port)
+        worker_argv, web_argv, bulk_argv, described = serving(args.old_serving, var, port)
         print(described)
         worker_log = var / "worker.log"
         procs.append(start(worker_argv, worker_log, lambda: " ready." in worker_log.read_text()))
+        if bulk_argv:
+            sock = Path(os.environ["CUTROOM_BULK_SOCKET"])
+            procs.append(start(bulk_argv, var / "web-bulk.log", sock.exists, CUTROOM_BULK_SOCKET=""))
         procs.append(start(web_argv, var / "web.log", lambda: answers(port)))
         ann = Client(port, data.tokens["ann"])
         ann.call("GET", "/api/me/")  # warm both connections' first request

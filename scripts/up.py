@@ -33,10 +33,15 @@ LONGEST_PAUSE = 300.0
 # The workers run at this nice value, so on a small machine the web server's requests
 # win the CPU over detection and suggestion jobs.
 WORKER_NICE = 10
-# gunicorn: 2 processes of 16 threads. A thread waiting for one of its process's
-# CUTROOM_HEAVY_REQUESTS slots sleeps (no CPU, no GIL); with this many threads a light
-# request still finds a free one while 20 page loads of a long take are in progress.
-WEB_WORKERS, WEB_THREADS = 2, 16
+# gunicorn: 2 processes of 32 threads. A thread waiting in its process's bulk lane
+# (cutroom/lanes.py; at most CUTROOM_BULK_QUEUE = 24 of them) or for a CUTROOM_HEAVY_REQUESTS
+# slot sleeps (no CPU, no GIL); with this many threads a light request still finds a free
+# one while 20 page loads of a long take are in progress.
+WEB_WORKERS, WEB_THREADS = 2, 32
+# The bulk lane's web server (cutroom/lanes.py): requests about long takes, handed to it
+# by the web server over a Unix socket under var/run/, at a lower CPU priority than the web
+# server's own requests and a higher one than the workers' jobs.
+BULK_NICE = 10
 
 
 def parse_args(argv=None):
@@ -178,6 +183,29 @@ def web(env, logs, host, port):
     return Child("web server", argv, env, logs / "web.log")
 
 
+def bulk_socket(env):
+    """The bulk lane server's socket path ('' when CUTROOM_BULK_SOCKET is set empty: none)."""
+    if "CUTROOM_BULK_SOCKET" in env:
+        return env["CUTROOM_BULK_SOCKET"]
+    return str(var_dir() / "run" / "bulk.sock")
+
+
+def bulk_web(env, logs):
+    """The bulk lane's server, or None; ``env`` (the web server's too) gets its socket."""
+    path = env["CUTROOM_BULK_SOCKET"] = bulk_socket(env)
+    if not path:
+        return None
+    Path(path).parent.mkdir(parents=True, exist_ok=True)
+    argv = [
+        "nice", "-n", str(BULK_NICE),
+        str(BIN / "gunicorn"), "cutroom.wsgi:application", "--bind", f"unix:{path}",
+        "--workers", str(WEB_WORKERS), "--threads", str(WEB_THREADS), "--timeout", "120",
+        "--keep-alive", "75", "--access-logfile", "-", "--error-logfile", "-",
+    ]
+    # It serves what it is handed, and hands nothing on.
+    return Child("bulk lane server", argv, {**env, "CUTROOM_BULK_SOCKET": ""}, logs / "web-bulk.log")
+
+
 def wait_ready(worker_child, web_child, url, timeout=90):
     """Block until the worker logged "ready" and the web server answers; False if one died."""
     deadline = time.monotonic() + timeout
@@ -271,16 +299,23 @@ class Watchdog:
             connection.close()
 
 
-def supervise(worker_child, web_child, watchdog, convert_child=None):
+def supervise(worker_child, web_child, watchdog, convert_child=None, bulk_child=None):
     """Watch the children until a signal arrives; returns the exit code for up.py.
 
     The web server keeps serving whatever happens to the worker; a worker that died or
-    stalled is restarted (rate-limited by Restarts)."""
+    stalled is restarted (rate-limited by Restarts). A bulk lane server that died is
+    restarted at once; meanwhile the web server serves those requests itself."""
     restarts = Restarts()
     while True:
         time.sleep(0.5)
         if convert_child is not None and convert_child.exited() is not None:
             restart_convert_worker(convert_child)
+        if bulk_child is not None and bulk_child.exited() is not None:
+            say(f"the bulk lane server died (exit code {bulk_child.exited()}); end of "
+                f"{bulk_child.log}:\n{bulk_child.tail()}")
+            bulk_child.kill()
+            bulk_child.start()
+            say(f"bulk lane server restarted, pid {bulk_child.proc.pid}")
         if web_child.exited() is not None:
             say(f"the web server stopped unexpectedly (exit code {web_child.exited()}); "
                 f"end of {web_child.log}:\n{web_child.tail()}")
@@ -373,28 +408,36 @@ def main(argv=None):
     url = f"http://{args.host}:{args.port}/"
     worker_child = worker(env, logs, args.concurrency)
     convert_child = convert_worker(env, logs)
+    bulk_child = bulk_web(env, logs)
     web_child = web(env, logs, args.host, args.port)
+    children = [c for c in (web_child, bulk_child, worker_child, convert_child) if c]
     signal.signal(signal.SIGINT, on_signal)
     signal.signal(signal.SIGTERM, on_signal)
     code = 1
     try:
         worker_child.start()
         convert_child.start()
+        if bulk_child:
+            bulk_child.start()
         web_child.start()
         if wait_ready(worker_child, web_child, url):
             banner(url, worker_child, web_child, logs, not args.no_demo)
             say(f"FBX convert worker pid {convert_child.proc.pid} (Blender), log "
                 f"{convert_child.log}")
-            code = supervise(worker_child, web_child, Watchdog(env, args.concurrency), convert_child)
+            if bulk_child:
+                say(f"bulk lane server pid {bulk_child.proc.pid} (requests about long takes, "
+                    f"nice {BULK_NICE}), log {bulk_child.log}")
+            code = supervise(worker_child, web_child, Watchdog(env, args.concurrency),
+                             convert_child, bulk_child)
     except Stop as stop:
         say(f"{stop} received; stopping the web server and the worker")
         code = 0
     finally:
         signal.signal(signal.SIGINT, signal.SIG_IGN)
         signal.signal(signal.SIGTERM, signal.SIG_IGN)
-        for child in (web_child, worker_child, convert_child):
+        for child in children:
             child.stop()
-        for child in (web_child, worker_child, convert_child):
+        for child in children:
             if child.proc:
                 child.wait(30)
     say("stopped")

@@ -46,3 +46,19 @@ def answer_cache():
     heavy.answer_cache().clear()
     yield heavy.answer_cache()
     heavy.answer_cache().clear()
+
+
+@pytest.fixture
+def up(tmp_path):
+    """Start ``scripts/up.py`` (``Up``) on a fresh port; every one started is stopped after."""
+    from tests.segmentation.test_command_up import Up, free_port
+
+    started = []
+
+    def start(*args, var=tmp_path / "var", env=None):
+        started.append(Up(var, free_port(), *args, env=env))
+        return started[-1]
+
+    yield start
+    for process in started:
+        process.close()

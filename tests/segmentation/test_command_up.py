@@ -111,19 +111,6 @@ def _live_in_group(stat, pgid):
     return int(fields[2]) == pgid and fields[0] != "Z"
 
 
-@pytest.fixture
-def up(tmp_path):
-    started = []
-
-    def start(*args, var=tmp_path / "var", env=None):
-        started.append(Up(var, free_port(), *args, env=env))
-        return started[-1]
-
-    yield start
-    for process in started:
-        process.close()
-
-
 def test_it_serves_the_demo_survives_a_dead_worker_stops_on_ctrl_c_and_runs_again(up):
     # One test walks the whole life cycle: each start of up.py costs seconds.
     server = up()

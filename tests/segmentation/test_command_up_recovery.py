@@ -13,24 +13,11 @@ from pathlib import Path
 import pytest
 
 from tests.segmentation.base import synthetic_bvh
-from tests.segmentation.test_command_up import UP, Up, free_port, wait_until, wait_until_detected
+from tests.segmentation.test_command_up import UP, wait_until, wait_until_detected
 
 pytestmark = pytest.mark.slow
 
 FAST_WATCH = {"CUTROOM_STALL_SECONDS": "10", "CUTROOM_SWEEP_SECONDS": "2"}
-
-
-@pytest.fixture
-def up(tmp_path):
-    started = []
-
-    def start(*args, env=None):
-        started.append(Up(tmp_path / "var", free_port(), *args, env=env))
-        return started[-1]
-
-    yield start
-    for process in started:
-        process.close()
 
 
 def load_up_script():

@@ -1,0 +1,356 @@
+"""Two lanes per web process, so that many people opening a long take never slow down
+everyone else's requests.
+
+A review page of a one-hour take makes requests that each cost tens of milliseconds of
+CPU (its review of hundreds of segments, their label suggestions, the signals, the
+frames); twenty people opening it at once make a hundred and forty of them. Under the
+GIL a request's time grows with the number of threads of its process that want the CPU,
+so a small capture's requests, a few milliseconds alone, would wait behind all of them.
+
+So each request is put in one of two lanes before any of its work is done:
+
+- the *bulk* lane: a request about a capture of at least ``CUTROOM_LARGE_TAKE_FRAMES``
+  frames (``/api/captures/<id>/…``), and any request of a client (its token, session or
+  address) that made such a request in the last ``CUTROOM_BULK_LINGER`` seconds (the
+  same page's ``/api/me/`` and ``/api/projects/``);
+- the *light* lane: everything else.
+
+At most ``CUTROOM_BULK_REQUESTS`` bulk requests run at once per process; the others
+wait on a lock, which holds neither the GIL nor a CPU, in arrival order. Light
+requests never wait for a slot, so they share their process with at most that many
+bulk requests. A process keeps at most ``CUTROOM_BULK_QUEUE`` bulk requests waiting
+(fewer than its threads, so a light request always finds a free thread); one more, or
+one that waited ``CUTROOM_HEAVY_WAIT`` seconds, gets a 429 with Retry-After.
+
+Where the bulk lane runs. ``make up`` starts a web server of its own for it, at a lower
+CPU priority (``nice``), on a Unix socket (``CUTROOM_BULK_SOCKET``), and the main web
+server's processes hand each bulk request to it (:class:`Upstream`) and wait for its
+answer on the socket, which costs them no CPU: on a busy machine the operating system
+then gives the light requests the CPU first, whatever the bulk lane is doing; on an idle
+one the bulk lane has all of it. Without that server (not configured, not running) a
+process serves its bulk requests itself, still at most ``CUTROOM_BULK_REQUESTS`` at once.
+
+Which lane a request is in decides only when it runs, never whether it is allowed:
+permissions are checked by the view as always. The client key is a hash of the
+``Authorization`` header or session cookie as sent, or of the address when there is
+neither; a client that sends someone else's credentials only moves that key's requests.
+"""
+
+import hashlib
+import hmac
+import http.client
+import logging
+import re
+import socket
+import threading
+import time
+from collections import OrderedDict
+from http.cookies import SimpleCookie
+
+from django.conf import settings
+from django.http import HttpResponse, JsonResponse, StreamingHttpResponse
+
+logger = logging.getLogger(__name__)
+
+CAPTURE_PATH = re.compile(r"^/api/captures/(\d+)/")
+
+# Captures' frame counts, by id: written at ingest and never changed after.
+_frames_lock = threading.Lock()
+_frames = OrderedDict()
+_FRAMES_KEPT = 4096
+
+
+def capture_frames(capture_id):
+    """The capture's frame count, or None (unknown id, or not ingested yet)."""
+    with _frames_lock:
+        if capture_id in _frames:
+            _frames.move_to_end(capture_id)
+            return _frames[capture_id]
+    from segmentation.models import Capture
+
+    n = Capture.objects.filter(pk=capture_id).values_list("n_frames", flat=True).first()
+    if n is not None:  # a capture still ingesting may become large: ask again next time
+        with _frames_lock:
+            _frames[capture_id] = n
+            while len(_frames) > _FRAMES_KEPT:
+                _frames.popitem(last=False)
+    return n
+
+
+def client_key(request):
+    meta = request.META
+    who = (meta.get("HTTP_AUTHORIZATION") or request.COOKIES.get(settings.SESSION_COOKIE_NAME)
+           or meta.get("REMOTE_ADDR", ""))
+    return hashlib.blake2b(who.encode(), digest_size=8).digest()
+
+
+class Lanes:
+    """One process's bulk lane: its slots, its waiting count and its lingering clients."""
+
+    def __init__(self, slots):
+        self.size, self.slots = slots, threading.Semaphore(slots)
+        self.lock = threading.Lock()
+        self.waiting = 0
+        self.bulk_until = {}  # client key -> monotonic time its requests stay bulk
+
+    def is_bulk(self, request, now):
+        key = client_key(request)
+        match = CAPTURE_PATH.match(request.path_info)
+        large = False
+        if match:
+            n = capture_frames(int(match.group(1)))
+            large = n is not None and n >= settings.CUTROOM_LARGE_TAKE_FRAMES
+        with self.lock:
+            if large:
+                self.bulk_until[key] = now + settings.CUTROOM_BULK_LINGER
+                if len(self.bulk_until) > 10_000:
+                    self.bulk_until = {k: t for k, t in self.bulk_until.items() if t > now}
+                return True
+            until = self.bulk_until.get(key)
+            return until is not None and until > now
+
+    def enter(self):
+        """Take a bulk slot; False when the queue is full or the wait too long."""
+        with self.lock:
+            if self.waiting >= settings.CUTROOM_BULK_QUEUE:
+                return False
+            self.waiting += 1
+        try:
+            return self.slots.acquire(timeout=settings.CUTROOM_HEAVY_WAIT)
+        finally:
+            with self.lock:
+                self.waiting -= 1
+
+    def leave(self):
+        self.slots.release()
+
+
+_lanes = None
+_lanes_lock = threading.Lock()
+
+
+def lanes():
+    """This process's lanes (made anew if ``CUTROOM_BULK_REQUESTS`` changed)."""
+    global _lanes
+    with _lanes_lock:
+        if _lanes is None or _lanes.size != settings.CUTROOM_BULK_REQUESTS:
+            _lanes = Lanes(settings.CUTROOM_BULK_REQUESTS)
+        return _lanes
+
+
+def unanswered():
+    response = JsonResponse(
+        {"detail": "the server that answers requests about long takes stopped while "
+                   "answering this one; try again"}, status=502)
+    response["Retry-After"] = "5"
+    return response
+
+
+def busy():
+    response = JsonResponse(
+        {"detail": "the server is busy with other requests about long takes "
+                   "(CUTROOM_BULK_REQUESTS, CUTROOM_BULK_QUEUE); try again in a few seconds"},
+        status=429)
+    response["Retry-After"] = "5"
+    return response
+
+
+# Headers the main server adds to a request it hands on: proof that it did (an HMAC of the
+# SECRET_KEY), and the address the request came from.
+LANE_HEADER, ADDRESS_HEADER = "X-Cutroom-Lane", "X-Cutroom-Client-Address"
+# Hop-by-hop headers (RFC 9110 7.6.1) are never handed on, in either direction.
+HOP_BY_HOP = {"connection", "keep-alive", "proxy-authenticate", "proxy-authorization", "te",
+              "trailer", "transfer-encoding", "upgrade", "content-length"}
+# Request bodies up to this size are handed on; a larger one is served here.
+MAX_FORWARDED_BODY = 2**20
+# An answer without a length, or longer than this, is streamed through rather than read whole.
+STREAM_ABOVE = 8 * 2**20
+
+
+def lane_proof():
+    return hmac.new(settings.SECRET_KEY.encode(), b"cutroom bulk lane", "sha256").hexdigest()
+
+
+class UnixConnection(http.client.HTTPConnection):
+    def __init__(self, path, timeout):
+        super().__init__("localhost", timeout=timeout)
+        self.socket_path = path
+
+    def connect(self):
+        sock = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+        sock.settimeout(self.timeout)
+        try:
+            sock.connect(self.socket_path)
+        except OSError:
+            sock.close()
+            raise
+        self.sock = sock
+
+
+class Unreachable(Exception):
+    """The bulk server did not take the request: serve it here."""
+
+
+class Upstream:
+    """The bulk server on ``path``: one kept-alive connection per thread."""
+
+    def __init__(self, path, timeout):
+        self.path, self.timeout = path, timeout
+        self.local = threading.local()
+
+    def connection(self, fresh=False):
+        conn = getattr(self.local, "conn", None)
+        if conn is None or fresh:
+            if conn is not None:
+                conn.close()
+            conn = self.local.conn = UnixConnection(self.path, self.timeout)
+        return conn
+
+    def forward(self, request):
+        """The bulk server's answer to ``request``; :class:`Unreachable` if it took none.
+
+        A read may go over a kept-alive connection, and again over a new one if the server
+        had closed it meanwhile; a write always goes over a new connection, so that it is
+        never sent twice.
+        """
+        body = request.body if _content_length(request) else None
+        headers = _request_headers(request)
+        idempotent = request.method in ("GET", "HEAD")
+        for attempt in range(2 if idempotent else 1):
+            conn = self.connection(fresh=attempt > 0 or not idempotent)
+            try:
+                conn.request(request.method, request.get_full_path(), body=body, headers=headers)
+                upstream = conn.getresponse()
+            except (ConnectionRefusedError, FileNotFoundError) as exc:  # not running
+                self.local.conn = None
+                raise Unreachable(str(exc)) from exc
+            except OSError as exc:  # incl. RemoteDisconnected: closed while idle, or died
+                self.local.conn = None
+                conn.close()
+                if idempotent:  # once more over a new connection, then served here
+                    if attempt == 0:
+                        continue
+                    raise Unreachable(str(exc)) from exc
+                logger.warning("bulk lane server gave no answer to %s %s: %s",
+                               request.method, request.path, exc)
+                return unanswered()
+            return self.response(upstream)
+        raise Unreachable("no answer")
+
+    def response(self, upstream):
+        length = upstream.getheader("Content-Length")
+        if length is not None and int(length) <= STREAM_ABOVE:
+            response = HttpResponse(upstream.read(), status=upstream.status)
+        else:  # this connection belongs to the stream until it ends
+            self.local.conn = None
+            response = StreamingHttpResponse(_chunks(upstream), status=upstream.status)
+        response.reason_phrase = upstream.reason
+        for name, value in upstream.getheaders():
+            lower = name.lower()
+            if lower == "set-cookie":
+                response.cookies.load(SimpleCookie(value))
+            elif lower not in HOP_BY_HOP:
+                response[name] = value
+        return response
+
+
+def _chunks(upstream):
+    try:
+        while chunk := upstream.read(2**16):
+            yield chunk
+    finally:
+        upstream.close()
+
+
+def _content_length(request):
+    try:
+        return int(request.META.get("CONTENT_LENGTH") or 0)
+    except ValueError:
+        return 0
+
+
+def _request_headers(request):
+    headers = {}
+    for key, value in request.META.items():
+        if key.startswith("HTTP_"):
+            name = key[5:].replace("_", "-").title()
+            if name.lower() not in HOP_BY_HOP and not name.lower().startswith("x-cutroom-"):
+                headers[name] = value
+    for key, name in (("CONTENT_TYPE", "Content-Type"), ("CONTENT_LENGTH", "Content-Length")):
+        if request.META.get(key):
+            headers[name] = request.META[key]
+    headers[LANE_HEADER] = lane_proof()
+    headers[ADDRESS_HEADER] = request.META.get("REMOTE_ADDR", "")
+    return headers
+
+
+_upstream = None
+
+
+def upstream():
+    """The configured bulk server, or None."""
+    global _upstream
+    path = settings.CUTROOM_BULK_SOCKET
+    if not path:
+        return None
+    with _lanes_lock:
+        if _upstream is None or _upstream.path != path:
+            _upstream = Upstream(path, timeout=settings.CUTROOM_BULK_TIMEOUT)
+        return _upstream
+
+
+def forwardable(request):
+    length = _content_length(request)
+    if request.method not in ("GET", "HEAD") and length > MAX_FORWARDED_BODY:
+        return False
+    return not request.META.get("CONTENT_TYPE", "").startswith("multipart/")
+
+
+class LaneMiddleware:
+    """Puts each API request in its lane (see the module docstring); off when
+    ``CUTROOM_BULK_REQUESTS`` is 0.
+
+    A request the web server handed on (it carries the proof) is served where it arrives,
+    with the address it came from restored (throttles and logs go by it). A bulk request's
+    answer says where it was served: ``X-Cutroom-Lane: bulk-server`` or ``bulk-here``.
+    """
+
+    def __init__(self, get_response):
+        self.get_response = get_response
+        self.warned = False
+
+    def __call__(self, request):
+        handed_on = self.handed_on(request)
+        if not settings.CUTROOM_BULK_REQUESTS or not request.path_info.startswith("/api/"):
+            return self.get_response(request)
+        lane = lanes()
+        if not handed_on and not lane.is_bulk(request, time.monotonic()):
+            return self.get_response(request)
+        server = None if handed_on else upstream()
+        if server is not None and forwardable(request):
+            try:
+                return server.forward(request)
+            except Unreachable as exc:
+                if not self.warned:
+                    logger.warning("bulk lane server at %s unreachable (%s): serving bulk "
+                                   "requests here", server.path, exc)
+                    self.warned = True
+        if not lane.enter():
+            return busy()
+        try:
+            response = self.get_response(request)
+        finally:
+            lane.leave()
+        response[LANE_HEADER] = "bulk-server" if handed_on else "bulk-here"
+        return response
+
+    @staticmethod
+    def handed_on(request):
+        """Whether the web server handed this request on (then its address is restored)."""
+        meta = request.META
+        proof = meta.pop("HTTP_" + LANE_HEADER.upper().replace("-", "_"), None)
+        address = meta.pop("HTTP_" + ADDRESS_HEADER.upper().replace("-", "_"), None)
+        if proof is None or not hmac.compare_digest(proof, lane_proof()):
+            return False
+        meta["REMOTE_ADDR"] = address or ""
+        return True
