@@ -1,5 +1,5 @@
 # Cutroom image: the built front end plus the Python package. One image runs every
-# role of docker-compose.yml (migrate, web, worker, beat); the command picks the role.
+# role of docker-compose.yml (migrate, web, worker, convert, watchdog); the command picks the role.
 
 # --- front end: TypeScript -> frontend/dist ---
 FROM node:20-bookworm-slim AS frontend

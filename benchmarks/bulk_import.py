@@ -30,10 +30,10 @@ import tempfile
 import time
 from pathlib import Path
 
-from harness import REPO, drop_database, scratch_database, start_django, stop
+from harness import REPO, drop_database, scratch_database, start_django, stop, up_script
 
 # The workers run as `make up` runs them: one core per pool process, no BLAS threads.
-SINGLE_THREADED = {"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
+SINGLE_THREADED = up_script().SINGLE_THREADED
 
 OUT = REPO / "benchmarks" / "out"
 

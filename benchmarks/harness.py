@@ -1,6 +1,7 @@
 """What the service benchmarks share: a scratch PostgreSQL database, Django started on
-a chosen environment, and stopping a child process group."""
+a chosen environment, stopping a child process group, and `make up`'s own script."""
 
+import importlib.util
 import os
 import signal
 import subprocess
@@ -9,6 +10,15 @@ from pathlib import Path
 from urllib.parse import urlparse, urlunparse
 
 REPO = Path(__file__).resolve().parents[1]
+
+
+def up_script():
+    """``scripts/up.py`` as a module (it is a script, not part of a package), so a benchmark
+    starts processes the way `make up` does."""
+    spec = importlib.util.spec_from_file_location("up", REPO / "scripts" / "up.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
 
 
 def database_url(server, name):

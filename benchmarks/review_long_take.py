@@ -40,7 +40,6 @@ load <= 2x alone.
 
 import argparse
 import http.client
-import importlib.util
 import json
 import multiprocessing
 import os
@@ -56,7 +55,7 @@ import types
 from pathlib import Path
 
 import numpy as np
-from harness import REPO, start_django, stop
+from harness import REPO, start_django, stop, up_script
 
 TARGET_MS = 100.0
 TARGET_SLOWDOWN = 2.0
@@ -411,13 +410,6 @@ def answers(port):
         return True
     except OSError:
         return False
-
-
-def up_script():
-    spec = importlib.util.spec_from_file_location("up", REPO / "scripts" / "up.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
 
 
 def serving(old, var, port):

@@ -243,11 +243,13 @@ CUTROOM_BULK_TIMEOUT = envint("CUTROOM_BULK_TIMEOUT", 300)
 # submits made meanwhile join the same training.
 CUTROOM_RETRAIN_DELAY = envint("CUTROOM_RETRAIN_DELAY", 10)
 # Time limits per job (seconds): past the soft limit the job fails with a message; past
-# soft + 30 s its process is killed. Ingest includes the default detection run.
+# soft + CUTROOM_TIME_LIMIT_GRACE its process is killed and the job fails at once (the same
+# input would run as long again). Ingest includes the default detection run.
 CUTROOM_INGEST_TIME_LIMIT = envint("CUTROOM_INGEST_TIME_LIMIT", 600)
 CUTROOM_DETECT_TIME_LIMIT = envint("CUTROOM_DETECT_TIME_LIMIT", 300)
 CUTROOM_RETRAIN_TIME_LIMIT = envint("CUTROOM_RETRAIN_TIME_LIMIT", 600)
 CUTROOM_SUGGEST_TIME_LIMIT = envint("CUTROOM_SUGGEST_TIME_LIMIT", 900)
+CUTROOM_TIME_LIMIT_GRACE = envint("CUTROOM_TIME_LIMIT_GRACE", 30)
 # Quotas (0 = no limit): uploads per user per hour, stored MB per project and per user,
 # detection runs queued or running at once per project.
 CUTROOM_UPLOADS_PER_HOUR = envint("CUTROOM_UPLOADS_PER_HOUR", 120)

@@ -285,13 +285,10 @@ class Watchdog:
         self.due = time.monotonic() + self.interval
         from django.db import connection
 
-        from segmentation.services import health, sweep_stale_claims
-        from segmentation.services.adaptation import sweep_stale_trainings
+        from segmentation.services import health
 
         try:
-            sweep_stale_claims()
-            sweep_stale_trainings()
-            return health.stalled(self.concurrency)
+            return health.look(self.concurrency)[1]
         except Exception as exc:  # the database busy or gone: look again next time
             say(f"could not check the jobs ({type(exc).__name__}: {exc})")
             return None

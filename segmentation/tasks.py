@@ -11,9 +11,11 @@ import threading
 import time
 import uuid
 
-from celery import shared_task
+from celery import Task, shared_task
+from celery.exceptions import TimeLimitExceeded
 from celery.signals import worker_init, worker_process_init, worker_ready
 from django.conf import settings
+from django.db import connection
 
 from segmentation import services, similar_index, suggestions
 from segmentation.models import Capture, DetectionRun
@@ -23,12 +25,37 @@ from segmentation.services.convert import convert_capture
 log = logging.getLogger(__name__)
 
 
+class JobTask(Task):
+    """A task that works on one job row, the first argument: ``job_model``, named
+    ``job_name`` in messages, under the time limit of setting ``limit_setting``.
+
+    Celery kills the process of a job still running at its hard time limit (it did not
+    stop at the soft one). That is deterministic for the same input, so the job fails at
+    once, naming the limit, instead of being retried until CUTROOM_MAX_ATTEMPTS.
+    """
+
+    job_model, job_name, limit_setting = None, "", ""
+
+    def on_failure(self, exc, task_id, args, kwargs, einfo):
+        # Called in the worker's main process (the pool process is gone).
+        if not isinstance(exc, TimeLimitExceeded) or self.job_model is None:
+            return
+        try:
+            jobs.fail_at_time_limit(self.job_model, args[0], task_id, self.job_name,
+                                    self.limit_setting)
+        except Exception:  # the claim goes stale and the sweep takes over, as before
+            log.exception("could not fail %s %s after its time limit", self.name, args[0])
+        finally:
+            connection.close()
+
+
 def _claim(model, pk, task):
     """The claimed row, or None if another worker has it or it is already done."""
     return jobs.claim(model, pk, task.request.id or uuid.uuid4().hex)
 
 
-@shared_task(bind=True, acks_late=True, reject_on_worker_lost=True)
+@shared_task(bind=True, acks_late=True, reject_on_worker_lost=True, base=JobTask,
+             job_model=Capture, job_name="Ingest", limit_setting="CUTROOM_INGEST_TIME_LIMIT")
 def ingest(self, capture_id):
     """Parse a capture, store its metadata and positions, then queue default detection."""
     capture = _claim(Capture, capture_id, self)
@@ -37,7 +64,8 @@ def ingest(self, capture_id):
 
 
 @shared_task(bind=True, acks_late=True, reject_on_worker_lost=True,
-             time_limit=settings.CUTROOM_CONVERT_TIME_LIMIT)
+             time_limit=settings.CUTROOM_CONVERT_TIME_LIMIT, base=JobTask, job_model=Capture,
+             job_name="Conversion", limit_setting="CUTROOM_CONVERT_TIME_LIMIT")
 def convert(self, capture_id):
     """Read an FBX capture with Blender (convert queue), then queue each animation's ingest."""
     capture = _claim(Capture, capture_id, self)
@@ -66,7 +94,9 @@ def _warm_blender():
     log.info("Blender ready in %.1f s (pid %s)", time.perf_counter() - started, shared().pid)
 
 
-@shared_task(bind=True, acks_late=True, reject_on_worker_lost=True)
+@shared_task(bind=True, acks_late=True, reject_on_worker_lost=True, base=JobTask,
+             job_model=DetectionRun, job_name="Detection",
+             limit_setting="CUTROOM_DETECT_TIME_LIMIT")
 def detect(self, run_id):
     """Compute a run's candidate cuts."""
     run = _claim(DetectionRun, run_id, self)
@@ -106,7 +136,8 @@ def sweep():
 @worker_init.connect
 def apply_time_limits(**kwargs):
     """Per-task time limits from the worker's own settings: a soft limit (the job stops
-    and fails with a message), then a hard one 30 s later (its process is killed).
+    and fails with a message), then a hard one CUTROOM_TIME_LIMIT_GRACE s later (its
+    process is killed and the job fails, see JobTask).
 
     Set here rather than on the decorators, where the sending process would write its
     own values into each message."""
@@ -117,7 +148,8 @@ def apply_time_limits(**kwargs):
         (suggest, settings.CUTROOM_SUGGEST_TIME_LIMIT),
         (sweep, 60),
     ):
-        task.soft_time_limit, task.time_limit = seconds, seconds + 30
+        task.soft_time_limit = seconds
+        task.time_limit = seconds + settings.CUTROOM_TIME_LIMIT_GRACE
 
 
 @worker_ready.connect

@@ -25,7 +25,7 @@ from segmentation.errors import (
     UploadTooLarge,
     internal_error,
 )
-from segmentation.models import Capture, DetectionRun
+from segmentation.models import Capture, DetectionRun, Project
 from segmentation.services import adaptation, jobs, quotas
 from segmentation.services.jobs import enqueue
 from segmentation.services.reviews import do_take_in_candidates
@@ -160,8 +160,8 @@ def do_start_run(capture, user, method, params):
     if capture.status != "ready":
         raise NotReady(f"capture {capture.pk} is {capture.status}; detection needs a ready capture")
     method, params = validate_method(method, params)
-    quotas.check_active_runs(capture.project)
     with transaction.atomic():
+        quotas.check_active_runs(capture.project)
         run = DetectionRun.objects.create(
             capture=capture, method=method, params=params, created_by=user
         )
@@ -312,6 +312,9 @@ def do_redetect(capture, user):
         raise NotReady(f"capture {capture.pk} is {capture.status}; detection needs a ready capture")
     project = capture.project
     with transaction.atomic():
+        # The project row before the capture's, as every transaction that locks both
+        # does (starting a run locks the project to count its runs; see quotas).
+        Project.objects.select_for_update().filter(pk=project.pk).first()
         # One re-detection or review start at a time per capture.
         Capture.objects.select_for_update().filter(pk=capture.pk).first()
         names = sorted(capture.reviews.values_list("annotator__username", flat=True))

@@ -1,5 +1,6 @@
 """Is background work making progress? Asked by a watcher outside the workers (``make
-up``'s supervisor, ``manage.py watch_jobs``), so a worker that hangs cannot hide it."""
+up``'s supervisor, ``manage.py watch_jobs`` in compose's watchdog), so a worker that hangs
+cannot hide it, and the jobs of a dead or hung worker are requeued without it."""
 
 from django.conf import settings
 from django.db.models import Max, Min, Q
@@ -8,8 +9,21 @@ from django.utils import timezone
 
 from segmentation.models import Capture, DetectionRun
 from segmentation.models.jobs import claim_cutoff
+from segmentation.services.adaptation import sweep_stale_trainings
+from segmentation.services.jobs import sweep_stale_claims
 
 JOBS = (Capture, DetectionRun)
+
+
+def look(concurrency):
+    """One look by the watcher, every CUTROOM_SWEEP_SECONDS: requeue the jobs of processes
+    that died (failing those started too often), resend jobs whose message was lost, then
+    ask whether the workers are stuck.
+
+    Returns (jobs requeued, failed or resent; why the workers look stuck, or None).
+    """
+    swept = sweep_stale_claims() + sweep_stale_trainings()
+    return swept, stalled(concurrency)
 
 
 def stalled(concurrency, after=None):

@@ -95,6 +95,27 @@ def give_up(job):
     )
 
 
+def fail_at_time_limit(model, pk, token, what, setting):
+    """Fail the job whose process was killed at its hard time limit (it did not stop at
+    the soft one), if it still holds the claim ``token``.
+
+    Unlike a process that died for another reason, this job is not retried: the same
+    input would run as long again. Returns whether the job was failed.
+    """
+    job = model.objects.filter(pk=pk, status="processing", claim_token=token).first()
+    if job is None:
+        return False
+    seconds = getattr(settings, setting)
+    extra = {"finished_at": timezone.now()} if isinstance(job, DetectionRun) else {}
+    return job.fail(
+        f"{what} stopped after its time limit of {seconds} s ({setting}): it did not stop "
+        "by itself, so its process was killed. The same input would run as long again, so "
+        "it is not retried; try parameters that cost less, or ask the administrators to "
+        "raise the limit. The original upload is kept.",
+        **extra,
+    )
+
+
 def sweep_stale_claims():
     """Requeue jobs whose worker vanished mid-way (failing those retried too often) and
     resend jobs queued for longer than the claim timeout.

@@ -7,7 +7,7 @@ from django.db.models import Sum
 from django.utils import timezone
 
 from segmentation.errors import QuotaExceeded, TooManyRequests
-from segmentation.models import Capture, DetectionRun
+from segmentation.models import Capture, DetectionRun, Project
 
 MB = 1024 * 1024
 
@@ -51,7 +51,13 @@ def _stored(**owner):
 
 def check_active_runs(project):
     """TooManyRequests while ``project`` has CUTROOM_PROJECT_ACTIVE_RUNS detection runs
-    queued or running."""
+    queued or running.
+
+    Call it in the transaction that creates the run: it locks the project row until that
+    transaction ends, so starts at the same moment count one after the other and never
+    both pass the last free place (on SQLite the IMMEDIATE transaction serialises them).
+    """
+    Project.objects.select_for_update().filter(pk=project.pk).first()
     limit = settings.CUTROOM_PROJECT_ACTIVE_RUNS
     active = DetectionRun.objects.filter(
         capture__project=project, status__in=("queued", "processing")

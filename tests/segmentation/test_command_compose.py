@@ -2,13 +2,22 @@
 parses, its services wait for healthy dependencies, workers can be scaled, and every
 variable it passes to the app is one that the settings actually read."""
 
+import importlib.util
 import re
 from pathlib import Path
 
 import yaml
 
 REPO = Path(__file__).resolve().parents[2]
-APP_SERVICES = ("migrate", "web", "worker", "convert", "beat")
+APP_SERVICES = ("migrate", "web", "worker", "convert", "watchdog")
+WORKERS = ("worker", "convert")
+
+
+def up_script():
+    spec = importlib.util.spec_from_file_location("up", REPO / "scripts" / "up.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
 
 
 def compose():
@@ -34,7 +43,8 @@ def test_it_runs_the_app_on_postgresql_and_redis():
 
 
 def test_every_variable_given_to_the_app_is_read_by_the_settings():
-    known = settings_variables() | {"WEB_CONCURRENCY"}  # WEB_CONCURRENCY is gunicorn's
+    # WEB_CONCURRENCY is gunicorn's; the BLAS thread counts are numpy's libraries'.
+    known = settings_variables() | {"WEB_CONCURRENCY"} | set(up_script().SINGLE_THREADED)
     assert {"DATABASE_URL", "SECRET_KEY", "CELERY_BROKER_URL"} <= known
     for name in APP_SERVICES:
         unknown = set(compose()["services"][name]["environment"]) - known
@@ -46,8 +56,9 @@ def documented():
 
 
 def test_every_variable_given_to_the_app_is_documented_in_env_example():
+    fixed = set(up_script().SINGLE_THREADED)  # not settings: the workers' BLAS threads
     for name in APP_SERVICES:
-        missing = set(compose()["services"][name]["environment"]) - documented()
+        missing = set(compose()["services"][name]["environment"]) - documented() - fixed
         assert not missing, f"{name}: {sorted(missing)}"
 
 
@@ -64,7 +75,7 @@ def test_the_secret_key_must_be_set_rather_than_defaulted():
 
 def test_web_and_workers_start_after_healthy_services_and_migrations():
     services = compose()["services"]
-    for name in ("web", "worker", "convert", "beat"):
+    for name in ("web", "worker", "convert", "watchdog"):
         depends = services[name]["depends_on"]
         assert depends["postgres"]["condition"] == "service_healthy", name
         assert depends["redis"]["condition"] == "service_healthy", name
@@ -74,8 +85,29 @@ def test_web_and_workers_start_after_healthy_services_and_migrations():
 
 def test_every_long_running_service_has_a_health_check():
     services = compose()["services"]
-    for name in ("postgres", "redis", "web", "worker", "convert"):
+    for name in ("postgres", "redis", "web", "worker", "convert", "watchdog"):
         assert services[name]["healthcheck"]["test"], name
+
+
+def test_workers_run_single_threaded_blas_as_make_up_does():
+    # One job per core per pool process: BLAS threads of their own would oversubscribe it.
+    for name in WORKERS:
+        env = compose()["services"][name]["environment"]
+        assert {k: env.get(k) for k in up_script().SINGLE_THREADED} == up_script().SINGLE_THREADED, name
+
+
+def test_the_sweep_and_stall_check_run_outside_the_workers():
+    # The jobs of a hung or dead worker are requeued by a process that is not a worker,
+    # as make up's supervisor does: exactly one watchdog, no scheduler sending the sweep
+    # to the workers it should rescue.
+    services = compose()["services"]
+    watchdog = services["watchdog"]
+    assert watchdog["command"][:3] == ["python", "manage.py", "watch_jobs"]
+    assert "--concurrency" in watchdog["command"]
+    assert "beat" not in services
+    assert all("beat" not in " ".join(map(str, service.get("command", [])))
+               for service in services.values())
+    assert "watch_jobs --once" in " ".join(watchdog["healthcheck"]["test"])
 
 
 def test_the_worker_can_be_scaled():

@@ -11,7 +11,8 @@ import type { Adjudication, Span } from "../library/types";
 import { advance, frameOf, seek, togglePlay, type Playback } from "../player/clock";
 import { SkeletonView } from "../player/skeletonView";
 import { FrameStore, loadFrames } from "../review/frames";
-import { commandFor, isTypingTarget, type Command } from "../review/keymap";
+import { labelForHotkey, pageCommand } from "../review/keys";
+import type { Command } from "../review/keymap";
 import { openPalette } from "../review/palette";
 import { formatTime } from "../review/timescale";
 import { clear, dialog, h, toast } from "../ui/dom";
@@ -63,7 +64,10 @@ class AdjudicationPage {
   private readonly player: SkeletonView | null = null;
   private readonly tiers: Tiers;
   private readonly el: Record<string, HTMLElement> = {};
-  private readonly onKey = (e: KeyboardEvent) => this.handleKey(e);
+  private readonly onKey = (e: KeyboardEvent) => {
+    const command = pageCommand(e);
+    if (command) this.command(command);
+  };
   private readonly onResize = () => this.refresh();
 
   constructor(
@@ -310,14 +314,6 @@ class AdjudicationPage {
     document.body.append(box);
   }
 
-  private handleKey(e: KeyboardEvent): void {
-    if (isTypingTarget(e.target) || document.querySelector(".modal-backdrop:not(.help)")) return;
-    const c = commandFor(e);
-    if (!c) return;
-    e.preventDefault();
-    this.command(c);
-  }
-
   private command(c: Command): void {
     const frame = this.frame();
     const all = [...new Set([...this.draft.cuts, ...this.reviews.flatMap((r) => r.cuts)])].sort((a, b) => a - b);
@@ -358,7 +354,7 @@ class AdjudicationPage {
         }
         return;
       case "label": {
-        const label = this.labels.find((l) => l.hotkey === c.hotkey) ?? (this.labels.some((l) => l.hotkey) ? undefined : this.labels[Number(c.hotkey) - 1]);
+        const label = labelForHotkey(this.labels, c.hotkey);
         if (label) this.labelUnderPlayhead(label.name);
         else toast(`No label has hotkey ${c.hotkey}.`);
         return;

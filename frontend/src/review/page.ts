@@ -14,7 +14,8 @@ import { navigate } from "../router";
 import { promptDialog } from "../ui/prompt";
 import { FrameStore, decodeFloat32, loadFrames } from "./frames";
 import { changeFor, emptyHistory, record, redo, undo, type Change, type History } from "./history";
-import { commandFor, HELP, isTypingTarget, type Command } from "./keymap";
+import { labelForHotkey, pageCommand } from "./keys";
+import { HELP, type Command } from "./keymap";
 import { openPalette } from "./palette";
 import { Saver } from "./saver";
 import { applyEdit, clampFrame, describeDifferences, EditError, neighbourCut, segmentAt, withTempIds, type Edit } from "./state";
@@ -130,7 +131,10 @@ class ReviewPage {
   private readonly abort: AbortController;
   private readonly labels: Label[];
   private readonly el: Elements;
-  private readonly onKey = (e: KeyboardEvent) => this.handleKey(e);
+  private readonly onKey = (e: KeyboardEvent) => {
+    const command = pageCommand(e);
+    if (command) this.command(command);
+  };
 
   constructor(
     root: HTMLElement,
@@ -497,14 +501,6 @@ class ReviewPage {
 
   // ---- commands ------------------------------------------------------------------------
 
-  private handleKey(e: KeyboardEvent): void {
-    if (isTypingTarget(e.target) || document.querySelector(".modal-backdrop:not(.help)")) return;
-    const command = commandFor(e);
-    if (!command) return;
-    e.preventDefault();
-    this.command(command);
-  }
-
   private command(c: Command): void {
     if (!this.editCommand(c)) this.viewCommand(c);
     this.refresh();
@@ -569,8 +565,7 @@ class ReviewPage {
         return true;
       case "label": {
         // Labels without hotkeys answer to their position in the taxonomy instead.
-        const active = this.activeLabels();
-        const label = active.find((l) => l.hotkey === c.hotkey) ?? (active.some((l) => l.hotkey) ? undefined : active[Number(c.hotkey) - 1]);
+        const label = labelForHotkey(this.activeLabels(), c.hotkey);
         if (label) this.labelCurrent(label.name);
         else toast(`No label has hotkey ${c.hotkey}.`);
         return true;

@@ -12,6 +12,7 @@ import signal
 import socket
 import subprocess
 import sys
+import threading
 import time
 import uuid
 from pathlib import Path
@@ -19,7 +20,9 @@ from urllib.parse import urlparse
 
 import pytest
 from django.conf import settings
+from django.contrib.auth import get_user_model
 from django.db import connection
+from rest_framework.test import APIClient
 
 REPO = Path(__file__).resolve().parents[3]
 CELERY = Path(sys.executable).with_name("celery")
@@ -194,3 +197,41 @@ def wait_for(predicate, timeout=60, interval=0.05, what="condition"):
             return value
         time.sleep(interval)
     raise AssertionError(f"timed out after {timeout}s waiting for {what}")
+
+
+@pytest.fixture
+def two_admins(transactional_db, services_env):
+    """A project with two admins, alice (who created it) and rachel: (project, alice, rachel)."""
+    from segmentation import services
+    from segmentation.models import Membership
+
+    users = get_user_model().objects
+    alice = users.create_user("alice", password="alice-password")
+    rachel = users.create_user("rachel", password="rachel-password")
+    project = services.do_create_project(alice, "Studio A")
+    Membership.objects.create(project=project, user=rachel, role="admin")
+    return project, alice, rachel
+
+
+def at_once(calls, timeout=30):
+    """Make the API requests of ``calls`` — (user, request) pairs, where ``request(client)``
+    sends one request with a client signed in as that user — each from its own thread,
+    released together; their responses, sorted by status code."""
+    start = threading.Barrier(len(calls))
+    responses = []
+
+    def one(user, request):
+        client = APIClient()
+        client.force_authenticate(user)
+        try:
+            start.wait()
+            responses.append(request(client))
+        finally:
+            connection.close()
+
+    threads = [threading.Thread(target=one, args=call) for call in calls]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join(timeout)
+    return sorted(responses, key=lambda response: response.status_code)

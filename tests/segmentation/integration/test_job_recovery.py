@@ -124,3 +124,41 @@ def test_it_stops_a_detection_run_at_its_time_limit_and_says_why(
     error = DetectionRun.objects.get(pk=r.json()["id"]).error
     assert "took too long and was stopped" in error
     assert "detection 1 s, CUTROOM_DETECT_TIME_LIMIT" in error
+
+
+def test_it_fails_at_once_a_run_killed_at_its_hard_time_limit(production_workers, owner, long_take):
+    """A job that does not stop at its soft limit (as in native code that never returns
+    to Python: here its pool process is stopped with SIGSTOP, so the soft limit's signal
+    is never handled) has its process killed at the hard limit. The same input would run
+    as long again, so the run fails at once, naming the limit, and is not retried."""
+    production_workers.env.update(CUTROOM_DETECT_TIME_LIMIT="1", CUTROOM_TIME_LIMIT_GRACE="2")
+    worker = production_workers.start()
+    client = api(owner)
+    data = {"project": project_of(owner).pk, "file": SimpleUploadedFile("long.bvh", long_take)}
+    capture_id = client.post("/api/captures/", data, format="multipart").json()["id"]
+    wait_for(lambda: Capture.objects.get(pk=capture_id).status == "ready", timeout=120,
+             what="ingest")
+    wait_for(lambda: not DetectionRun.objects.filter(capture_id=capture_id,
+                                                     status__in=("queued", "processing")).exists(),
+             timeout=120, what="the default run")
+    r = client.post(f"/api/captures/{capture_id}/runs/",
+                    {"method": "ppca", "params": {"step_s": 0.04}}, format="json")
+    assert r.status_code == 202, r.json()
+    wait_for(lambda: DetectionRun.objects.get(pk=r.json()["id"]).status == "processing",
+             interval=0.01, what="the run to start")
+    [child] = production_workers.children(worker)
+    os.kill(child, signal.SIGSTOP)
+    stopped = time.monotonic()
+
+    sweeping_until(lambda: DetectionRun.objects.get(pk=r.json()["id"]).status != "processing",
+                   timeout=45)
+    assert time.monotonic() - stopped < 15
+    run = DetectionRun.objects.get(pk=r.json()["id"])
+    assert run.status == "failed" and run.attempts == 1
+    assert run.error.startswith("Detection stopped after its time limit of 1 s "
+                                "(CUTROOM_DETECT_TIME_LIMIT)"), run.error
+    assert run.finished_at is not None
+    assert "Hard time limit" in worker.log.read_text()
+    time.sleep(2)  # the message given back or acknowledged: either way nothing runs it again
+    services.sweep_stale_claims()
+    assert DetectionRun.objects.get(pk=r.json()["id"]).attempts == 1
