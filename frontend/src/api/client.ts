@@ -56,7 +56,13 @@ export async function api<T>(method: string, url: string, body?: unknown): Promi
     headers["Content-Type"] = "application/json";
     init.body = JSON.stringify(body);
   }
-  const response = await fetch(url, init);
+  let response = await fetch(url, init);
+  for (let attempt = 0; ; attempt++) {
+    const wait = retryDelay(method, response.status, response.headers.get("Retry-After"), attempt);
+    if (wait === null) break;
+    await new Promise((resolve) => setTimeout(resolve, wait));
+    response = await fetch(url, init);
+  }
   const text = await response.text();
   let parsed: unknown = text;
   try {
@@ -68,6 +74,22 @@ export async function api<T>(method: string, url: string, body?: unknown): Promi
   if (!response.ok) throw new ApiError(response.status, errorText(response.status, parsed), parsed);
   return parsed as T;
 }
+
+/** Milliseconds to wait before asking again, or null to give the answer to the caller.
+
+A server that is busy (429, e.g. many people opening one long take) did not run the
+request: ask again after its Retry-After, a few times. A 502/503 may come after a write
+ran, so only reads are asked again then. */
+export function retryDelay(method: string, status: number, retryAfter: string | null, attempt: number): number | null {
+  const busy = status === 429 || ((status === 502 || status === 503) && (method === "GET" || method === "HEAD"));
+  if (!busy || retryAfter === null || attempt >= MAX_RETRIES) return null;
+  const seconds = Number(retryAfter);
+  if (!Number.isFinite(seconds) || seconds < 0) return null;
+  return Math.min(seconds, MAX_RETRY_WAIT_S) * 1000;
+}
+
+const MAX_RETRIES = 3;
+const MAX_RETRY_WAIT_S = 10;
 
 /** DRF answers 403 (session auth) or 401 (token auth) when nobody is logged in. */
 export function isLoggedOut(status: number, body: unknown): boolean {
