@@ -106,7 +106,7 @@ All durations are in seconds, so the same defaults work at any frame rate.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from scipy.signal import find_peaks
@@ -438,11 +438,21 @@ class Analysis:
     gamma: float
     novelty: np.ndarray
     timings: dict[str, float]
+    _short: dict = field(default_factory=dict, repr=False)
 
     @property
     def rate(self) -> float:
         """Novelty samples per second."""
         return self.fps / self.step
+
+    def short_novelty(self, window_s: float) -> np.ndarray:
+        """(n // step,) MMD² with one window of ``window_s`` seconds (computed once)."""
+        w = max(1, int(round(window_s * self.rate)))
+        if w not in self._short:
+            blocks = block_mean(self.x, self.step)
+            self._short[w] = mirrored_novelties(blocks, [w], self.gamma)[0] \
+                if len(blocks) >= 4 else np.zeros(len(blocks))
+        return self._short[w]
 
     def with_windows(self, *windows: tuple[float, float]) -> list[Analysis]:
         """The same pose stream and kernel with the novelty at other window lengths.
@@ -454,7 +464,7 @@ class Analysis:
         union = sorted({w for ws in widths for w in ws})
         blocks = block_mean(self.x, self.step)
         curves = dict(zip(union, mirrored_novelties(blocks, union, self.gamma), strict=True))
-        return [replace(self, novelty=np.mean([curves[w] for w in ws], axis=0))
+        return [replace(self, novelty=np.mean([curves[w] for w in ws], axis=0), _short={})
                 for ws in widths]
 
     def peak_frames(self, peaks: np.ndarray) -> np.ndarray:
@@ -529,6 +539,12 @@ class Default(Segmenter):
             "bool", True, 0, 1,
             "Move a cut that falls in a pause to its end, the onset of the next activity.",
         ),
+        "short_activity": Param(
+            "float", 0.0, 0.0, 100.0,
+            "Also cut the far side of an activity shorter than the shortest window when "
+            "min_segment_s windows show it this many times more clearly than the "
+            "changes inside activities (0 = off).",
+        ),
     }
 
     @classmethod
@@ -546,7 +562,7 @@ class Default(Segmenter):
         if analysis is None:
             return empty_segmentation(take)
         t0 = time.perf_counter()
-        peaks, strength = self.select_peaks(analysis.novelty, analysis.rate, p)
+        peaks, strength = self.choose_peaks(analysis, p)
         cuts, speed = self._place(analysis.x, analysis.peak_frames(peaks), analysis.fps,
                                   analysis.gamma, p)
         result = analysis.segmentation(cuts, confidence(strength, p), speed)
@@ -596,6 +612,15 @@ class Default(Segmenter):
         widths = window_widths(p["scale_min_s"], p["scale_max_s"], rate)
         return np.mean(mirrored_novelties(x, widths, gamma), axis=0)
 
+    @classmethod
+    def choose_peaks(cls, analysis: Analysis, p: dict) -> tuple[np.ndarray, np.ndarray]:
+        """The novelty peaks that become cuts (``select_peaks``, then, with
+        ``short_activity``, the far sides of short activities), and their evidence."""
+        peaks, strength = cls.select_peaks(analysis.novelty, analysis.rate, p)
+        if p["short_activity"] > 0:
+            peaks, strength = short_activity_peaks(analysis, peaks, strength, p)
+        return peaks, strength
+
     @staticmethod
     def select_peaks(novelty: np.ndarray, rate: float, p: dict) -> tuple[np.ndarray, np.ndarray]:
         """Novelty peaks that become cuts, and each one's evidence (its prominence).
@@ -614,6 +639,68 @@ class Default(Segmenter):
         edge = p["min_segment_s"] * rate / 2
         keep = (peaks + 0.5 >= edge) & (len(novelty) - peaks - 0.5 >= edge)
         return peaks[keep], prominence[keep]
+
+
+# How far (s) a short-window peak may lie from the long-window peak or shoulder it confirms.
+SHORT_PEAK_TOLERANCE_S = 0.5
+
+
+def short_activity_peaks(analysis: Analysis, peaks: np.ndarray, strength: np.ndarray,
+                         p: dict) -> tuple[np.ndarray, np.ndarray]:
+    """Add the far side of activities too short for the long windows (step 4b).
+
+    Between two long activities, windows of ``scale_min_s`` and more see a short one as
+    a single broad peak: the boundary it does not pick is at most a *shoulder* (a local
+    maximum without the prominence) at most ``scale_min_s`` away. Windows of
+    ``min_segment_s`` (the shortest activity to find) resolve the two. Such a shoulder
+    becomes a cut, at its short-window peak, when the short-window novelty has a peak
+    within ``SHORT_PEAK_TOLERANCE_S`` of both the shoulder and the kept peak, each
+    ``short_activity`` times as prominent as the median short-window peak inside the
+    activities (farther than ``scale_min_s / 2`` from every kept peak) and at least
+    ``prominence``: short windows also fire on changes within an activity, so only a
+    pair that stands well above the take's own such changes counts.
+
+    Returns
+    -------
+    peaks, evidence : as ``Default.select_peaks``, sorted; an added peak's evidence is the
+        ``prominence`` setting (confidence 0.5, the weakest peak kept on its own).
+    """
+    if len(peaks) == 0:
+        return peaks, strength
+    rate, novelty = analysis.rate, analysis.novelty
+    short = analysis.short_novelty(p["min_segment_s"])
+    tops, props = find_peaks(np.concatenate([[0.0], short, [0.0]]), prominence=0.0)
+    tops, prominence = tops - 1, props["prominences"]
+    reach = p["scale_min_s"] * rate
+    inside = np.abs(tops[:, None] - peaks[None, :]).min(axis=1) > reach / 2
+    if not inside.any():
+        return peaks, strength
+    level = max(p["short_activity"] * float(np.median(prominence[inside])), p["prominence"])
+    strong = tops[prominence >= level]
+    tolerance = SHORT_PEAK_TOLERANCE_S * rate
+    distance = p["min_segment_s"] * rate
+
+    def confirmed(sample: int) -> int | None:
+        if not len(strong):
+            return None
+        best = strong[np.argmin(np.abs(strong - sample))]
+        return int(best) if abs(best - sample) <= tolerance else None
+
+    shoulders, _ = find_peaks(np.concatenate([[0.0], novelty, [0.0]]),
+                              height=max(p["threshold"], 1e-12))
+    cuts = list(peaks)
+    for shoulder in shoulders - 1:
+        kept = int(peaks[np.argmin(np.abs(peaks - shoulder))])
+        if np.abs(np.asarray(cuts) - shoulder).min() < distance or \
+                abs(shoulder - kept) > reach or confirmed(kept) is None:
+            continue
+        side = confirmed(shoulder)
+        if side is not None and np.abs(np.asarray(cuts) - side).min() >= distance:
+            cuts.append(side)
+    added = np.asarray(cuts[len(peaks):], dtype=np.int64)
+    order = np.argsort(np.concatenate([peaks, added]), kind="stable")
+    evidence = np.concatenate([strength, np.full(len(added), p["prominence"])])
+    return np.concatenate([peaks, added])[order], evidence[order]
 
 
 def confidence(evidence: np.ndarray, p: dict) -> np.ndarray:
