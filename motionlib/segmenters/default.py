@@ -25,6 +25,11 @@ repeats every second or so; a boundary is where that distribution changes. So:
    grows with the peak's prominence q (0.5 at the setting), so candidates rank by
    evidence. Prominence, not height, is what tells a boundary from a wobble on the
    shoulder of a broad peak: most false peaks have a prominence near 0.
+
+   b. *Short activities* (``short_activity``, off by default; see below). Optionally,
+      a shoulder of a kept peak at most ``scale_min_s`` away also becomes a cut when
+      windows of ``min_segment_s`` show prominent peaks at both
+      (``short_activity_peaks``).
 5. Placement, coarse to fine. The novelty peak locates a change only to within a
    block and a window; an annotator cuts at "the moment the motion changes": the end
    of the last movement of the old activity, where the body is momentarily still, or,
@@ -85,7 +90,9 @@ are what is missing there: 86_01, read from its full AMC and from its four chann
 scored against the same Krüger windows (cut = first frame after the window's best
 estimate, as the labels' README defines it), gets 0.07 s and 0.42 s; the four-channel
 errors have both signs (no shift toward a window edge or the next activity's onset
-would remove them) and about 70 % of those cuts lie inside the annotators' window. The
+would remove them). Of the matched cuts, 0.83 lie inside the annotators' transition
+window on 86_01 from the full skeleton and 0.70 (0.67 leave-one-take-out) on the
+four-channel takes (the bench's "in window" column and placement summary). The
 steps a-c were chosen earlier on the three full-skeleton takes (split alone 0.24 s,
 +turning point 0.09 s, +pause one more cut fixed); not kept then: the turning point
 with the best split statistic instead of the nearest, joint velocities in the split
@@ -93,12 +100,58 @@ statistic, a linear (mean-pose) cost instead of the kernel (0.54 s: periodic act
 share a mean pose), a context of ``scale_max_s`` and the native frame rate for the
 split.
 
-Known limit: windows of 3-6 s see an activity shorter than about 2.5 s between two long
-ones as one broad peak, so one of its two boundaries is often lost (synthetic takes with
-1.5-6 s activities: 60 % of the boundaries beside a short activity found within 1 s).
-Shorter windows find them (93 % with 1.5-6 s windows) but cut inside real activities
-(table above), so the zero-shot detector keeps 3-6 s and ``motionlib.adapt`` switches
-to shorter windows when a studio's own examples hold such activities (91 %).
+Short activities: tried, not shipped
+------------------------------------
+Windows of 3-6 s see an activity shorter than about 2.5 s between two long ones as one
+broad peak, so one of its two boundaries is often lost: on synthetic takes with 1.5-6 s
+activities (``bench_quality.short_activity_check``) 21 of the 35 boundaries beside an
+activity shorter than 2.5 s are found within 1 s (0.60), and on synthetic takes of 6 s,
+1.8 s and 6 s activities (30 seeds and action triples) both boundaries of the short one
+in 20 %. Shorter windows find them (0.93 with 1.5-6 s windows) but cut inside real
+activities (table above). Step 4b keeps the 3-6 s windows for deciding where the big
+boundaries are and asks windows of ``min_segment_s`` only about the far side of a
+kept peak: a shoulder of it (a local maximum without the prominence, at most
+``scale_min_s`` away) becomes a cut when the short-window novelty has a peak within
+0.5 s of both the shoulder and the kept peak, each ``short_activity`` times as prominent
+as the take's median short-window peak inside its activities. On the synthetic takes
+``short_activity`` 4 finds 26/35 (0.74) and both sides of the 1.8 s activity in 77 %;
+8 finds 25/35 (0.71) and 70 %.
+
+On the real takes it does not pay. With ``short_activity`` options 0 (off), 4 and 8
+added to the grid (``tuning.TRIED``), the choice made without the take scored gets mean
+F1@1 s 0.947 and 0.43 edits per true cut (row ``tried/loo``), against 0.957 and 0.41
+without them (``default/loo``). On the other takes, min_segment_s 2 s with
+``short_activity`` 8 scores best (it finds the one short real activity, 86_14's 1.6 s,
+four channels); on the take left out it adds a false cut to 86_03 and 86_08, and with
+86_14 itself left out it is not chosen: one real short activity among 11 takes cannot
+carry the choice. With the option imposed, the others still chosen without the take:
+off 0.957/0.41, 4 0.934/0.44, 8 0.955/0.41. The three full-skeleton takes get no extra
+cut at 4 or 8; on the four-channel takes almost every added cut is false. What the
+short windows see there is the transition itself: annotators' windows are 0.4-1.25 s
+wide, and the performer leaving one exercise and settling into the next looks to a
+1.5-2 s window just like a short activity, so most false cuts lie 1.5-2.5 s from a true
+one, on the other side of its transition. Other designs, each scored on all 11 takes with
+the other settings at the shipped values (every option of theirs that found more
+short-activity boundaries lowered the mean F1@1 s there, 0.957 off, so none was a
+choice to make leave-one-take-out):
+
+- a pair of prominent 1.5 s-window peaks around a kept peak with the long-window novelty
+  between them at least 0.3-0.8 of the peak (a plateau): mean F1@1 s 0.78-0.95, synthetic
+  21-28/35;
+- a three-segment kernel fit around each kept peak (the extra split kept when it
+  lowers the kernel cost by 0.2-1 times the first split's gain): 0.69-0.95, synthetic at
+  most 24/35 (real transitions fit three segments as well as short activities do);
+- shoulders confirmed by short-window peaks of a fixed prominence (0.1-0.6 MMD²):
+  0.82-0.95;
+- as step 4b with the level a quantile of the take's short-window peaks (0.75, 0.9,
+  the largest) instead of a multiple of the median: 0.82-0.957 (no cut added at the
+  largest), synthetic 21-26/35;
+- strong short-window peaks within ``scale_min_s`` of a kept peak, no shoulder needed
+  (4-8 x the median): synthetic 27-30/35 but 0.84-0.90.
+
+So the zero-shot detector keeps ``short_activity`` off; a studio whose takes hold such
+activities gets them from its own examples (``motionlib.adapt`` switches to shorter
+windows: 0.91 on the synthetic check) or can set ``short_activity`` 4.
 
 All durations are in seconds, so the same defaults work at any frame rate.
 """
