@@ -314,13 +314,15 @@ def short_activity_check(seeds: int = 6) -> str:
         lengths = np.asarray([s[1] - s[0] for s in segments]) / take.fps
         short = np.minimum(lengths[:-1], lengths[1:]) < SHORT_S
         takes.append((take, cuts, short))
-    options = tuning.TRIED["short_activity"]
-    found = {name: [0, 0] for name in
-             ["zero-shot", *[f"short_activity={k:g}" for k in options], "adapted"]}
+    options = {f"short_activity={k:g}" + (f"/uniformity={u:g}" if u else ""):
+               {"short_activity": k, "short_uniformity": u}
+               for k in tuning.TRIED["short_activity"]
+               for u in (0.0, *tuning.TRIED["short_uniformity"])}
+    found = {name: [0, 0] for name in ["zero-shot", *options, "adapted"]}
     for i, (take, cuts, short) in enumerate(takes):
         model = adapt.fit_cut_model([(t, c) for j, (t, c, _) in enumerate(takes) if j != i])
         runs = [("zero-shot", None, {}),
-                *[(f"short_activity={k:g}", None, {"short_activity": k}) for k in options],
+                *[(name, None, params) for name, params in options.items()],
                 ("adapted", model, {})]
         for name, m, params in runs:
             detected = adapt.detect(take, m, **params).cuts

@@ -39,6 +39,7 @@ GRID = {
 # value, the ``default`` segmenter's default, stays an option.
 TRIED = {
     "short_activity": (4.0, 8.0),
+    "short_uniformity": (0.2, 0.3),
 }
 
 

@@ -118,21 +118,32 @@ as the take's median short-window peak inside its activities. On the synthetic t
 8 finds 25/35 (0.71) and 70 %.
 
 On the real takes it does not pay. With ``short_activity`` options 0 (off), 4 and 8
-added to the grid (``tuning.TRIED``), the choice made without the take scored gets mean
-F1@1 s 0.947 and 0.43 edits per true cut (row ``tried/loo``), against 0.957 and 0.41
-without them (``default/loo``). On the other takes, min_segment_s 2 s with
-``short_activity`` 8 scores best (it finds the one short real activity, 86_14's 1.6 s,
+and ``short_uniformity`` options 0 (no test), 0.2 and 0.3 added to the grid
+(``tuning.TRIED``), the choice made without the take scored gets mean F1@1 s 0.947 and
+0.43 edits per true cut (row ``tried/loo``), against 0.957 and 0.41 without them
+(``default/loo``). On the other takes, min_segment_s 2 s with ``short_activity`` 8 and
+no uniformity test scores best (it finds the one short real activity, 86_14's 1.6 s,
 four channels); on the take left out it adds a false cut to 86_03 and 86_08, and with
 86_14 itself left out it is not chosen: one real short activity among 11 takes cannot
-carry the choice. With the option imposed, the others still chosen without the take:
-off 0.957/0.41, 4 0.934/0.44, 8 0.955/0.41. The three full-skeleton takes get no extra
-cut at 4 or 8; on the four-channel takes almost every added cut is false. What the
-short windows see there is the transition itself: annotators' windows are 0.4-1.25 s
-wide, and the performer leaving one exercise and settling into the next looks to a
-1.5-2 s window just like a short activity, so most false cuts lie 1.5-2.5 s from a true
-one, on the other side of its transition. Other designs, each scored on all 11 takes with
-the other settings at the shipped values (every option of theirs that found more
-short-activity boundaries lowered the mean F1@1 s there, 0.957 off, so none was a
+carry the choice. With one option imposed, the others still chosen without the take:
+``short_activity`` off 0.957/0.41, 4 0.911/0.49, 8 0.947/0.43; ``short_uniformity`` 0
+0.947/0.43, 0.2 and 0.3 0.957/0.41 (with the test imposed, ``short_activity`` off is
+chosen for every take: the test makes the step harmless, not useful, here). The three
+full-skeleton takes get no extra cut at 4 or 8; on the four-channel takes almost every
+added cut is false. What the short windows see there is the transition itself:
+annotators' windows are 0.4-1.25 s wide, and the performer leaving one exercise and
+settling into the next looks to a 1.5-2 s window just like a short activity, so most
+false cuts lie 1.5-2.5 s from a true one, on the other side of its transition. The
+uniformity test (``mixing``: an activity repeats, so its two halves look alike; a
+passage from one activity into the next morphs) removes most of them: scored on all 11
+takes with the other settings at the shipped values, ``short_activity`` 4 gets 0.886
+and 0.54 edits without it, 0.948/0.41 with 0.2 and 0.941/0.41 with 0.3 (8: 0.948 and
+0.945); the cuts left are on 86_02, a 1.6 s stretch that looks like one activity and
+that the annotators cut in the middle, and 86_08. It also loses short activities: on
+the synthetic check 23/35 and 25/35 at 4 (22 and 24 at 8), both sides of the 1.8 s
+activity in 60 % and 63 % (53 % and 57 % at 8). Other designs, each scored on all 11
+takes with the other settings at the shipped values (every option of theirs that found
+more short-activity boundaries lowered the mean F1@1 s there, 0.957 off, so none was a
 choice to make leave-one-take-out):
 
 - a pair of prominent 1.5 s-window peaks around a kept peak with the long-window novelty
@@ -147,11 +158,15 @@ choice to make leave-one-take-out):
   the largest) instead of a multiple of the median: 0.82-0.957 (no cut added at the
   largest), synthetic 21-26/35;
 - strong short-window peaks within ``scale_min_s`` of a kept peak, no shoulder needed
-  (4-8 x the median): synthetic 27-30/35 but 0.84-0.90.
+  (4-8 x the median): synthetic 27-30/35 but 0.84-0.90;
+- step 4b with the uniformity test and a pause test (a short stretch moving at less
+  than half its neighbours' speed is a pause, not an activity): no change (86_02's
+  stretch is not a pause in its four angles).
 
 So the zero-shot detector keeps ``short_activity`` off; a studio whose takes hold such
 activities gets them from its own examples (``motionlib.adapt`` switches to shorter
-windows: 0.91 on the synthetic check) or can set ``short_activity`` 4.
+windows: 0.91 on the synthetic check) or can set ``short_activity`` 4 with
+``short_uniformity`` 0.3.
 
 All durations are in seconds, so the same defaults work at any frame rate.
 """
@@ -598,6 +613,12 @@ class Default(Segmenter):
             "min_segment_s windows show it this many times more clearly than the "
             "changes inside activities (0 = off).",
         ),
+        "short_uniformity": Param(
+            "float", 0.0, 0.0, 10.0,
+            "With short_activity: keep such a cut only if the short activity's two halves "
+            "differ at most this fraction as much as it differs from its neighbours "
+            "(0 = no test).",
+        ),
     }
 
     @classmethod
@@ -711,7 +732,9 @@ def short_activity_peaks(analysis: Analysis, peaks: np.ndarray, strength: np.nda
     ``short_activity`` times as prominent as the median short-window peak inside the
     activities (farther than ``scale_min_s / 2`` from every kept peak) and at least
     ``prominence``: short windows also fire on changes within an activity, so only a
-    pair that stands well above the take's own such changes counts.
+    pair that stands well above the take's own such changes counts. With
+    ``short_uniformity`` the stretch between the two must also look like one activity
+    (``mixing`` at most that), not like the passage from one activity into the next.
 
     Returns
     -------
@@ -748,12 +771,43 @@ def short_activity_peaks(analysis: Analysis, peaks: np.ndarray, strength: np.nda
                 abs(shoulder - kept) > reach or confirmed(kept) is None:
             continue
         side = confirmed(shoulder)
-        if side is not None and np.abs(np.asarray(cuts) - side).min() >= distance:
-            cuts.append(side)
+        if side is None or np.abs(np.asarray(cuts) - side).min() < distance:
+            continue
+        if p["short_uniformity"] > 0 and not (
+                mixing(analysis, kept, side, int(round(distance))) <= p["short_uniformity"]):
+            continue
+        cuts.append(side)
     added = np.asarray(cuts[len(peaks):], dtype=np.int64)
     order = np.argsort(np.concatenate([peaks, added]), kind="stable")
     evidence = np.concatenate([strength, np.full(len(added), p["prominence"])])
     return np.concatenate([peaks, added])[order], evidence[order]
+
+
+def mixing(analysis: Analysis, a: int, b: int, context: int) -> float:
+    """How unlike itself the stretch between novelty samples ``a`` and ``b`` is.
+
+    MMD² between the stretch's two halves over MMD² between the stretch and the nearer-
+    looking of its neighbours (``context`` samples each side), on the novelty blocks and
+    kernel. An activity repeats, so its halves look alike (near 0); the passage from one
+    activity into the next morphs, so its halves differ about as much as it differs from
+    its neighbours (near 1 and above). NaN when a part is too short to compare.
+    """
+    lo, hi = sorted((a, b))
+    blocks = block_mean(analysis.x, analysis.step)
+    middle, before, after = blocks[lo:hi], blocks[max(0, lo - context):lo], blocks[hi:hi + context]
+    if len(middle) < 4 or min(len(before), len(after)) < 2:
+        return float("nan")
+    half = len(middle) // 2
+    inner = mmd(middle[:half], middle[half:], analysis.gamma)
+    return inner / max(min(mmd(before, middle, analysis.gamma),
+                           mmd(middle, after, analysis.gamma)), 1e-12)
+
+
+def mmd(x: np.ndarray, y: np.ndarray, gamma: float) -> float:
+    """Biased MMD² between the samples ``x`` (n, d) and ``y`` (m, d), Gaussian kernel."""
+    def mean_k(u, v):
+        return float(np.exp(-gamma * cdist(u, v, "sqeuclidean")).mean())
+    return mean_k(x, x) + mean_k(y, y) - 2 * mean_k(x, y)
 
 
 def confidence(evidence: np.ndarray, p: dict) -> np.ndarray:
