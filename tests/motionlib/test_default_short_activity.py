@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from motionlib import benchdata, metrics, synth, tuning
-from motionlib.segmenters.default import Default
+from motionlib.segmenters.default import Analysis, Default, mixing
 
 FPS = 60.0
 # A 1.8 s activity between two of 6 s: the 3-6 s windows see one broad peak.
@@ -72,3 +72,25 @@ def test_it_adds_no_cut_to_the_real_full_skeleton_takes():
         take = labelled.read()
         np.testing.assert_array_equal(Default(short_activity=4.0).fit_predict(take).cuts,
                                       Default().fit_predict(take).cuts)
+
+
+def _stream(*parts):
+    """A 1-D pose stream at 10 Hz: (mean, samples) parts with a little noise."""
+    rng = np.random.default_rng(0)
+    x = np.concatenate([rng.normal(mean, 0.3, n) for mean, n in parts])[:, None]
+    return Analysis(x=x, fps=10.0, step=1, first=0, gamma=1.0, novelty=np.zeros(len(x)),
+                    timings={})
+
+
+def test_it_sees_one_activity_as_uniform_and_a_passage_between_two_as_mixed():
+    one = _stream((0, 20), (5, 20), (10, 20))
+    passage = _stream((0, 20), (3, 10), (7, 10), (10, 20))
+    assert mixing(one, 20, 40, 15) < 0.1
+    assert mixing(passage, 20, 40, 15) > 1.0
+    assert np.isnan(mixing(passage, 20, 22, 15))  # too short to halve
+
+
+def test_it_keeps_a_uniform_short_activity_under_the_uniformity_test():
+    take, truth = _short_between_long(*SHORT_BETWEEN_LONG[1])
+    cuts = Default(short_activity=4.0, short_uniformity=0.3).fit_predict(take).cuts
+    assert _found(cuts, truth) == 2
