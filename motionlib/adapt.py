@@ -323,7 +323,7 @@ def _add_residuals(residuals: dict, take, cuts, analysis, p: dict) -> dict[int, 
     -------
     novelty peak index -> take frame where the zero-shot detector places that peak.
     """
-    peaks, _ = Default.select_peaks(analysis.novelty, analysis.rate, p)
+    peaks, _ = Default.choose_peaks(analysis, p)
     stages, _ = place_stages(analysis.x, analysis.peak_frames(peaks), analysis.fps,
                              analysis.gamma, p)
     for name, placed in stages.items():
@@ -354,7 +354,7 @@ def _placement(residuals: dict, zero_shot: str) -> tuple[str, float]:
 
 
 def _segment(analysis, p: dict, placement: str, offset_s: float) -> Segmentation:
-    peaks, strength = Default.select_peaks(analysis.novelty, analysis.rate, p)
+    peaks, strength = Default.choose_peaks(analysis, p)
     stages, speed = place_stages(analysis.x, analysis.peak_frames(peaks), analysis.fps,
                                  analysis.gamma, p)
     cuts = stages[placement] + int(round(offset_s * analysis.fps))

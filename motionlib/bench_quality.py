@@ -45,8 +45,8 @@ RUPTURES_PENALTY = 3.0
 COLUMNS = (
     ("P@.5s", "precision@0.5s"), ("R@.5s", "recall@0.5s"), ("F1@.5s", "f1@0.5s"),
     ("P@1s", "precision@1s"), ("R@1s", "recall@1s"), ("F1@1s", "f1@1s"),
-    ("edits/cut", "edits_per_cut"), ("med err s", "median_error_s"), ("time s", "time_s"),
-    ("cuts", "n_cuts"),
+    ("edits/cut", "edits_per_cut"), ("med err s", "median_error_s"), ("in window", "in_window"),
+    ("time s", "time_s"), ("cuts", "n_cuts"),
 )
 
 
@@ -132,10 +132,10 @@ def run(root: Path | None = None, only: list[str] | None = None, *, loo: bool = 
             if c.labelled.kind == "skeleton" or name in FEATURE_ONLY
         }
     if loo:
-        selection = tuning.select(cache)
+        tried = tuning.select(cache, tuning.grid_choices(tuning.tried_grid()))
         if selection_out is not None:
-            selection_out.append(selection)
-        for key, per_take in loo_rows(cache, selection).items():
+            selection_out.append(tried)
+        for key, per_take in loo_rows(cache, tried).items():
             for c, row in zip(cache, per_take, strict=True):
                 results[title(c.labelled)][key] = row
     return results
@@ -143,19 +143,26 @@ def run(root: Path | None = None, only: list[str] | None = None, *, loo: bool = 
 
 LOO_ROWS = {
     "default/loo": "default settings chosen from tuning.GRID on the other takes",
+    "tried/loo": "the same with the options tried and not shipped (tuning.TRIED) in the grid",
     "adapted/loo": "default adapted (motionlib.adapt) to the other takes of the same label "
                    "source as examples",
     "ruptures/loo": "ruptures_kernel with its penalty chosen on the other takes",
 }
 
 
-def loo_rows(cache: list[tuning.TakeCache], selection: tuning.Selection) -> dict[str, list[dict]]:
-    """The leave-one-take-out rows, one list of rows (in ``cache`` order) per name."""
-    chosen = selection.leave_one_out()
+def loo_rows(cache: list[tuning.TakeCache], tried: tuning.Selection) -> dict[str, list[dict]]:
+    """The leave-one-take-out rows, one list of rows (in ``cache`` order) per name.
+
+    ``tried`` scores every choice of ``tuning.tried_grid()``; the shipped grid is its
+    subset with each tried setting at its shipped value.
+    """
+    shipped = tried.subset(**{key: Default.params[key].default for key in tuning.TRIED})
     out: dict[str, list[dict]] = {name: [] for name in LOO_ROWS}
-    for c, (params, _) in zip(cache, chosen, strict=True):
-        out["default/loo"].append(_timed_row(lambda t, p=params: Default(**p).fit_predict(t).cuts,
-                                             c.take, c.labelled.truth))
+    for name, selection in (("default/loo", shipped), ("tried/loo", tried)):
+        for c, (params, _) in zip(cache, selection.leave_one_out(), strict=True):
+            out[name].append(_timed_row(lambda t, p=params: Default(**p).fit_predict(t).cuts,
+                                        c.take, c.labelled.truth))
+    for c in cache:
         examples = _examples(cache, c)
         if not examples:  # the only take of its label source: nothing to learn from
             out["adapted/loo"].append({key: float("nan") for _, key in COLUMNS})
@@ -255,6 +262,7 @@ def main(root: Path | None = None, only: list[str] | None = None, out=None, *,
         if names:
             mean = mean_rows({n: results[n] for n in names})
             print(format_table(f"\nmean over {len(names)} {group} takes", mean), file=out)
+    print("\n" + placement_summary(results, groups), file=out)
     if selections:
         print("\n" + out_of_sample_table(selections[0]), file=out)
     if not only or "default" in only:
@@ -266,12 +274,36 @@ def main(root: Path | None = None, only: list[str] | None = None, out=None, *,
     return 0
 
 
+def placement_summary(results: dict[str, dict], groups: list[tuple[str, list[str]]],
+                      names=("default", "default/loo")) -> str:
+    """Placement of the default rows by kind of take: the mean over takes of the median
+    |cut - best estimate| (s), and of the share of matched cuts inside the annotators'
+    transition window on takes whose labels give one ("in window")."""
+    lines = ["placement by kind of take (mean over takes; 'in window': share of matched cuts "
+             "inside the labelled transition window, takes with windows only):"]
+    for name in names:
+        parts = []
+        for group, takes in groups:
+            rows = [results[t][name] for t in takes if name in results[t]]
+            if not rows:
+                continue
+            error = _nanmean([r["median_error_s"] for r in rows])
+            inside = [r["in_window"] for r in rows if not math.isnan(r["in_window"])]
+            share = (f", in window {_nanmean(inside):.2f} ({len(inside)} "
+                     f"take{'s' if len(inside) > 1 else ''})") if inside else ""
+            parts.append(f"{group} {error:.3f} s{share}")
+        if parts:
+            lines.append(f"  {name:<12} " + "; ".join(parts))
+    return "\n".join(lines)
+
+
 SHORT_S = 2.5
 
 
 def short_activity_check(seeds: int = 6) -> str:
-    """Recall of boundaries beside short activities on synthetic takes, zero-shot and
-    adapted (each take's model fitted on the other seeds' takes)."""
+    """Recall of boundaries beside short activities on synthetic takes: zero-shot (the
+    shipped settings), zero-shot with each ``short_activity`` option of ``tuning.GRID``,
+    and adapted (each take's model fitted on the other seeds' takes)."""
     from motionlib import synth
 
     takes = []
@@ -282,11 +314,18 @@ def short_activity_check(seeds: int = 6) -> str:
         lengths = np.asarray([s[1] - s[0] for s in segments]) / take.fps
         short = np.minimum(lengths[:-1], lengths[1:]) < SHORT_S
         takes.append((take, cuts, short))
-    found = {"zero-shot": [0, 0], "adapted": [0, 0]}
+    options = {f"short_activity={k:g}" + (f"/uniformity={u:g}" if u else ""):
+               {"short_activity": k, "short_uniformity": u}
+               for k in tuning.TRIED["short_activity"]
+               for u in (0.0, *tuning.TRIED["short_uniformity"])}
+    found = {name: [0, 0] for name in ["zero-shot", *options, "adapted"]}
     for i, (take, cuts, short) in enumerate(takes):
         model = adapt.fit_cut_model([(t, c) for j, (t, c, _) in enumerate(takes) if j != i])
-        for name, m in (("zero-shot", None), ("adapted", model)):
-            detected = adapt.detect(take, m).cuts
+        runs = [("zero-shot", None, {}),
+                *[(name, None, params) for name, params in options.items()],
+                ("adapted", model, {})]
+        for name, m, params in runs:
+            detected = adapt.detect(take, m, **params).cuts
             _, ti = metrics.match(detected, cuts, tolerance=int(take.fps))
             hit = np.zeros(len(cuts), dtype=bool)
             hit[ti] = True
@@ -298,9 +337,12 @@ def short_activity_check(seeds: int = 6) -> str:
             f"within 1 s: " + ", ".join(parts) + " (adapted: fitted on the other seeds)")
 
 
-def out_of_sample_table(selection: tuning.Selection) -> str:
+def out_of_sample_table(tried: tuning.Selection) -> str:
     """The default's settings: what was chosen on all takes, and how each option of each
-    setting scores leave-one-take-out (the others still chosen without the take)."""
+    setting scores leave-one-take-out (the others still chosen without the take), first
+    in the shipped grid, then for the options tried and not shipped (``tuning.TRIED``,
+    chosen with all of ``tuning.tried_grid()``)."""
+    selection = tried.subset(**{key: Default.params[key].default for key in tuning.TRIED})
     chosen = selection.chosen()
     lines = [f"default settings chosen on all {len(selection.cache)} takes from tuning.GRID: "
              + ", ".join(f"{k}={v:g}" if not isinstance(v, bool) else f"{k}={v}"
@@ -308,6 +350,10 @@ def out_of_sample_table(selection: tuning.Selection) -> str:
              "out of sample (leave-one-take-out) with one setting imposed:",
              f"  {'setting':<15}{'value':>12}{'F1@1s':>9}{'edits/cut':>11}"]
     for key, value, f1, edits in tuning.out_of_sample(selection):
+        lines.append(f"  {key:<15}{str(value):>12}{f1:>9.3f}{edits:>11.3f}")
+    lines.append("  tried, not shipped (the other settings chosen from the grid with them):")
+    grid = tuning.tried_grid()
+    for key, value, f1, edits in tuning.out_of_sample(tried, {k: grid[k] for k in tuning.TRIED}):
         lines.append(f"  {key:<15}{str(value):>12}{f1:>9.3f}{edits:>11.3f}")
     return "\n".join(lines)
 

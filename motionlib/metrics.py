@@ -125,8 +125,26 @@ def median_error_s(candidates, truth, *, fps: float, tolerance_s: float = 1.0) -
     return float(np.median(np.abs(cand[ci] - win[ti, 1]))) / fps
 
 
+def in_window_fraction(candidates, truth, *, fps: float, tolerance_s: float = 1.0) -> float:
+    """Fraction of the matched cuts that lie inside their true cut's window ``[lo, hi]``.
+
+    Pairs are matched within ``tolerance_s`` as for ``median_error_s``; only true cuts
+    with a labelled transition window (``lo < hi``) count, since a plain cut's window is
+    one frame. NaN when no such true cut is matched (e.g. labels without windows).
+    """
+    cand = np.asarray(candidates, dtype=np.int64).reshape(-1)
+    win = as_windows(truth)
+    ci, ti = match(cand, win, tolerance=int(round(tolerance_s * fps)))
+    windowed = win[ti, 0] < win[ti, 2]
+    if not windowed.any():
+        return float("nan")
+    c, w = cand[ci][windowed], win[ti][windowed]
+    return float(np.mean((c >= w[:, 0]) & (c <= w[:, 2])))
+
+
 def evaluate(candidates, truth, *, fps: float) -> dict[str, float]:
-    """The benchmark's row: P/R/F1 at 0.5 s and 1 s, edits per true cut, median error."""
+    """The benchmark's row: P/R/F1 at 0.5 s and 1 s, edits per true cut, median error,
+    and the fraction of matched cuts inside a labelled transition window."""
     row: dict[str, float] = {}
     for tol in (0.5, 1.0):
         scores = boundary_scores(candidates, truth, fps=fps, tolerance_s=tol)
@@ -134,4 +152,5 @@ def evaluate(candidates, truth, *, fps: float) -> dict[str, float]:
             row[f"{key}@{tol:g}s"] = scores[key]
     row["edits_per_cut"] = edit_cost(candidates, truth, fps=fps)["edits_per_cut"]
     row["median_error_s"] = median_error_s(candidates, truth, fps=fps)
+    row["in_window"] = in_window_fraction(candidates, truth, fps=fps)
     return row

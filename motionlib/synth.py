@@ -190,7 +190,7 @@ def _smoothstep(x):
 
 def generate(seed: int = 0, fps: float = 120.0, *, duration: float | None = None,
              n_segments: int = 6, actions=ACTIONS, segment_seconds=(4.0, 8.0),
-             transition_seconds: float = 0.5, noise_degrees: float = 0.3):
+             transition_seconds: float = 0.5, noise_degrees: float = 0.3, plan=None):
     """Generate a synthetic take of known actions.
 
     Parameters
@@ -212,6 +212,9 @@ def generate(seed: int = 0, fps: float = 120.0, *, duration: float | None = None
         Cross-fade length around each boundary.
     noise_degrees : float
         Amplitude of the slow drift and jitter added to every angle.
+    plan : sequence of (str, float), optional
+        The take's actions and their lengths in seconds, in order, instead of drawn ones
+        (``duration``, ``n_segments``, ``actions`` and ``segment_seconds`` are then unused).
 
     Returns
     -------
@@ -221,9 +224,12 @@ def generate(seed: int = 0, fps: float = 120.0, *, duration: float | None = None
         0-based frames, ``stop`` exclusive, covering ``[0, n_frames)``; a boundary is the
         middle of its transition.
     """
-    _check(fps, duration, n_segments, actions, segment_seconds, transition_seconds)
     rng = np.random.default_rng(seed)
-    lengths, labels = _plan(rng, fps, duration, n_segments, list(actions), segment_seconds)
+    if plan is None:
+        _check(fps, duration, n_segments, actions, segment_seconds, transition_seconds)
+        lengths, labels = _plan(rng, fps, duration, n_segments, list(actions), segment_seconds)
+    else:
+        labels, lengths = _check_plan(plan, fps, transition_seconds)
     bounds = np.concatenate([[0], np.cumsum(lengths)])
     n = int(bounds[-1])
     sk = skeleton()
@@ -264,6 +270,24 @@ def _noise(rng, t, n_channels, amplitude):
     weights = rng.standard_normal((16, n_channels)) / 4
     jitter = rng.standard_normal((t.size, n_channels), dtype=np.float32)
     return amplitude * (waves @ weights + 0.1 * jitter)
+
+
+def _check_plan(plan, fps, transition_seconds) -> tuple[list[str], list[int]]:
+    """Labels and lengths in frames of a given plan; InputError naming a bad entry."""
+    if not fps > 0:
+        raise InputError(f"fps must be positive, got {fps}")
+    labels, lengths = [], []
+    for i, (label, seconds) in enumerate(plan):
+        if label not in ACTIONS:
+            raise InputError(f"plan[{i}]: unknown action {label!r} (one of {', '.join(ACTIONS)})")
+        if not seconds > transition_seconds:
+            raise InputError(f"plan[{i}]: {label} must last longer than transition_seconds "
+                             f"({transition_seconds}), got {seconds}")
+        labels.append(str(label))
+        lengths.append(int(round(seconds * fps)))
+    if not labels:
+        raise InputError("plan: no actions")
+    return labels, lengths
 
 
 def _check(fps, duration, n_segments, actions, segment_seconds, transition_seconds):

@@ -8,6 +8,10 @@ full AMC) and scores the result on the take left out.
 
 The score of a setting over some takes is the mean F1 at 1 s, ties broken by fewer
 edits per true cut (``metrics``).
+
+Options that were tried and not shipped (:data:`TRIED`) are scored the same way, with
+the choice made from :func:`tried_grid`, so that the record of why they are not shipped
+can be re-run (``python -m motionlib bench-quality --loo``).
 """
 
 from __future__ import annotations
@@ -29,6 +33,20 @@ GRID = {
     "min_segment_s": (1.5, 2.0),
     "onset": (False, True),
 }
+
+# Options scored out of sample beside GRID but not shipped: adding them to the choice
+# lowers its leave-one-take-out score (``segmenters.default``). Each setting's shipped
+# value, the ``default`` segmenter's default, stays an option.
+TRIED = {
+    "short_activity": (4.0, 8.0),
+    "short_uniformity": (0.2, 0.3),
+}
+
+
+def tried_grid() -> dict:
+    """:data:`GRID` with each :data:`TRIED` setting's shipped value and tried options."""
+    return {**GRID, **{key: (Default.params[key].default, *values)
+                       for key, values in TRIED.items()}}
 
 
 def grid_choices(grid: dict | None = None) -> list[dict]:
@@ -71,7 +89,7 @@ class TakeCache:
         a = self.analysis(p)
         if a is None:
             return np.zeros(0, dtype=np.int64)
-        peaks, _ = Default.select_peaks(a.novelty, a.rate, p)
+        peaks, _ = Default.choose_peaks(a, p)
         key = (id(a), p["refine_s"], tuple(peaks))
         if key not in self.placed:
             self.placed[key] = place_stages(a.x, a.peak_frames(peaks), a.fps, a.gamma, p)[0]
@@ -96,6 +114,13 @@ class Selection:
     choices: list[dict]
     cache: list[TakeCache]
     rows: list[list[dict]]
+
+    def subset(self, **fixed) -> Selection:
+        """The choices whose settings equal ``fixed`` (e.g. the shipped grid inside
+        :func:`tried_grid`), with their scores."""
+        idx = [i for i, ch in enumerate(self.choices)
+               if all(_value(ch, key) == value for key, value in fixed.items())]
+        return Selection([self.choices[i] for i in idx], self.cache, [self.rows[i] for i in idx])
 
     def best(self, keep: Sequence[bool]) -> int:
         """Index of the best choice on the takes where ``keep`` is true (the first
@@ -127,9 +152,11 @@ def select(cache: Sequence[TakeCache], choices: list[dict] | None = None) -> Sel
 
 
 def _value(choice: dict, key: str):
+    """A choice's value of a setting of the grid (the shipped value if it sets none)."""
     if key == "windows":
         return (choice["scale_min_s"], choice["scale_max_s"])
-    return choice[key]
+    return choice[key] if key in choice or key not in Default.params \
+        else Default.params[key].default
 
 
 def out_of_sample(selection: Selection, grid: dict | None = None) -> list[tuple[str, object,
@@ -148,10 +175,7 @@ def out_of_sample(selection: Selection, grid: dict | None = None) -> list[tuple[
     out = []
     for key, values in grid.items():
         for value in values:
-            idx = [i for i, ch in enumerate(selection.choices) if _value(ch, key) == value]
-            sub = Selection([selection.choices[i] for i in idx], selection.cache,
-                            [selection.rows[i] for i in idx])
-            rows = [row for _, row in sub.leave_one_out()]
+            rows = [row for _, row in selection.subset(**{key: value}).leave_one_out()]
             out.append((key, value, float(np.mean([r["f1@1s"] for r in rows])),
                         float(np.mean([r["edits_per_cut"] for r in rows]))))
     return out

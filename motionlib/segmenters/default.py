@@ -25,6 +25,11 @@ repeats every second or so; a boundary is where that distribution changes. So:
    grows with the peak's prominence q (0.5 at the setting), so candidates rank by
    evidence. Prominence, not height, is what tells a boundary from a wobble on the
    shoulder of a broad peak: most false peaks have a prominence near 0.
+
+   b. *Short activities* (``short_activity``, off by default; see below). Optionally,
+      a shoulder of a kept peak at most ``scale_min_s`` away also becomes a cut when
+      windows of ``min_segment_s`` show prominent peaks at both
+      (``short_activity_peaks``).
 5. Placement, coarse to fine. The novelty peak locates a change only to within a
    block and a window; an annotator cuts at "the moment the motion changes": the end
    of the last movement of the old activity, where the body is momentarily still, or,
@@ -85,7 +90,9 @@ are what is missing there: 86_01, read from its full AMC and from its four chann
 scored against the same Krüger windows (cut = first frame after the window's best
 estimate, as the labels' README defines it), gets 0.07 s and 0.42 s; the four-channel
 errors have both signs (no shift toward a window edge or the next activity's onset
-would remove them) and about 70 % of those cuts lie inside the annotators' window. The
+would remove them). Of the matched cuts, 0.83 lie inside the annotators' transition
+window on 86_01 from the full skeleton and 0.70 (0.67 leave-one-take-out) on the
+four-channel takes (the bench's "in window" column and placement summary). The
 steps a-c were chosen earlier on the three full-skeleton takes (split alone 0.24 s,
 +turning point 0.09 s, +pause one more cut fixed); not kept then: the turning point
 with the best split statistic instead of the nearest, joint velocities in the split
@@ -93,12 +100,73 @@ statistic, a linear (mean-pose) cost instead of the kernel (0.54 s: periodic act
 share a mean pose), a context of ``scale_max_s`` and the native frame rate for the
 split.
 
-Known limit: windows of 3-6 s see an activity shorter than about 2.5 s between two long
-ones as one broad peak, so one of its two boundaries is often lost (synthetic takes with
-1.5-6 s activities: 60 % of the boundaries beside a short activity found within 1 s).
-Shorter windows find them (93 % with 1.5-6 s windows) but cut inside real activities
-(table above), so the zero-shot detector keeps 3-6 s and ``motionlib.adapt`` switches
-to shorter windows when a studio's own examples hold such activities (91 %).
+Short activities: tried, not shipped
+------------------------------------
+Windows of 3-6 s see an activity shorter than about 2.5 s between two long ones as one
+broad peak, so one of its two boundaries is often lost: on synthetic takes with 1.5-6 s
+activities (``bench_quality.short_activity_check``) 21 of the 35 boundaries beside an
+activity shorter than 2.5 s are found within 1 s (0.60), and on synthetic takes of 6 s,
+1.8 s and 6 s activities (30 seeds and action triples) both boundaries of the short one
+in 20 %. Shorter windows find them (0.93 with 1.5-6 s windows) but cut inside real
+activities (table above). Step 4b keeps the 3-6 s windows for deciding where the big
+boundaries are and asks windows of ``min_segment_s`` only about the far side of a
+kept peak: a shoulder of it (a local maximum without the prominence, at most
+``scale_min_s`` away) becomes a cut when the short-window novelty has a peak within
+0.5 s of both the shoulder and the kept peak, each ``short_activity`` times as prominent
+as the take's median short-window peak inside its activities. On the synthetic takes
+``short_activity`` 4 finds 26/35 (0.74) and both sides of the 1.8 s activity in 77 %;
+8 finds 25/35 (0.71) and 70 %.
+
+On the real takes it does not pay. With ``short_activity`` options 0 (off), 4 and 8
+and ``short_uniformity`` options 0 (no test), 0.2 and 0.3 added to the grid
+(``tuning.TRIED``), the choice made without the take scored gets mean F1@1 s 0.947 and
+0.43 edits per true cut (row ``tried/loo``), against 0.957 and 0.41 without them
+(``default/loo``). On the other takes, min_segment_s 2 s with ``short_activity`` 8 and
+no uniformity test scores best (it finds the one short real activity, 86_14's 1.6 s,
+four channels); on the take left out it adds a false cut to 86_03 and 86_08, and with
+86_14 itself left out it is not chosen: one real short activity among 11 takes cannot
+carry the choice. With one option imposed, the others still chosen without the take:
+``short_activity`` off 0.957/0.41, 4 0.911/0.49, 8 0.947/0.43; ``short_uniformity`` 0
+0.947/0.43, 0.2 and 0.3 0.957/0.41 (with the test imposed, ``short_activity`` off is
+chosen for every take: the test makes the step harmless, not useful, here). The three
+full-skeleton takes get no extra cut at 4 or 8; on the four-channel takes almost every
+added cut is false. What the short windows see there is the transition itself:
+annotators' windows are 0.4-1.25 s wide, and the performer leaving one exercise and
+settling into the next looks to a 1.5-2 s window just like a short activity, so most
+false cuts lie 1.5-2.5 s from a true one, on the other side of its transition. The
+uniformity test (``mixing``: an activity repeats, so its two halves look alike; a
+passage from one activity into the next morphs) removes most of them: scored on all 11
+takes with the other settings at the shipped values, ``short_activity`` 4 gets 0.886
+and 0.54 edits without it, 0.948/0.41 with 0.2 and 0.941/0.41 with 0.3 (8: 0.948 and
+0.945); the cuts left are on 86_02, a 1.6 s stretch that looks like one activity and
+that the annotators cut in the middle, and 86_08. It also loses short activities: on
+the synthetic check 23/35 and 25/35 at 4 (22 and 24 at 8), both sides of the 1.8 s
+activity in 60 % and 63 % (53 % and 57 % at 8). Other designs, each scored on all 11
+takes with the other settings at the shipped values (every option of theirs that found
+more short-activity boundaries lowered the mean F1@1 s there, 0.957 off, so none was a
+choice to make leave-one-take-out):
+
+- a pair of prominent 1.5 s-window peaks around a kept peak with the long-window novelty
+  between them at least 0.3-0.8 of the peak (a plateau): mean F1@1 s 0.78-0.95, synthetic
+  21-28/35;
+- a three-segment kernel fit around each kept peak (the extra split kept when it
+  lowers the kernel cost by 0.2-1 times the first split's gain): 0.69-0.95, synthetic at
+  most 24/35 (real transitions fit three segments as well as short activities do);
+- shoulders confirmed by short-window peaks of a fixed prominence (0.1-0.6 MMD²):
+  0.82-0.95;
+- as step 4b with the level a quantile of the take's short-window peaks (0.75, 0.9,
+  the largest) instead of a multiple of the median: 0.82-0.957 (no cut added at the
+  largest), synthetic 21-26/35;
+- strong short-window peaks within ``scale_min_s`` of a kept peak, no shoulder needed
+  (4-8 x the median): synthetic 27-30/35 but 0.84-0.90;
+- step 4b with the uniformity test and a pause test (a short stretch moving at less
+  than half its neighbours' speed is a pause, not an activity): no change (86_02's
+  stretch is not a pause in its four angles).
+
+So the zero-shot detector keeps ``short_activity`` off; a studio whose takes hold such
+activities gets them from its own examples (``motionlib.adapt`` switches to shorter
+windows: 0.91 on the synthetic check) or can set ``short_activity`` 4 with
+``short_uniformity`` 0.3.
 
 All durations are in seconds, so the same defaults work at any frame rate.
 """
@@ -106,7 +174,7 @@ All durations are in seconds, so the same defaults work at any frame rate.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from scipy.signal import find_peaks
@@ -438,11 +506,21 @@ class Analysis:
     gamma: float
     novelty: np.ndarray
     timings: dict[str, float]
+    _short: dict = field(default_factory=dict, repr=False)
 
     @property
     def rate(self) -> float:
         """Novelty samples per second."""
         return self.fps / self.step
+
+    def short_novelty(self, window_s: float) -> np.ndarray:
+        """(n // step,) MMD² with one window of ``window_s`` seconds (computed once)."""
+        w = max(1, int(round(window_s * self.rate)))
+        if w not in self._short:
+            blocks = block_mean(self.x, self.step)
+            self._short[w] = mirrored_novelties(blocks, [w], self.gamma)[0] \
+                if len(blocks) >= 4 else np.zeros(len(blocks))
+        return self._short[w]
 
     def with_windows(self, *windows: tuple[float, float]) -> list[Analysis]:
         """The same pose stream and kernel with the novelty at other window lengths.
@@ -454,7 +532,7 @@ class Analysis:
         union = sorted({w for ws in widths for w in ws})
         blocks = block_mean(self.x, self.step)
         curves = dict(zip(union, mirrored_novelties(blocks, union, self.gamma), strict=True))
-        return [replace(self, novelty=np.mean([curves[w] for w in ws], axis=0))
+        return [replace(self, novelty=np.mean([curves[w] for w in ws], axis=0), _short={})
                 for ws in widths]
 
     def peak_frames(self, peaks: np.ndarray) -> np.ndarray:
@@ -529,6 +607,18 @@ class Default(Segmenter):
             "bool", True, 0, 1,
             "Move a cut that falls in a pause to its end, the onset of the next activity.",
         ),
+        "short_activity": Param(
+            "float", 0.0, 0.0, 100.0,
+            "Also cut the far side of an activity shorter than the shortest window when "
+            "min_segment_s windows show it this many times more clearly than the "
+            "changes inside activities (0 = off).",
+        ),
+        "short_uniformity": Param(
+            "float", 0.0, 0.0, 10.0,
+            "With short_activity: keep such a cut only if the short activity's two halves "
+            "differ at most this fraction as much as it differs from its neighbours "
+            "(0 = no test).",
+        ),
     }
 
     @classmethod
@@ -546,7 +636,7 @@ class Default(Segmenter):
         if analysis is None:
             return empty_segmentation(take)
         t0 = time.perf_counter()
-        peaks, strength = self.select_peaks(analysis.novelty, analysis.rate, p)
+        peaks, strength = self.choose_peaks(analysis, p)
         cuts, speed = self._place(analysis.x, analysis.peak_frames(peaks), analysis.fps,
                                   analysis.gamma, p)
         result = analysis.segmentation(cuts, confidence(strength, p), speed)
@@ -596,6 +686,15 @@ class Default(Segmenter):
         widths = window_widths(p["scale_min_s"], p["scale_max_s"], rate)
         return np.mean(mirrored_novelties(x, widths, gamma), axis=0)
 
+    @classmethod
+    def choose_peaks(cls, analysis: Analysis, p: dict) -> tuple[np.ndarray, np.ndarray]:
+        """The novelty peaks that become cuts (``select_peaks``, then, with
+        ``short_activity``, the far sides of short activities), and their evidence."""
+        peaks, strength = cls.select_peaks(analysis.novelty, analysis.rate, p)
+        if p["short_activity"] > 0:
+            peaks, strength = short_activity_peaks(analysis, peaks, strength, p)
+        return peaks, strength
+
     @staticmethod
     def select_peaks(novelty: np.ndarray, rate: float, p: dict) -> tuple[np.ndarray, np.ndarray]:
         """Novelty peaks that become cuts, and each one's evidence (its prominence).
@@ -614,6 +713,101 @@ class Default(Segmenter):
         edge = p["min_segment_s"] * rate / 2
         keep = (peaks + 0.5 >= edge) & (len(novelty) - peaks - 0.5 >= edge)
         return peaks[keep], prominence[keep]
+
+
+# How far (s) a short-window peak may lie from the long-window peak or shoulder it confirms.
+SHORT_PEAK_TOLERANCE_S = 0.5
+
+
+def short_activity_peaks(analysis: Analysis, peaks: np.ndarray, strength: np.ndarray,
+                         p: dict) -> tuple[np.ndarray, np.ndarray]:
+    """Add the far side of activities too short for the long windows (step 4b).
+
+    Between two long activities, windows of ``scale_min_s`` and more see a short one as
+    a single broad peak: the boundary it does not pick is at most a *shoulder* (a local
+    maximum without the prominence) at most ``scale_min_s`` away. Windows of
+    ``min_segment_s`` (the shortest activity to find) resolve the two. Such a shoulder
+    becomes a cut, at its short-window peak, when the short-window novelty has a peak
+    within ``SHORT_PEAK_TOLERANCE_S`` of both the shoulder and the kept peak, each
+    ``short_activity`` times as prominent as the median short-window peak inside the
+    activities (farther than ``scale_min_s / 2`` from every kept peak) and at least
+    ``prominence``: short windows also fire on changes within an activity, so only a
+    pair that stands well above the take's own such changes counts. With
+    ``short_uniformity`` the stretch between the two must also look like one activity
+    (``mixing`` at most that), not like the passage from one activity into the next.
+
+    Returns
+    -------
+    peaks, evidence : as ``Default.select_peaks``, sorted; an added peak's evidence is the
+        ``prominence`` setting (confidence 0.5, the weakest peak kept on its own).
+    """
+    if len(peaks) == 0:
+        return peaks, strength
+    rate, novelty = analysis.rate, analysis.novelty
+    short = analysis.short_novelty(p["min_segment_s"])
+    tops, props = find_peaks(np.concatenate([[0.0], short, [0.0]]), prominence=0.0)
+    tops, prominence = tops - 1, props["prominences"]
+    reach = p["scale_min_s"] * rate
+    inside = np.abs(tops[:, None] - peaks[None, :]).min(axis=1) > reach / 2
+    if not inside.any():
+        return peaks, strength
+    level = max(p["short_activity"] * float(np.median(prominence[inside])), p["prominence"])
+    strong = tops[prominence >= level]
+    tolerance = SHORT_PEAK_TOLERANCE_S * rate
+    distance = p["min_segment_s"] * rate
+
+    def confirmed(sample: int) -> int | None:
+        if not len(strong):
+            return None
+        best = strong[np.argmin(np.abs(strong - sample))]
+        return int(best) if abs(best - sample) <= tolerance else None
+
+    shoulders, _ = find_peaks(np.concatenate([[0.0], novelty, [0.0]]),
+                              height=max(p["threshold"], 1e-12))
+    cuts = list(peaks)
+    for shoulder in shoulders - 1:
+        kept = int(peaks[np.argmin(np.abs(peaks - shoulder))])
+        if np.abs(np.asarray(cuts) - shoulder).min() < distance or \
+                abs(shoulder - kept) > reach or confirmed(kept) is None:
+            continue
+        side = confirmed(shoulder)
+        if side is None or np.abs(np.asarray(cuts) - side).min() < distance:
+            continue
+        if p["short_uniformity"] > 0 and not (
+                mixing(analysis, kept, side, int(round(distance))) <= p["short_uniformity"]):
+            continue
+        cuts.append(side)
+    added = np.asarray(cuts[len(peaks):], dtype=np.int64)
+    order = np.argsort(np.concatenate([peaks, added]), kind="stable")
+    evidence = np.concatenate([strength, np.full(len(added), p["prominence"])])
+    return np.concatenate([peaks, added])[order], evidence[order]
+
+
+def mixing(analysis: Analysis, a: int, b: int, context: int) -> float:
+    """How unlike itself the stretch between novelty samples ``a`` and ``b`` is.
+
+    MMD² between the stretch's two halves over MMD² between the stretch and the nearer-
+    looking of its neighbours (``context`` samples each side), on the novelty blocks and
+    kernel. An activity repeats, so its halves look alike (near 0); the passage from one
+    activity into the next morphs, so its halves differ about as much as it differs from
+    its neighbours (near 1 and above). NaN when a part is too short to compare.
+    """
+    lo, hi = sorted((a, b))
+    blocks = block_mean(analysis.x, analysis.step)
+    middle, before, after = blocks[lo:hi], blocks[max(0, lo - context):lo], blocks[hi:hi + context]
+    if len(middle) < 4 or min(len(before), len(after)) < 2:
+        return float("nan")
+    half = len(middle) // 2
+    inner = mmd(middle[:half], middle[half:], analysis.gamma)
+    return inner / max(min(mmd(before, middle, analysis.gamma),
+                           mmd(middle, after, analysis.gamma)), 1e-12)
+
+
+def mmd(x: np.ndarray, y: np.ndarray, gamma: float) -> float:
+    """Biased MMD² between the samples ``x`` (n, d) and ``y`` (m, d), Gaussian kernel."""
+    def mean_k(u, v):
+        return float(np.exp(-gamma * cdist(u, v, "sqeuclidean")).mean())
+    return mean_k(x, x) + mean_k(y, y) - 2 * mean_k(x, y)
 
 
 def confidence(evidence: np.ndarray, p: dict) -> np.ndarray:

@@ -99,3 +99,18 @@ def test_it_answers_to_its_older_name_bench_too(tmp_path):
                            str(tmp_path / "missing")], capture_output=True, text=True)
     assert done.returncode == 2
     assert "benchmark data folder not found" in done.stderr
+
+
+def test_it_summarises_placement_by_kind_of_take():
+    results = {
+        "a": {"default": {"median_error_s": 0.1, "in_window": float("nan")}},
+        "b": {"default": {"median_error_s": 0.3, "in_window": 1.0}},
+        "c": {"default": {"median_error_s": 0.4, "in_window": 0.5}},
+        "d": {"default": {"median_error_s": 0.6, "in_window": 0.7}},
+    }
+    text = bench_quality.placement_summary(results, [("full-skeleton", ["a", "b"]),
+                                                     ("four-channel", ["c", "d"])])
+    line = text.splitlines()[1]
+    assert line.split()[0] == "default"
+    assert "full-skeleton 0.200 s, in window 1.00 (1 take)" in line
+    assert "four-channel 0.500 s, in window 0.60 (2 takes)" in line

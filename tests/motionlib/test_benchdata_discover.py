@@ -87,3 +87,20 @@ def test_it_prints_leave_one_take_out_rows_beside_the_others(layout, capsys):
         assert out.count(f"\n{row} ") == 2 + 3  # two takes, three mean tables
     assert "mean over 1 full-skeleton takes" in out and "mean over 2 labelled takes" in out
     assert "out of sample (leave-one-take-out)" in out
+
+
+def test_it_keeps_the_shipped_value_first_among_the_tried_options():
+    grid = tuning.tried_grid()
+    for key, values in tuning.TRIED.items():
+        assert grid[key][0] == tuning.Default.params[key].default
+        assert set(values) <= set(grid[key])
+    assert {k: v for k, v in grid.items() if k not in tuning.TRIED} == tuning.GRID
+
+
+def test_it_finds_the_shipped_grid_inside_the_tried_one():
+    choices = [{"threshold": 0.1, "short_activity": 0.0}, {"threshold": 0.1, "short_activity": 4.0},
+               {"threshold": 0.2}]
+    rows = [[{"f1@1s": 0.0, "edits_per_cut": 0.0}]] * 3
+    shipped = tuning.Selection(choices, [None], rows).subset(short_activity=0.0)
+    # A choice that does not set it has the shipped value.
+    assert shipped.choices == [choices[0], choices[2]]

@@ -81,3 +81,21 @@ def test_it_builds_the_benchmark_row():
     assert row["f1@1s"] == 1.0
     assert row["edits_per_cut"] == 1.0  # both matched, both more than 0.25 s off
     assert row["median_error_s"] == pytest.approx(0.55)
+
+
+def test_it_counts_matched_cuts_inside_their_transition_window():
+    truth = [[500, 550, 600], [1000, 1050, 1100], [2000, 2000, 2000]]
+    # 590 inside its window, 1150 matched but outside, 2010 has no window, 5000 unmatched.
+    share = metrics.in_window_fraction([590, 1150, 2010, 5000], truth, fps=100)
+    assert share == 0.5
+
+
+def test_it_has_no_in_window_share_without_labelled_windows():
+    assert math.isnan(metrics.in_window_fraction([1010], [1000], fps=100))
+    assert math.isnan(metrics.in_window_fraction([], [[500, 550, 600]], fps=100))
+
+
+def test_it_adds_the_in_window_share_to_the_benchmark_row():
+    row = metrics.evaluate(np.array([590]), [[500, 550, 600]], fps=100)
+    assert row["in_window"] == 1.0
+    assert row["median_error_s"] == pytest.approx(0.4)  # still measured from the mid

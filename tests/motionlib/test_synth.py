@@ -103,3 +103,20 @@ def test_it_cuts_without_a_transition_when_asked():
     jump = np.abs(take.channels[boundary] - take.channels[boundary - 1]).max()
     typical = np.abs(np.diff(take.channels[:boundary - 1], axis=0)).max()
     assert jump > typical
+
+
+def test_it_follows_a_given_plan_of_actions_and_lengths():
+    take, segments = synth.generate(seed=1, fps=60.0, plan=[("idle", 6.0), ("kick", 1.8),
+                                                             ("walk", 6.0)])
+    assert segments == [(0, 360, "idle"), (360, 468, "kick"), (468, 828, "walk")]
+    assert take.n_frames == 828
+
+
+@pytest.mark.parametrize("plan, fault", [
+    ([("idle", 6.0), ("dance", 2.0)], r"plan\[1\]: unknown action 'dance'"),
+    ([("idle", 0.3)], r"plan\[0\]: idle must last longer than transition_seconds"),
+    ([], "plan: no actions"),
+])
+def test_it_refuses_a_plan_it_cannot_follow(plan, fault):
+    with pytest.raises(ValueError, match=fault):
+        synth.generate(plan=plan)
