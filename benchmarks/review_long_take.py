@@ -307,6 +307,9 @@ def page_load(client, capture):
     return times
 
 
+SMALL_REQUESTS = ("GET review", "PATCH label", "GET capture")
+
+
 def small_round(client, capture, state):
     """One round of the small capture's requests: review GET, a label edit, capture GET."""
     url = f"/api/captures/{capture.pk}/review/"
@@ -502,6 +505,9 @@ def main():
             row(f"small capture, during wave {wave}", values)
         loaded = [ms for values in loaded for ms in values]
         row("small capture, during all waves", loaded)
+        for i, kind in enumerate(SMALL_REQUESTS):  # each round makes these, in this order
+            row(f"  {kind}, alone", alone[i::3])
+            row(f"  {kind}, during the waves", loaded[i::3])
         for q in (50, 95):
             ratio = pct(loaded, q) / pct(alone, q)
             print(f"small capture p{q} slowdown: {ratio:.2f}x  "

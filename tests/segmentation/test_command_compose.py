@@ -9,7 +9,7 @@ from pathlib import Path
 import yaml
 
 REPO = Path(__file__).resolve().parents[2]
-APP_SERVICES = ("migrate", "web", "worker", "convert", "watchdog")
+APP_SERVICES = ("migrate", "web", "web-bulk", "worker", "convert", "watchdog")
 WORKERS = ("worker", "convert")
 
 
@@ -85,7 +85,7 @@ def test_web_and_workers_start_after_healthy_services_and_migrations():
 
 def test_every_long_running_service_has_a_health_check():
     services = compose()["services"]
-    for name in ("postgres", "redis", "web", "worker", "convert", "watchdog"):
+    for name in ("postgres", "redis", "web", "web-bulk", "worker", "convert", "watchdog"):
         assert services[name]["healthcheck"]["test"], name
 
 
@@ -123,6 +123,18 @@ def test_web_and_workers_share_the_originals_and_the_database_persists():
         assert "media:/data/media" in data["services"][name]["volumes"], name
     assert "pgdata:/var/lib/postgresql/data" in data["services"]["postgres"]["volumes"]
     assert {"pgdata", "media"} <= set(data["volumes"])
+
+
+def test_web_hands_requests_about_long_takes_to_a_bulk_lane_server_of_lower_cpu_weight():
+    services = compose()["services"]
+    web, bulk = services["web"], services["web-bulk"]
+    socket = web["environment"]["CUTROOM_BULK_SOCKET"]
+    assert bulk["command"][:4] == ["gunicorn", "cutroom.wsgi:application", "--bind", f"unix:{socket}"]
+    assert bulk["environment"]["CUTROOM_BULK_SOCKET"] == ""  # it hands nothing on
+    shared = {v for v in web["volumes"] if v.endswith(str(Path(socket).parent))}
+    assert shared and shared <= set(bulk["volumes"])
+    assert bulk["cpu_shares"] < 1024  # web's is the default, 1024
+    assert "ports" not in bulk
 
 
 def test_the_image_builds_the_front_end_and_installs_the_package():
