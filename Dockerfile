@@ -19,7 +19,8 @@ ENV PYTHONDONTWRITEBYTECODE=1 \
     CUTROOM_MEDIA_ROOT=/data/media \
     CUTROOM_SIMILAR_INDEX_DIR=/data/media/similar
 RUN useradd --create-home --uid 1000 cutroom \
-    && mkdir -p /data/var /data/media && chown -R cutroom:cutroom /data
+    && mkdir -p /data/var /data/media /run/cutroom \
+    && chown -R cutroom:cutroom /data /run/cutroom
 WORKDIR /app
 COPY --chown=cutroom:cutroom . .
 # Editable, so the code, its templates and migrations stay where settings expect them. The

@@ -135,6 +135,9 @@ def test_web_hands_requests_about_long_takes_to_a_bulk_lane_server_of_lower_cpu_
     assert shared and shared <= set(bulk["volumes"])
     assert bulk["cpu_shares"] < 1024  # web's is the default, 1024
     assert "ports" not in bulk
+    # The app runs as its own user: the socket's folder in the image (which a new named
+    # volume copies) must be theirs.
+    assert f"chown -R cutroom:cutroom /data {Path(socket).parent}" in (REPO / "Dockerfile").read_text()
 
 
 def test_the_image_builds_the_front_end_and_installs_the_package():
