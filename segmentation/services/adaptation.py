@@ -15,6 +15,7 @@ import functools
 import logging
 import time
 
+from celery.exceptions import SoftTimeLimitExceeded
 from django.conf import settings
 from django.db import IntegrityError, transaction
 from django.db.models import Max
@@ -161,6 +162,13 @@ def train_project_model(job):
     try:
         with heartbeat(job):  # a training outlives the claim timeout; a dead one must not
             _train(job)
+    except SoftTimeLimitExceeded:
+        job.fail(
+            "Training took too long and was stopped (time limit "
+            f"{settings.CUTROOM_RETRAIN_TIME_LIMIT} s, CUTROOM_RETRAIN_TIME_LIMIT); ask the "
+            "administrators to raise the limit.",
+            finished_at=timezone.now(),
+        )
     except (MotionlibError, CutroomError) as exc:
         job.fail(f"training: {exc}", finished_at=timezone.now())
     except Exception:

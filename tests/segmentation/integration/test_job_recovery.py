@@ -240,3 +240,29 @@ def test_it_fails_at_once_a_training_killed_at_its_hard_time_limit_and_trains_wh
     assert trained.claimed_at >= failed.finished_at
     adaptation.sweep_stale_trainings()
     assert ProjectCutModel.objects.get(pk=training.pk).attempts == 1
+
+
+def test_it_stops_a_training_at_its_soft_time_limit_and_says_why(
+    production_workers, owner, long_take, settings
+):
+    """A training still running at its soft limit stops and fails naming the limit (not as
+    an internal error). Its pool process is stopped (SIGSTOP) past the limit and then
+    continued, so the limit's signal lands during the training however fast it is."""
+    settings.CUTROOM_RETRAIN_DELAY = 0
+    production_workers.env["CUTROOM_RETRAIN_TIME_LIMIT"] = "1"
+    worker = production_workers.start()
+    client, project = api(owner), project_of(owner)
+    submit_review(client, upload_and_detect(client, project, "long.bvh", long_take))
+    training = wait_for(lambda: ProjectCutModel.objects.filter(status="processing").first(),
+                        timeout=30, interval=0.01, what="the training to start")
+    [child] = production_workers.children(worker)
+    os.kill(child, signal.SIGSTOP)
+    time.sleep(2)
+    os.kill(child, signal.SIGCONT)
+
+    wait_for(lambda: ProjectCutModel.objects.get(pk=training.pk).status != "processing",
+             timeout=20, what="the training to stop")
+    failed = ProjectCutModel.objects.get(pk=training.pk)
+    assert (failed.status, failed.version) == ("failed", None)
+    assert failed.error.startswith("Training took too long and was stopped (time limit 1 s, "
+                                   "CUTROOM_RETRAIN_TIME_LIMIT)"), failed.error
