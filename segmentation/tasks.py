@@ -18,7 +18,7 @@ from django.conf import settings
 from django.db import connection
 
 from segmentation import services, similar_index, suggestions
-from segmentation.models import Capture, DetectionRun
+from segmentation.models import Capture, DetectionRun, ProjectCutModel
 from segmentation.services import adaptation, jobs
 from segmentation.services.convert import convert_capture
 
@@ -41,12 +41,25 @@ class JobTask(Task):
         if not isinstance(exc, TimeLimitExceeded) or self.job_model is None:
             return
         try:
-            jobs.fail_at_time_limit(self.job_model, args[0], task_id, self.job_name,
-                                    self.limit_setting)
+            self.fail_at_time_limit(args[0], task_id)
         except Exception:  # the claim goes stale and the sweep takes over, as before
             log.exception("could not fail %s %s after its time limit", self.name, args[0])
         finally:
             connection.close()
+
+    def fail_at_time_limit(self, pk, token):
+        """Fail job ``pk`` if the task's claim ``token`` still holds it."""
+        jobs.fail_at_time_limit(self.job_model, pk, token, self.job_name, self.limit_setting)
+
+
+class TrainingTask(JobTask):
+    """A cut-model training: killed at its hard time limit, it fails at once as other jobs
+    do, and the training that waited behind it is started, as when a training ends."""
+
+    job_model = ProjectCutModel
+
+    def fail_at_time_limit(self, pk, token):
+        adaptation.fail_at_time_limit(pk, token)
 
 
 def _claim(model, pk, task):
@@ -104,7 +117,7 @@ def detect(self, run_id):
         services.detect_run(run)
 
 
-@shared_task(bind=True, acks_late=True, reject_on_worker_lost=True)
+@shared_task(bind=True, acks_late=True, reject_on_worker_lost=True, base=TrainingTask)
 def retrain(self, model_id):
     """Train a project's cut model from its reviewed takes (one at a time per project:
     the claim fails while another training of the project runs, which starts this one

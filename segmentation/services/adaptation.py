@@ -15,6 +15,7 @@ import functools
 import logging
 import time
 
+from celery.exceptions import SoftTimeLimitExceeded
 from django.conf import settings
 from django.db import IntegrityError, transaction
 from django.db.models import Max
@@ -134,12 +135,40 @@ def _give_up(job):
     return failed
 
 
+def fail_at_time_limit(pk, token):
+    """Fail the training whose process was killed at its hard time limit (it did not stop
+    at the soft one), if it still holds the claim ``token``, then start the training that
+    waited behind it. Returns whether it was failed.
+
+    Unlike a training whose process died for another reason, it is not retried: the same
+    examples would take as long again. The project keeps its previous model.
+    """
+    job = ProjectCutModel.objects.filter(pk=pk, status="processing", claim_token=token).first()
+    if job is None:
+        return False
+    failed = job.fail(
+        f"{jobs.killed_at_time_limit('Training', 'CUTROOM_RETRAIN_TIME_LIMIT')} The same "
+        "examples would take as long again, so it is not retried; ask the administrators to "
+        "raise the limit.",
+        finished_at=timezone.now(),
+    )
+    _start_waiting(job.project_id)
+    return failed
+
+
 def train_project_model(job):
     """Train a claimed ProjectCutModel row from the project's current examples, store it
     as the next version (or the reason it failed), then start the training that waited."""
     try:
         with heartbeat(job):  # a training outlives the claim timeout; a dead one must not
             _train(job)
+    except SoftTimeLimitExceeded:
+        job.fail(
+            "Training took too long and was stopped (time limit "
+            f"{settings.CUTROOM_RETRAIN_TIME_LIMIT} s, CUTROOM_RETRAIN_TIME_LIMIT); ask the "
+            "administrators to raise the limit.",
+            finished_at=timezone.now(),
+        )
     except (MotionlibError, CutroomError) as exc:
         job.fail(f"training: {exc}", finished_at=timezone.now())
     except Exception:

@@ -105,15 +105,19 @@ def fail_at_time_limit(model, pk, token, what, setting):
     job = model.objects.filter(pk=pk, status="processing", claim_token=token).first()
     if job is None:
         return False
-    seconds = getattr(settings, setting)
     extra = {"finished_at": timezone.now()} if isinstance(job, DetectionRun) else {}
     return job.fail(
-        f"{what} stopped after its time limit of {seconds} s ({setting}): it did not stop "
-        "by itself, so its process was killed. The same input would run as long again, so "
+        f"{killed_at_time_limit(what, setting)} The same input would run as long again, so "
         "it is not retried; try parameters that cost less, or ask the administrators to "
         "raise the limit. The original upload is kept.",
         **extra,
     )
+
+
+def killed_at_time_limit(what, setting):
+    """The first sentence of the error of a job killed at its hard time limit."""
+    return (f"{what} stopped after its time limit of {getattr(settings, setting)} s "
+            f"({setting}): it did not stop by itself, so its process was killed.")
 
 
 def sweep_stale_claims():

@@ -211,6 +211,46 @@ class StaleTrainingTestCase(AdaptationTestCase):
         self.assertEqual(len(sends), 1)
 
 
+class TimeLimitTrainingTestCase(AdaptationTestCase):
+    """A training killed at its hard time limit (with a real worker:
+    tests/segmentation/integration/test_job_recovery.py)."""
+
+    def setUp(self):
+        super().setUp()
+        self.v1 = self.trained(1)
+        self.capture = self.ready_capture()
+        commit(self.submit_review(self.capture, self.bob))
+        self.running = ProjectCutModel.objects.get(status="queued")
+        ProjectCutModel.objects.claim(self.running.pk, "worker-1")
+        self.waiting = adaptation.request_training(self.project.pk)
+
+    def test_it_fails_at_once_naming_the_limit_and_sends_the_one_that_waited(self):
+        with self.captureOnCommitCallbacks() as sends:
+            self.assertTrue(adaptation.fail_at_time_limit(self.running.pk, "worker-1"))
+        job = ProjectCutModel.objects.get(pk=self.running.pk)
+        self.assertEqual((job.status, job.version, job.attempts), ("failed", None, 1))
+        self.assertTrue(job.error.startswith(
+            "Training stopped after its time limit of 600 s (CUTROOM_RETRAIN_TIME_LIMIT)"), job.error)
+        self.assertIn("not retried", job.error)
+        self.assertIsNotNone(job.finished_at)
+        self.assertEqual(len(sends), 1)
+        self.assertEqual(ProjectCutModel.objects.get(pk=self.waiting.pk).status, "queued")
+
+    def test_the_project_keeps_its_model_and_the_review_page_says_why(self):
+        adaptation.fail_at_time_limit(self.running.pk, "worker-1")
+        self.assertEqual(ProjectCutModel.objects.newest(self.project.pk), self.v1)
+        self.login(self.bob)
+        adapted = self.client.get(f"/api/captures/{self.capture.pk}/review/").json()["adaptation"]
+        self.assertIn("(CUTROOM_RETRAIN_TIME_LIMIT)", adapted["training_error"])
+        self.assertEqual(adapted["project_model"]["version"], 1)
+
+    def test_it_leaves_alone_a_training_another_claim_holds(self):
+        ProjectCutModel.objects.filter(pk=self.running.pk).update(claim_token="worker-2")
+        with self.captureOnCommitCallbacks() as sends:
+            self.assertFalse(adaptation.fail_at_time_limit(self.running.pk, "worker-1"))
+        self.assertEqual(ProjectCutModel.objects.get(pk=self.running.pk).status, "processing")
+        self.assertEqual(sends, [])
+
 
 class CutModelsEndpointTestCase(AdaptationTestCase):
     def test_members_see_the_projects_trainings_newest_first_with_failures_explained(self):

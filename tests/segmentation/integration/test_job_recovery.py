@@ -12,7 +12,8 @@ from django.core.files.uploadedfile import SimpleUploadedFile
 from rest_framework.test import APIClient
 
 from segmentation import services
-from segmentation.models import Capture, DetectionRun
+from segmentation.models import Capture, DetectionRun, ProjectCutModel
+from segmentation.services import adaptation
 from tests.segmentation.base import synthetic_bvh
 from tests.segmentation.integration.conftest import Workers, new_queue, sending_to, wait_for
 
@@ -57,6 +58,7 @@ def sweeping_until(predicate, timeout):
     """Run the sweep every second (as `make up`'s supervisor does) until ``predicate``."""
     def swept():
         services.sweep_stale_claims()
+        adaptation.sweep_stale_trainings()
         return predicate()
     return wait_for(swept, timeout=timeout, interval=1.0, what="the job to finish")
 
@@ -162,3 +164,105 @@ def test_it_fails_at_once_a_run_killed_at_its_hard_time_limit(production_workers
     time.sleep(2)  # the message given back or acknowledged: either way nothing runs it again
     services.sweep_stale_claims()
     assert DetectionRun.objects.get(pk=r.json()["id"]).attempts == 1
+
+
+def upload_and_detect(client, project, name, content):
+    data = {"project": project.pk, "file": SimpleUploadedFile(name, content)}
+    capture_id = client.post("/api/captures/", data, format="multipart").json()["id"]
+    wait_for(lambda: Capture.objects.get(pk=capture_id).status == "ready"
+             and not DetectionRun.objects.filter(capture_id=capture_id,
+                                                 status__in=("queued", "processing")).exists(),
+             timeout=120, what=f"ingest and detection of {name}")
+    return capture_id
+
+
+def submit_review(client, capture_id):
+    """Review the capture keeping its candidates, and submit (which asks for a training)."""
+    review = client.post(f"/api/captures/{capture_id}/review/").json()
+    r = client.post(f"/api/captures/{capture_id}/review/submit/", {"version": review["version"]},
+                    format="json")
+    assert r.status_code == 200, r.json()
+
+
+def retrains_done(worker):
+    return sum("segmentation.tasks.retrain[" in line and "succeeded" in line
+               for line in worker.log.read_text().splitlines())
+
+
+def test_it_fails_at_once_a_training_killed_at_its_hard_time_limit_and_trains_what_waited(
+    production_workers, owner, long_take, settings
+):
+    """As for a run: a training that does not stop at its soft limit (its pool process
+    stopped with SIGSTOP) is killed at the hard one and fails at once, naming the limit,
+    and is not retried. The training asked for while it ran, whose message the other
+    worker dropped (not its turn), is sent again when it fails."""
+    settings.CUTROOM_RETRAIN_DELAY = 0
+    production_workers.env.update(CUTROOM_RETRAIN_TIME_LIMIT="2", CUTROOM_TIME_LIMIT_GRACE="2")
+    workers = [production_workers.start(), production_workers.start()]
+    client, project = api(owner), project_of(owner)
+    first = upload_and_detect(client, project, "long.bvh", long_take)
+    second = upload_and_detect(client, project, "short.bvh", synthetic_bvh(seed=8, duration=40.0))
+    submit_review(client, first)
+    training = wait_for(lambda: ProjectCutModel.objects.filter(status="processing").first(),
+                        timeout=30, interval=0.01, what="the training to start")
+    children = {child: worker for worker in workers for child in production_workers.children(worker)}
+    for child in children:
+        os.kill(child, signal.SIGSTOP)
+    stopped = time.monotonic()
+    holder = wait_for(lambda: next((w for w in workers if training.claim_token in w.log.read_text()),
+                                   None), timeout=5, what="the worker of the training")
+    [other] = [w for w in workers if w is not holder]
+    for child, worker in children.items():
+        if worker is other:
+            os.kill(child, signal.SIGCONT)
+    assert ProjectCutModel.objects.get(pk=training.pk).status == "processing"
+    before = retrains_done(other)
+    submit_review(client, second)  # while the training runs: the next one waits for it
+    waiting = ProjectCutModel.objects.get(project=project, status="queued")
+    wait_for(lambda: retrains_done(other) > before, timeout=10, what="the other worker to drop it")
+
+    sweeping_until(
+        lambda: ProjectCutModel.objects.get(pk=training.pk).status != "processing", timeout=45)
+    assert time.monotonic() - stopped < 15
+    failed = ProjectCutModel.objects.get(pk=training.pk)
+    assert (failed.status, failed.attempts, failed.version) == ("failed", 1, None)
+    assert failed.error.startswith("Training stopped after its time limit of 2 s "
+                                   "(CUTROOM_RETRAIN_TIME_LIMIT)"), failed.error
+    assert failed.finished_at is not None
+    assert "Hard time limit" in holder.log.read_text()
+    rows = client.get(f"/api/projects/{project.pk}/cut-models/").json()
+    assert failed.error in [row["error"] for row in rows]
+
+    wait_for(lambda: ProjectCutModel.objects.get(pk=waiting.pk).status in ("ready", "failed"),
+             timeout=30, what="the training that waited")
+    trained = ProjectCutModel.objects.get(pk=waiting.pk)
+    assert (trained.status, trained.version, trained.n_takes) == ("ready", 1, 2), trained.error
+    assert trained.claimed_at >= failed.finished_at
+    adaptation.sweep_stale_trainings()
+    assert ProjectCutModel.objects.get(pk=training.pk).attempts == 1
+
+
+def test_it_stops_a_training_at_its_soft_time_limit_and_says_why(
+    production_workers, owner, long_take, settings
+):
+    """A training still running at its soft limit stops and fails naming the limit (not as
+    an internal error). Its pool process is stopped (SIGSTOP) past the limit and then
+    continued, so the limit's signal lands during the training however fast it is."""
+    settings.CUTROOM_RETRAIN_DELAY = 0
+    production_workers.env["CUTROOM_RETRAIN_TIME_LIMIT"] = "1"
+    worker = production_workers.start()
+    client, project = api(owner), project_of(owner)
+    submit_review(client, upload_and_detect(client, project, "long.bvh", long_take))
+    training = wait_for(lambda: ProjectCutModel.objects.filter(status="processing").first(),
+                        timeout=30, interval=0.01, what="the training to start")
+    [child] = production_workers.children(worker)
+    os.kill(child, signal.SIGSTOP)
+    time.sleep(2)
+    os.kill(child, signal.SIGCONT)
+
+    wait_for(lambda: ProjectCutModel.objects.get(pk=training.pk).status != "processing",
+             timeout=20, what="the training to stop")
+    failed = ProjectCutModel.objects.get(pk=training.pk)
+    assert (failed.status, failed.version) == ("failed", None)
+    assert failed.error.startswith("Training took too long and was stopped (time limit 1 s, "
+                                   "CUTROOM_RETRAIN_TIME_LIMIT)"), failed.error
