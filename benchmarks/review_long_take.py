@@ -398,7 +398,7 @@ def free_port():
 def start(argv, log, ready, **extra_env):
     handle = log.open("w")
     proc = subprocess.Popen(argv, cwd=REPO, env={**os.environ, **extra_env}, stdout=handle,
-                            stderr=subprocess.STDOUT, start_new_session=True)
+                            stderr=subprocess.STDOUT, process_group=0)  # as make up: one session
     deadline = time.monotonic() + 90
     while not ready():
         if proc.poll() is not None or time.monotonic() > deadline:

@@ -41,7 +41,7 @@ WEB_WORKERS, WEB_THREADS = 2, 32
 # The bulk lane's web server (cutroom/lanes.py): requests about long takes, handed to it
 # by the web server over a Unix socket under var/run/, at a lower CPU priority than the web
 # server's own requests and a higher one than the workers' jobs.
-BULK_NICE = 10
+BULK_NICE = 5
 
 
 def parse_args(argv=None):
@@ -104,7 +104,10 @@ class Child:
         out = self.log.open("ab")
         self.proc = subprocess.Popen(
             self.argv, cwd=REPO, env=self.env, stdout=out, stderr=subprocess.STDOUT,
-            stdin=subprocess.DEVNULL, start_new_session=True,  # Ctrl-C reaches us only
+            # A process group of its own, so that Ctrl-C reaches up.py only; not a session of
+            # its own: the kernel's autogroups share the CPU equally between sessions, which
+            # would make the workers' and the bulk lane's nice values count for nothing.
+            stdin=subprocess.DEVNULL, process_group=0,
         )
         out.close()
         return self
@@ -408,8 +411,9 @@ def main(argv=None):
     bulk_child = bulk_web(env, logs)
     web_child = web(env, logs, args.host, args.port)
     children = [c for c in (web_child, bulk_child, worker_child, convert_child) if c]
-    signal.signal(signal.SIGINT, on_signal)
-    signal.signal(signal.SIGTERM, on_signal)
+    # SIGHUP too: the children are in the terminal's session, and closing it must stop them.
+    for stop_signal in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
+        signal.signal(stop_signal, on_signal)
     code = 1
     try:
         worker_child.start()
@@ -430,8 +434,8 @@ def main(argv=None):
         say(f"{stop} received; stopping the web server and the worker")
         code = 0
     finally:
-        signal.signal(signal.SIGINT, signal.SIG_IGN)
-        signal.signal(signal.SIGTERM, signal.SIG_IGN)
+        for stop_signal in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
+            signal.signal(stop_signal, signal.SIG_IGN)
         for child in children:
             child.stop()
         for child in children:

@@ -1,7 +1,8 @@
 """``make up``'s bulk lane: requests about long takes are served by a niced web server of
 their own, which still checks who may see what, and which up.py restarts when it dies while
-the web server serves those requests itself."""
+the web server serves those requests itself; the niced children's nice values count."""
 
+import importlib.util
 import json
 import os
 import re
@@ -11,9 +12,22 @@ import urllib.request
 
 import pytest
 
-from tests.segmentation.test_command_up import gone, wait_until, wait_until_detected
+from tests.segmentation.test_command_up import UP, gone, wait_until, wait_until_detected
 
 pytestmark = pytest.mark.slow
+
+
+def stat(pid):
+    """(session id, nice value) of a process, from /proc."""
+    fields = open(f"/proc/{pid}/stat").read().rsplit(")", 1)[1].split()
+    return int(fields[3]), int(fields[16])
+
+
+def up_constants():
+    spec = importlib.util.spec_from_file_location("up_script", UP)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
 
 
 def get(server, path, token=None):
@@ -53,4 +67,18 @@ def test_the_bulk_lane_server_answers_checks_access_and_is_restarted_when_it_die
     output = server.wait_for("bulk lane server restarted, pid")
     assert "the bulk lane server died (exit code -9)" in output
     wait_until(lambda: get(server, review, token)[1] == "bulk-server", timeout=60)
-    assert server.ctrl_c() == 0
+    # The niced children share up.py's session: the kernel shares the CPU equally between
+    # sessions (autogroups), so in sessions of their own their nice values would not count.
+    web, worker = server.pids()
+    bulk = int(re.findall(r"bulk lane server restarted, pid (\d+)", server.output())[-1])
+    session = stat(server.proc.pid)[0]
+    constants = up_constants()
+    assert stat(bulk) == (session, constants.BULK_NICE)
+    assert stat(worker) == (session, constants.WORKER_NICE)
+    assert stat(web) == (session, 0)
+
+    # Closing the terminal stops it all, as Ctrl-C does.
+    server.proc.send_signal(signal.SIGHUP)
+    assert server.proc.wait(60) == 0
+    assert "SIGHUP received; stopping" in server.output()
+    assert gone(web) and gone(worker) and gone(bulk)
