@@ -13,7 +13,8 @@ five-minute take.
 detection with an adapted model (median of several runs), and fitting a model on 50 such
 takes (10 distinct takes, each given five times, so the examples fit in memory; fitting
 visits every example in full either way), with wall and CPU time of this process and the
-load average (run it with ``OMP_NUM_THREADS=1`` for one core).
+load average, on one BLAS thread, as Cutroom's workers run (``make up`` and compose set
+``OPENBLAS_NUM_THREADS=1``): BLAS threads of its own would count their waiting as CPU time.
 """
 
 from __future__ import annotations
@@ -138,6 +139,13 @@ def _timed(fn) -> tuple[float, float, object]:
 
 
 def run_adapt(args) -> int:
+    from threadpoolctl import threadpool_limits
+
+    with threadpool_limits(limits=1):
+        return _run_adapt(args)
+
+
+def _run_adapt(args) -> int:
     import numpy as np
 
     from motionlib import adapt, synth
@@ -163,7 +171,7 @@ def run_adapt(args) -> int:
           f"{'ok' if fit_cpu <= TARGET_FIT_S else 'MISSED'} ({model.n_cuts} cuts)")
     print("ok/MISSED compare the CPU time of this single-threaded process, its time on one "
           "free core;\nwall time also counts waiting for a core on a busy machine.")
-    print(f"threads: OMP_NUM_THREADS={os.environ.get('OMP_NUM_THREADS', 'unset')}; "
+    print("threads: one BLAS thread, as the workers run; "
           f"load average during the run: {' '.join(f'{x:.2f}' for x in os.getloadavg())}")
     return 0
 
