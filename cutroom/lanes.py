@@ -7,13 +7,14 @@ frames); twenty people opening it at once make a hundred and forty of them. Unde
 GIL a request's time grows with the number of threads of its process that want the CPU,
 so a small capture's requests, a few milliseconds alone, would wait behind all of them.
 
-So each request is put in one of two lanes before any of its work is done:
+So each read (GET, HEAD) is put in one of two lanes before any of its work is done:
 
-- the *bulk* lane: a request about a capture of at least ``CUTROOM_LARGE_TAKE_FRAMES``
-  frames (``/api/captures/<id>/…``), and any request of a client (its token, session or
-  address) that made such a request in the last ``CUTROOM_BULK_LINGER`` seconds (the
-  same page's ``/api/me/`` and ``/api/projects/``);
-- the *light* lane: everything else.
+- the *bulk* lane: a read about a capture of at least ``CUTROOM_LARGE_TAKE_FRAMES``
+  frames (``/api/captures/<id>/…``), and any read of a client (its token, session or
+  address) that made such a read in the last ``CUTROOM_BULK_LINGER`` seconds (the same
+  page's ``/api/me/`` and ``/api/projects/``);
+- the *light* lane: everything else, and every write: a person editing a long take is
+  working, not browsing, and an edit costs only the rows it changes.
 
 At most ``CUTROOM_BULK_REQUESTS`` bulk requests run at once per process; the others
 wait on a lock, which holds neither the GIL nor a CPU, in arrival order. Light
@@ -138,14 +139,6 @@ def lanes():
         return _lanes
 
 
-def unanswered():
-    response = JsonResponse(
-        {"detail": "the server that answers requests about long takes stopped while "
-                   "answering this one; try again"}, status=502)
-    response["Retry-After"] = "5"
-    return response
-
-
 def busy():
     response = JsonResponse(
         {"detail": "the server is busy with other requests about long takes "
@@ -161,8 +154,6 @@ LANE_HEADER, ADDRESS_HEADER = "X-Cutroom-Lane", "X-Cutroom-Client-Address"
 # Hop-by-hop headers (RFC 9110 7.6.1) are never handed on, in either direction.
 HOP_BY_HOP = {"connection", "keep-alive", "proxy-authenticate", "proxy-authorization", "te",
               "trailer", "transfer-encoding", "upgrade", "content-length"}
-# Request bodies up to this size are handed on; a larger one is served here.
-MAX_FORWARDED_BODY = 2**20
 # An answer without a length, or longer than this, is streamed through rather than read whole.
 STREAM_ABOVE = 8 * 2**20
 
@@ -207,33 +198,21 @@ class Upstream:
         return conn
 
     def forward(self, request):
-        """The bulk server's answer to ``request``; :class:`Unreachable` if it took none.
-
-        A read may go over a kept-alive connection, and again over a new one if the server
-        had closed it meanwhile; a write always goes over a new connection, so that it is
-        never sent twice.
-        """
-        body = request.body if _content_length(request) else None
+        """The bulk server's answer to the read ``request``; :class:`Unreachable` if it gave
+        none (over a kept-alive connection, then once more over a new one, since the server
+        may have closed the first while it was idle)."""
         headers = _request_headers(request)
-        idempotent = request.method in ("GET", "HEAD")
-        for attempt in range(2 if idempotent else 1):
-            conn = self.connection(fresh=attempt > 0 or not idempotent)
+        for attempt in range(2):
+            conn = self.connection(fresh=attempt > 0)
             try:
-                conn.request(request.method, request.get_full_path(), body=body, headers=headers)
+                conn.request(request.method, request.get_full_path(), headers=headers)
                 upstream = conn.getresponse()
-            except (ConnectionRefusedError, FileNotFoundError) as exc:  # not running
-                self.local.conn = None
-                raise Unreachable(str(exc)) from exc
-            except OSError as exc:  # incl. RemoteDisconnected: closed while idle, or died
+            except OSError as exc:  # not running, closed while idle, or died answering
                 self.local.conn = None
                 conn.close()
-                if idempotent:  # once more over a new connection, then served here
-                    if attempt == 0:
-                        continue
-                    raise Unreachable(str(exc)) from exc
-                logger.warning("bulk lane server gave no answer to %s %s: %s",
-                               request.method, request.path, exc)
-                return unanswered()
+                if attempt == 0 and not isinstance(exc, (ConnectionRefusedError, FileNotFoundError)):
+                    continue
+                raise Unreachable(str(exc)) from exc
             return self.response(upstream)
         raise Unreachable("no answer")
 
@@ -260,13 +239,6 @@ def _chunks(upstream):
             yield chunk
     finally:
         upstream.close()
-
-
-def _content_length(request):
-    try:
-        return int(request.META.get("CONTENT_LENGTH") or 0)
-    except ValueError:
-        return 0
 
 
 def _request_headers(request):
@@ -299,13 +271,6 @@ def upstream():
         return _upstream
 
 
-def forwardable(request):
-    length = _content_length(request)
-    if request.method not in ("GET", "HEAD") and length > MAX_FORWARDED_BODY:
-        return False
-    return not request.META.get("CONTENT_TYPE", "").startswith("multipart/")
-
-
 class LaneMiddleware:
     """Puts each API request in its lane (see the module docstring); off when
     ``CUTROOM_BULK_REQUESTS`` is 0.
@@ -321,13 +286,14 @@ class LaneMiddleware:
 
     def __call__(self, request):
         handed_on = self.handed_on(request)
-        if not settings.CUTROOM_BULK_REQUESTS or not request.path_info.startswith("/api/"):
+        if (not settings.CUTROOM_BULK_REQUESTS or not request.path_info.startswith("/api/")
+                or request.method not in ("GET", "HEAD")):
             return self.get_response(request)
         lane = lanes()
         if not handed_on and not lane.is_bulk(request, time.monotonic()):
             return self.get_response(request)
         server = None if handed_on else upstream()
-        if server is not None and forwardable(request):
+        if server is not None:
             try:
                 return server.forward(request)
             except Unreachable as exc:
