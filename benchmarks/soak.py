@@ -40,6 +40,8 @@ import uuid
 from collections import Counter
 from pathlib import Path
 
+from harness import up_script
+
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
@@ -296,8 +298,10 @@ def report(args, var, out, client, captures, uploads, kills, refused, states, dr
     no_answer = sum(n for code, n in client.statuses.items() if isinstance(code, str))
     text = out.read_text()
     worker_log = (var / "log" / "worker.log").read_text(errors="replace")
+    up = up_script()
     print(f"soak: embedded default (up.py: SQLite, SQLite broker, 1 worker x 2 pool processes, "
-          f"gunicorn 2x4), {args.minutes:g} min of load + drain {drained:.0f} s; "
+          f"gunicorn {up.WEB_WORKERS}x{up.WEB_THREADS}, bulk lane server at nice {up.BULK_NICE}), "
+          f"{args.minutes:g} min of load + drain {drained:.0f} s; "
           f"{os.cpu_count()} CPUs shared; total {time.monotonic() - started:.0f} s")
     print(f"load: {uploads} uploads (20-90 s takes at 120 fps, one per {args.upload_every:g} s), "
           f"{sum(client.statuses.values())} HTTP requests, kills every {args.kill_every:g} s:")
