@@ -19,9 +19,11 @@ So each read (GET, HEAD) is put in one of two lanes before any of its work is do
 At most ``CUTROOM_BULK_REQUESTS`` bulk requests run at once per process; the others
 wait on a lock, which holds neither the GIL nor a CPU, in arrival order. Light
 requests never wait for a slot, so they share their process with at most that many
-bulk requests. A process keeps at most ``CUTROOM_BULK_QUEUE`` bulk requests waiting
-(fewer than its threads, so a light request always finds a free thread); one more, or
-one that waited ``CUTROOM_HEAVY_WAIT`` seconds, gets a 429 with Retry-After.
+bulk requests. A process holds at most ``CUTROOM_BULK_QUEUE`` bulk requests (waiting,
+running or handed on; fewer than its threads, so a light request always finds a free
+thread), at most ``CUTROOM_BULK_PER_CLIENT`` of them from one client (so one client
+cannot take every place); one more, or one that waited ``CUTROOM_HEAVY_WAIT`` seconds,
+gets a 429 with Retry-After.
 
 Where the bulk lane runs. ``make up`` starts a web server of its own for it, at a lower
 CPU priority (``nice``), on a Unix socket (``CUTROOM_BULK_SOCKET``), and the main web
@@ -86,16 +88,17 @@ def client_key(request):
 
 
 class Lanes:
-    """One process's bulk lane: its slots, its waiting count and its lingering clients."""
+    """One process's bulk lane: its slots, the bulk requests it has in hand (in all and per
+    client) and its lingering clients."""
 
     def __init__(self, slots):
         self.size, self.slots = slots, threading.Semaphore(slots)
         self.lock = threading.Lock()
-        self.waiting = 0
+        self.in_hand = 0
+        self.per_client = {}  # client key -> bulk requests of it in hand
         self.bulk_until = {}  # client key -> monotonic time its requests stay bulk
 
-    def is_bulk(self, request, now):
-        key = client_key(request)
+    def is_bulk(self, request, key, now):
         match = CAPTURE_PATH.match(request.path_info)
         large = False
         if match:
@@ -110,17 +113,29 @@ class Lanes:
             until = self.bulk_until.get(key)
             return until is not None and until > now
 
-    def enter(self):
-        """Take a bulk slot; False when the queue is full or the wait too long."""
+    def admit(self, key):
+        """Count a bulk request in (waiting, running or handed on); False when this process
+        has ``CUTROOM_BULK_QUEUE`` of them in hand, or the client
+        ``CUTROOM_BULK_PER_CLIENT``: a thread is kept for light requests, and one client
+        cannot take every place."""
         with self.lock:
-            if self.waiting >= settings.CUTROOM_BULK_QUEUE:
+            mine = self.per_client.get(key, 0)
+            if self.in_hand >= settings.CUTROOM_BULK_QUEUE or mine >= settings.CUTROOM_BULK_PER_CLIENT:
                 return False
-            self.waiting += 1
-        try:
-            return self.slots.acquire(timeout=settings.CUTROOM_HEAVY_WAIT)
-        finally:
-            with self.lock:
-                self.waiting -= 1
+            self.in_hand += 1
+            self.per_client[key] = mine + 1
+            return True
+
+    def release(self, key):
+        with self.lock:
+            self.in_hand -= 1
+            mine = self.per_client.pop(key) - 1
+            if mine:
+                self.per_client[key] = mine
+
+    def enter(self):
+        """Take a bulk slot; False after ``CUTROOM_HEAVY_WAIT`` seconds."""
+        return self.slots.acquire(timeout=settings.CUTROOM_HEAVY_WAIT)
 
     def leave(self):
         self.slots.release()
@@ -142,7 +157,7 @@ def lanes():
 def busy():
     response = JsonResponse(
         {"detail": "the server is busy with other requests about long takes "
-                   "(CUTROOM_BULK_REQUESTS, CUTROOM_BULK_QUEUE); try again in a few seconds"},
+                   "(CUTROOM_BULK_QUEUE, CUTROOM_BULK_PER_CLIENT); try again in a few seconds"},
         status=429)
     response["Retry-After"] = "5"
     return response
@@ -289,9 +304,17 @@ class LaneMiddleware:
         if (not settings.CUTROOM_BULK_REQUESTS or not request.path_info.startswith("/api/")
                 or request.method not in ("GET", "HEAD")):
             return self.get_response(request)
-        lane = lanes()
-        if not handed_on and not lane.is_bulk(request, time.monotonic()):
+        lane, key = lanes(), client_key(request)
+        if not handed_on and not lane.is_bulk(request, key, time.monotonic()):
             return self.get_response(request)
+        if not lane.admit(key):
+            return busy()
+        try:
+            return self.bulk(request, lane, handed_on)
+        finally:
+            lane.release(key)
+
+    def bulk(self, request, lane, handed_on):
         server = None if handed_on else upstream()
         if server is not None:
             try:

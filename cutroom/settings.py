@@ -230,11 +230,13 @@ CUTROOM_ANSWER_CACHE_MB = envint("CUTROOM_ANSWER_CACHE_MB", 64)
 # Requests about a capture of at least CUTROOM_LARGE_TAKE_FRAMES frames (about 14 minutes
 # at 120 fps), and the other requests of their client for CUTROOM_BULK_LINGER s, run at most
 # CUTROOM_BULK_REQUESTS at a time per web process (0: no lane), at most CUTROOM_BULK_QUEUE
-# waiting (then 429), so they never slow down other people's requests. See cutroom/lanes.py.
+# in hand per process and CUTROOM_BULK_PER_CLIENT per client (then 429), so they never slow
+# down other people's requests. See cutroom/lanes.py.
 CUTROOM_LARGE_TAKE_FRAMES = envint("CUTROOM_LARGE_TAKE_FRAMES", 100_000)
 CUTROOM_BULK_LINGER = envint("CUTROOM_BULK_LINGER", 10)
 CUTROOM_BULK_REQUESTS = envint("CUTROOM_BULK_REQUESTS", 1)
 CUTROOM_BULK_QUEUE = envint("CUTROOM_BULK_QUEUE", 24)
+CUTROOM_BULK_PER_CLIENT = envint("CUTROOM_BULK_PER_CLIENT", 8)
 # The bulk lane's own web server (make up starts it, niced): its Unix socket, and how long
 # a request handed to it may take. Unset: each process serves its bulk requests itself.
 CUTROOM_BULK_SOCKET = os.environ.get("CUTROOM_BULK_SOCKET", "")

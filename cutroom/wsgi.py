@@ -13,7 +13,3 @@ application = get_wsgi_application()
 get_resolver().check()
 gc.collect()
 gc.freeze()
-
-import sys  # noqa: E402
-
-sys.setswitchinterval(float(os.environ.get("CUTROOM_SWITCH_INTERVAL", "0.005")))

@@ -89,7 +89,7 @@ class LanesTestCase(LaneTestCase):
         got = []
         waiter = threading.Thread(target=lambda: got.append(self.through_the_middleware(self.large)))
         waiter.start()
-        wait_until(lambda: lane.waiting == 1)
+        wait_until(lambda: lane.in_hand == 1)
         time.sleep(0.1)
         self.assertEqual(got, [])
         lane.leave()
@@ -98,14 +98,14 @@ class LanesTestCase(LaneTestCase):
         self.assertEqual(got[0]["X-Cutroom-Lane"], "bulk-here")
 
     @override_settings(CUTROOM_BULK_QUEUE=1)
-    def test_it_answers_429_when_its_queue_of_bulk_requests_is_full(self):
+    def test_it_answers_429_when_it_has_as_many_bulk_requests_in_hand_as_it_may(self):
         lanes.capture_frames(self.large.pk)
         lane = self.hold_the_slot()
         got = []
         waiter = threading.Thread(target=lambda: got.append(self.through_the_middleware(self.large)))
         waiter.start()
-        wait_until(lambda: lane.waiting == 1)
-        response = self.get(self.large)
+        wait_until(lambda: lane.in_hand == 1)
+        response = self.get(self.large, who="Token rachel")
         lane.leave()
         waiter.join(10)
         self.assertEqual(response.status_code, 429)
@@ -113,6 +113,22 @@ class LanesTestCase(LaneTestCase):
         self.assertIn("CUTROOM_BULK_QUEUE", response.json()["detail"])
         self.assertEqual(got[0].content, b"served")
         lane.enter()  # given back by the cleanup
+        # Another client's light request still goes through.
+        self.login(self.alice)
+        self.assertEqual(self.get(self.small, who="Token alice").status_code, 200)
+
+    @override_settings(CUTROOM_BULK_PER_CLIENT=1)
+    def test_it_answers_429_to_a_client_with_as_many_bulk_requests_in_hand_as_one_may(self):
+        lane = lanes.lanes()
+        bob = lanes.client_key(RequestFactory().get("/", HTTP_AUTHORIZATION="Token bob"))
+        self.assertTrue(lane.admit(bob))  # one of bob's is in hand
+        self.addCleanup(lane.release, bob)
+        refused = self.get(self.large)
+        self.assertEqual(refused.status_code, 429)
+        self.assertIn("CUTROOM_BULK_PER_CLIENT", refused.json()["detail"])
+        self.login(self.rachel)
+        self.assertEqual(self.get(self.large, who="Token rachel").status_code, 200)
+        self.assertEqual(lane.in_hand, 1)  # rachel's was counted out again
 
     @override_settings(CUTROOM_BULK_REQUESTS=0)
     def test_it_has_no_bulk_lane_when_it_is_switched_off(self):
@@ -182,7 +198,15 @@ class ForwardingTestCase(LaneTestCase):
         super().setUp()
         folder = Path(tempfile.mkdtemp())
         self.path = str(folder / "bulk.sock")
-        self.server = UnixServer(self.path, Recorder)
+        self.server_requests = []
+        seen = self.server_requests
+
+        class Recording(Recorder):
+            def answer(self):
+                seen.append(self.path)
+                super().answer()
+
+        self.server = UnixServer(self.path, Recording)
         threading.Thread(target=self.server.serve_forever, daemon=True).start()
         self.addCleanup(self.server.server_close)
         self.addCleanup(self.server.shutdown)
@@ -210,6 +234,13 @@ class ForwardingTestCase(LaneTestCase):
         self.assertEqual(response.status_code, 201)
         self.assertIn(50, [c["frame"] for c in response.json()["cuts"]])
         self.assertNotIn("X-Cutroom-Lane", response)
+
+    def test_it_counts_what_it_handed_on_against_its_limit(self):
+        # Each request handed on holds one of the web server's threads while it waits.
+        with override_settings(CUTROOM_BULK_SOCKET=self.path, CUTROOM_BULK_QUEUE=0):
+            response = self.get(self.large)
+        self.assertEqual(response.status_code, 429)
+        self.assertEqual(self.server_requests, [])
 
     def test_it_streams_an_answer_of_unknown_length(self):
         with override_settings(CUTROOM_BULK_SOCKET=self.path):
