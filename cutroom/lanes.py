@@ -48,10 +48,12 @@ import socket
 import threading
 import time
 from collections import OrderedDict
-from http.cookies import SimpleCookie
+from urllib.parse import quote
 
 from django.conf import settings
-from django.http import HttpResponse, JsonResponse, StreamingHttpResponse
+from django.db import close_old_connections
+from django.http import JsonResponse
+from django.http.cookie import parse_cookie
 
 logger = logging.getLogger(__name__)
 
@@ -80,10 +82,10 @@ def capture_frames(capture_id):
     return n
 
 
-def client_key(request):
-    meta = request.META
-    who = (meta.get("HTTP_AUTHORIZATION") or request.COOKIES.get(settings.SESSION_COOKIE_NAME)
-           or meta.get("REMOTE_ADDR", ""))
+def client_key(meta):
+    """Who is asking, as far as scheduling goes (``request.META`` or a WSGI environ)."""
+    session = parse_cookie(meta.get("HTTP_COOKIE", "")).get(settings.SESSION_COOKIE_NAME)
+    who = meta.get("HTTP_AUTHORIZATION") or session or meta.get("REMOTE_ADDR", "")
     return hashlib.blake2b(who.encode(), digest_size=8).digest()
 
 
@@ -98,8 +100,8 @@ class Lanes:
         self.per_client = {}  # client key -> bulk requests of it in hand
         self.bulk_until = {}  # client key -> monotonic time its requests stay bulk
 
-    def is_bulk(self, request, key, now):
-        match = CAPTURE_PATH.match(request.path_info)
+    def is_bulk(self, path, key, now):
+        match = CAPTURE_PATH.match(path)
         large = False
         if match:
             n = capture_frames(int(match.group(1)))
@@ -212,15 +214,15 @@ class Upstream:
             conn = self.local.conn = UnixConnection(self.path, self.timeout)
         return conn
 
-    def forward(self, request):
-        """The bulk server's answer to the read ``request``; :class:`Unreachable` if it gave
-        none (over a kept-alive connection, then once more over a new one, since the server
-        may have closed the first while it was idle)."""
-        headers = _request_headers(request)
+    def forward(self, environ):
+        """The bulk server's answer to the read in ``environ``: (status line, headers, body
+        iterable); :class:`Unreachable` if it gave none (over a kept-alive connection, then
+        once more over a new one, since the server may have closed the first while idle)."""
+        target, headers = _target(environ), _request_headers(environ)
         for attempt in range(2):
             conn = self.connection(fresh=attempt > 0)
             try:
-                conn.request(request.method, request.get_full_path(), headers=headers)
+                conn.request(environ["REQUEST_METHOD"], target, headers=headers)
                 upstream = conn.getresponse()
             except OSError as exc:  # not running, closed while idle, or died answering
                 self.local.conn = None
@@ -228,24 +230,20 @@ class Upstream:
                 if attempt == 0 and not isinstance(exc, (ConnectionRefusedError, FileNotFoundError)):
                     continue
                 raise Unreachable(str(exc)) from exc
-            return self.response(upstream)
+            return self.answer(upstream)
         raise Unreachable("no answer")
 
-    def response(self, upstream):
+    def answer(self, upstream):
+        headers = [(name, value) for name, value in upstream.getheaders()
+                   if name.lower() not in HOP_BY_HOP]
         length = upstream.getheader("Content-Length")
         if length is not None and int(length) <= STREAM_ABOVE:
-            response = HttpResponse(upstream.read(), status=upstream.status)
+            body = [upstream.read()]
+            headers.append(("Content-Length", length))
         else:  # this connection belongs to the stream until it ends
             self.local.conn = None
-            response = StreamingHttpResponse(_chunks(upstream), status=upstream.status)
-        response.reason_phrase = upstream.reason
-        for name, value in upstream.getheaders():
-            lower = name.lower()
-            if lower == "set-cookie":
-                response.cookies.load(SimpleCookie(value))
-            elif lower not in HOP_BY_HOP:
-                response[name] = value
-        return response
+            body = _chunks(upstream)
+        return f"{upstream.status} {upstream.reason}", headers, body
 
 
 def _chunks(upstream):
@@ -256,18 +254,27 @@ def _chunks(upstream):
         upstream.close()
 
 
-def _request_headers(request):
+def _target(environ):
+    """The request target as the client sent it."""
+    raw = environ.get("RAW_URI")  # gunicorn's
+    if raw:
+        return raw
+    path = quote((environ.get("SCRIPT_NAME", "") + environ.get("PATH_INFO", "")).encode("latin-1"))
+    query = environ.get("QUERY_STRING")
+    return f"{path}?{query}" if query else path
+
+
+def _request_headers(environ):
     headers = {}
-    for key, value in request.META.items():
+    for key, value in environ.items():
         if key.startswith("HTTP_"):
             name = key[5:].replace("_", "-").title()
             if name.lower() not in HOP_BY_HOP and not name.lower().startswith("x-cutroom-"):
                 headers[name] = value
-    for key, name in (("CONTENT_TYPE", "Content-Type"), ("CONTENT_LENGTH", "Content-Length")):
-        if request.META.get(key):
-            headers[name] = request.META[key]
+    if environ.get("CONTENT_TYPE"):
+        headers["Content-Type"] = environ["CONTENT_TYPE"]
     headers[LANE_HEADER] = lane_proof()
-    headers[ADDRESS_HEADER] = request.META.get("REMOTE_ADDR", "")
+    headers[ADDRESS_HEADER] = environ.get("REMOTE_ADDR", "")
     return headers
 
 
@@ -286,50 +293,92 @@ def upstream():
         return _upstream
 
 
-class LaneMiddleware:
-    """Puts each API request in its lane (see the module docstring); off when
-    ``CUTROOM_BULK_REQUESTS`` is 0.
+PROOF_KEY = "HTTP_" + LANE_HEADER.upper().replace("-", "_")
+ADDRESS_KEY = "HTTP_" + ADDRESS_HEADER.upper().replace("-", "_")
 
-    A request the web server handed on (it carries the proof) is served where it arrives,
-    with the address it came from restored (throttles and logs go by it). A bulk request's
-    answer says where it was served: ``X-Cutroom-Lane: bulk-server`` or ``bulk-here``.
+
+def _bulk_read(environ):
+    return (settings.CUTROOM_BULK_REQUESTS and environ.get("REQUEST_METHOD") in ("GET", "HEAD")
+            and environ.get("PATH_INFO", "").startswith("/api/"))
+
+
+class LaneDispatcher:
+    """WSGI: hands bulk reads to the bulk lane's server before Django sees them, so that a
+    request handed on costs this process only the copy of its answer; everything else,
+    and whatever it could not hand on, goes to ``app``."""
+
+    def __init__(self, app):
+        self.app = app
+        self.warned = False
+
+    def __call__(self, environ, start_response):
+        server = upstream()
+        if server is None or PROOF_KEY in environ or not _bulk_read(environ):
+            return self.app(environ, start_response)
+        try:
+            lane, key = lanes(), client_key(environ)
+            bulk = lane.is_bulk(environ["PATH_INFO"], key, time.monotonic())
+        except Exception:  # the database unreachable, say: Django answers, as for any request
+            logger.exception("could not choose a lane for %s", environ.get("PATH_INFO"))
+            bulk = False
+        finally:
+            close_old_connections()  # outside Django's request cycle, as at its end
+        if not bulk:
+            return self.app(environ, start_response)
+        if not lane.admit(key):
+            return _wsgi_busy(start_response)
+        try:
+            status, headers, body = server.forward(environ)
+        except Unreachable as exc:
+            if not self.warned:
+                logger.warning("bulk lane server at %s unreachable (%s): serving bulk "
+                               "requests here", server.path, exc)
+                self.warned = True
+            return self.app(environ, start_response)  # served here, in this process's lane
+        finally:
+            lane.release(key)
+        start_response(status, headers)
+        return body
+
+
+def _wsgi_busy(start_response):
+    response = busy()
+    start_response(f"{response.status_code} {response.reason_phrase}",
+                   [*response.items(), ("Content-Length", str(len(response.content)))])
+    return [response.content]
+
+
+class LaneMiddleware:
+    """Runs bulk reads (see the module docstring) at most ``CUTROOM_BULK_REQUESTS`` at a time
+    in this process; off when that setting is 0. (Handing them to the bulk lane's server
+    is :class:`LaneDispatcher`'s, before Django.)
+
+    A request the web server handed on (it carries the proof) is served here, with the
+    address it came from restored (throttles and logs go by it). A bulk read's answer says
+    where it was served: ``X-Cutroom-Lane: bulk-server`` or ``bulk-here``.
     """
 
     def __init__(self, get_response):
         self.get_response = get_response
-        self.warned = False
 
     def __call__(self, request):
         handed_on = self.handed_on(request)
-        if (not settings.CUTROOM_BULK_REQUESTS or not request.path_info.startswith("/api/")
-                or request.method not in ("GET", "HEAD")):
+        if not _bulk_read(request.META):
             return self.get_response(request)
-        lane, key = lanes(), client_key(request)
-        if not handed_on and not lane.is_bulk(request, key, time.monotonic()):
+        lane, key = lanes(), client_key(request.META)
+        if not handed_on and not lane.is_bulk(request.path_info, key, time.monotonic()):
             return self.get_response(request)
         if not lane.admit(key):
             return busy()
         try:
-            return self.bulk(request, lane, handed_on)
+            if not lane.enter():
+                return busy()
+            try:
+                response = self.get_response(request)
+            finally:
+                lane.leave()
         finally:
             lane.release(key)
-
-    def bulk(self, request, lane, handed_on):
-        server = None if handed_on else upstream()
-        if server is not None:
-            try:
-                return server.forward(request)
-            except Unreachable as exc:
-                if not self.warned:
-                    logger.warning("bulk lane server at %s unreachable (%s): serving bulk "
-                                   "requests here", server.path, exc)
-                    self.warned = True
-        if not lane.enter():
-            return busy()
-        try:
-            response = self.get_response(request)
-        finally:
-            lane.leave()
         response[LANE_HEADER] = "bulk-server" if handed_on else "bulk-here"
         return response
 
@@ -337,8 +386,7 @@ class LaneMiddleware:
     def handed_on(request):
         """Whether the web server handed this request on (then its address is restored)."""
         meta = request.META
-        proof = meta.pop("HTTP_" + LANE_HEADER.upper().replace("-", "_"), None)
-        address = meta.pop("HTTP_" + ADDRESS_HEADER.upper().replace("-", "_"), None)
+        proof, address = meta.pop(PROOF_KEY, None), meta.pop(ADDRESS_KEY, None)
         if proof is None or not hmac.compare_digest(proof, lane_proof()):
             return False
         meta["REMOTE_ADDR"] = address or ""

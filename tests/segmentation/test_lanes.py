@@ -10,10 +10,12 @@ import threading
 import time
 from pathlib import Path
 
+from django.core.handlers.wsgi import WSGIHandler
 from django.http import HttpResponse
 from django.test import RequestFactory, override_settings
 
 from cutroom import lanes
+from cutroom.accounts.models import ApiToken
 from tests.segmentation.base import BaseTestCase
 
 LARGE = 300
@@ -120,7 +122,7 @@ class LanesTestCase(LaneTestCase):
     @override_settings(CUTROOM_BULK_PER_CLIENT=1)
     def test_it_answers_429_to_a_client_with_as_many_bulk_requests_in_hand_as_one_may(self):
         lane = lanes.lanes()
-        bob = lanes.client_key(RequestFactory().get("/", HTTP_AUTHORIZATION="Token bob"))
+        bob = lanes.client_key(RequestFactory().get("/", HTTP_AUTHORIZATION="Token bob").META)
         self.assertTrue(lane.admit(bob))  # one of bob's is in hand
         self.addCleanup(lane.release, bob)
         refused = self.get(self.large)
@@ -194,6 +196,8 @@ class UnixServer(socketserver.ThreadingMixIn, socketserver.UnixStreamServer):
 
 
 class ForwardingTestCase(LaneTestCase):
+    """The web server's WSGI application hands bulk reads to the bulk lane's server."""
+
     def setUp(self):
         super().setUp()
         folder = Path(tempfile.mkdtemp())
@@ -211,58 +215,78 @@ class ForwardingTestCase(LaneTestCase):
         self.addCleanup(self.server.server_close)
         self.addCleanup(self.server.shutdown)
         lanes._upstream = None
+        _, self.key = ApiToken.objects.issue(self.bob)
+        self.app = lanes.LaneDispatcher(WSGIHandler())
 
-    def test_it_hands_a_bulk_request_to_the_bulk_server_with_its_headers(self):
+    def call(self, path, method="GET", body=None, **headers):
+        """(status, headers, body, streamed) of ``path`` through the web server's application."""
+        factory = RequestFactory()
+        headers.setdefault("HTTP_AUTHORIZATION", f"Token {self.key}")
+        if body is None:
+            environ = factory.generic(method, path, **headers).environ
+        else:
+            environ = factory.generic(method, path, json.dumps(body), "application/json", **headers).environ
+        got = {}
+
+        def start_response(status, response_headers):
+            got["status"], got["headers"] = int(status.split()[0]), response_headers
+
         with override_settings(CUTROOM_BULK_SOCKET=self.path):
-            response = self.client.get(f"/api/captures/{self.large.pk}/review/?x=1",
-                                       HTTP_AUTHORIZATION="Token bob", HTTP_IF_NONE_MATCH='"abc"')
-        seen = response.json()
-        self.assertEqual(response.status_code, 200)
+            answer = self.app(environ, start_response)
+            content = b"".join(answer)
+        return got["status"], dict(got["headers"]), got["headers"], content, not isinstance(answer, list)
+
+    def test_it_hands_a_bulk_read_to_the_bulk_server_with_its_headers(self):
+        status, headers, _, body, _ = self.call(f"/api/captures/{self.large.pk}/review/?x=1",
+                                                HTTP_IF_NONE_MATCH='"abc"')
+        seen = json.loads(body)
+        self.assertEqual(status, 200)
         self.assertEqual((seen["method"], seen["path"]), ("GET", f"/api/captures/{self.large.pk}/review/?x=1"))
-        self.assertEqual(seen["headers"]["Authorization"], "Token bob")
+        self.assertEqual(seen["headers"]["Authorization"], f"Token {self.key}")
         self.assertEqual(seen["headers"]["If-None-Match"], '"abc"')
         self.assertEqual(seen["headers"]["X-Cutroom-Lane"], lanes.lane_proof())
         self.assertEqual(seen["headers"]["X-Cutroom-Client-Address"], "127.0.0.1")
-        self.assertEqual(response["ETag"], '"abc"')
-        self.assertEqual(response.cookies["seen"].value, "1")
+        self.assertEqual(headers["ETag"], '"abc"')
+        self.assertEqual(headers["Set-Cookie"], "seen=1; Path=/")
+        self.assertEqual(headers["Content-Length"], str(len(body)))
 
-    def test_it_serves_a_write_about_a_large_take_in_the_light_lane_itself(self):
-        with override_settings(CUTROOM_BULK_SOCKET=self.path):
-            response = self.client.post(f"/api/captures/{self.large.pk}/review/cuts/",
-                                        {"frame": 50, "version": 1}, format="json",
-                                        HTTP_AUTHORIZATION="Token bob")
-        self.assertEqual(response.status_code, 201)
-        self.assertIn(50, [c["frame"] for c in response.json()["cuts"]])
-        self.assertNotIn("X-Cutroom-Lane", response)
+    def test_it_serves_a_write_about_a_large_take_itself(self):
+        status, headers, _, body, _ = self.call(f"/api/captures/{self.large.pk}/review/cuts/",
+                                                method="POST", body={"frame": 50, "version": 1})
+        self.assertEqual(status, 201)
+        self.assertIn(50, [c["frame"] for c in json.loads(body)["cuts"]])
+        self.assertNotIn("X-Cutroom-Lane", headers)
+        self.assertEqual(self.server_requests, [])
 
     def test_it_counts_what_it_handed_on_against_its_limit(self):
-        # Each request handed on holds one of the web server's threads while it waits.
-        with override_settings(CUTROOM_BULK_SOCKET=self.path, CUTROOM_BULK_QUEUE=0):
-            response = self.get(self.large)
-        self.assertEqual(response.status_code, 429)
+        # Each read handed on holds one of the web server's threads while it waits.
+        with override_settings(CUTROOM_BULK_QUEUE=0):
+            status, headers, _, body, _ = self.call(f"/api/captures/{self.large.pk}/review/")
+        self.assertEqual(status, 429)
+        self.assertEqual(headers["Retry-After"], "5")
+        self.assertIn("CUTROOM_BULK_QUEUE", json.loads(body)["detail"])
         self.assertEqual(self.server_requests, [])
 
     def test_it_streams_an_answer_of_unknown_length(self):
-        with override_settings(CUTROOM_BULK_SOCKET=self.path):
-            response = self.client.get(f"/api/captures/{self.large.pk}/chunked",
-                                       HTTP_AUTHORIZATION="Token bob")
-        self.assertTrue(response.streaming)
-        self.assertEqual(json.loads(b"".join(response.streaming_content))["method"], "GET")
+        status, headers, _, body, streamed = self.call(f"/api/captures/{self.large.pk}/chunked")
+        self.assertTrue(streamed)
+        self.assertNotIn("Transfer-Encoding", headers)  # the web server chunks it again itself
+        self.assertEqual(json.loads(body)["method"], "GET")
 
     def test_it_hands_nothing_about_a_small_take_on(self):
-        with override_settings(CUTROOM_BULK_SOCKET=self.path):
-            response = self.get(self.small)
-        self.assertIn("cuts", response.json())
+        status, _, _, body, _ = self.call(f"/api/captures/{self.small.pk}/review/")
+        self.assertEqual(status, 200)
+        self.assertIn("cuts", json.loads(body))
+        self.assertEqual(self.server_requests, [])
 
-    def test_it_serves_the_bulk_request_itself_when_the_bulk_server_is_not_there(self):
+    def test_it_serves_the_bulk_read_itself_when_the_bulk_server_is_not_there(self):
         self.server.shutdown()
         self.server.server_close()
         Path(self.path).unlink()
-        with override_settings(CUTROOM_BULK_SOCKET=self.path):
-            response = self.get(self.large)
-        self.assertEqual(response.status_code, 200)
-        self.assertEqual(response["X-Cutroom-Lane"], "bulk-here")
-        self.assertIn("cuts", response.json())
+        status, headers, _, body, _ = self.call(f"/api/captures/{self.large.pk}/review/")
+        self.assertEqual(status, 200)
+        self.assertEqual(headers["X-Cutroom-Lane"], "bulk-here")
+        self.assertIn("cuts", json.loads(body))
 
 
 def wait_until(predicate, timeout=10):
