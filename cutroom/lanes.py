@@ -27,8 +27,9 @@ gets a 429 with Retry-After.
 
 Where the bulk lane runs. ``make up`` starts a web server of its own for it, at a lower
 CPU priority (``nice``), on a Unix socket (``CUTROOM_BULK_SOCKET``), and the main web
-server's processes hand each bulk request to it (:class:`Upstream`) and wait for its
-answer on the socket, which costs them no CPU: on a busy machine the operating system
+server's processes hand each bulk read to it before Django sees it (:class:`LaneDispatcher`,
+the WSGI application of ``cutroom/wsgi.py``) and wait for its answer on the socket, which
+costs them no CPU: on a busy machine the operating system
 then gives the light requests the CPU first, whatever the bulk lane is doing; on an idle
 one the bulk lane has all of it. Without that server (not configured, not running) a
 process serves its bulk requests itself, still at most ``CUTROOM_BULK_REQUESTS`` at once.
