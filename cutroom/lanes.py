@@ -296,6 +296,15 @@ def upstream():
 
 PROOF_KEY = "HTTP_" + LANE_HEADER.upper().replace("-", "_")
 ADDRESS_KEY = "HTTP_" + ADDRESS_HEADER.upper().replace("-", "_")
+# The dispatcher's choice for a request it passes to Django, (bulk, client key), so that
+# the middleware does not choose again.
+CHOICE_KEY = "cutroom.lane"
+
+
+def _proven(environ):
+    """Whether the request carries the web server's proof that it handed it on."""
+    proof = environ.get(PROOF_KEY)
+    return proof is not None and hmac.compare_digest(proof, lane_proof())
 
 
 def _bulk_read(environ):
@@ -314,18 +323,18 @@ class LaneDispatcher:
 
     def __call__(self, environ, start_response):
         server = upstream()
-        if server is None or PROOF_KEY in environ or not _bulk_read(environ):
+        if server is None or not _bulk_read(environ) or _proven(environ):
             return self.app(environ, start_response)
         try:
             lane, key = lanes(), client_key(environ)
             bulk = lane.is_bulk(environ["PATH_INFO"], key, time.monotonic())
         except Exception:  # the database unreachable, say: Django answers, as for any request
             logger.exception("could not choose a lane for %s", environ.get("PATH_INFO"))
-            bulk = False
-        finally:
-            close_old_connections()  # outside Django's request cycle, as at its end
-        if not bulk:
             return self.app(environ, start_response)
+        environ[CHOICE_KEY] = (bulk, key)
+        if not bulk:
+            return self.app(environ, start_response)  # its request cycle closes old connections
+        close_old_connections()  # outside Django's request cycle, as it does at the end of one
         if not lane.admit(key):
             return _wsgi_busy(start_response)
         try:
@@ -366,8 +375,13 @@ class LaneMiddleware:
         handed_on = self.handed_on(request)
         if not _bulk_read(request.META):
             return self.get_response(request)
-        lane, key = lanes(), client_key(request.META)
-        if not handed_on and not lane.is_bulk(request.path_info, key, time.monotonic()):
+        lane, choice = lanes(), request.META.get(CHOICE_KEY)
+        if choice is None:
+            key = client_key(request.META)
+            bulk = handed_on or lane.is_bulk(request.path_info, key, time.monotonic())
+        else:  # the dispatcher chose, then could not hand it on
+            bulk, key = choice
+        if not bulk:
             return self.get_response(request)
         if not lane.admit(key):
             return busy()
@@ -387,8 +401,9 @@ class LaneMiddleware:
     def handed_on(request):
         """Whether the web server handed this request on (then its address is restored)."""
         meta = request.META
-        proof, address = meta.pop(PROOF_KEY, None), meta.pop(ADDRESS_KEY, None)
-        if proof is None or not hmac.compare_digest(proof, lane_proof()):
-            return False
-        meta["REMOTE_ADDR"] = address or ""
-        return True
+        proven = _proven(meta)
+        meta.pop(PROOF_KEY, None)
+        address = meta.pop(ADDRESS_KEY, None)
+        if proven:
+            meta["REMOTE_ADDR"] = address or ""
+        return proven

@@ -250,6 +250,14 @@ class ForwardingTestCase(LaneTestCase):
         self.assertEqual(headers["Set-Cookie"], "seen=1; Path=/")
         self.assertEqual(headers["Content-Length"], str(len(body)))
 
+    def test_it_hands_on_a_bulk_read_that_claims_a_proof_it_does_not_have(self):
+        # Else a client could have its reads of long takes served at the web server's priority.
+        status, _, _, body, _ = self.call(f"/api/captures/{self.large.pk}/review/",
+                                          HTTP_X_CUTROOM_LANE="guessed")
+        self.assertEqual(status, 200)
+        self.assertEqual(json.loads(body)["headers"]["X-Cutroom-Lane"], lanes.lane_proof())
+        self.assertEqual(len(self.server_requests), 1)
+
     def test_it_serves_a_write_about_a_large_take_itself(self):
         status, headers, _, body, _ = self.call(f"/api/captures/{self.large.pk}/review/cuts/",
                                                 method="POST", body={"frame": 50, "version": 1})
