@@ -2,22 +2,16 @@
 parses, its services wait for healthy dependencies, workers can be scaled, and every
 variable it passes to the app is one that the settings actually read."""
 
-import importlib.util
 import re
 from pathlib import Path
 
 import yaml
 
+from tests.segmentation.test_command_up import up_script
+
 REPO = Path(__file__).resolve().parents[2]
 APP_SERVICES = ("migrate", "web", "web-bulk", "worker", "convert", "watchdog")
 WORKERS = ("worker", "convert")
-
-
-def up_script():
-    spec = importlib.util.spec_from_file_location("up", REPO / "scripts" / "up.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
 
 
 def compose():

@@ -1,6 +1,7 @@
 """``scripts/up.py`` (``make up``) as a person runs it: a real gunicorn and a real Celery
 worker on the embedded default (SQLite + SQLite broker in a fresh var folder)."""
 
+import importlib.util
 import json
 import os
 import re
@@ -20,6 +21,14 @@ REPO = Path(__file__).resolve().parents[2]
 UP = REPO / "scripts" / "up.py"
 
 pytestmark = pytest.mark.slow
+
+
+def up_script():
+    """``scripts/up.py`` as a module (its constants, its classes), without running it."""
+    spec = importlib.util.spec_from_file_location("up_script", UP)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
 
 
 def free_port():

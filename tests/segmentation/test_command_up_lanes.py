@@ -2,7 +2,6 @@
 their own, which still checks who may see what, and which up.py restarts when it dies while
 the web server serves those requests itself; the niced children's nice values count."""
 
-import importlib.util
 import json
 import os
 import re
@@ -12,7 +11,7 @@ import urllib.request
 
 import pytest
 
-from tests.segmentation.test_command_up import UP, gone, wait_until, wait_until_detected
+from tests.segmentation.test_command_up import gone, up_script, wait_until, wait_until_detected
 
 pytestmark = pytest.mark.slow
 
@@ -21,13 +20,6 @@ def stat(pid):
     """(session id, nice value) of a process, from /proc."""
     fields = open(f"/proc/{pid}/stat").read().rsplit(")", 1)[1].split()
     return int(fields[3]), int(fields[16])
-
-
-def up_constants():
-    spec = importlib.util.spec_from_file_location("up_script", UP)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
 
 
 def get(server, path, token=None):
@@ -72,7 +64,7 @@ def test_the_bulk_lane_server_answers_checks_access_and_is_restarted_when_it_die
     web, worker = server.pids()
     bulk = int(re.findall(r"bulk lane server restarted, pid (\d+)", server.output())[-1])
     session = stat(server.proc.pid)[0]
-    constants = up_constants()
+    constants = up_script()
     assert stat(bulk) == (session, constants.BULK_NICE)
     assert stat(worker) == (session, constants.WORKER_NICE)
     assert stat(web) == (session, 0)

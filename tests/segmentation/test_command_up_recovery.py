@@ -1,7 +1,6 @@
 """``make up`` recovers its worker without a person: a pool that hangs after one of its
 processes was killed, a worker that keeps dying; the web server serves throughout."""
 
-import importlib.util
 import io
 import json
 import os
@@ -13,22 +12,15 @@ from pathlib import Path
 import pytest
 
 from tests.segmentation.base import synthetic_bvh
-from tests.segmentation.test_command_up import UP, wait_until, wait_until_detected
+from tests.segmentation.test_command_up import up_script, wait_until, wait_until_detected
 
 pytestmark = pytest.mark.slow
 
 FAST_WATCH = {"CUTROOM_STALL_SECONDS": "10", "CUTROOM_SWEEP_SECONDS": "2"}
 
 
-def load_up_script():
-    spec = importlib.util.spec_from_file_location("up_script", UP)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
 def test_it_restarts_at_once_up_to_the_rate_limit_then_waits_longer_each_time():
-    script = load_up_script()
+    script = up_script()
     now = [0.0]
     restarts = script.Restarts(clock=lambda: now[0])
     pauses = []
