@@ -104,26 +104,27 @@ def test_it_recovers_promptly_the_capture_a_killed_worker_was_ingesting(
     assert Capture.objects.get(pk=capture_id).status == "ready"
 
 
+def start_slow_run(owner, long_take):
+    """Upload the long take, wait for its ingest and default run, then start a run that
+    takes seconds (ppca at a fine step); its id."""
+    client = api(owner)
+    capture_id = upload_and_detect(client, project_of(owner), "long.bvh", long_take)
+    r = client.post(f"/api/captures/{capture_id}/runs/",
+                    {"method": "ppca", "params": {"step_s": 0.04}}, format="json")
+    assert r.status_code == 202, r.json()
+    return r.json()["id"]
+
+
 def test_it_stops_a_detection_run_at_its_time_limit_and_says_why(
     production_workers, owner, long_take
 ):
     production_workers.env["CUTROOM_DETECT_TIME_LIMIT"] = "1"
     production_workers.start()
-    client = api(owner)
-    data = {"project": project_of(owner).pk, "file": SimpleUploadedFile("long.bvh", long_take)}
-    capture_id = client.post("/api/captures/", data, format="multipart").json()["id"]
-    wait_for(lambda: Capture.objects.get(pk=capture_id).status == "ready", timeout=120,
-             what="ingest")
-    wait_for(lambda: not DetectionRun.objects.filter(capture_id=capture_id,
-                                                     status__in=("queued", "processing")).exists(),
-             timeout=120, what="the default run")
-    r = client.post(f"/api/captures/{capture_id}/runs/",
-                    {"method": "ppca", "params": {"step_s": 0.04}}, format="json")
-    assert r.status_code == 202, r.json()
+    run_id = start_slow_run(owner, long_take)
 
-    wait_for(lambda: DetectionRun.objects.get(pk=r.json()["id"]).status == "failed",
+    wait_for(lambda: DetectionRun.objects.get(pk=run_id).status == "failed",
              timeout=120, what="the run to be stopped")
-    error = DetectionRun.objects.get(pk=r.json()["id"]).error
+    error = DetectionRun.objects.get(pk=run_id).error
     assert "took too long and was stopped" in error
     assert "detection 1 s, CUTROOM_DETECT_TIME_LIMIT" in error
 
@@ -135,27 +136,17 @@ def test_it_fails_at_once_a_run_killed_at_its_hard_time_limit(production_workers
     as long again, so the run fails at once, naming the limit, and is not retried."""
     production_workers.env.update(CUTROOM_DETECT_TIME_LIMIT="1", CUTROOM_TIME_LIMIT_GRACE="2")
     worker = production_workers.start()
-    client = api(owner)
-    data = {"project": project_of(owner).pk, "file": SimpleUploadedFile("long.bvh", long_take)}
-    capture_id = client.post("/api/captures/", data, format="multipart").json()["id"]
-    wait_for(lambda: Capture.objects.get(pk=capture_id).status == "ready", timeout=120,
-             what="ingest")
-    wait_for(lambda: not DetectionRun.objects.filter(capture_id=capture_id,
-                                                     status__in=("queued", "processing")).exists(),
-             timeout=120, what="the default run")
-    r = client.post(f"/api/captures/{capture_id}/runs/",
-                    {"method": "ppca", "params": {"step_s": 0.04}}, format="json")
-    assert r.status_code == 202, r.json()
-    wait_for(lambda: DetectionRun.objects.get(pk=r.json()["id"]).status == "processing",
+    run_id = start_slow_run(owner, long_take)
+    wait_for(lambda: DetectionRun.objects.get(pk=run_id).status == "processing",
              interval=0.01, what="the run to start")
     [child] = production_workers.children(worker)
     os.kill(child, signal.SIGSTOP)
     stopped = time.monotonic()
 
-    sweeping_until(lambda: DetectionRun.objects.get(pk=r.json()["id"]).status != "processing",
+    sweeping_until(lambda: DetectionRun.objects.get(pk=run_id).status != "processing",
                    timeout=45)
     assert time.monotonic() - stopped < 15
-    run = DetectionRun.objects.get(pk=r.json()["id"])
+    run = DetectionRun.objects.get(pk=run_id)
     assert run.status == "failed" and run.attempts == 1
     assert run.error.startswith("Detection stopped after its time limit of 1 s "
                                 "(CUTROOM_DETECT_TIME_LIMIT)"), run.error
@@ -163,7 +154,7 @@ def test_it_fails_at_once_a_run_killed_at_its_hard_time_limit(production_workers
     assert "Hard time limit" in worker.log.read_text()
     time.sleep(2)  # the message given back or acknowledged: either way nothing runs it again
     services.sweep_stale_claims()
-    assert DetectionRun.objects.get(pk=r.json()["id"]).attempts == 1
+    assert DetectionRun.objects.get(pk=run_id).attempts == 1
 
 
 def upload_and_detect(client, project, name, content):
