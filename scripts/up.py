@@ -178,13 +178,17 @@ def convert_worker(env, logs):
                  logs / "convert-worker.log")
 
 
-def web(env, logs, host, port):
-    argv = [
-        str(BIN / "gunicorn"), "cutroom.wsgi:application", "--bind", f"{host}:{port}",
+def gunicorn(bind):
+    """gunicorn's command line, as both web servers run it."""
+    return [
+        str(BIN / "gunicorn"), "cutroom.wsgi:application", "--bind", bind,
         "--workers", str(WEB_WORKERS), "--threads", str(WEB_THREADS), "--timeout", "120",
         "--access-logfile", "-", "--error-logfile", "-",
     ]
-    return Child("web server", argv, env, logs / "web.log")
+
+
+def web(env, logs, host, port):
+    return Child("web server", gunicorn(f"{host}:{port}"), env, logs / "web.log")
 
 
 def bulk_socket(env):
@@ -200,12 +204,8 @@ def bulk_web(env, logs):
     if not path:
         return None
     Path(path).parent.mkdir(parents=True, exist_ok=True)
-    argv = [
-        "nice", "-n", str(BULK_NICE),
-        str(BIN / "gunicorn"), "cutroom.wsgi:application", "--bind", f"unix:{path}",
-        "--workers", str(WEB_WORKERS), "--threads", str(WEB_THREADS), "--timeout", "120",
-        "--keep-alive", "75", "--access-logfile", "-", "--error-logfile", "-",
-    ]
+    # Kept-alive connections from the web server, reused from request to request.
+    argv = ["nice", "-n", str(BULK_NICE), *gunicorn(f"unix:{path}"), "--keep-alive", "75"]
     # It serves what it is handed, and hands nothing on.
     return Child("bulk lane server", argv, {**env, "CUTROOM_BULK_SOCKET": ""}, logs / "web-bulk.log")
 
@@ -309,14 +309,9 @@ def supervise(worker_child, web_child, watchdog, convert_child=None, bulk_child=
     restarts = Restarts()
     while True:
         time.sleep(0.5)
-        if convert_child is not None and convert_child.exited() is not None:
-            restart_convert_worker(convert_child)
-        if bulk_child is not None and bulk_child.exited() is not None:
-            say(f"the bulk lane server died (exit code {bulk_child.exited()}); end of "
-                f"{bulk_child.log}:\n{bulk_child.tail()}")
-            bulk_child.kill()
-            bulk_child.start()
-            say(f"bulk lane server restarted, pid {bulk_child.proc.pid}")
+        for child in (convert_child, bulk_child):
+            if child is not None and child.exited() is not None:
+                restart_at_once(child)
         if web_child.exited() is not None:
             say(f"the web server stopped unexpectedly (exit code {web_child.exited()}); "
                 f"end of {web_child.log}:\n{web_child.tail()}")
@@ -349,16 +344,17 @@ def restart(worker_child, pause):
     say(f"worker restarted, pid {worker_child.proc.pid}")
 
 
-def restart_convert_worker(child):
-    """A convert worker that died is restarted at once. (Its conversion in hand is requeued
-    by the periodic sweep once its claim is stale: sweeping now would also take the other
-    worker's running jobs.) Blender crashing or hanging on a file does not get here: that
-    costs Blender's process only, and fails that capture."""
-    say(f"the convert worker died (exit code {child.exited()}); end of {child.log}:\n"
+def restart_at_once(child):
+    """Restart a child that died, at once: the convert worker (its conversion in hand is
+    requeued by the periodic sweep once its claim is stale: sweeping now would also take
+    the other worker's running jobs; Blender crashing or hanging on a file does not get
+    here: that costs Blender's process only, and fails that capture) or the bulk lane
+    server (meanwhile the web server serves its requests itself)."""
+    say(f"the {child.name} died (exit code {child.exited()}); end of {child.log}:\n"
         f"{child.tail()}")
     child.kill()
     child.start()
-    say(f"convert worker restarted, pid {child.proc.pid}")
+    say(f"{child.name} restarted, pid {child.proc.pid}")
 
 
 def requeue_abandoned(env):
