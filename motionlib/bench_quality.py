@@ -156,7 +156,7 @@ def loo_rows(cache: list[tuning.TakeCache], tried: tuning.Selection) -> dict[str
     ``tried`` scores every choice of ``tuning.tried_grid()``; the shipped grid is its
     subset with each tried setting at its shipped value.
     """
-    shipped = tried.subset(**{key: Default.params[key].default for key in tuning.TRIED})
+    shipped = tried.shipped()
     out: dict[str, list[dict]] = {name: [] for name in LOO_ROWS}
     for name, selection in (("default/loo", shipped), ("tried/loo", tried)):
         for c, (params, _) in zip(cache, selection.leave_one_out(), strict=True):
@@ -342,7 +342,7 @@ def out_of_sample_table(tried: tuning.Selection) -> str:
     setting scores leave-one-take-out (the others still chosen without the take), first
     in the shipped grid, then for the options tried and not shipped (``tuning.TRIED``,
     chosen with all of ``tuning.tried_grid()``)."""
-    selection = tried.subset(**{key: Default.params[key].default for key in tuning.TRIED})
+    selection = tried.shipped()
     chosen = selection.chosen()
     lines = [f"default settings chosen on all {len(selection.cache)} takes from tuning.GRID: "
              + ", ".join(f"{k}={v:g}" if not isinstance(v, bool) else f"{k}={v}"

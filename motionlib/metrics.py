@@ -112,17 +112,24 @@ def edit_cost(
     }
 
 
+def _matched(candidates, truth, fps: float, tolerance_s: float):
+    """The candidate frames and true windows (rows lo, mid, hi) of the pairs matched within
+    ``tolerance_s``, in matching order."""
+    cand = np.asarray(candidates, dtype=np.int64).reshape(-1)
+    win = as_windows(truth)
+    ci, ti = match(cand, win, tolerance=int(round(tolerance_s * fps)))
+    return cand[ci], win[ti]
+
+
 def median_error_s(candidates, truth, *, fps: float, tolerance_s: float = 1.0) -> float:
     """Median ``|candidate - mid|`` in seconds over pairs matched within ``tolerance_s``.
 
     NaN when nothing matches.
     """
-    cand = np.asarray(candidates, dtype=np.int64).reshape(-1)
-    win = as_windows(truth)
-    ci, ti = match(cand, win, tolerance=int(round(tolerance_s * fps)))
-    if len(ci) == 0:
+    cand, win = _matched(candidates, truth, fps, tolerance_s)
+    if len(cand) == 0:
         return float("nan")
-    return float(np.median(np.abs(cand[ci] - win[ti, 1]))) / fps
+    return float(np.median(np.abs(cand - win[:, 1]))) / fps
 
 
 def in_window_fraction(candidates, truth, *, fps: float, tolerance_s: float = 1.0) -> float:
@@ -132,13 +139,11 @@ def in_window_fraction(candidates, truth, *, fps: float, tolerance_s: float = 1.
     with a labelled transition window (``lo < hi``) count, since a plain cut's window is
     one frame. NaN when no such true cut is matched (e.g. labels without windows).
     """
-    cand = np.asarray(candidates, dtype=np.int64).reshape(-1)
-    win = as_windows(truth)
-    ci, ti = match(cand, win, tolerance=int(round(tolerance_s * fps)))
-    windowed = win[ti, 0] < win[ti, 2]
+    cand, win = _matched(candidates, truth, fps, tolerance_s)
+    windowed = win[:, 0] < win[:, 2]
     if not windowed.any():
         return float("nan")
-    c, w = cand[ci][windowed], win[ti][windowed]
+    c, w = cand[windowed], win[windowed]
     return float(np.mean((c >= w[:, 0]) & (c <= w[:, 2])))
 
 

@@ -115,6 +115,11 @@ class Selection:
     cache: list[TakeCache]
     rows: list[list[dict]]
 
+    def shipped(self) -> Selection:
+        """The choices of the shipped grid (:data:`GRID`) inside one made from
+        :func:`tried_grid`: each :data:`TRIED` setting at its shipped value."""
+        return self.subset(**{key: Default.params[key].default for key in TRIED})
+
     def subset(self, **fixed) -> Selection:
         """The choices whose settings equal ``fixed`` (e.g. the shipped grid inside
         :func:`tried_grid`), with their scores."""
