@@ -395,9 +395,9 @@ def free_port():
         return sock.getsockname()[1]
 
 
-def start(argv, log, ready, **extra_env):
+def start(argv, log, ready, env=None):
     handle = log.open("w")
-    proc = subprocess.Popen(argv, cwd=REPO, env={**os.environ, **extra_env}, stdout=handle,
+    proc = subprocess.Popen(argv, cwd=REPO, env=env or os.environ.copy(), stdout=handle,
                             stderr=subprocess.STDOUT, process_group=0)  # as make up: one session
     deadline = time.monotonic() + 90
     while not ready():
@@ -416,13 +416,12 @@ def answers(port):
 
 
 def serving(old, var, port):
-    """(worker argv, gunicorn argv, bulk lane server argv or None, description) as
-    `make up` starts them, or as before. Sets the environment the processes get."""
+    """(worker argv, gunicorn argv, bulk lane server (up.py's Child) or None, description)
+    as `make up` starts them, or as before. Sets the environment the processes get."""
     up, env = up_script(), os.environ.copy()
     env["CUTROOM_VAR_DIR"] = str(var)
     worker_argv = up.worker(env, var, 2).argv
     bulk = None if old else up.bulk_web(env, var)
-    bulk_argv = bulk.argv if bulk else None
     web_argv = up.web(env, var, "127.0.0.1", port).argv
     if old:
         os.environ.update(CUTROOM_HEAVY_REQUESTS="0", CUTROOM_ANSWER_CACHE_MB="0",
@@ -439,8 +438,8 @@ def serving(old, var, port):
     niced = f"nice {worker_argv[2]}" if worker_argv[0] == "nice" else "not niced"
     lane = ("no bulk lane" if old else
             f"bulk lane (CUTROOM_BULK_REQUESTS={settings.CUTROOM_BULK_REQUESTS}) on its own server, "
-            f"nice {bulk_argv[2]}" if bulk_argv else "bulk lane in the web server's processes")
-    return worker_argv, web_argv, bulk_argv, (
+            f"nice {bulk.argv[2]}" if bulk else "bulk lane in the web server's processes")
+    return worker_argv, web_argv, bulk, (
         f"{'OLD' if old else 'NEW'} serving: gunicorn {workers} workers x {threads} threads, "
         f"worker {niced}, CUTROOM_HEAVY_REQUESTS={heavy}, CUTROOM_ANSWER_CACHE_MB={cache_mb}, {lane}")
 
@@ -470,13 +469,13 @@ def main():
         old = time_old_path(data, args.old_repeats)
 
         port = free_port()
-        worker_argv, web_argv, bulk_argv, described = serving(args.old_serving, var, port)
+        worker_argv, web_argv, bulk, described = serving(args.old_serving, var, port)
         print(described)
         worker_log = var / "worker.log"
         procs.append(start(worker_argv, worker_log, lambda: " ready." in worker_log.read_text()))
-        if bulk_argv:
+        if bulk:
             sock = Path(os.environ["CUTROOM_BULK_SOCKET"])
-            procs.append(start(bulk_argv, var / "web-bulk.log", sock.exists, CUTROOM_BULK_SOCKET=""))
+            procs.append(start(bulk.argv, var / "web-bulk.log", sock.exists, env=bulk.env))
         procs.append(start(web_argv, var / "web.log", lambda: answers(port)))
         ann = Client(port, data.tokens["ann"])
         ann.call("GET", "/api/me/")  # warm both connections' first request
