@@ -100,6 +100,20 @@ statistic, a linear (mean-pose) cost instead of the kernel (0.54 s: periodic act
 share a mean pose), a context of ``scale_max_s`` and the native frame rate for the
 split.
 
+The Krüger windows span the whole passage from one exercise into the next (0.25-2 s)
+and their best estimate is its middle (mid at 0.5 of the window on 86_01, 0.14-0.96
+elsewhere), while step d puts a cut after a pause at the onset of the next activity,
+the window's end. Tried for the four-channel takes, scored on all 11 takes with the
+other settings at the shipped values (mean over the eight four-channel takes of the
+median error; full-skeleton takes in brackets), none near 0.15 s: each placement step's
+own estimate, split 0.34 s (0.24), turning point 0.30 s (0.09), pause 0.37 s (0.09),
+onset as shipped 0.39 s (0.09); the middle of the pause the cut lies in instead of its
+end, 0.37 s (0.08); the mean of the split and turning point, 0.32 s (0.14), of peak,
+split and turning point, 0.31 s (0.13); the middle of the transition segment of a
+three-segment kernel fit around the split, 0.39-0.57 s (0.38-0.65). The turning point
+alone would lower the four-channel error but raise the edits per true cut (0.45 against
+0.43 there) and not reach the target, so placement stays as chosen.
+
 Short activities: tried, not shipped
 ------------------------------------
 Windows of 3-6 s see an activity shorter than about 2.5 s between two long ones as one
