@@ -17,7 +17,13 @@ so, because one or two reviewed takes are all a new project has:
    :data:`PROMINENCE_GRID` whose peaks match the human cuts best (summed F1 at 1 s,
    one-to-one within 1 s), less a prior cost of moving away from the zero-shot
    prominence, is kept. Prominence, not height, is what separated true from false peaks
-   out of sample (``segmenters.default``). When an example activity is shorter than the
+   out of sample (``segmenters.default``). How strong that prior is depends on how many
+   examples there are: with one or two, a fixed :data:`PROMINENCE_PRIOR`; from
+   :data:`PRIOR_CV_TAKES` on, the strength of :data:`PRIOR_OPTIONS` (from weak to "keep
+   the zero-shot prominence") that predicts each example best when the count is chosen
+   on the others (leave-one-example-take-out). So examples that agree move the count,
+   and a single example that alone wants another count (a take with unusual
+   activities) does not move it for all. When an example activity is shorter than the
    zero-shot shortest window (3 s), the shorter windows of :data:`WINDOW_OPTIONS` are
    scored the same way (all windows on unplaced peaks) and kept if they beat the
    zero-shot windows by :data:`WINDOW_PRIOR`.
@@ -30,16 +36,25 @@ so, because one or two reviewed takes are all a new project has:
    statistical change; a handful of cuts cannot show that).
 
 Each example take is analysed once and then dropped (only its peaks and offsets are
-kept), so a project's examples can be read one at a time.
+kept), so a project's examples can be read one at a time. What is kept of an example, its
+*study*, can be stored (``fit_cut_model(..., studies=...)``, :class:`Example` with a key):
+refitting after one more reviewed take then reads and analyses that take only, and
+learns the same model. A study holds for the example's cuts and the detector settings it
+was made with; an example whose activity is shorter than every other one and than 2 s
+changes the minimum segment (step 1), and with it every study.
 
 Scored on the 11 labelled takes under ``shared/data`` with the other takes of the same
-label source as examples (``python -m motionlib bench-quality --loo``, row ``adapted/loo``):
-mean F1@1 s 0.947 and 0.40 edits per true cut, against 0.957 and 0.41 for the zero-shot
-default chosen without the take: on these takes the zero-shot settings already are what
-the examples would teach (mocap6 13_29 and 13_30 teach each other nothing new; the
-subject-86 takes teach a slightly higher prominence, which loses one cut of 86_14). On
-synthetic takes whose annotators cut 0.6 s after the change, or that hold activities of
-1.5-2.5 s, the adapted model follows them where the zero-shot one cannot (tests).
+label source as examples (``python -m motionlib bench --loo``, row ``adapted/loo``):
+mean F1@1 s 0.957 and 0.386 edits per true cut, against 0.957 and 0.406 for the zero-shot
+default chosen without the take. With a fixed prior of 0.05 at any number of examples
+(the earlier design) it was 0.947 and 0.401: the subject-86 takes taught a prominence of
+0.14, pulled up by one take (86_10, whose four channels show four extra peaks), and with
+it 86_14 lost a cut; chosen by leave-one-example-take-out, the strength keeps 0.1 for
+every take scored (mocap6 13_29 and 13_30 teach each other nothing new either). The
+adapted model gains over the zero-shot one by its shorter minimum segment (86_07: one
+cut fewer moved). On synthetic takes whose annotators cut 0.6 s after the change, or
+that hold activities of 1.5-2.5 s, the adapted model follows them where the zero-shot
+one cannot (tests).
 
 Pure numpy/scipy, no Django; the service stores ``CutModel.to_json()``.
 """
@@ -47,13 +62,15 @@ Pure numpy/scipy, no Django; the service stores ``CutModel.to_json()``.
 from __future__ import annotations
 
 import csv
+import hashlib
 import json
 import math
 import os
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass
 from pathlib import Path
+from typing import Protocol
 
 import numpy as np
 
@@ -151,6 +168,8 @@ class CutModel:
 
 
 def _where(take) -> str:
+    if isinstance(take, Example):
+        return take.name
     return os.path.basename(take.path) if getattr(take, "path", None) else take.name
 
 
@@ -168,15 +187,71 @@ def _checked_cuts(take, cuts) -> np.ndarray:
     return np.unique(np.asarray(out, dtype=np.int64))
 
 
-def fit_cut_model(examples: Sequence[tuple[object, Sequence[int]]]) -> CutModel:
+@dataclass(frozen=True)
+class Example:
+    """An example take described before it is read, so that a stored study can stand in
+    for reading and analysing it (``fit_cut_model``'s ``studies``).
+
+    name : how an error names the take; cuts : its human cuts (0-based take frames);
+    fps, n_frames : the take's frame rate and length; read : returns the take;
+    key : identifies the take's content (e.g. its file's checksum), or None to never
+    store its study.
+    """
+
+    name: str
+    cuts: Sequence[int]
+    fps: float
+    n_frames: int
+    read: Callable[[], object]
+    key: str | None = None
+
+
+class Studies(Protocol):
+    """Where ``fit_cut_model`` keeps what it learnt from each example (its *study*).
+
+    A study is a dict of numpy arrays; ``study_key`` names the example's cuts and the
+    detector settings it was made with, and a store returns a study only for the same
+    ``study_key`` (a store may keep one study per ``example_key``).
+    """
+
+    def load(self, example_key: str, study_key: str) -> dict[str, np.ndarray] | None: ...
+
+    def save(self, example_key: str, study_key: str, arrays: dict[str, np.ndarray]) -> None: ...
+
+
+class MemoryStudies:
+    """``Studies`` in a dict: one study per example, for as long as the object lives."""
+
+    def __init__(self):
+        self.items: dict[str, tuple[str, dict[str, np.ndarray]]] = {}
+
+    def load(self, example_key, study_key):
+        stored = self.items.get(example_key)
+        return stored[1] if stored is not None and stored[0] == study_key else None
+
+    def save(self, example_key, study_key, arrays):
+        self.items[example_key] = (study_key, arrays)
+
+
+# Bump when what a study holds, or how the detector computes it, changes: every stored
+# study then misses once and is made again.
+STUDY_VERSION = 1
+
+
+def fit_cut_model(examples: Sequence, *, studies: Studies | None = None) -> CutModel:
     """Adapt the default detector to example takes with human cuts.
 
     Parameters
     ----------
-    examples : sequence of (take, cuts); cuts are 0-based take frames where a new segment
-        starts (a take with no cut is a valid example: one activity throughout). A take
-        is a ``motionlib.Take`` (or anything ``segmenters.default.take_features`` reads);
-        each is analysed once, in order, and not kept.
+    examples : sequence of (take, cuts), or of :class:`Example`; cuts are 0-based take
+        frames where a new segment starts (a take with no cut is a valid example: one
+        activity throughout). A take is a ``motionlib.Take`` (or anything
+        ``segmenters.default.take_features`` reads); each is analysed once, in order,
+        and not kept.
+    studies : where what was learnt from each :class:`Example` with a ``key`` is kept.
+        An example whose study for the same cuts and settings is stored there is
+        neither read nor analysed, so refitting after one more reviewed take analyses
+        that one take; the model is the same as without ``studies``.
 
     Returns
     -------
@@ -190,7 +265,8 @@ def fit_cut_model(examples: Sequence[tuple[object, Sequence[int]]]) -> CutModel:
     if len(examples) == 0:
         raise ExampleError("no example takes to learn from")
     p = Default.validate_params({})
-    checked = [(take, _checked_cuts(take, cuts)) for take, cuts in examples]
+    checked = [(example, _checked_cuts(example, example.cuts))
+               for example in map(_as_example, examples)]
     shortest = _shortest_segment(checked)
     if shortest is not None:  # only ever shorter: a longer one would hide short activities
         p["min_segment_s"] = float(np.clip(MIN_SEGMENT_FACTOR * shortest, MIN_SEGMENT_S,
@@ -201,16 +277,15 @@ def fit_cut_model(examples: Sequence[tuple[object, Sequence[int]]]) -> CutModel:
     options = _window_options(zero_windows, shortest)
     peaks = {w: [] for w in [*options, "placed"]}
     residuals = {name: [] for name in PLACEMENTS}
-    for take, cuts in checked:
-        analysis = Default.analyse(take, p)
-        if analysis is None:
-            raise ExampleError(f"{_where(take)}: too short to learn from "
-                               f"({take.n_frames} frames)")
-        placed = _add_residuals(residuals, take, cuts, analysis, p)
-        peaks["placed"].append(_all_peaks(take, cuts, analysis, p, placed))
-        others = analysis.with_windows(*options[1:]) if len(options) > 1 else []
-        for windows, other in zip(options[1:], others, strict=True):
-            peaks[windows].append(_all_peaks(take, cuts, other, p, {}))
+    for example, cuts in checked:
+        study = _study(example, cuts, p, options, studies)
+        tol = int(round(MATCH_S * example.fps))
+        for name in PLACEMENTS:
+            residuals[name].extend(study[f"residual_{name}"].tolist())
+        for windows in ["placed", *options[1:]]:
+            label = _label(windows)
+            peaks[windows].append((study[f"{label}_frames"], study[f"{label}_prominence"],
+                                   cuts, tol, study[f"{label}_raw"]))
     windows = zero_windows
     if len(options) > 1:
         # Windows compete on unplaced peaks (placing them all would cost a detection each);
@@ -226,6 +301,54 @@ def fit_cut_model(examples: Sequence[tuple[object, Sequence[int]]]) -> CutModel:
                     threshold=p["threshold"], prominence=prominence,
                     min_segment_s=p["min_segment_s"], scale_min_s=windows[0],
                     scale_max_s=windows[1], placement=placement, offset_s=offset)
+
+
+def _as_example(item) -> Example:
+    if isinstance(item, Example):
+        return item
+    take, cuts = item
+    return Example(name=_where(take), cuts=cuts, fps=float(take.fps), n_frames=take.n_frames,
+                   read=lambda: take)
+
+
+def _label(windows) -> str:
+    """A study's array-name prefix for the peaks of ``windows`` ("placed": zero-shot)."""
+    return windows if isinstance(windows, str) else f"windows_{windows[0]:g}_{windows[1]:g}"
+
+
+def _study_key(cuts: np.ndarray, p: dict, options) -> str:
+    """What a study depends on besides its take: the cuts, the settings, the windows."""
+    text = json.dumps([STUDY_VERSION, cuts.tolist(), sorted(p.items()),
+                       [list(w) for w in options]])
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+def _study(example: Example, cuts: np.ndarray, p: dict, options, studies) -> dict:
+    """What one example teaches, as arrays: each placement step's residuals and the
+    novelty peaks at the zero-shot and other ``options`` windows. From ``studies`` when
+    stored there for these cuts and settings, else computed (and stored)."""
+    names = {f"residual_{name}" for name in PLACEMENTS} | {
+        f"{_label(w)}_{part}" for w in ["placed", *options[1:]]
+        for part in ("frames", "prominence", "raw")}
+    keep = studies is not None and example.key is not None
+    key = _study_key(cuts, p, options) if keep else ""
+    if keep:
+        stored = studies.load(example.key, key)
+        if stored is not None and names <= set(stored):
+            return stored
+    take = example.read()
+    analysis = Default.analyse(take, p)
+    if analysis is None:
+        raise ExampleError(f"{example.name}: too short to learn from "
+                           f"({example.n_frames} frames)")
+    study, placed = _residuals(cuts, analysis, p)
+    study.update(_all_peaks("placed", analysis, p, placed))
+    others = analysis.with_windows(*options[1:]) if len(options) > 1 else []
+    for windows, other in zip(options[1:], others, strict=True):
+        study.update(_all_peaks(_label(windows), other, p, {}))
+    if keep:
+        studies.save(example.key, key, study)
+    return study
 
 
 def _window_options(zero_windows: tuple[float, float],
@@ -252,6 +375,11 @@ def _shortest_segment(checked) -> float | None:
 PROMINENCE_GRID = tuple(sorted({*np.round(np.geomspace(0.02, 2.0, 41), 4),
                                 Default.params["prominence"].default}))
 PROMINENCE_PRIOR = 0.05
+# From this many example takes on, the prior's strength is itself chosen among
+# PRIOR_OPTIONS (inf: keep the zero-shot prominence) by leave-one-example-take-out: the
+# strength whose count, chosen on the other examples, fits the example left out best.
+PRIOR_OPTIONS = (0.02, 0.05, 0.1, 0.2, 0.5, 1.0, math.inf)
+PRIOR_CV_TAKES = 3
 # Shorter novelty windows (s) the examples may choose when they hold activities shorter
 # than the zero-shot shortest window, and the summed example F1 such a choice must buy.
 WINDOW_OPTIONS = ((2.0, 4.0), (1.5, 3.0))
@@ -274,8 +402,9 @@ def matched_count(candidates: np.ndarray, truth: np.ndarray, tolerance: int) -> 
     return matched
 
 
-def _all_peaks(take, cuts, analysis, p: dict, placed: dict) -> tuple:
-    """Every novelty peak of one example (frames, prominences) with its cuts and tolerance.
+def _all_peaks(label: str, analysis, p: dict, placed: dict) -> dict[str, np.ndarray]:
+    """Every novelty peak of one example, as study arrays ``<label>_frames``,
+    ``_prominence`` and ``_raw`` (the peak's own frame), in frame order.
 
     A peak the zero-shot detector keeps is counted where it places it (``placed``: peak
     index -> take frame), since its placement can move it by more than the tolerance
@@ -287,8 +416,8 @@ def _all_peaks(take, cuts, analysis, p: dict, placed: dict) -> tuple:
     frames = np.asarray([placed.get(int(k), f) for k, f in zip(peaks, raw, strict=True)],
                         dtype=np.int64)
     order = np.argsort(frames, kind="stable")
-    return (frames[order], prominence[order], np.sort(cuts), int(round(MATCH_S * take.fps)),
-            raw[order])
+    return {f"{label}_frames": frames[order], f"{label}_prominence": prominence[order],
+            f"{label}_raw": raw[order]}
 
 
 def _unplaced(take_peaks: tuple) -> tuple:
@@ -301,37 +430,85 @@ def _unplaced(take_peaks: tuple) -> tuple:
 def _count(per_take, zero: float) -> tuple[float, float]:
     """The prominence of PROMINENCE_GRID whose peaks fit the example cuts best.
 
-    Returns (score, prominence): the summed F1 less the prior, and the prominence.
+    The summed example F1 at each prominence, less the prior (``_prior_strength``) times
+    how far (log factor) it lies from ``zero``, the zero-shot prominence.
+
+    Returns (score, prominence): the best score and its prominence.
     """
-    best, best_score = zero, -math.inf
-    for prominence in PROMINENCE_GRID:
-        score = -PROMINENCE_PRIOR * abs(math.log(prominence / zero))
-        for frames, prom, cuts, tol, _ in per_take:
+    f1 = _f1_by_prominence(per_take)
+    away = np.abs(np.log(np.asarray(PROMINENCE_GRID) / zero))
+    score = f1.sum(axis=0) - _penalty(away, _prior_strength(f1, away))
+    best = _first_best(score)
+    return float(score[best]), float(PROMINENCE_GRID[best])
+
+
+def _f1_by_prominence(per_take) -> np.ndarray:
+    """(n_takes, len(PROMINENCE_GRID)) F1 at 1 s of each example's peaks kept at each
+    prominence (1 for a take with neither peaks nor cuts)."""
+    out = np.ones((len(per_take), len(PROMINENCE_GRID)))
+    for i, (frames, prom, cuts, tol, _) in enumerate(per_take):
+        for j, prominence in enumerate(PROMINENCE_GRID):
             kept = frames[prom >= prominence]
             total = len(kept) + len(cuts)
-            score += 2 * matched_count(kept, cuts, tol) / total if total else 1.0
-        if score > best_score + 1e-9:
-            best, best_score = float(prominence), score
-    return best_score, best
+            if total:
+                out[i, j] = 2 * matched_count(kept, cuts, tol) / total
+    return out
 
 
-def _add_residuals(residuals: dict, take, cuts, analysis, p: dict) -> dict[int, int]:
-    """Add each placement step's signed (human - placed) offsets in seconds, over the
-    zero-shot cuts that match a human cut within 1 s.
+def _penalty(away: np.ndarray, strength: float) -> np.ndarray:
+    """The prior's cost at each prominence (0 at the zero-shot one, whatever the strength)."""
+    out = np.zeros_like(away)
+    out[away > 0] = strength * away[away > 0]
+    return out
+
+
+def _first_best(score: np.ndarray) -> int:
+    """Index of the best score; ties (within 1e-9) go to the lowest prominence."""
+    return int(np.flatnonzero(score >= score.max() - 1e-9)[0])
+
+
+def _prior_strength(f1: np.ndarray, away: np.ndarray) -> float:
+    """How strongly the count holds to the zero-shot prominence.
+
+    With fewer than ``PRIOR_CV_TAKES`` examples, ``PROMINENCE_PRIOR``. With more, the
+    option of ``PRIOR_OPTIONS`` that predicts each example best from the others: for
+    each example, the count is chosen on the other examples with that strength and
+    scored (F1) on the one left out; the summed held-out F1 decides, ties going to the
+    stronger prior. Examples that agree with each other move the count; one example
+    that alone wants a different count (a take with unusual activities) no longer can.
+    """
+    if len(f1) < PRIOR_CV_TAKES:
+        return PROMINENCE_PRIOR
+    total = f1.sum(axis=0)
+    best, best_held = PROMINENCE_PRIOR, -math.inf
+    for strength in PRIOR_OPTIONS:
+        penalty = _penalty(away, strength)
+        held = sum(f1[i, _first_best(total - f1[i] - penalty)] for i in range(len(f1)))
+        if held >= best_held - 1e-9:
+            best, best_held = strength, held
+    return best
+
+
+def _residuals(cuts: np.ndarray, analysis, p: dict) -> tuple[dict, dict[int, int]]:
+    """Each placement step's signed (human - placed) offsets in seconds over the
+    zero-shot cuts that match a human cut within 1 s, as study arrays
+    ``residual_<step>``.
 
     Returns
     -------
-    novelty peak index -> take frame where the zero-shot detector places that peak.
+    the arrays, and novelty peak index -> take frame where the zero-shot detector places
+    that peak.
     """
     peaks, _ = Default.choose_peaks(analysis, p)
     stages, _ = place_stages(analysis.x, analysis.peak_frames(peaks), analysis.fps,
                              analysis.gamma, p)
+    arrays = {}
     for name, placed in stages.items():
         placed = placed + analysis.first
-        ci, ti = metrics.match(placed, cuts, tolerance=int(round(MATCH_S * take.fps)))
-        residuals[name].extend(((cuts[ti] - placed[ci]) / take.fps).tolist())
+        ci, ti = metrics.match(placed, cuts, tolerance=int(round(MATCH_S * analysis.fps)))
+        arrays[f"residual_{name}"] = (cuts[ti] - placed[ci]) / analysis.fps
     zero_shot = stages["onset" if p["onset"] else "pause"] + analysis.first
-    return dict(zip(peaks.tolist(), zero_shot.tolist(), strict=True))
+    return arrays, dict(zip(peaks.tolist(), zero_shot.tolist(), strict=True))
 
 
 def _placement(residuals: dict, zero_shot: str) -> tuple[str, float]:

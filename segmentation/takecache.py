@@ -8,11 +8,16 @@ is stored once as two files under ``derived/takes/``: the channel values as a ``
 (float64, exactly what the parser read; memory-mapped when read back from a local
 filesystem, so fifty takes cost page cache rather than private memory) and the skeleton
 and take metadata as a small ``.npz``. Nothing is pickled.
+
+What fitting a project's cut model learnt from a reviewed capture (a study, see
+``motionlib.adapt``) is stored beside it under ``derived/studies/``: one ``.npz`` per
+capture, replaced when its cuts or the detector's settings change.
 """
 
 import io
 import json
 import logging
+import zipfile
 
 import numpy as np
 from django.core.files.base import ContentFile
@@ -104,3 +109,47 @@ def _channels(storage, name):
     except NotImplementedError:
         with storage.open(name, "rb") as handle:
             return np.load(io.BytesIO(handle.read()), allow_pickle=False)
+
+
+def example_key(capture):
+    """What identifies a capture's content: its id and its original's checksum."""
+    return f"{capture.pk}-{capture.checksum[:16]}"
+
+
+class StoredStudies:
+    """``motionlib.adapt.Studies`` in the media storage: one ``.npz`` per capture holding
+    the study and the key it was made for. A file that cannot be read is a miss (the take
+    is analysed again); one that cannot be written is logged and skipped."""
+
+    def __init__(self, storage):
+        self.storage = storage
+
+    @staticmethod
+    def name(example_key):
+        return f"derived/studies/v{FORMAT}/{example_key}.npz"
+
+    def load(self, example_key, study_key):
+        name = self.name(example_key)
+        try:
+            if not self.storage.exists(name):
+                return None
+            with self.storage.open(name, "rb") as handle:
+                with np.load(io.BytesIO(handle.read()), allow_pickle=False) as data:
+                    arrays = {key: data[key] for key in data.files}
+        except (OSError, ValueError, EOFError, zipfile.BadZipFile):
+            log.warning("could not read the stored study %s; analysing the take again", name)
+            return None
+        if str(arrays.pop("study_key", "")) != study_key:
+            return None
+        return arrays
+
+    def save(self, example_key, study_key, arrays):
+        name = self.name(example_key)
+        content = io.BytesIO()
+        np.savez(content, study_key=np.array(study_key), **arrays)
+        try:
+            if self.storage.exists(name):
+                self.storage.delete(name)
+            self.storage.save(name, ContentFile(content.getvalue()))
+        except OSError:
+            log.exception("could not store the study of %s", example_key)

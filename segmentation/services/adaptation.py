@@ -8,6 +8,11 @@ waits join it); a worker trains with ``motionlib.adapt.fit_cut_model`` and store
 model as the project's next version. Runs of the ``default`` method detect with the
 newest version; a project without one uses the zero-shot detector. A failed training
 stores its reason and leaves the newest version in use.
+
+What the fit learnt from each reviewed take (its study) is stored beside the parsed take
+(``takecache.StoredStudies``), so a retraining after one more submit reads and analyses
+that one take; the others' studies are used as long as their cuts and the detector's
+settings are unchanged.
 """
 
 import dataclasses
@@ -112,6 +117,18 @@ def example_take(capture):
     return dataclasses.replace(take, name=f"capture {capture.pk} ({capture.name})", path=None)
 
 
+def example(capture, cuts):
+    """The capture as an example for ``motionlib.adapt.fit_cut_model``: read (``example_take``)
+    only if its stored study does not stand in for it; its key is its content."""
+    from motionlib import adapt
+
+    return adapt.Example(
+        name=f"capture {capture.pk} ({capture.name})", cuts=cuts, fps=capture.fps,
+        n_frames=capture.n_frames, read=functools.partial(example_take, capture),
+        key=takecache.example_key(capture),
+    )
+
+
 def claim_training(pk, token):
     """The claimed training row, or None when it is not its turn (another training of
     the project runs), another worker has it, or it is done. A training that was
@@ -187,10 +204,12 @@ def _train(job):
     examples = project_examples(job.project_id)
     if not examples:
         raise Invalid("the project has no submitted review or gold version to learn from")
-    takes = [(example_take(capture), cuts) for capture, cuts in examples]
     from motionlib import adapt
 
-    model = adapt.fit_cut_model(takes)
+    model = adapt.fit_cut_model(
+        [example(capture, cuts) for capture, cuts in examples],
+        studies=takecache.StoredStudies(Capture._meta.get_field("original").storage),
+    )
     with transaction.atomic():
         newest = ProjectCutModel.objects.filter(project_id=job.project_id).aggregate(v=Max("version"))
         job.finish(

@@ -3,15 +3,21 @@ method, the zero-shot detector before any training, the registry's segmenter for
 methods. Jobs run in-process here; with real workers see
 tests/segmentation/integration/test_adaptation_flow.py."""
 
-from motionlib import synth
-from segmentation import services, tasks
+from django.core.files.base import ContentFile
+
+from motionlib import adapt, synth
+from segmentation import services, takecache, tasks
 from segmentation.models import DetectionRun, ProjectCutModel
+from segmentation.services import adaptation
+from segmentation.takecache import StoredStudies
 from tests.segmentation.base import BaseTestCase, synthetic_bvh
 
 SECONDS = 30.0
 
 
-class DetectionWithModelTestCase(BaseTestCase):
+class ReviewedTakesTestCase(BaseTestCase):
+    """Synthetic takes ingested for real, reviewed to their true boundaries, trained on."""
+
     def ingested(self, seed):
         self.login(self.alice)
         response = self.upload(synthetic_bvh(seed=seed, duration=SECONDS), name=f"take_{seed}.bvh")
@@ -40,6 +46,8 @@ class DetectionWithModelTestCase(BaseTestCase):
         self.assertEqual(job.status, "ready", job.error)
         return job
 
+
+class DetectionWithModelTestCase(ReviewedTakesTestCase):
     def test_a_project_without_a_model_detects_zero_shot(self):
         run = self.ingested(seed=91).latest_run()
         self.assertEqual((run.status, run.method), ("ready", "default"))
@@ -59,3 +67,62 @@ class DetectionWithModelTestCase(BaseTestCase):
         tasks.detect(run.pk)
         run = DetectionRun.objects.get(pk=run.pk)
         self.assertEqual((run.status, run.model_version), ("ready", None), run.error)
+
+
+class StoredStudiesTestCase(ReviewedTakesTestCase):
+    """What a training learnt from each reviewed take is stored, so a retraining after
+    one more submit reads and analyses only what changed, and learns the same model."""
+
+    def retrain(self):
+        job = adaptation.request_training(self.project.pk)
+        tasks.retrain(job.pk)
+        job.refresh_from_db()
+        self.assertEqual(job.status, "ready", job.error)
+        return job
+
+    def fresh_model(self):
+        """The model fitted from the takes themselves, nothing stored."""
+        examples = adaptation.project_examples(self.project.pk)
+        return adapt.fit_cut_model([(adaptation.example_take(c), cuts) for c, cuts in examples])
+
+    def test_a_retraining_reads_no_take_whose_study_is_stored(self):
+        first = self.train([81, 82])
+        captures = [c for c, _ in adaptation.project_examples(self.project.pk)]
+        storage = captures[0].original.storage
+        for capture in captures:
+            self.assertTrue(storage.exists(StoredStudies.name(takecache.example_key(capture))))
+            # Without its original and its parsed copy, a take that had to be read would
+            # fail the training.
+            for name in (capture.original.name, *takecache.cache_names(capture)):
+                storage.delete(name)
+        again = self.retrain()
+        self.assertEqual((again.version, again.model), (first.version + 1, first.model))
+
+    def test_a_take_reviewed_again_is_analysed_again_and_the_model_is_as_learnt_afresh(self):
+        self.train([83, 84])
+        capture, cuts = adaptation.project_examples(self.project.pk)[0]
+        name = StoredStudies.name(takecache.example_key(capture))
+        storage = capture.original.storage
+        with storage.open(name, "rb") as handle:
+            before = handle.read()
+        review = services.get_or_create_review(capture, self.rachel)
+        for cut in list(review.cuts.all()):
+            if cut.frame == cuts[0]:
+                services.do_change_cut(review, self.rachel, cut, review.version, fate="deleted")
+        services.do_submit_review(review, self.rachel, review.version)
+        job = self.retrain()
+        with storage.open(name, "rb") as handle:
+            self.assertNotEqual(handle.read(), before)
+        self.assertEqual(adapt.CutModel.from_json(job.model), self.fresh_model())
+
+    def test_an_unreadable_stored_study_is_made_again(self):
+        first = self.train([85])
+        capture, _ = adaptation.project_examples(self.project.pk)[0]
+        name = StoredStudies.name(takecache.example_key(capture))
+        storage = capture.original.storage
+        storage.delete(name)
+        storage.save(name, ContentFile(b"not a zip file"))
+        again = self.retrain()
+        self.assertEqual(again.model, first.model)
+        with storage.open(name, "rb") as handle:
+            self.assertTrue(handle.read().startswith(b"PK"))
