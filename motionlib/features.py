@@ -92,7 +92,8 @@ def body_frame_positions(
     -------
     (n_frames, n_joints or len(which), 3) positions, same unit as the input.
     """
-    chosen = positions if which is None else positions[:, which]
+    # np.take copies the chosen joints several times faster than fancy indexing does.
+    chosen = positions if which is None else np.take(positions, which, axis=1)
     rel = chosen - positions[:, joints["root"]][:, None, :]
     hips = positions[:, joints["right_hip"]] - positions[:, joints["left_hip"]]
     angle = np.arctan2(hips[:, 2], hips[:, 0])  # hip axis angle in the ground plane

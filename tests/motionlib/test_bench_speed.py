@@ -45,3 +45,14 @@ def test_it_says_when_the_captures_are_missing(tmp_path, capsys):
     assert main(["bench-speed", "io", "--data", str(tmp_path)]) == 2
     assert capsys.readouterr().err.startswith(
         "motionlib bench-speed io: error: CMU captures not found under")
+
+
+def test_the_adapt_benchmark_times_detection_fitting_and_a_refit(capsys):
+    assert main(["bench-speed", "adapt", "--takes", "3", "--minutes", "0.5", "--runs", "1"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    cases = [line[:48].strip() for line in lines[1:4]]
+    assert cases == ["detect, adapted model, 0.5-min 120 fps take", "fit on 3 0.5-min 120 fps takes",
+                     "refit, 1 of 3 changed, studies stored"]
+    for line in lines[1:4]:
+        wall, cpu, target = (float(v) for v in line[48:].split()[:3])
+        assert wall > 0 and cpu > 0 and target > 0
