@@ -110,9 +110,14 @@ own estimate, split 0.34 s (0.24), turning point 0.30 s (0.09), pause 0.37 s (0.
 onset as shipped 0.39 s (0.09); the middle of the pause the cut lies in instead of its
 end, 0.37 s (0.08); the mean of the split and turning point, 0.32 s (0.14), of peak,
 split and turning point, 0.31 s (0.13); the middle of the transition segment of a
-three-segment kernel fit around the split, 0.39-0.57 s (0.38-0.65). The turning point
-alone would lower the four-channel error but raise the edits per true cut (0.45 against
-0.43 there) and not reach the target, so placement stays as chosen.
+three-segment kernel fit around the split, 0.39-0.57 s (0.38-0.65); where each frame
+near the cut stops looking like the poses 1-4 s before it and starts looking like those
+1-4 s after (kernel witness crossing), 0.28-0.30 s (0.24-0.29), and the middle between
+the last old-looking and the first new-looking frame, 0.30-0.37 s (0.14-0.39). The
+turning point alone would lower the four-channel error but raise the edits per true cut
+(0.45 against 0.43 there), the witness crossing would lower both there but triple the
+error on the full-skeleton takes, and neither reaches the target, so placement stays as
+chosen.
 
 Short activities: tried, not shipped
 ------------------------------------
