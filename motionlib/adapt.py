@@ -246,7 +246,8 @@ class MemoryStudies:
 STUDY_VERSION = 1
 
 
-def fit_cut_model(examples: Sequence, *, studies: Studies | None = None) -> CutModel:
+def fit_cut_model(examples: Sequence, *, studies: Studies | None = None,
+                  base: dict | None = None) -> CutModel:
     """Adapt the default detector to example takes with human cuts.
 
     Parameters
@@ -260,6 +261,9 @@ def fit_cut_model(examples: Sequence, *, studies: Studies | None = None) -> CutM
         An example whose study for the same cuts and settings is stored there is
         neither read nor analysed, so refitting after one more reviewed take analyses
         that one take; the model is the same as without ``studies``.
+    base : the ``default`` segmenter's parameters adaptation starts from (its zero-shot
+        settings when None); detect with the same parameters (``detect(take, model,
+        **base)``). The benchmark passes the settings chosen without the take it scores.
 
     Returns
     -------
@@ -272,7 +276,7 @@ def fit_cut_model(examples: Sequence, *, studies: Studies | None = None) -> CutM
     """
     if len(examples) == 0:
         raise ExampleError("no example takes to learn from")
-    p = Default.validate_params({})
+    p = Default.validate_params(base or {})
     checked = [(example, _checked_cuts(example, example.cuts))
                for example in map(_as_example, examples)]
     shortest = _shortest_segment(checked)

@@ -19,7 +19,8 @@ Both are imported only here, and only when the bench runs.
 
 With ``--loo`` three rows are scored leave-one-take-out (``LOO_ROWS``): the default's
 settings chosen from ``tuning.GRID`` without the take scored, the default adapted to the
-other takes of the same label source (``motionlib.adapt``), and ruptures with its
+other takes of the same label source (``motionlib.adapt``, starting from those settings
+chosen without the take, since the shipped ones were chosen on it too), and ruptures with its
 penalty chosen without the take; the out-of-sample score of every option of every
 setting, and a short-activity check on synthetic takes, follow the tables. Each take is
 scored separately and the means are given per kind of take and over all.
@@ -145,7 +146,7 @@ LOO_ROWS = {
     "default/loo": "default settings chosen from tuning.GRID on the other takes",
     "tried/loo": "the same with the options tried and not shipped (tuning.TRIED) in the grid",
     "adapted/loo": "default adapted (motionlib.adapt) to the other takes of the same label "
-                   "source as examples",
+                   "source as examples, from the settings of default/loo",
     "ruptures/loo": "ruptures_kernel with its penalty chosen on the other takes",
 }
 
@@ -162,14 +163,16 @@ def loo_rows(cache: list[tuning.TakeCache], tried: tuning.Selection) -> dict[str
         for c, (params, _) in zip(cache, selection.leave_one_out(), strict=True):
             out[name].append(_timed_row(lambda t, p=params: Default(**p).fit_predict(t).cuts,
                                         c.take, c.labelled.truth))
-    for c in cache:
+    # Adaptation starts from the zero-shot settings chosen without the take (those of
+    # default/loo), not the shipped ones: they were chosen on every take, this one too.
+    for c, (params, _) in zip(cache, shipped.leave_one_out(), strict=True):
         examples = _examples(cache, c)
         if not examples:  # the only take of its label source: nothing to learn from
             out["adapted/loo"].append({key: float("nan") for _, key in COLUMNS})
             continue
-        model = adapt.fit_cut_model(examples)
-        out["adapted/loo"].append(_timed_row(lambda t, m=model: adapt.detect(t, m).cuts,
-                                             c.take, c.labelled.truth))
+        model = adapt.fit_cut_model(examples, base=params)
+        out["adapted/loo"].append(_timed_row(
+            lambda t, m=model, p=params: adapt.detect(t, m, **p).cuts, c.take, c.labelled.truth))
     out["ruptures/loo"] = _ruptures_loo(cache)
     return out
 

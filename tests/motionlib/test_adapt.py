@@ -201,3 +201,11 @@ def test_examples_without_a_key_are_never_stored():
     studies = MemoryStudies()
     fit_cut_model([_take(1), _take(2)], studies=studies)
     assert studies.items == {}
+
+
+def test_it_starts_from_the_settings_it_is_given():
+    model = fit_cut_model([_take(1), _take(2)], base={"threshold": 0.2, "min_segment_s": 1.0})
+    assert model.threshold == 0.2
+    assert model.min_segment_s <= 1.0  # never longer than where it started
+    zero_shot = fit_cut_model([_take(1), _take(2)])
+    assert (zero_shot.threshold, zero_shot.min_segment_s) == (0.1, 1.5)
