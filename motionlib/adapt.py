@@ -179,8 +179,6 @@ class CutModel:
 
 
 def _where(take) -> str:
-    if isinstance(take, Example):
-        return take.name
     return os.path.basename(take.path) if getattr(take, "path", None) else take.name
 
 
@@ -338,18 +336,22 @@ def _study_key(cuts: np.ndarray, p: dict, options) -> str:
     return hashlib.sha256(text.encode()).hexdigest()
 
 
+def _study_names(options) -> set[str]:
+    """The arrays a complete study holds."""
+    return {f"residual_{name}" for name in PLACEMENTS} | {
+        f"{_label(w)}_{part}" for w in ["placed", *options[1:]]
+        for part in ("frames", "prominence", "raw")}
+
+
 def _study(example: Example, cuts: np.ndarray, p: dict, options, studies) -> dict:
     """What one example teaches, as arrays: each placement step's residuals and the
     novelty peaks at the zero-shot and other ``options`` windows. From ``studies`` when
     stored there for these cuts and settings, else computed (and stored)."""
-    names = {f"residual_{name}" for name in PLACEMENTS} | {
-        f"{_label(w)}_{part}" for w in ["placed", *options[1:]]
-        for part in ("frames", "prominence", "raw")}
     keep = studies is not None and example.key is not None
     key = _study_key(cuts, p, options) if keep else ""
     if keep:
         stored = studies.load(example.key, key)
-        if stored is not None and names <= set(stored):
+        if stored is not None and _study_names(options) <= set(stored):
             return stored
     take = example.read()
     analysis = Default.analyse(take, p)

@@ -157,15 +157,15 @@ def loo_rows(cache: list[tuning.TakeCache], tried: tuning.Selection) -> dict[str
     ``tried`` scores every choice of ``tuning.tried_grid()``; the shipped grid is its
     subset with each tried setting at its shipped value.
     """
-    shipped = tried.shipped()
+    shipped = tried.shipped().leave_one_out()
     out: dict[str, list[dict]] = {name: [] for name in LOO_ROWS}
-    for name, selection in (("default/loo", shipped), ("tried/loo", tried)):
-        for c, (params, _) in zip(cache, selection.leave_one_out(), strict=True):
+    for name, chosen in (("default/loo", shipped), ("tried/loo", tried.leave_one_out())):
+        for c, (params, _) in zip(cache, chosen, strict=True):
             out[name].append(_timed_row(lambda t, p=params: Default(**p).fit_predict(t).cuts,
                                         c.take, c.labelled.truth))
     # Adaptation starts from the zero-shot settings chosen without the take (those of
     # default/loo), not the shipped ones: they were chosen on every take, this one too.
-    for c, (params, _) in zip(cache, shipped.leave_one_out(), strict=True):
+    for c, (params, _) in zip(cache, shipped, strict=True):
         examples = _examples(cache, c)
         if not examples:  # the only take of its label source: nothing to learn from
             out["adapted/loo"].append({key: float("nan") for _, key in COLUMNS})

@@ -14,8 +14,10 @@ detection with an adapted model (median of several runs), and fitting a model on
 takes (10 distinct takes, each given five times, so the examples fit in memory; fitting
 visits every example in full either way), and refitting them after one example's cuts
 changed with every example's study stored (``adapt.MemoryStudies``; what the service
-does after a submit), with wall and CPU time of this process and the load average, on one BLAS thread, as Cutroom's workers run (``make up`` and compose set
-``OPENBLAS_NUM_THREADS=1``): BLAS threads of its own would count their waiting as CPU time.
+does after a submit), with wall and CPU time of this process and the load average, on
+one BLAS thread, as Cutroom's workers run (``make up`` and compose set
+``OPENBLAS_NUM_THREADS=1``): BLAS threads of its own would count their waiting as CPU
+time.
 """
 
 from __future__ import annotations
