@@ -85,10 +85,15 @@ def _meta_arrays(take):
     return arrays
 
 
-def _load(storage, channels_name, meta_name):
-    with storage.open(meta_name, "rb") as handle:
+def _read_npz(storage, name):
+    """The arrays of a stored ``.npz`` (nothing pickled)."""
+    with storage.open(name, "rb") as handle:
         with np.load(io.BytesIO(handle.read()), allow_pickle=False) as data:
-            meta = {key: data[key] for key in data.files}
+            return {key: data[key] for key in data.files}
+
+
+def _load(storage, channels_name, meta_name):
+    meta = _read_npz(storage, meta_name)
     text = json.loads(str(meta["text"]))
     skeleton = Skeleton(
         names=text["names"], parents=meta["parents"], offsets=meta["offsets"],
@@ -133,9 +138,7 @@ class StoredStudies:
         try:
             if not self.storage.exists(name):
                 return None
-            with self.storage.open(name, "rb") as handle:
-                with np.load(io.BytesIO(handle.read()), allow_pickle=False) as data:
-                    arrays = {key: data[key] for key in data.files}
+            arrays = _read_npz(self.storage, name)
         except (OSError, ValueError, EOFError, zipfile.BadZipFile):
             log.warning("could not read the stored study %s; analysing the take again", name)
             return None

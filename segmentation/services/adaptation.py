@@ -105,6 +105,12 @@ def project_examples(project_id):
     return examples
 
 
+def example_name(capture):
+    """How training names a reviewed capture: motionlib names a take by its path when it
+    has one, and the stored file's name is a random folder away from what the studio knows."""
+    return f"capture {capture.pk} ({capture.name})"
+
+
 def example_take(capture):
     """The capture's take (parsed once, then from ``takecache``), named after the capture
     so that an error names it."""
@@ -112,9 +118,7 @@ def example_take(capture):
         take = takecache.read_cached(capture, read_take)
     except (MotionlibError, CutroomError, OSError) as exc:
         raise Invalid(f"reviewed capture {capture.pk} ({capture.name!r}) cannot be read: {exc}") from exc
-    # motionlib names a take by its path when it has one: the stored file's name is a
-    # random folder away from what the studio knows, so name the capture instead.
-    return dataclasses.replace(take, name=f"capture {capture.pk} ({capture.name})", path=None)
+    return dataclasses.replace(take, name=example_name(capture), path=None)
 
 
 def example(capture, cuts):
@@ -123,7 +127,7 @@ def example(capture, cuts):
     from motionlib import adapt
 
     return adapt.Example(
-        name=f"capture {capture.pk} ({capture.name})", cuts=cuts, fps=capture.fps,
+        name=example_name(capture), cuts=cuts, fps=capture.fps,
         n_frames=capture.n_frames, read=functools.partial(example_take, capture),
         key=takecache.example_key(capture),
     )

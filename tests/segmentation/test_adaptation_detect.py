@@ -40,7 +40,10 @@ class ReviewedTakesTestCase(BaseTestCase):
     def train(self, seeds):
         for seed in seeds:
             self.review_to_the_truth(self.ingested(seed), seed)
-        job = ProjectCutModel.objects.get(project=self.project, status="queued")
+        return self.run_training(ProjectCutModel.objects.get(project=self.project, status="queued"))
+
+    def run_training(self, job):
+        """Run the training ``job`` in-process; it must succeed."""
         tasks.retrain(job.pk)
         job.refresh_from_db()
         self.assertEqual(job.status, "ready", job.error)
@@ -74,11 +77,7 @@ class StoredStudiesTestCase(ReviewedTakesTestCase):
     one more submit reads and analyses only what changed, and learns the same model."""
 
     def retrain(self):
-        job = adaptation.request_training(self.project.pk)
-        tasks.retrain(job.pk)
-        job.refresh_from_db()
-        self.assertEqual(job.status, "ready", job.error)
-        return job
+        return self.run_training(adaptation.request_training(self.project.pk))
 
     def fresh_model(self):
         """The model fitted from the takes themselves, nothing stored."""
