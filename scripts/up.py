@@ -43,6 +43,9 @@ WEB_WORKERS, WEB_THREADS = 2, 32
 # (benchmarks/review_long_take.py, twenty page loads of a one-hour take: nice 10 kept a
 # small capture's requests within 1.4-1.5x of alone at p95, nice 5 within 1.9-2.1x).
 BULK_NICE = 10
+# What stops everything; SIGHUP too: the children are in the terminal's session, and
+# closing it must stop them.
+STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
 
 
 def parse_args(argv=None):
@@ -408,8 +411,7 @@ def main(argv=None):
     bulk_child = bulk_web(env, logs)
     web_child = web(env, logs, args.host, args.port)
     children = [c for c in (web_child, bulk_child, worker_child, convert_child) if c]
-    # SIGHUP too: the children are in the terminal's session, and closing it must stop them.
-    for stop_signal in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
+    for stop_signal in STOP_SIGNALS:
         signal.signal(stop_signal, on_signal)
     code = 1
     try:
@@ -431,7 +433,7 @@ def main(argv=None):
         say(f"{stop} received; stopping the web server and the worker")
         code = 0
     finally:
-        for stop_signal in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
+        for stop_signal in STOP_SIGNALS:
             signal.signal(stop_signal, signal.SIG_IGN)
         for child in children:
             child.stop()
