@@ -138,3 +138,6 @@ def test_an_admin_edits_the_taxonomy_and_the_palette_applies_a_label(live_server
     # The new hotkey applies its label at once.
     ann.keyboard.press("6")
     expect(ann.get_by_test_id("current-segment")).to_contain_text("labelled crouch")
+    # The edit is saved before the test ends: the database is emptied after it, and a save
+    # still being written holds a lock on the review's tables.
+    expect(ann.get_by_test_id("save-state")).to_have_text("Saved")
