@@ -184,6 +184,7 @@ def train_project_model(job):
         with heartbeat(job):  # a training outlives the claim timeout; a dead one must not
             _train(job)
     except SoftTimeLimitExceeded:
+        jobs.usable_connection()
         job.fail(
             "Training took too long and was stopped (time limit "
             f"{settings.CUTROOM_RETRAIN_TIME_LIMIT} s, CUTROOM_RETRAIN_TIME_LIMIT); ask the "
@@ -194,6 +195,7 @@ def train_project_model(job):
         job.fail(f"training: {exc}", finished_at=timezone.now())
     except Exception:
         reference = internal_error(f"training of project {job.project_id}", log)
+        jobs.usable_connection()
         job.fail(
             f"training failed with an internal error (reference {reference}); "
             "report this reference to the service's administrators",

@@ -181,6 +181,7 @@ def _guarded(job, what, work, **fail_fields):
         with jobs.heartbeat(job):
             work()
     except SoftTimeLimitExceeded:
+        jobs.usable_connection()
         job.fail(
             f"{what} took too long and was stopped (time limits: ingest with its default "
             f"detection {settings.CUTROOM_INGEST_TIME_LIMIT} s, CUTROOM_INGEST_TIME_LIMIT; "
@@ -192,6 +193,7 @@ def _guarded(job, what, work, **fail_fields):
         job.fail(_bounded(str(exc), 2000), **fail_fields)
     except Exception:
         reference = internal_error(what, log)
+        jobs.usable_connection()
         job.fail(
             f"{what} failed with an internal error (reference {reference}). The original "
             "upload is kept; report this reference to the service's administrators.",

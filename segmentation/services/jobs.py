@@ -80,6 +80,22 @@ def heartbeat(job):
         beating.join()
 
 
+def usable_connection():
+    """Close this thread's database connection if it can no longer run a query, so the
+    next query opens a new one.
+
+    A task's soft time limit raises its exception from a signal handler, wherever the job
+    is: inside a query waiting for its result, too. That connection is then left in the
+    middle of a command and every later query on it fails ("another command is already in
+    progress"), the one that records why the job failed included.
+    """
+    if connection.connection is None or connection.in_atomic_block:
+        return
+    if not connection.is_usable():
+        log.warning("closing a database connection left in the middle of a command")
+        connection.close()
+
+
 def exhausted(job):
     """A job claimed more than CUTROOM_MAX_ATTEMPTS times: its input keeps killing workers."""
     return job.attempts > settings.CUTROOM_MAX_ATTEMPTS

@@ -2,17 +2,21 @@
 long are stopped: real workers, with the claim timeout and time limits of production
 unless a test says otherwise."""
 
+import contextlib
 import os
 import signal
 import time
 
+import psycopg
 import pytest
+from celery.exceptions import SoftTimeLimitExceeded
 from django.contrib.auth import get_user_model
 from django.core.files.uploadedfile import SimpleUploadedFile
+from django.db import connection
 from rest_framework.test import APIClient
 
 from segmentation import services
-from segmentation.models import Capture, DetectionRun, ProjectCutModel
+from segmentation.models import Capture, DetectionRun, ProjectCutModel, Review
 from segmentation.services import adaptation
 from tests.segmentation.base import synthetic_bvh
 from tests.segmentation.integration.conftest import Workers, new_queue, sending_to, wait_for
@@ -257,3 +261,64 @@ def test_it_stops_a_training_at_its_soft_time_limit_and_says_why(
     assert (failed.status, failed.version) == ("failed", None)
     assert failed.error.startswith("Training took too long and was stopped (time limit 1 s, "
                                    "CUTROOM_RETRAIN_TIME_LIMIT)"), failed.error
+
+
+@contextlib.contextmanager
+def soft_limit_after(seconds):
+    """Raise SoftTimeLimitExceeded in this thread after ``seconds``, from a signal handler,
+    as a worker's pool process does at a task's soft time limit: the exception lands
+    wherever the job is, a database call included."""
+    def reached(signum, frame):
+        raise SoftTimeLimitExceeded()
+
+    previous = signal.signal(signal.SIGALRM, reached)
+    signal.setitimer(signal.ITIMER_REAL, seconds)
+    try:
+        yield
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, previous)
+
+
+@contextlib.contextmanager
+def table_locked(model):
+    """Hold an exclusive lock on ``model``'s table from another connection, so a query on
+    it waits until the block ends."""
+    db = connection.settings_dict
+    with psycopg.connect(host=db["HOST"] or "127.0.0.1", port=db["PORT"] or 5432,
+                         user=db["USER"], dbname=db["NAME"], password=db["PASSWORD"]) as other:
+        other.execute(f'LOCK TABLE "{model._meta.db_table}" IN ACCESS EXCLUSIVE MODE')
+        yield
+        other.rollback()
+
+
+def test_a_training_whose_soft_limit_lands_inside_a_query_still_fails_naming_the_limit(
+    services_env, owner
+):
+    """The soft limit's exception interrupts the query the training waits on, leaving that
+    connection in the middle of a command; the failure is still written (on a connection
+    that works) instead of the row staying "processing"."""
+    job = ProjectCutModel.objects.create(project=project_of(owner), status="processing",
+                                         claim_token="token")
+    with table_locked(Review), soft_limit_after(0.5):
+        adaptation.train_project_model(job)
+
+    failed = ProjectCutModel.objects.get(pk=job.pk)
+    assert (failed.status, failed.version) == ("failed", None)
+    assert failed.error.startswith("Training took too long and was stopped"), failed.error
+
+
+def test_a_detection_whose_soft_limit_lands_inside_a_query_still_fails_naming_the_limit(
+    services_env, owner
+):
+    capture = Capture.objects.create(project=project_of(owner), name="take.bvh",
+                                     status="ready", fps=120, n_frames=1200)
+    run = DetectionRun.objects.create(capture=capture, method="default", status="processing",
+                                      claim_token="token")
+    with table_locked(Capture), soft_limit_after(0.5):
+        services.captures._guarded(run, "Detection", lambda: list(Capture.objects.all()),
+                                   finished_at=None)
+
+    failed = DetectionRun.objects.get(pk=run.pk)
+    assert failed.status == "failed"
+    assert "took too long and was stopped" in failed.error, failed.error
