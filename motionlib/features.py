@@ -94,15 +94,17 @@ def body_frame_positions(
     """
     # np.take copies the chosen joints several times faster than fancy indexing does.
     chosen = positions if which is None else np.take(positions, which, axis=1)
-    rel = chosen - positions[:, joints["root"]][:, None, :]
+    root = positions[:, joints["root"]]
     hips = positions[:, joints["right_hip"]] - positions[:, joints["left_hip"]]
     angle = np.arctan2(hips[:, 2], hips[:, 0])  # hip axis angle in the ground plane
-    c, s = np.cos(angle), np.sin(angle)
-    x, z = rel[..., 0], rel[..., 2]
-    out = rel.copy()
+    c, s = np.cos(angle)[:, None], np.sin(angle)[:, None]
+    x = chosen[..., 0] - root[:, 0:1]
+    z = chosen[..., 2] - root[:, 2:3]
+    out = np.empty(chosen.shape)
+    np.subtract(chosen[..., 1], root[:, 1:2], out=out[..., 1])
     # Rotate about Y by +angle so the hip axis lies on +X for every frame.
-    out[..., 0] = c[:, None] * x + s[:, None] * z
-    out[..., 2] = -s[:, None] * x + c[:, None] * z
+    out[..., 0] = c * x + s * z
+    out[..., 2] = -s * x + c * z
     return out
 
 
@@ -247,4 +249,5 @@ def frame_speed(x: np.ndarray, *, fps: float) -> np.ndarray:
     (n_frames,) Euclidean norm of the central-difference derivative, units per second.
     """
     flat = np.asarray(x, dtype=float).reshape(len(x), -1)
-    return np.linalg.norm(np.gradient(flat, axis=0), axis=1) * fps
+    d = np.gradient(flat, axis=0)
+    return np.sqrt(np.einsum("ij,ij->i", d, d)) * fps

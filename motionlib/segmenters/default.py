@@ -264,7 +264,9 @@ def median_sq_distance(x: np.ndarray, max_points: int = 1000) -> float:
     sub = x[:: max(1, len(x) // max_points)]
     sq = (sub * sub).sum(axis=1)
     d2 = sq[:, None] + sq[None, :] - 2 * sub @ sub.T
-    return float(np.median(d2[np.triu_indices(len(sub), 1)]))
+    # The pairs above the diagonal, row by row: the order np.triu_indices gives, without
+    # its two index arrays of n² / 2 entries each.
+    return float(np.median(np.concatenate([row[i + 1:] for i, row in enumerate(d2)])))
 
 
 def mmd_novelty(x: np.ndarray, w: int, gamma: float) -> np.ndarray:
@@ -297,19 +299,14 @@ def multi_mmd_novelty(x: np.ndarray, widths, gamma: float) -> list[np.ndarray]:
         if w >= 1 and n >= 2 * w:
             t = np.arange(w, n - w + 1)
             acc[w] = (t, np.zeros(len(t)), np.zeros(len(t)))
-    for lag in range(0, 2 * max(acc, default=0)):
-        k = np.exp(-gamma * ((x[lag:] - x[: n - lag]) ** 2).sum(axis=1))
-        c = np.concatenate([[0.0], np.cumsum(k)])  # c[i] = sum of k[:i]
-        for w, (t, within, cross) in acc.items():
-            if lag >= 2 * w:
-                continue
-            if lag < w:  # pairs (i, i + lag) inside the past and inside the future window
-                mult = 1.0 if lag == 0 else 2.0
-                within += mult * (c[t - lag] - c[t - w] + c[t + w - lag] - c[t])
-            if lag >= 1:  # pairs with i in the past window and i + lag in the future one
-                lo = np.maximum(t - w, t - lag)
-                hi = np.minimum(t, t + w - lag)
-                cross += np.where(hi > lo, c[np.maximum(hi, lo)] - c[lo], 0.0)
+    n_lags = 2 * max(acc, default=0)
+    for first in range(0, n_lags, LAG_GROUP):
+        lags = range(first, min(n_lags, first + LAG_GROUP))
+        # sums[i, j]: the kernel at lag lags[j] summed over the pairs starting before i
+        sums = np.zeros((n + 1, len(lags)))
+        np.cumsum(lag_kernel(x, lags, gamma), axis=0, out=sums[1:])
+        for lag, c in zip(lags, sums.T, strict=True):
+            _add_lag(acc, lag, np.ascontiguousarray(c))
     out = []
     for w in widths:
         curve = np.zeros(n)
@@ -318,6 +315,68 @@ def multi_mmd_novelty(x: np.ndarray, widths, gamma: float) -> list[np.ndarray]:
             curve[t] = np.maximum((within - 2 * cross) / (w * w), 0.0)
         out.append(curve)
     return out
+
+
+# Lags whose kernels are computed together (memory: n x LAG_GROUP), and the rows per
+# matrix product when they are (each row's product also covers LAG_GROUP - 1 columns it
+# does not need, so short blocks waste less).
+LAG_GROUP = 64
+LAG_ROWS = 128
+
+
+def lag_kernel(x: np.ndarray, lags: range, gamma: float) -> np.ndarray:
+    """The Gaussian kernel between each sample and the one ``lag`` later, for each lag.
+
+    ``|a - b|² = |a|² + |b|² - 2 a.b`` with the dot products from matrix products over
+    short blocks of rows: the products of a band of the Gram matrix, several times fewer
+    passes over memory than differencing the samples lag by lag.
+
+    Returns
+    -------
+    (n, len(lags)): ``exp(-gamma |x[i + lag] - x[i]|²)``, 0 where ``i + lag`` is past the
+    end; exactly 1 at lag 0.
+    """
+    n, m, first = len(x), len(lags), lags[0]
+    sq = np.einsum("ij,ij->i", x, x)
+    dots = np.empty((n, m))
+    for a in range(0, n, LAG_ROWS):
+        b = min(n, a + LAG_ROWS)
+        block = np.zeros((b - a, b - a + m - 1))
+        later = x[a + first : b + first + m - 1]
+        block[:, : len(later)] = x[a:b] @ later.T
+        # row r of the band starts at block[r, r]: one step further along each row
+        dots[a:b] = np.lib.stride_tricks.as_strided(
+            block, shape=(b - a, m), strides=(block.strides[0] + block.strides[1],
+                                              block.strides[1]))
+    padded = np.concatenate([sq, np.zeros(first + m)])
+    sq_later = np.lib.stride_tricks.sliding_window_view(padded[first:], m)[:n]
+    k = np.exp(-gamma * np.maximum(sq[:, None] + sq_later - 2 * dots, 0.0))
+    for j, lag in enumerate(lags):
+        k[max(0, n - lag):, j] = 0.0
+    if first == 0:
+        k[:, 0] = 1.0
+    return k
+
+
+def _add_lag(acc: dict, lag: int, c: np.ndarray) -> None:
+    """Add the pairs at ``lag`` to each width's within- and cross-window kernel sums;
+    ``c[i]`` sums their kernel over the pairs starting before ``i``."""
+    for w, (t, within, cross) in acc.items():
+        if lag >= 2 * w:
+            continue
+
+        def at(offset, w=w, t=t):  # c[t + offset] for every split t (a slice, not a gather)
+            return c[t[0] + offset : t[0] + offset + len(t)]
+
+        if lag < w:  # pairs (i, i + lag) inside the past and inside the future window
+            mult = 1.0 if lag == 0 else 2.0
+            within += mult * (at(-lag) - at(-w) + at(w - lag) - at(0))
+        # pairs with i in the past window and i + lag in the future one: i from
+        # max(t - w, t - lag) up to min(t, t + w - lag)
+        if 1 <= lag <= w:
+            cross += at(0) - at(-lag)
+        elif lag > w:
+            cross += at(w - lag) - at(-w)
 
 
 def mirrored_novelty(x: np.ndarray, w: int, gamma: float) -> np.ndarray:
@@ -414,11 +473,14 @@ def split_gains(x: np.ndarray, gamma: float) -> np.ndarray:
     # cdist rather than a matrix product: threaded BLAS on matrices this small costs
     # more in thread hand-offs than the arithmetic on a busy machine.
     k = np.exp(-gamma * cdist(x, x, "sqeuclidean"))
-    c = np.zeros((n + 1, n + 1))
-    c[1:, 1:] = k.cumsum(axis=0).cumsum(axis=1)  # c[a, b] = sum of k[:a, :b]
+    # With c[a, b] the sum of k[:a, :b] and k symmetric: c[t, n] sums the first t rows,
+    # and c[t, t] adds, row by row, the diagonal entry and twice the entries left of it.
+    rows = np.cumsum(k.sum(axis=1))  # c[t, n] for t = 1 .. n
+    square = np.cumsum(2 * np.tril(k, -1).sum(axis=1) + k.diagonal())  # c[t, t]
     t = np.arange(1, n)
-    right = c[n, n] - 2 * c[t, n] + c[t, t]  # k is symmetric: c[t, n] == c[n, t]
-    return c[t, t] / t + right / (n - t)
+    inside, before = square[:-1], rows[:-1]
+    right = square[-1] - 2 * before + inside
+    return inside / t + right / (n - t)
 
 
 def best_split(x: np.ndarray, cut: int, lo: int, hi: int, *, step: int, radius: int,

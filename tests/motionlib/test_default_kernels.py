@@ -1,0 +1,85 @@
+"""The default detector's kernel arithmetic against its definitions, computed the slow
+and obvious way: the MMD² novelty, the lag kernels it is built from, and the median
+heuristic's squared distance."""
+
+import numpy as np
+import pytest
+
+from motionlib.segmenters import default
+from motionlib.segmenters.default import LAG_GROUP, LAG_ROWS, lag_kernel, multi_mmd_novelty
+
+
+def _samples(n, d=5, seed=0):
+    rng = np.random.default_rng(seed)
+    # Two regimes, so the novelty has a peak and the kernel values spread over (0, 1].
+    x = rng.normal(size=(n, d))
+    x[n // 2 :] += 1.5
+    return x
+
+
+def _mmd2(past, future, gamma):
+    def mean_kernel(a, b):
+        d2 = ((a[:, None, :] - b[None, :, :]) ** 2).sum(axis=2)
+        return np.exp(-gamma * d2).mean()
+
+    return mean_kernel(past, past) + mean_kernel(future, future) - 2 * mean_kernel(past, future)
+
+
+@pytest.mark.parametrize("n, widths", [
+    (60, [1, 3, 7]),
+    (LAG_ROWS + 37, [5, 20]),
+    # more lags than one group: 2 w > LAG_GROUP
+    (3 * LAG_ROWS + 5, [LAG_GROUP // 2 + 9, 11]),
+])
+def test_the_novelty_is_the_mmd2_of_the_windows_before_and_after_each_instant(n, widths):
+    x, gamma = _samples(n), 0.3
+    curves = multi_mmd_novelty(x, widths, gamma)
+    for w, curve in zip(widths, curves, strict=True):
+        expected = np.zeros(n)
+        for t in range(w, n - w + 1):
+            expected[t] = max(_mmd2(x[t - w : t], x[t : t + w], gamma), 0.0)
+        np.testing.assert_allclose(curve, expected, rtol=1e-9, atol=1e-12)
+
+
+def test_a_window_longer_than_half_the_take_gives_no_novelty():
+    x = _samples(10)
+    [curve] = multi_mmd_novelty(x, [6], 0.3)
+    np.testing.assert_array_equal(curve, np.zeros(10))
+
+
+@pytest.mark.parametrize("lags", [range(0, 7), range(5, 5 + LAG_GROUP), range(60, 75)])
+def test_the_lag_kernel_is_the_kernel_between_each_sample_and_the_one_lag_later(lags):
+    x, gamma = _samples(2 * LAG_ROWS + 9, d=4, seed=1), 0.7
+    k = lag_kernel(x, lags, gamma)
+    assert k.shape == (len(x), len(lags))
+    for j, lag in enumerate(lags):
+        expected = np.zeros(len(x))
+        expected[: len(x) - lag] = np.exp(-gamma * ((x[lag:] - x[: len(x) - lag]) ** 2).sum(1))
+        np.testing.assert_allclose(k[:, j], expected, rtol=1e-12, atol=1e-14)
+    if lags[0] == 0:
+        np.testing.assert_array_equal(k[:, 0], np.ones(len(x)))
+
+
+def test_the_median_squared_distance_is_over_the_distinct_pairs_of_the_subsample():
+    x = _samples(2500, d=3, seed=2)
+    sub = x[::2]  # 2500 // 1000 = 2
+    pairs = [((sub[i] - sub[j]) ** 2).sum() for i in range(len(sub)) for j in range(i + 1, len(sub))]
+    assert default.median_sq_distance(x) == pytest.approx(np.median(pairs), rel=1e-9)
+
+
+def test_the_novelty_of_one_width_is_the_same_alone_or_with_others():
+    x, gamma = _samples(400, seed=3), 0.4
+    [alone] = multi_mmd_novelty(x, [40], gamma)
+    together = multi_mmd_novelty(x, [12, 40, 70], gamma)[1]
+    np.testing.assert_allclose(alone, together, rtol=1e-12, atol=1e-14)
+    np.testing.assert_allclose(default.mmd_novelty(x, 40, gamma), alone, rtol=1e-12,
+                               atol=1e-14)
+
+
+def test_the_split_gain_sums_the_kernel_inside_each_side_of_the_split():
+    x, gamma = _samples(90, d=4, seed=4), 0.2
+    k = np.exp(-gamma * ((x[:, None, :] - x[None, :, :]) ** 2).sum(axis=2))
+    expected = [k[:t, :t].sum() / t + k[t:, t:].sum() / (90 - t) for t in range(1, 90)]
+    gains = default.split_gains(x, gamma)
+    np.testing.assert_allclose(gains, expected, rtol=1e-10)
+    assert np.argmax(gains) + 1 == 45  # the regimes change half-way
