@@ -300,8 +300,9 @@ def multi_mmd_novelty(x: np.ndarray, widths, gamma: float) -> list[np.ndarray]:
             t = np.arange(w, n - w + 1)
             acc[w] = (t, np.zeros(len(t)), np.zeros(len(t)))
     n_lags = 2 * max(acc, default=0)
-    for first in range(0, n_lags, LAG_GROUP):
-        lags = range(first, min(n_lags, first + LAG_GROUP))
+    group = max(1, min(LAG_GROUP, LAG_ELEMENTS // max(n, 1)))
+    for first in range(0, n_lags, group):
+        lags = range(first, min(n_lags, first + group))
         # sums[i, j]: the kernel at lag lags[j] summed over the pairs starting before i
         sums = np.zeros((n + 1, len(lags)))
         np.cumsum(lag_kernel(x, lags, gamma), axis=0, out=sums[1:])
@@ -317,10 +318,12 @@ def multi_mmd_novelty(x: np.ndarray, widths, gamma: float) -> list[np.ndarray]:
     return out
 
 
-# Lags whose kernels are computed together (memory: n x LAG_GROUP), and the rows per
-# matrix product when they are (each row's product also covers LAG_GROUP - 1 columns it
-# does not need, so short blocks waste less).
+# Lags whose kernels are computed together: LAG_GROUP, fewer on long inputs so that each
+# of the few (n, lags) arrays holds at most LAG_ELEMENTS values (8 MB: an hour-long take
+# needs no more memory than a short one); and the rows per matrix product (each row's
+# product also covers lags - 1 columns it does not need, so short blocks waste less).
 LAG_GROUP = 64
+LAG_ELEMENTS = 2**20
 LAG_ROWS = 128
 
 

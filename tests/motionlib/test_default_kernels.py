@@ -83,3 +83,12 @@ def test_the_split_gain_sums_the_kernel_inside_each_side_of_the_split():
     gains = default.split_gains(x, gamma)
     np.testing.assert_allclose(gains, expected, rtol=1e-10)
     assert np.argmax(gains) + 1 == 45  # the regimes change half-way
+
+
+def test_a_long_input_takes_its_lags_in_smaller_groups_with_the_same_novelty(monkeypatch):
+    x, gamma = _samples(300, seed=5), 0.3
+    whole = multi_mmd_novelty(x, [10, 25], gamma)
+    monkeypatch.setattr(default, "LAG_ELEMENTS", 300 * 7)  # 7 lags at a time
+    grouped = multi_mmd_novelty(x, [10, 25], gamma)
+    for a, b in zip(whole, grouped, strict=True):
+        np.testing.assert_allclose(a, b, rtol=1e-12, atol=1e-14)
