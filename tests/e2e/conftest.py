@@ -8,6 +8,8 @@ The front end must be built (``make test`` runs ``npm run build`` first). Withou
 import io
 import os
 import shutil
+import threading
+import time
 from pathlib import Path
 
 import pytest
@@ -200,3 +202,24 @@ def new_page(browser, live_server):
     yield open_as
     for context in contexts:
         context.close()
+    _wait_for_requests_in_flight()
+
+
+# How long a test's teardown waits for the live server to finish the requests its pages
+# sent (a save still running when the test's last check passed).
+REQUESTS_IN_FLIGHT_TIMEOUT_S = 15
+
+
+def _wait_for_requests_in_flight():
+    """Wait until the live server's request threads have ended.
+
+    The database is emptied after each test; a request still being answered then (a save
+    the page sent just before the test ended) holds a lock that makes the flush fail
+    ("table is locked"), an error at teardown of a test that passed. Closing the browser
+    contexts closes their connections, so each of the server's threads (one per
+    connection, named after ``process_request_thread``) ends once its request is done.
+    """
+    deadline = time.monotonic() + REQUESTS_IN_FLIGHT_TIMEOUT_S
+    for thread in threading.enumerate():
+        if thread.name.endswith("(process_request_thread)"):
+            thread.join(max(0.0, deadline - time.monotonic()))
