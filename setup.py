@@ -6,5 +6,8 @@ from setuptools import Extension, setup
 
 setup(ext_modules=[
     Extension("motionlib.io._parse", ["motionlib/io/_parse.c"]),
-    Extension("motionlib._kinematics", ["motionlib/_kinematics.c"]),
+    # No fused multiply-adds (compilers contract a * b + c into one where the CPU has it):
+    # body_frame() must round as numpy's separate multiplies and adds do.
+    Extension("motionlib._kinematics", ["motionlib/_kinematics.c"],
+              extra_compile_args=["-ffp-contract=off"]),
 ])

@@ -160,6 +160,58 @@ PyDoc_STRVAR(positions_doc,
 "(n_joints, 3, 2), (axis 0-2, channel) in composition order, axis -1 for none; axes:\n"
 "float64 (n_joints, 3, 3) or None.");
 
+/* The layout from the buffers positions() and body_frame() take; 0 when they are
+ * consistent and safe to walk, else -1 with a ValueError set. */
+static int read_layout(Layout *L, const Py_buffer *ch, const Py_buffer *parents,
+                       const Py_buffer *offsets, const Py_buffer *position,
+                       const Py_buffer *rotation, const Py_buffer *axes, const char *name) {
+    L->n_joints = parents->len / (Py_ssize_t)sizeof(Py_ssize_t);
+    Py_ssize_t J = L->n_joints, F = L->n_frames;
+    if (L->n_channels < 0 || F < 0 || ch->len != F * L->n_channels * (Py_ssize_t)sizeof(double) ||
+        offsets->len != J * 3 * (Py_ssize_t)sizeof(double) ||
+        position->len != J * 3 * (Py_ssize_t)sizeof(Py_ssize_t) ||
+        rotation->len != J * 2 * MAX_ROTATIONS * (Py_ssize_t)sizeof(Py_ssize_t) ||
+        (axes->buf && axes->len != J * 9 * (Py_ssize_t)sizeof(double))) {
+        PyErr_Format(PyExc_ValueError, "%s: buffer sizes do not match", name);
+        return -1;
+    }
+    L->channels = ch->buf;
+    L->parents = parents->buf;
+    L->offsets = offsets->buf;
+    L->position = position->buf;
+    L->rotation = rotation->buf;
+    L->axes = axes->buf;
+    if (check_layout(L)) {
+        PyErr_Format(PyExc_ValueError, "%s: joint layout out of range", name);
+        return -1;
+    }
+    return 0;
+}
+
+/* Scratch for walking L; 0 on success, else -1 with MemoryError set (free_work either way). */
+static int alloc_work(const Layout *L, Work *W) {
+    Py_ssize_t J = L->n_joints;
+    size_t n = (size_t)(J > 0 ? J : 1);
+    W->G = PyMem_Malloc(sizeof(double) * (9 + 2 * MAX_ROTATIONS) * n);
+    W->global = PyMem_Malloc(sizeof(double *) * n);
+    W->parent = PyMem_Calloc(n, 1);
+    if (!W->G || !W->global || !W->parent) {
+        PyErr_NoMemory();
+        return -1;
+    }
+    W->SC = W->G + 9 * J;
+    for (Py_ssize_t j = 0; j < J; j++)
+        if (L->parents[j] >= 0)
+            W->parent[L->parents[j]] = 1;
+    return 0;
+}
+
+static void free_work(Work *W) {
+    PyMem_Free(W->G);
+    PyMem_Free(W->global);
+    PyMem_Free(W->parent);
+}
+
 static PyObject *positions(PyObject *self, PyObject *args) {
     (void)self;
     Py_buffer ch, parents, offsets, position, rotation, out, axes = {0};
@@ -172,49 +224,23 @@ static PyObject *positions(PyObject *self, PyObject *args) {
     Work W = {0};
     if (axes_obj != Py_None && PyObject_GetBuffer(axes_obj, &axes, PyBUF_SIMPLE) < 0)
         goto done;
-    L.n_joints = parents.len / (Py_ssize_t)sizeof(Py_ssize_t);
+    if (read_layout(&L, &ch, &parents, &offsets, &position, &rotation, &axes, "positions"))
+        goto done;
     Py_ssize_t J = L.n_joints, F = L.n_frames;
-    if (L.n_channels < 0 || F < 0 || ch.len != F * L.n_channels * (Py_ssize_t)sizeof(double) ||
-        offsets.len != J * 3 * (Py_ssize_t)sizeof(double) ||
-        position.len != J * 3 * (Py_ssize_t)sizeof(Py_ssize_t) ||
-        rotation.len != J * 2 * MAX_ROTATIONS * (Py_ssize_t)sizeof(Py_ssize_t) ||
-        (axes.buf && axes.len != J * 9 * (Py_ssize_t)sizeof(double)) ||
-        out.len != F * J * 3 * (Py_ssize_t)sizeof(double)) {
+    if (out.len != F * J * 3 * (Py_ssize_t)sizeof(double)) {
         PyErr_SetString(PyExc_ValueError, "positions: buffer sizes do not match");
         goto done;
     }
-    L.channels = ch.buf;
-    L.parents = parents.buf;
-    L.offsets = offsets.buf;
-    L.position = position.buf;
-    L.rotation = rotation.buf;
-    L.axes = axes.buf;
     L.out = out.buf;
-    if (check_layout(&L)) {
-        PyErr_SetString(PyExc_ValueError, "positions: joint layout out of range");
+    if (alloc_work(&L, &W))
         goto done;
-    }
-    size_t n = (size_t)(J > 0 ? J : 1);
-    W.G = PyMem_Malloc(sizeof(double) * (9 + 2 * MAX_ROTATIONS) * n);
-    W.global = PyMem_Malloc(sizeof(double *) * n);
-    W.parent = PyMem_Calloc(n, 1);
-    if (!W.G || !W.global || !W.parent) {
-        PyErr_NoMemory();
-        goto done;
-    }
-    W.SC = W.G + 9 * J;
-    for (Py_ssize_t j = 0; j < J; j++)
-        if (L.parents[j] >= 0)
-            W.parent[L.parents[j]] = 1;
     Py_BEGIN_ALLOW_THREADS
     for (Py_ssize_t f = 0; f < F; f++)
         frame_positions(&L, L.channels + f * L.n_channels, &W, L.out + f * J * 3);
     Py_END_ALLOW_THREADS
     ok = 1;
 done:
-    PyMem_Free(W.G);
-    PyMem_Free(W.global);
-    PyMem_Free(W.parent);
+    free_work(&W);
     PyBuffer_Release(&ch);
     PyBuffer_Release(&parents);
     PyBuffer_Release(&offsets);
@@ -228,8 +254,89 @@ done:
     Py_RETURN_NONE;
 }
 
+PyDoc_STRVAR(body_frame_doc,
+"body_frame(channels, n_frames, n_channels, parents, offsets, position, rotation, axes,\n"
+"           chosen, root, left_hip, right_hip, out)\n\n"
+"Each frame's ``chosen`` joints relative to the root with the heading removed, then the\n"
+"root's height, into ``out`` (float64, n_frames x (3 len(chosen) + 1)): what\n"
+"motionlib.features.body_frame_positions gives from positions(), without writing every\n"
+"joint of every frame first. chosen: intp joint indices; the rest as for positions().");
+
+static PyObject *body_frame(PyObject *self, PyObject *args) {
+    (void)self;
+    Py_buffer ch, parents, offsets, position, rotation, chosen, out, axes = {0};
+    PyObject *axes_obj;
+    Py_ssize_t root, left_hip, right_hip;
+    Layout L;
+    if (!PyArg_ParseTuple(args, "y*nny*y*y*y*Oy*nnnw*", &ch, &L.n_frames, &L.n_channels, &parents,
+                          &offsets, &position, &rotation, &axes_obj, &chosen, &root, &left_hip,
+                          &right_hip, &out))
+        return NULL;
+    int ok = 0;
+    Work W = {0};
+    double *frame = NULL;
+    if (axes_obj != Py_None && PyObject_GetBuffer(axes_obj, &axes, PyBUF_SIMPLE) < 0)
+        goto done;
+    if (read_layout(&L, &ch, &parents, &offsets, &position, &rotation, &axes, "body_frame"))
+        goto done;
+    Py_ssize_t J = L.n_joints, F = L.n_frames;
+    Py_ssize_t K = chosen.len / (Py_ssize_t)sizeof(Py_ssize_t), width = 3 * K + 1;
+    const Py_ssize_t *which = chosen.buf;
+    int in_range = root >= 0 && root < J && left_hip >= 0 && left_hip < J && right_hip >= 0 &&
+                   right_hip < J;
+    for (Py_ssize_t k = 0; k < K; k++)
+        in_range &= which[k] >= 0 && which[k] < J;
+    if (!in_range || out.len != F * width * (Py_ssize_t)sizeof(double)) {
+        PyErr_SetString(PyExc_ValueError, "body_frame: joint index out of range or output size");
+        goto done;
+    }
+    frame = PyMem_Malloc(sizeof(double) * 3 * (size_t)(J > 0 ? J : 1));
+    if (!frame) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    if (alloc_work(&L, &W))
+        goto done;
+    Py_BEGIN_ALLOW_THREADS
+    for (Py_ssize_t f = 0; f < F; f++) {
+        frame_positions(&L, L.channels + f * L.n_channels, &W, frame);
+        const double *r = frame + 3 * root, *lh = frame + 3 * left_hip, *rh = frame + 3 * right_hip;
+        /* The hip axis (left -> right) turned onto +X about Y, as body_frame_positions does:
+         * the same operations in the same order, so the same values. */
+        double angle = atan2(rh[2] - lh[2], rh[0] - lh[0]);
+        double c = cos(angle), s = sin(angle);
+        double *row = (double *)out.buf + f * width;
+        for (Py_ssize_t k = 0; k < K; k++) {
+            const double *p = frame + 3 * which[k];
+            double x = p[0] - r[0], z = p[2] - r[2];
+            row[3 * k] = c * x + s * z;
+            row[3 * k + 1] = p[1] - r[1];
+            row[3 * k + 2] = -s * x + c * z;
+        }
+        row[3 * K] = r[1];
+    }
+    Py_END_ALLOW_THREADS
+    ok = 1;
+done:
+    PyMem_Free(frame);
+    free_work(&W);
+    PyBuffer_Release(&ch);
+    PyBuffer_Release(&parents);
+    PyBuffer_Release(&offsets);
+    PyBuffer_Release(&position);
+    PyBuffer_Release(&rotation);
+    PyBuffer_Release(&chosen);
+    PyBuffer_Release(&out);
+    if (axes.buf)
+        PyBuffer_Release(&axes);
+    if (!ok)
+        return NULL;
+    Py_RETURN_NONE;
+}
+
 static PyMethodDef methods[] = {
     {"positions", positions, METH_VARARGS, positions_doc},
+    {"body_frame", body_frame, METH_VARARGS, body_frame_doc},
     {NULL, NULL, 0, NULL},
 };
 

@@ -143,6 +143,32 @@ def forward_kinematics(take, channels: np.ndarray | None = None) -> np.ndarray:
     return out
 
 
+def body_frame_rows(take, chosen: list[int], *, root: int, left_hip: int, right_hip: int,
+                    first: int = 0) -> np.ndarray:
+    """``features.body_frame_positions`` of the ``chosen`` joints and the root's height,
+    straight from the channels of frames ``first ..``.
+
+    The same values as computing ``forward_kinematics`` and then those features, without
+    writing every joint of every frame to memory first: each frame's positions stay in a
+    small scratch array (``_kinematics.body_frame``), which makes it several times faster
+    on a take of minutes.
+
+    Returns
+    -------
+    (n_frames - first, 3 len(chosen) + 1): per frame, each chosen joint's body-frame x, y,
+    z, then the root's height (Y).
+    """
+    skeleton = take.skeleton
+    channels = np.ascontiguousarray(take.channels[first:], dtype=np.float64)
+    if channels.ndim != 2 or channels.shape[1] != skeleton.n_channels:
+        raise InputError(f"channels must have shape (n_frames, {skeleton.n_channels}), got "
+                         f"{channels.shape}")
+    out = np.empty((channels.shape[0], 3 * len(chosen) + 1))
+    _kinematics.body_frame(channels, channels.shape[0], skeleton.n_channels, *_layout(skeleton),
+                           np.asarray(chosen, dtype=np.intp), root, left_hip, right_hip, out)
+    return out
+
+
 def rest_positions(take) -> np.ndarray:
     """Joint and End Site positions with every channel at zero, shape (n_joints + n_ends, 3)."""
     skeleton = take.skeleton

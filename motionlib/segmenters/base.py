@@ -177,6 +177,12 @@ def _checked(result: Segmentation, n_frames: int) -> Segmentation:
     return result
 
 
+def first_frame(take: Any) -> int:
+    """The first frame of the performance: after the added T-pose frame of a cgspeed BVH
+    (``take.rest_pose_frame``), else 0."""
+    return 0 if take.rest_pose_frame is None else int(take.rest_pose_frame) + 1
+
+
 def take_positions(take: Any) -> tuple[np.ndarray, dict[str, int], int]:
     """World joint positions of the frames a segmenter should look at.
 
@@ -192,7 +198,7 @@ def take_positions(take: Any) -> tuple[np.ndarray, dict[str, int], int]:
     """
     import motionlib
 
-    first = 0 if take.rest_pose_frame is None else int(take.rest_pose_frame) + 1
+    first = first_frame(take)
     known = getattr(take, "positions", None)
     positions = (motionlib.forward_kinematics(take) if known is None else known)[first:]
     return positions, motionlib.canonical_indices(take), first

@@ -200,14 +200,17 @@ from scipy.signal import find_peaks
 from scipy.spatial.distance import cdist
 
 from motionlib import features
+from motionlib.kinematics import body_frame_rows
 from motionlib.segmenters.base import (
     Param,
     ParamError,
     Segmentation,
     Segmenter,
+    first_frame,
     full_length,
     take_positions,
 )
+from motionlib.skeleton import canonical_indices
 
 POSE_JOINTS = (
     "head", "chest", "left_elbow", "right_elbow", "left_wrist", "right_wrist",
@@ -230,6 +233,10 @@ def pose_features(
     pose = body.reshape(len(positions), -1)
     height = positions[:, joints["root"], 1:2]
     x = np.concatenate([pose, height - np.median(height)], axis=1)
+    return _with_velocities(x, fps=fps, velocity_s=velocity_s)
+
+
+def _with_velocities(x: np.ndarray, *, fps: float, velocity_s: float) -> np.ndarray:
     if velocity_s > 0:
         smooth = features.lowpass(x, fps=fps, cutoff_hz=min(3.0, 0.45 * fps))
         x = np.concatenate([x, np.gradient(smooth, axis=0) * fps * velocity_s], axis=1)
@@ -249,8 +256,15 @@ def take_features(take, *, velocity_s: float = 0.0) -> tuple[np.ndarray, int]:
     """
     if getattr(take, "skeleton", None) is None:
         return np.radians(np.asarray(take.channels, dtype=float)), 0
-    positions, joints, first = take_positions(take)
-    return pose_features(positions, joints, fps=float(take.fps), velocity_s=velocity_s), first
+    if getattr(take, "positions", None) is not None:  # computed already: used as they are
+        positions, joints, first = take_positions(take)
+        return pose_features(positions, joints, fps=float(take.fps), velocity_s=velocity_s), first
+    # Else the same features straight from the channels, without every joint's positions.
+    joints, first = canonical_indices(take), first_frame(take)
+    x = body_frame_rows(take, [joints[j] for j in POSE_JOINTS], root=joints["root"],
+                        left_hip=joints["left_hip"], right_hip=joints["right_hip"], first=first)
+    x[:, -1] -= np.median(x[:, -1])
+    return _with_velocities(x, fps=float(take.fps), velocity_s=velocity_s), first
 
 
 def block_mean(x: np.ndarray, step: int) -> np.ndarray:

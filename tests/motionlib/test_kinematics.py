@@ -5,7 +5,8 @@ import pytest
 from numpy.testing import assert_allclose
 
 import motionlib
-from motionlib.kinematics import euler_to_matrix, matrix_to_euler_zyx
+from motionlib import features
+from motionlib.kinematics import body_frame_rows, euler_to_matrix, matrix_to_euler_zyx
 from motionlib.skeleton import Skeleton
 from motionlib.take import Take
 
@@ -220,3 +221,35 @@ def test_it_refuses_channels_of_the_wrong_shape():
 def test_it_handles_a_take_without_frames():
     take = chain(np.zeros((0, 9)))
     assert motionlib.forward_kinematics(take).shape == (0, 3, 3)
+
+
+def _body_frame_oracle(take, chosen, root, left_hip, right_hip, first=0):
+    positions = motionlib.forward_kinematics(take)[first:]
+    body = features.body_frame_positions(positions, {"root": root, "left_hip": left_hip,
+                                                     "right_hip": right_hip}, chosen)
+    return np.concatenate([body.reshape(len(positions), -1), positions[:, root, 1:2]], axis=1)
+
+
+@pytest.mark.parametrize("with_axes", [False, True])
+def test_body_frame_rows_are_the_body_frame_positions_of_the_kinematics(with_axes):
+    """The same values (not merely close): the same operations in the same order."""
+    take = random_take(np.random.default_rng(11), n_frames=40, with_axes=with_axes)
+    chosen = [8, 3, 0, 5]
+    rows = body_frame_rows(take, chosen, root=0, left_hip=1, right_hip=2, first=3)
+    np.testing.assert_array_equal(rows, _body_frame_oracle(take, chosen, 0, 1, 2, first=3))
+
+
+def test_body_frame_rows_of_a_real_take(amc_13_29):
+    take = motionlib.read(amc_13_29[0], asf=amc_13_29[1])
+    at = motionlib.canonical_indices(take)
+    chosen = [at[j] for j in ("head", "left_wrist", "right_ankle")]
+    rows = body_frame_rows(take, chosen, root=at["root"], left_hip=at["left_hip"],
+                           right_hip=at["right_hip"])
+    expected = _body_frame_oracle(take, chosen, at["root"], at["left_hip"], at["right_hip"])
+    np.testing.assert_array_equal(rows, expected)
+
+
+def test_body_frame_rows_refuse_a_joint_that_is_not_in_the_skeleton():
+    take = random_take(np.random.default_rng(12))
+    with pytest.raises(ValueError, match="joint index out of range"):
+        body_frame_rows(take, [0, 99], root=0, left_hip=1, right_hip=2)

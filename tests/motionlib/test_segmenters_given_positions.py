@@ -38,3 +38,18 @@ def test_a_slice_keeps_the_positions_of_its_frames(take):
     given = motionlib.Take(**{**take.__dict__, "positions": motionlib.forward_kinematics(take)})
     part = given.slice(100, 700)
     np.testing.assert_array_equal(part.positions, motionlib.forward_kinematics(part))
+
+
+@pytest.mark.parametrize("velocity_s", [0.0, 0.3])
+def test_the_default_detectors_features_from_the_channels_equal_those_from_positions(
+    take, velocity_s
+):
+    """Without positions the default detector computes its features straight from the
+    channels (``kinematics.body_frame_rows``): the same values to the last bit."""
+    from motionlib.segmenters.default import take_features
+
+    given = motionlib.Take(**{**take.__dict__, "positions": motionlib.forward_kinematics(take)})
+    from_channels, first = take_features(take, velocity_s=velocity_s)
+    from_positions, first_given = take_features(given, velocity_s=velocity_s)
+    assert first == first_given == 0
+    np.testing.assert_array_equal(from_channels, from_positions)
