@@ -334,14 +334,21 @@ def multi_mmd_novelty(x: np.ndarray, widths, gamma: float) -> list[np.ndarray]:
 
 # Lags whose kernels are computed together: LAG_GROUP, fewer on long inputs so that each
 # of the few (n, lags) arrays holds at most LAG_ELEMENTS values (8 MB: an hour-long take
-# needs no more memory than a short one); and the rows per matrix product (each row's
-# product also covers lags - 1 columns it does not need, so short blocks waste less).
-# 64 rows keep each product (64 x 127 x d, d ~ 31) below the size at which OpenBLAS
-# splits it over threads: on a 2-core machine with the other core busy, 128 rows took
-# twice as long as 64 with BLAS threads on, and the same with one thread.
+# needs no more memory than a short one); and the most rows per matrix product (each
+# row's product also covers lags - 1 columns it does not need, so short blocks waste
+# less), fewer when the product would exceed SMALL_PRODUCT.
 LAG_GROUP = 64
 LAG_ELEMENTS = 2**20
 LAG_ROWS = 64
+# Matrix products of m x n x k at most this size: OpenBLAS computes them on one thread and
+# splits larger ones over threads. On a 2-core machine with the other core busy, a split
+# product took 2x (64 x 191 x 31) to 40x (180 x 180 x 31) as long as on one thread.
+SMALL_PRODUCT = 4 * 65536
+
+
+def _small_rows(rows: int, cols: int, d: int) -> int:
+    """At most ``rows``, and few enough that rows x cols x d stays within SMALL_PRODUCT."""
+    return max(1, min(rows, SMALL_PRODUCT // max(1, cols * d)))
 
 
 def lag_kernel(x: np.ndarray, lags: range, gamma: float) -> np.ndarray:
@@ -359,8 +366,11 @@ def lag_kernel(x: np.ndarray, lags: range, gamma: float) -> np.ndarray:
     n, m, first = len(x), len(lags), lags[0]
     sq = np.einsum("ij,ij->i", x, x)
     dots = np.empty((n, m))
-    for a in range(0, n, LAG_ROWS):
-        b = min(n, a + LAG_ROWS)
+    rows = LAG_ROWS
+    while rows > 1 and rows * (rows + m - 1) * x.shape[1] > SMALL_PRODUCT:
+        rows //= 2
+    for a in range(0, n, rows):
+        b = min(n, a + rows)
         block = np.zeros((b - a, b - a + m - 1))
         later = x[a + first : b + first + m - 1]
         block[:, : len(later)] = x[a:b] @ later.T
@@ -490,9 +500,7 @@ def split_gains(x: np.ndarray, gamma: float) -> np.ndarray:
     (n - 1,) gains of the splits t = 1 .. n - 1 (empty when n < 2).
     """
     n = len(x)
-    # cdist rather than a matrix product: threaded BLAS on matrices this small costs
-    # more in thread hand-offs than the arithmetic on a busy machine.
-    k = np.exp(-gamma * cdist(x, x, "sqeuclidean"))
+    k = np.exp(-gamma * sq_distances(x))
     # With c[a, b] the sum of k[:a, :b] and k symmetric: c[t, n] sums the first t rows,
     # and c[t, t] adds, row by row, the diagonal entry and twice the entries left of it.
     rows = np.cumsum(k.sum(axis=1))  # c[t, n] for t = 1 .. n
@@ -501,6 +509,19 @@ def split_gains(x: np.ndarray, gamma: float) -> np.ndarray:
     inside, before = square[:-1], rows[:-1]
     right = square[-1] - 2 * before + inside
     return inside / t + right / (n - t)
+
+
+def sq_distances(x: np.ndarray) -> np.ndarray:
+    """(n, n) squared distances between the rows of ``x``: ``|a|² + |b|² - 2 a.b`` (at
+    least 0) with the dot products from matrix products of a few rows each, small enough
+    (SMALL_PRODUCT) to run on one thread. Three times faster than ``cdist`` here."""
+    n, d = x.shape
+    sq = np.einsum("ij,ij->i", x, x)
+    gram = np.empty((n, n))
+    rows = _small_rows(n, n, d)
+    for a in range(0, n, rows):
+        gram[a : a + rows] = x[a : a + rows] @ x.T
+    return np.maximum(sq[:, None] + sq[None, :] - 2 * gram, 0.0)
 
 
 def best_split(x: np.ndarray, cut: int, lo: int, hi: int, *, step: int, radius: int,

@@ -92,3 +92,18 @@ def test_a_long_input_takes_its_lags_in_smaller_groups_with_the_same_novelty(mon
     grouped = multi_mmd_novelty(x, [10, 25], gamma)
     for a, b in zip(whole, grouped, strict=True):
         np.testing.assert_allclose(a, b, rtol=1e-12, atol=1e-14)
+
+
+@pytest.mark.parametrize("n, d", [(1, 3), (7, 2), (180, 31), (400, 62)])
+def test_the_squared_distances_are_those_between_every_pair_of_rows(n, d):
+    x = np.random.default_rng(n).normal(size=(n, d))
+    expected = ((x[:, None, :] - x[None, :, :]) ** 2).sum(axis=2)
+    d2 = default.sq_distances(x)
+    assert (d2 >= 0).all()
+    np.testing.assert_allclose(d2, expected, rtol=1e-10, atol=1e-10)
+
+
+def test_products_stay_small_enough_for_one_thread():
+    assert default._small_rows(180, 180, 31) * 180 * 31 <= default.SMALL_PRODUCT
+    assert default._small_rows(10, 5, 3) == 10  # a small matrix in one product
+    assert default._small_rows(500, 100_000, 31) == 1  # never no rows at all
