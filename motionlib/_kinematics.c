@@ -212,6 +212,18 @@ static void free_work(Work *W) {
     PyMem_Free(W->parent);
 }
 
+/* Release the buffers of a layout (axes only when one was given). */
+static void release_layout(Py_buffer *ch, Py_buffer *parents, Py_buffer *offsets,
+                           Py_buffer *position, Py_buffer *rotation, Py_buffer *axes) {
+    PyBuffer_Release(ch);
+    PyBuffer_Release(parents);
+    PyBuffer_Release(offsets);
+    PyBuffer_Release(position);
+    PyBuffer_Release(rotation);
+    if (axes->buf)
+        PyBuffer_Release(axes);
+}
+
 static PyObject *positions(PyObject *self, PyObject *args) {
     (void)self;
     Py_buffer ch, parents, offsets, position, rotation, out, axes = {0};
@@ -241,14 +253,8 @@ static PyObject *positions(PyObject *self, PyObject *args) {
     ok = 1;
 done:
     free_work(&W);
-    PyBuffer_Release(&ch);
-    PyBuffer_Release(&parents);
-    PyBuffer_Release(&offsets);
-    PyBuffer_Release(&position);
-    PyBuffer_Release(&rotation);
+    release_layout(&ch, &parents, &offsets, &position, &rotation, &axes);
     PyBuffer_Release(&out);
-    if (axes.buf)
-        PyBuffer_Release(&axes);
     if (!ok)
         return NULL;
     Py_RETURN_NONE;
@@ -320,15 +326,9 @@ static PyObject *body_frame(PyObject *self, PyObject *args) {
 done:
     PyMem_Free(frame);
     free_work(&W);
-    PyBuffer_Release(&ch);
-    PyBuffer_Release(&parents);
-    PyBuffer_Release(&offsets);
-    PyBuffer_Release(&position);
-    PyBuffer_Release(&rotation);
+    release_layout(&ch, &parents, &offsets, &position, &rotation, &axes);
     PyBuffer_Release(&chosen);
     PyBuffer_Release(&out);
-    if (axes.buf)
-        PyBuffer_Release(&axes);
     if (!ok)
         return NULL;
     Py_RETURN_NONE;

@@ -106,6 +106,16 @@ def _layout(skeleton):
             np.ascontiguousarray(skeleton.offsets, np.float64), position, rotation, axes)
 
 
+def _channels(skeleton, channels) -> np.ndarray:
+    """``channels`` as the compiled walk reads them: contiguous float64, one row per frame
+    with the skeleton's channels (an InputError naming the shape otherwise)."""
+    channels = np.ascontiguousarray(channels, dtype=np.float64)
+    if channels.ndim != 2 or channels.shape[1] != skeleton.n_channels:
+        raise InputError(f"channels must have shape (n_frames, {skeleton.n_channels}), got "
+                         f"{channels.shape}")
+    return channels
+
+
 def forward_kinematics(take, channels: np.ndarray | None = None) -> np.ndarray:
     """World positions of every joint in every frame.
 
@@ -132,11 +142,7 @@ def forward_kinematics(take, channels: np.ndarray | None = None) -> np.ndarray:
     zero angles are skipped exactly, and leaves (whose rotation moves no joint) not rotated.
     """
     skeleton = take.skeleton
-    channels = np.ascontiguousarray(take.channels if channels is None else channels,
-                                    dtype=np.float64)
-    if channels.ndim != 2 or channels.shape[1] != skeleton.n_channels:
-        raise InputError(f"channels must have shape (n_frames, {skeleton.n_channels}), got "
-                         f"{channels.shape}")
+    channels = _channels(skeleton, take.channels if channels is None else channels)
     out = np.empty((channels.shape[0], skeleton.n_joints, 3))
     _kinematics.positions(channels, channels.shape[0], skeleton.n_channels, *_layout(skeleton),
                           out)
@@ -159,10 +165,7 @@ def body_frame_rows(take, chosen: list[int], *, root: int, left_hip: int, right_
     z, then the root's height (Y).
     """
     skeleton = take.skeleton
-    channels = np.ascontiguousarray(take.channels[first:], dtype=np.float64)
-    if channels.ndim != 2 or channels.shape[1] != skeleton.n_channels:
-        raise InputError(f"channels must have shape (n_frames, {skeleton.n_channels}), got "
-                         f"{channels.shape}")
+    channels = _channels(skeleton, take.channels[first:])
     out = np.empty((channels.shape[0], 3 * len(chosen) + 1))
     _kinematics.body_frame(channels, channels.shape[0], skeleton.n_channels, *_layout(skeleton),
                            np.asarray(chosen, dtype=np.intp), root, left_hip, right_hip, out)
