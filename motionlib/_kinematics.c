@@ -307,10 +307,16 @@ static PyObject *body_frame(PyObject *self, PyObject *args) {
     for (Py_ssize_t f = 0; f < F; f++) {
         frame_positions(&L, L.channels + f * L.n_channels, &W, frame);
         const double *r = frame + 3 * root, *lh = frame + 3 * left_hip, *rh = frame + 3 * right_hip;
-        /* The hip axis (left -> right) turned onto +X about Y, as body_frame_positions does:
-         * the same operations in the same order, so the same values. */
-        double angle = atan2(rh[2] - lh[2], rh[0] - lh[0]);
-        double c = cos(angle), s = sin(angle);
+        /* The hip axis (left -> right) turned onto +X about Y, as body_frame_positions does
+         * (features.heading_cos_sin): the same operations in the same order, all of them
+         * correctly rounded, so the same values. */
+        double dx = rh[0] - lh[0], dz = rh[2] - lh[2];
+        double length = sqrt(dx * dx + dz * dz);
+        double c = 1.0, s = 0.0;
+        if (!(length == 0)) {
+            c = dx / length;
+            s = dz / length;
+        }
         double *row = (double *)out.buf + f * width;
         for (Py_ssize_t k = 0; k < K; k++) {
             const double *p = frame + 3 * which[k];

@@ -96,8 +96,8 @@ def body_frame_positions(
     chosen = positions if which is None else np.take(positions, which, axis=1)
     root = positions[:, joints["root"]]
     hips = positions[:, joints["right_hip"]] - positions[:, joints["left_hip"]]
-    angle = np.arctan2(hips[:, 2], hips[:, 0])  # hip axis angle in the ground plane
-    c, s = np.cos(angle)[:, None], np.sin(angle)[:, None]
+    c, s = heading_cos_sin(hips[:, 0], hips[:, 2])
+    c, s = c[:, None], s[:, None]
     x = chosen[..., 0] - root[:, 0:1]
     z = chosen[..., 2] - root[:, 2:3]
     out = np.empty(chosen.shape)
@@ -106,6 +106,20 @@ def body_frame_positions(
     out[..., 0] = c * x + s * z
     out[..., 2] = -s * x + c * z
     return out
+
+
+def heading_cos_sin(dx: np.ndarray, dz: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Cosine and sine of the angle of the ground-plane vectors ``(dx, dz)`` from +X: the
+    vector over its length, (1, 0) for a zero vector (as ``arctan2(0, 0)`` = 0 gives).
+
+    Division and square root round the same way on every CPU, unlike numpy's
+    trigonometry (its AVX-512 builds use their own, a few ulp from the C library's), so
+    the compiled ``kinematics.body_frame_rows`` gets the same values to the last bit.
+    """
+    length = np.sqrt(dx * dx + dz * dz)
+    flat = length == 0
+    safe = np.where(flat, 1.0, length)
+    return np.where(flat, 1.0, dx / safe), np.where(flat, 0.0, dz / safe)
 
 
 def lowpass(y: np.ndarray, *, fps: float, cutoff_hz: float, order: int = 2) -> np.ndarray:

@@ -121,3 +121,18 @@ def test_it_removes_frequencies_above_the_cutoff():
 def test_it_reports_speed_in_units_per_second():
     x = np.arange(10.0)[:, None] * 2.0  # 2 units per frame
     assert_allclose(features.frame_speed(x, fps=30), 60.0)
+
+
+def test_the_heading_is_the_ground_plane_vector_over_its_length():
+    rng = np.random.default_rng(5)
+    dx, dz = rng.normal(size=200) * 10.0 ** rng.integers(-3, 4, 200), rng.normal(size=200)
+    c, s = features.heading_cos_sin(dx, dz)
+    angle = np.arctan2(dz, dx)
+    assert_allclose(c, np.cos(angle), rtol=0, atol=1e-15)
+    assert_allclose(s, np.sin(angle), rtol=0, atol=1e-15)
+
+
+def test_a_zero_hip_axis_leaves_the_frame_unturned():
+    c, s = features.heading_cos_sin(np.array([0.0, -0.0, 1.0]), np.array([0.0, 0.0, 0.0]))
+    np.testing.assert_array_equal(c, [1.0, 1.0, 1.0])
+    np.testing.assert_array_equal(s, [0.0, 0.0, 0.0])
