@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import csv
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -269,3 +269,35 @@ def labelled_takes(root: Path | None = None, *, bvh: bool = True,
     """The labelled takes under ``root`` (see :func:`discover`), full-skeleton ones only
     unless ``channels``."""
     return discover(root, channels=channels, bvh=bvh)[0]
+
+
+def shortened(take, truth: np.ndarray, activity: int, seconds: float):
+    """``take`` with its inner activity ``activity`` (between true cuts ``activity`` and
+    ``activity + 1``) cut down to ``seconds`` by removing its middle: real motion holding a
+    real short activity, its entry and exit as the performer made them.
+
+    Returns
+    -------
+    (take, truth) : the shorter take (same type, ``positions`` dropped) and its true cuts,
+        those after the activity moved back by the frames removed; the two windows beside
+        it clipped at the join, so that no window reaches into the removed frames. None
+        when the activity (between the best estimates) is not longer than ``seconds``.
+    """
+    truth = np.asarray(truth, dtype=np.int64)
+    if not 0 <= activity < len(truth) - 1:
+        raise ValueError(f"activity {activity}: a take with {len(truth)} cuts has inner "
+                         f"activities 0 to {len(truth) - 2}")
+    keep = int(round(seconds * take.fps))
+    start, stop = int(truth[activity, 1]), int(truth[activity + 1, 1])
+    if stop - start <= keep:
+        return None
+    join, resume = start + keep // 2, stop - (keep - keep // 2)
+    channels = np.concatenate([take.channels[:join], take.channels[resume:]])
+    out = truth.copy()
+    out[activity + 1:] -= resume - join
+    out[activity, 2] = min(out[activity, 2], join - 1)
+    out[activity + 1, 0] = max(out[activity + 1, 0], join)
+    changes = {"channels": channels}
+    if hasattr(take, "positions"):
+        changes["positions"] = None
+    return replace(take, **changes), out

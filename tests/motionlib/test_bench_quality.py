@@ -6,7 +6,7 @@ import sys
 import numpy as np
 import pytest
 
-from motionlib import bench_quality, benchdata, metrics
+from motionlib import bench_quality, benchdata, metrics, synth
 from motionlib.segmenters import get_segmenter
 
 DATA = benchdata.data_dir()
@@ -114,3 +114,37 @@ def test_it_summarises_placement_by_kind_of_take():
     assert line.split()[0] == "default"
     assert "full-skeleton 0.200 s, in window 1.00 (1 take)" in line
     assert "four-channel 0.500 s, in window 0.60 (2 takes)" in line
+
+
+class _Labelled:
+    """A labelled synthetic take, as ``benchdata.LabelledTake`` is read by the check."""
+
+    def __init__(self, seed, kind="skeleton"):
+        self.take, segments = synth.generate(seed=seed, fps=30.0, duration=40.0)
+        cuts = np.asarray([s[0] for s in segments[1:]])
+        self.truth = np.repeat(cuts[:, None], 3, axis=1)
+        self.kind, self.name = kind, f"seed {seed}"
+
+    def read(self):
+        return self.take
+
+
+def test_the_real_short_activity_check_shortens_every_inner_activity_of_each_skeleton_take():
+    takes = [_Labelled(1), _Labelled(2), _Labelled(3, kind="channels")]
+    text = bench_quality.real_short_activity_check(takes, seconds=(1.8, 2.5))
+    expected = {d: sum(benchdata.shortened(t.take, t.truth, k, d) is not None
+                       for t in takes[:2] for k in range(len(t.truth) - 1)) for d in (1.8, 2.5)}
+    lines = text.splitlines()
+    assert f"({expected[1.8]} / {expected[2.5]} cases)" in lines[0]
+    assert [line.split("  ")[1].strip() for line in lines[2:]] == [
+        "zero-shot", "short_activity=4/uniformity=0.3", "windows 2-4 s", "adapted"]
+    for line in lines[2:]:
+        both, sides, _, both2, sides2, _ = line.split()[-6:]
+        assert both.endswith(f"/{expected[1.8]}") and sides.endswith(f"/{2 * expected[1.8]}")
+        assert both2.endswith(f"/{expected[2.5]}") and sides2.endswith(f"/{2 * expected[2.5]}")
+        assert int(both.split("/")[0]) <= int(sides.split("/")[0])
+
+
+def test_the_real_short_activity_check_says_so_without_a_skeleton_take():
+    text = bench_quality.real_short_activity_check([_Labelled(1, kind="channels")])
+    assert text == "short activities, real motion: no full-skeleton take"

@@ -1,6 +1,7 @@
+import numpy as np
 import pytest
 
-from motionlib import benchdata
+from motionlib import benchdata, synth
 
 DATA = benchdata.data_dir()
 needs_data = pytest.mark.skipif(not DATA.is_dir(), reason=f"benchmark data not found at {DATA}")
@@ -56,3 +57,45 @@ def test_it_lists_the_three_labelled_takes_with_their_cuts():
     assert takes["13_29"].truth[:, 1].tolist() == [469, 1213, 1921, 2701, 3805]  # BVH frames
     assert takes["86_01"].truth[0].tolist() == [500, 550, 600]
     assert all(t.path.is_file() for t in takes.values())
+
+
+def test_a_shortened_take_keeps_the_activity_ends_and_moves_the_later_cuts_back():
+    take, segments = synth.generate(seed=3, fps=60.0, duration=40.0)
+    truth = np.repeat(np.asarray([s[0] for s in segments[1:]])[:, None], 3, axis=1)
+    truth[:, 0] -= 60
+    truth[:, 2] += 60
+    start, stop = truth[1, 1], truth[2, 1]
+    short, moved = benchdata.shortened(take, truth, 1, 1.8)
+    removed = take.n_frames - short.n_frames
+    assert removed == stop - start - 108  # 1.8 s at 60 fps is left
+    join = start + 54
+    np.testing.assert_array_equal(short.channels[:join], take.channels[:join])
+    np.testing.assert_array_equal(short.channels[join:], take.channels[join + removed:])
+    np.testing.assert_array_equal(moved[:2, 1], truth[:2, 1])
+    np.testing.assert_array_equal(moved[2:, 1], truth[2:, 1] - removed)
+    assert moved[2, 1] - moved[1, 1] == 108
+    # The windows beside the join stop at it; no other window changes.
+    assert moved[1, 2] == join - 1 < truth[1, 2]
+    assert moved[2, 0] == join
+    np.testing.assert_array_equal(moved[3:], truth[3:] - removed)
+    assert short.positions is None and short.skeleton is take.skeleton
+
+
+def test_an_activity_already_as_short_is_not_shortened_and_a_wrong_index_is_named():
+    take, segments = synth.generate(seed=3, fps=60.0, duration=40.0)
+    cuts = np.asarray([s[0] for s in segments[1:]])
+    truth = np.repeat(cuts[:, None], 3, axis=1)
+    length = (cuts[1] - cuts[0]) / take.fps
+    assert benchdata.shortened(take, truth, 0, length) is None
+    with pytest.raises(ValueError, match=f"activity {len(cuts) - 1}: .* 0 to {len(cuts) - 2}"):
+        benchdata.shortened(take, truth, len(cuts) - 1, 1.8)
+
+
+def test_a_four_channel_take_is_shortened_the_same_way():
+    channels = np.arange(1200, dtype=float).reshape(300, 4)
+    take = benchdata.ChannelTake(name="t", fps=10.0, channels=channels)
+    truth = np.asarray([[100, 100, 100], [250, 250, 250]])
+    short, moved = benchdata.shortened(take, np.vstack([[20, 20, 20], truth]), 1, 5.0)
+    assert isinstance(short, benchdata.ChannelTake) and short.n_frames == 200
+    np.testing.assert_array_equal(short.channels[125], channels[225])
+    np.testing.assert_array_equal(moved[:, 1], [20, 100, 150])
