@@ -23,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-from motionlib.errors import MotionlibError
+from motionlib.errors import InputError, MotionlibError
 
 DEFAULT_DATA_DIR = Path(__file__).resolve().parents[1] / ".." / "shared" / "data"
 
@@ -285,7 +285,7 @@ def shortened(take, truth: np.ndarray, activity: int, seconds: float):
     """
     truth = np.asarray(truth, dtype=np.int64)
     if not 0 <= activity < len(truth) - 1:
-        raise ValueError(f"activity {activity}: a take with {len(truth)} cuts has inner "
+        raise InputError(f"activity {activity}: a take with {len(truth)} cuts has inner "
                          f"activities 0 to {len(truth) - 2}")
     keep = int(round(seconds * take.fps))
     start, stop = int(truth[activity, 1]), int(truth[activity + 1, 1])
