@@ -110,7 +110,7 @@ def body_frame_positions(
 
 def heading_cos_sin(dx: np.ndarray, dz: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Cosine and sine of the angle of the ground-plane vectors ``(dx, dz)`` from +X: the
-    vector over its length, (1, 0) for a zero vector (as ``arctan2(0, 0)`` = 0 gives).
+    vector over its length; (1, 0), no turn, for a zero vector.
 
     Division and square root round the same way on every CPU, unlike numpy's
     trigonometry (its AVX-512 builds use their own, a few ulp from the C library's), so
