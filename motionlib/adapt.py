@@ -454,12 +454,14 @@ def _count(per_take, zero: float) -> tuple[float, float]:
     """The prominence of PROMINENCE_GRID whose peaks fit the example cuts best.
 
     The summed example F1 at each prominence, less the prior (``_prior_strength``) times
-    how far (log factor) it lies from ``zero``, the zero-shot prominence.
+    how far (log factor) it lies from ``zero``, the zero-shot prominence. A zero-shot
+    without the prominence test (0) counts as the grid's lowest prominence, the nearest
+    test to none.
 
     Returns (score, prominence): the best score and its prominence.
     """
     f1 = _f1_by_prominence(per_take)
-    away = np.abs(np.log(np.asarray(PROMINENCE_GRID) / zero))
+    away = np.abs(np.log(np.asarray(PROMINENCE_GRID) / max(zero, PROMINENCE_GRID[0])))
     score = f1.sum(axis=0) - _penalty(away, _prior_strength(f1, away))
     best = _first_best(score)
     return float(score[best]), float(PROMINENCE_GRID[best])

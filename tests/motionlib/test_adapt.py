@@ -135,6 +135,15 @@ def test_examples_that_agree_still_move_the_count():
     assert _count([USUAL, USUAL, USUAL], 0.1)[1] == 0.1
 
 
+def test_examples_move_the_count_from_a_zero_shot_without_the_prominence_test():
+    from motionlib.adapt import _count
+
+    with np.errstate(divide="raise"):
+        assert _count([UNUSUAL, UNUSUAL, UNUSUAL], 0.0)[1] > 0.15
+        # The usual examples' false peak (0.05) goes, their weakest cut (0.12) stays.
+        assert 0.05 < _count([USUAL, USUAL, USUAL], 0.0)[1] <= 0.12
+
+
 def test_two_examples_keep_the_fixed_prior():
     from motionlib.adapt import _count
 
