@@ -25,6 +25,15 @@ penalty chosen without the take; the out-of-sample score of every option of ever
 setting, and two short-activity checks, on synthetic takes and on the real takes with
 one activity cut short (``real_short_activity_check``), follow the tables. Each take is
 scored separately and the means are given per kind of take and over all.
+
+Leave-one-take-out chooses on all the labelled material there is, not only on the takes
+scored: ``--pool DIR`` adds the labelled takes under DIR to what settings and penalties
+are chosen on and what the adaptation learns from, without scoring them. By default the
+pool is the folder the shipped settings were chosen on (``benchdata.DEFAULT_DATA_DIR``)
+when the takes scored are elsewhere, so that a few new takes are scored with settings
+chosen on everything else, as the shipped ones were; a pool take with the name and kind
+of a take scored is not added twice. A take with no other capture to choose on gets NaN
+in the /loo rows.
 """
 
 from __future__ import annotations
@@ -112,10 +121,11 @@ def _timed_row(detect, take, truth) -> dict:
 
 
 def run(root: Path | None = None, only: list[str] | None = None, *, loo: bool = False,
-        log=None, selection_out: list | None = None) -> dict[str, dict]:
+        log=None, selection_out: list | None = None, pool=()) -> dict[str, dict]:
     """Evaluate every method on every labelled take under ``root``.
 
-    With ``loo``, three more rows are scored leave-one-take-out (see ``LOO_ROWS``).
+    With ``loo``, four more rows are scored leave-one-take-out (see ``LOO_ROWS``), chosen
+    on the other takes under ``root`` and the labelled takes under the ``pool`` folders.
 
     Returns
     -------
@@ -134,13 +144,38 @@ def run(root: Path | None = None, only: list[str] | None = None, *, loo: bool = 
             if c.labelled.kind == "skeleton" or name in FEATURE_ONLY
         }
     if loo:
+        cache += pool_cache(pool, [c.labelled for c in cache], log)
         tried = tuning.select(cache, tuning.grid_choices(tuning.tried_grid()))
         if selection_out is not None:
             selection_out.append(tried)
+        scored = [c for c in cache if not c.pool]
         for key, per_take in loo_rows(cache, tried).items():
-            for c, row in zip(cache, per_take, strict=True):
+            for c, row in zip(scored, per_take, strict=True):
                 results[title(c.labelled)][key] = row
     return results
+
+
+def pool_cache(folders, scored, log=None) -> list[tuning.TakeCache]:
+    """The labelled takes under ``folders``, read, as ``pool`` takes: those with the name
+    and kind of a take in ``scored`` (or already pooled) left out."""
+    seen = {(t.name, t.kind) for t in scored}
+    out = []
+    for folder in folders:
+        takes, skipped = benchdata.discover(folder)
+        for line in skipped:
+            print(f"pool {folder}: {line}", file=log or sys.stderr)
+        for t in takes:
+            if (t.name, t.kind) not in seen:
+                seen.add((t.name, t.kind))
+                out.append(tuning.TakeCache(t, t.read(), pool=True))
+    return out
+
+
+def default_pool(folder: Path) -> list[Path]:
+    """The folder the shipped settings were chosen on, unless it is ``folder`` itself or
+    missing."""
+    shipped = benchdata.DEFAULT_DATA_DIR.resolve()
+    return [shipped] if shipped.is_dir() and shipped != Path(folder).resolve() else []
 
 
 LOO_ROWS = {
@@ -153,29 +188,41 @@ LOO_ROWS = {
 
 
 def loo_rows(cache: list[tuning.TakeCache], tried: tuning.Selection) -> dict[str, list[dict]]:
-    """The leave-one-take-out rows, one list of rows (in ``cache`` order) per name.
+    """The leave-one-take-out rows, one list of rows per name, for the takes of ``cache``
+    that are not ``pool`` takes (in ``cache`` order).
 
-    ``tried`` scores every choice of ``tuning.tried_grid()``; the shipped grid is its
-    subset with each tried setting at its shipped value.
+    ``tried`` scores every choice of ``tuning.tried_grid()`` on every take of ``cache``; the
+    shipped grid is its subset with each tried setting at its shipped value.
     """
+    scored = [not c.pool for c in cache]
     shipped = tried.shipped().leave_one_out()
     out: dict[str, list[dict]] = {name: [] for name in LOO_ROWS}
     for name, chosen in (("default/loo", shipped), ("tried/loo", tried.leave_one_out())):
-        for c, (params, _) in zip(cache, chosen, strict=True):
-            out[name].append(_timed_row(lambda t, p=params: Default(**p).fit_predict(t).cuts,
-                                        c.take, c.labelled.truth))
+        for c, found in _compress(zip(cache, chosen, strict=True), scored):
+            out[name].append(_nan_row() if found is None else _timed_row(
+                lambda t, p=found[0]: Default(**p).fit_predict(t).cuts, c.take,
+                c.labelled.truth))
     # Adaptation starts from the zero-shot settings chosen without the take (those of
     # default/loo), not the shipped ones: they were chosen on every take, this one too.
-    for c, (params, _) in zip(cache, shipped, strict=True):
+    for c, found in _compress(zip(cache, shipped, strict=True), scored):
         examples = _examples(cache, c)
-        if not examples:  # the only take of its label source: nothing to learn from
-            out["adapted/loo"].append({key: float("nan") for _, key in COLUMNS})
+        if found is None or not examples:  # nothing to choose on or to learn from
+            out["adapted/loo"].append(_nan_row())
             continue
+        params = found[0]
         model = adapt.fit_cut_model(examples, base=params)
         out["adapted/loo"].append(_timed_row(
             lambda t, m=model, p=params: adapt.detect(t, m, **p).cuts, c.take, c.labelled.truth))
-    out["ruptures/loo"] = _ruptures_loo(cache)
+    out["ruptures/loo"] = list(_compress(_ruptures_loo(cache), scored))
     return out
+
+
+def _compress(items, keep) -> list:
+    return [item for item, k in zip(items, keep, strict=True) if k]
+
+
+def _nan_row() -> dict:
+    return {key: float("nan") for _, key in COLUMNS}
 
 
 def _examples(cache, held_out) -> list[tuple]:
@@ -205,6 +252,9 @@ def _ruptures_loo(cache) -> list[dict]:
     out = []
     for j, c in enumerate(cache):
         keep = [other.key != c.key for other in cache]
+        if not any(keep):  # no other capture to choose the penalty on
+            out.append(_nan_row())
+            continue
         best = max(range(len(RUPTURES_PENALTIES)), key=lambda i: tuning.objective(
             [r for r, k in zip(by_penalty[i], keep, strict=True) if k]))
         out.append(by_penalty[best][j])
@@ -245,18 +295,25 @@ def format_table(title: str, rows: dict[str, dict]) -> str:
 
 
 def main(root: Path | None = None, only: list[str] | None = None, out=None, *,
-         loo: bool = False) -> int:
-    """Print a table per take and the mean tables; 0 on success, 2 without data."""
+         loo: bool = False, pool: list | None = None) -> int:
+    """Print a table per take and the mean tables; 0 on success, 2 without data.
+
+    ``pool``: folders of labelled takes that leave-one-take-out also chooses on (None: the
+    folder the shipped settings were chosen on, ``default_pool``).
+    """
     out = out or sys.stdout
     folder = Path(root) if root else benchdata.data_dir()
-    if not folder.is_dir():
-        print(f"error: benchmark data folder not found: {folder}", file=sys.stderr)
-        return 2
+    pool = default_pool(folder) if pool is None else [Path(p) for p in pool]
+    for where in [folder, *pool]:
+        if not where.is_dir():
+            print(f"error: benchmark data folder not found: {where}", file=sys.stderr)
+            return 2
     started = time.perf_counter()
     takes = {title(t): t for t in benchdata.discover(folder)[0]}
     selections: list = []
-    results = run(folder, only, loo=loo, log=out, selection_out=selections)
-    print(_legend(loo), file=out)
+    results = run(folder, only, loo=loo, log=out, selection_out=selections, pool=pool)
+    pooled = sum(c.pool for c in selections[0].cache) if selections else 0
+    print(_legend(loo, pool if pooled else [], pooled), file=out)
     for name, rows in results.items():
         print(format_table(f"\n{name} ({len(takes[name].truth)} true cuts, "
                            f"{takes[name].source})", rows), file=out)
@@ -356,7 +413,8 @@ def real_short_activity_check(takes: list, seconds=SHORT_REAL_S) -> str:
     full-skeleton takes, as they are and with each of their activities shortened the same
     way (a studio whose reviewed takes hold such activities). Synthetic short activities
     (``short_activity_check``) are easier than these: their two activities differ by
-    construction and they have no transitions.
+    construction and they have no transitions. With a single full-skeleton take there is
+    no adapted row.
     """
     read = [(t, t.read()) for t in takes if t.kind == "skeleton"]
     if not read:
@@ -368,16 +426,17 @@ def real_short_activity_check(takes: list, seconds=SHORT_REAL_S) -> str:
                         for k in range(len(t.truth) - 1)
                         if (cut := benchdata.shortened(take, t.truth, k, duration))]
              for duration in seconds}
-    found = {name: {d: [0, 0, 0] for d in seconds} for name in [*options, "adapted"]}
+    adapted = ["adapted"] if len(read) > 1 else []  # one take: nothing to learn from
+    found = {name: {d: [0, 0, 0] for d in seconds} for name in [*options, *adapted]}
     for duration, shortened in cases.items():
         models = []
         for i in range(len(read)):
             examples = [(take, t.truth[:, 1]) for j, (t, take) in enumerate(read) if j != i]
             examples += [(take, truth[:, 1]) for j, _, take, truth in shortened if j != i]
-            models.append(adapt.fit_cut_model(examples))
+            models.append(adapt.fit_cut_model(examples) if examples else None)
         for i, k, take, truth in shortened:
-            runs = [*[(name, None, params) for name, params in options.items()],
-                    ("adapted", models[i], {})]
+            runs = [(name, None, params) for name, params in options.items()]
+            runs += [("adapted", models[i], {})] if adapted else []
             for name, model, params in runs:
                 cuts = adapt.detect(take, model, **params).cuts
                 ci, ti = metrics.match(cuts, truth, tolerance=int(round(take.fps)))
@@ -407,7 +466,9 @@ def out_of_sample_table(tried: tuning.Selection) -> str:
     chosen with all of ``tuning.tried_grid()``)."""
     selection = tried.shipped()
     chosen = selection.chosen()
-    lines = [f"default settings chosen on all {len(selection.cache)} takes from tuning.GRID: "
+    pooled = sum(c.pool for c in selection.cache)
+    lines = [f"default settings chosen on all {len(selection.cache)} takes"
+             + (f" ({pooled} of them from the pool)" if pooled else "") + " from tuning.GRID: "
              + ", ".join(f"{k}={v:g}" if not isinstance(v, bool) else f"{k}={v}"
                          for k, v in chosen.items()),
              "out of sample (leave-one-take-out) with one setting imposed:",
@@ -421,15 +482,21 @@ def out_of_sample_table(tried: tuning.Selection) -> str:
     return "\n".join(lines)
 
 
-def _legend(loo: bool) -> str:
+def _legend(loo: bool, pool=(), pooled: int = 0) -> str:
     lines = ["Rows: registered segmenters with their default parameters (`default` uses the "
              "shipped settings,",
-             "which were chosen on these takes: in-sample here), ruptures_kernel (one fixed "
-             "penalty) and clasp (its defaults)."]
+             f"chosen on the labelled takes under {benchdata.DEFAULT_DATA_DIR.resolve()}: "
+             "in-sample for those takes,",
+             "out of sample for any other), ruptures_kernel (one fixed penalty) and clasp "
+             "(its defaults)."]
     if loo:
         lines.append("Rows ending in /loo were scored leave-one-take-out (a take and its "
                      "other views left out together):")
         lines += [f"  {name}: {text}" for name, text in LOO_ROWS.items()]
+        if pooled:
+            lines.append(f"  the other takes include {pooled} labelled takes under "
+                         f"{', '.join(str(p) for p in pool)} (the pool: chosen on and "
+                         "learnt from, not scored)")
     lines.append("Four-channel takes (cmu/channels4d) run only the methods that need no "
                  "skeleton.")
     return "\n".join(lines)
@@ -481,4 +548,11 @@ def add_bench_quality(subparsers) -> None:
                    help="also score leave-one-take-out: the default settings chosen, the "
                         "adapted model fitted and the ruptures penalty chosen without the "
                         "take scored")
-    p.set_defaults(handler=lambda args: main(args.data, args.method, loo=args.loo))
+    p.add_argument("--pool", action="append", metavar="DIR",
+                   help="with --loo, also choose on and learn from the labelled takes under "
+                        "DIR, without scoring them (repeatable; default: the folder the "
+                        "shipped settings were chosen on, when --data is another)")
+    p.add_argument("--no-pool", action="store_true",
+                   help="with --loo, choose on the other takes under --data only")
+    p.set_defaults(handler=lambda args: main(
+        args.data, args.method, loo=args.loo, pool=[] if args.no_pool else args.pool))

@@ -64,10 +64,15 @@ def grid_choices(grid: dict | None = None) -> list[dict]:
 
 @dataclass
 class TakeCache:
-    """One labelled take read once, with its novelty analyses by window setting."""
+    """One labelled take read once, with its novelty analyses by window setting.
+
+    A ``pool`` take is labelled material that settings are chosen on (and a model adapted
+    to) but that is not scored itself (``bench_quality``'s ``--pool``).
+    """
 
     labelled: object  # benchdata.LabelledTake
     take: object
+    pool: bool = False
     analyses: dict = field(default_factory=dict)
     placed: dict = field(default_factory=dict)
 
@@ -127,11 +132,11 @@ class Selection:
                if all(_value(ch, key) == value for key, value in fixed.items())]
         return Selection([self.choices[i] for i in idx], self.cache, [self.rows[i] for i in idx])
 
-    def best(self, keep: Sequence[bool]) -> int:
-        """Index of the best choice on the takes where ``keep`` is true (the first
-        choice when there is no such take: nothing to choose on)."""
+    def best(self, keep: Sequence[bool]) -> int | None:
+        """Index of the best choice on the takes where ``keep`` is true (None when
+        there is no such take: nothing to choose on)."""
         if not any(keep):
-            return 0
+            return None
         scores = [objective([r for r, k in zip(rows, keep, strict=True) if k])
                   for rows in self.rows]
         return max(range(len(scores)), key=lambda i: scores[i])
@@ -140,13 +145,13 @@ class Selection:
         """The choice on every take: the shipped default."""
         return self.choices[self.best([True] * len(self.cache))]
 
-    def leave_one_out(self) -> list[tuple[dict, dict]]:
-        """Per take: the choice made without it (and its other views), and its row there."""
+    def leave_one_out(self) -> list[tuple[dict, dict] | None]:
+        """Per take: the choice made without it (and its other views), and its row there;
+        None for a take with no other capture to choose on."""
         out = []
         for j, c in enumerate(self.cache):
-            keep = [other.key != c.key for other in self.cache]
-            i = self.best(keep)
-            out.append((self.choices[i], self.rows[i][j]))
+            i = self.best([other.key != c.key for other in self.cache])
+            out.append(None if i is None else (self.choices[i], self.rows[i][j]))
         return out
 
 
@@ -170,7 +175,8 @@ def out_of_sample(selection: Selection, grid: dict | None = None) -> list[tuple[
 
     For every setting and every value it can take, the leave-one-take-out mean F1@1 s and
     edits per true cut when that value is imposed and the other settings are still chosen
-    on the other takes.
+    on the other takes; the mean is over the takes scored (not ``pool``) that have another
+    capture to choose on.
 
     Returns
     -------
@@ -180,7 +186,14 @@ def out_of_sample(selection: Selection, grid: dict | None = None) -> list[tuple[
     out = []
     for key, values in grid.items():
         for value in values:
-            rows = [row for _, row in selection.subset(**{key: value}).leave_one_out()]
-            out.append((key, value, float(np.mean([r["f1@1s"] for r in rows])),
-                        float(np.mean([r["edits_per_cut"] for r in rows]))))
+            rows = [found[1] for found, c in zip(selection.subset(**{key: value})
+                                                 .leave_one_out(), selection.cache,
+                                                 strict=True)
+                    if found is not None and not c.pool]
+            out.append((key, value, _mean([r["f1@1s"] for r in rows]),
+                        _mean([r["edits_per_cut"] for r in rows])))
     return out
+
+
+def _mean(values: list[float]) -> float:
+    return float(np.mean(values)) if values else float("nan")

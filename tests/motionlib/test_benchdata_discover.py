@@ -80,7 +80,7 @@ def test_it_chooses_settings_without_the_take_scored_or_its_other_views():
 def test_it_prints_leave_one_take_out_rows_beside_the_others(layout, capsys):
     from motionlib import bench_quality
 
-    assert bench_quality.main(layout, ["bone_angle"], loo=True) == 0
+    assert bench_quality.main(layout, ["bone_angle"], loo=True, pool=[]) == 0
     out = capsys.readouterr().out
     assert "Rows ending in /loo were scored leave-one-take-out" in out
     for row in ("default/loo", "adapted/loo", "ruptures/loo"):
@@ -104,3 +104,67 @@ def test_it_finds_the_shipped_grid_inside_the_tried_one():
     shipped = tuning.Selection(choices, [None], rows).subset(short_activity=0.0)
     # A choice that does not set it has the shipped value.
     assert shipped.choices == [choices[0], choices[2]]
+
+
+def test_it_makes_no_leave_one_take_out_choice_for_a_take_with_no_other_capture():
+    class View:
+        def __init__(self, name):
+            self.labelled = type("L", (), {"name": name})()
+            self.key, self.pool = name, False
+
+    good = {"f1@1s": 1.0, "edits_per_cut": 0.0}
+    selection = tuning.Selection([{"c": 0}, {"c": 1}], [View("a"), View("a")],
+                                 [[good, good], [good, good]])
+    assert selection.leave_one_out() == [None, None]
+    assert all(np.isnan(f1) and np.isnan(edits)
+               for _, _, f1, edits in tuning.out_of_sample(selection, {"c": (0, 1)}))
+
+
+def _mocap6_folder(root, seeds, names):
+    """A data folder of synthetic BVH takes labelled in the mocap6 layout."""
+    for folder in ("cmu/bvh", "labels/mocap6/segments"):
+        (root / folder).mkdir(parents=True, exist_ok=True)
+    for seed, name in zip(seeds, names, strict=True):
+        take, segments = synth.generate(seed=seed, fps=60.0, duration=24.0)
+        write_bvh(take, root / f"cmu/bvh/{name}.bvh")
+        rows = "".join(f"{i + 1},{i + 1},{start + 1},{stop},1,{label}\n"
+                       for i, (start, stop, label) in enumerate(segments))
+        (root / f"labels/mocap6/segments/{name}.csv").write_text(SEGMENTS + rows)
+    return root
+
+
+def test_leave_one_take_out_also_chooses_on_and_learns_from_the_pool_without_scoring_it(
+        tmp_path):
+    from motionlib import bench_quality
+
+    scored = _mocap6_folder(tmp_path / "new", [3], ["40_01"])
+    # The pool holds two other takes and one with the scored take's name and kind.
+    pool = _mocap6_folder(tmp_path / "pool", [4, 5, 6], ["40_02", "40_03", "40_01"])
+    alone = bench_quality.run(scored, ["default"], loo=True)
+    assert np.isnan(alone["40_01"]["default/loo"]["f1@1s"])  # nothing else to choose on
+    assert np.isnan(alone["40_01"]["adapted/loo"]["f1@1s"])  # nothing to learn from
+
+    selections = []
+    results = bench_quality.run(scored, ["default"], loo=True, pool=[pool],
+                                selection_out=selections)
+    assert list(results) == ["40_01"]  # the pool is not scored
+    cache = selections[0].cache
+    assert [(c.labelled.name, c.pool) for c in cache] == [
+        ("40_01", False), ("40_02", True), ("40_03", True)]
+    # The scored take's settings are the ones chosen on the two pool takes.
+    on_pool = tuning.select(cache[1:]).chosen()
+    expected = bench_quality.metrics.evaluate(
+        cache[0].cuts(on_pool), cache[0].labelled.truth, fps=cache[0].take.fps)
+    row = results["40_01"]["default/loo"]
+    assert (row["f1@1s"], row["edits_per_cut"]) == (expected["f1@1s"],
+                                                     expected["edits_per_cut"])
+    assert not np.isnan(results["40_01"]["adapted/loo"]["f1@1s"])
+    assert not np.isnan(results["40_01"]["ruptures/loo"]["f1@1s"])
+
+
+def test_the_cli_says_so_when_a_pool_folder_is_missing(layout, tmp_path, capsys):
+    from motionlib import bench_quality
+
+    assert bench_quality.main(layout, ["bone_angle"], loo=True,
+                              pool=[tmp_path / "nowhere"]) == 2
+    assert f"benchmark data folder not found: {tmp_path / 'nowhere'}" in capsys.readouterr().err
