@@ -120,7 +120,12 @@ error on the full-skeleton takes, and neither reaches the target, so placement s
 chosen. Counted in moves (a matched cut outside its window widened to 0.25 s each side),
 the witness crossing does not pay either: started from the peak, the split or the placed
 cut, with contexts of 0.5-3, 1-3 or 1-4 s, 16-19 moves of the 59 matched four-channel
-cuts against 17 as shipped, and 4-6 against 4 on the full-skeleton takes.
+cuts against 17 as shipped, and 4-6 against 4 on the full-skeleton takes. The split
+over the whole neighbouring segments (from the previous kept peak to the next, as a
+global kernel change-point fit sees them) instead of at most ``scale_min_s`` and half-way
+to a neighbour: four-channel 0.33 s and 0.40 edits per true cut (0.39 s and 0.43 as
+shipped), full-skeleton 0.12 s and 0.33 (0.09 s and 0.27), capped at 4-10 s alike or
+worse: it trades the takes with a skeleton for those without.
 
 Short activities: tried, not shipped
 ------------------------------------
