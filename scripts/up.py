@@ -227,7 +227,7 @@ def wait_ready(worker_child, web_child, url, timeout=90):
         web_up = web_up or answers(url + "login/")
         if worker_up and web_up:
             return True
-        time.sleep(0.2)
+        nap(0.2)
     say(f"not ready after {timeout} s (worker ready: {worker_up}, web ready: {web_up})")
     return False
 
@@ -241,11 +241,30 @@ def answers(url):
 
 
 class Stop(Exception):
-    pass
+    """A stop signal arrived (its name); raised by ``nap``."""
+
+
+# The stop signals received, oldest first.
+STOPPING: list[str] = []
 
 
 def on_signal(signum, frame):
-    raise Stop(signal.Signals(signum).name)
+    """Note the signal; the supervisor stops at its next ``nap``. Raising from here
+    would land wherever the main thread happens to be: inside Django's first import
+    (the watchdog's, just after the banner) Python wraps it into a RuntimeError, and an
+    ``except Exception`` that keeps the watchdog going would swallow it."""
+    STOPPING.append(signal.Signals(signum).name)
+
+
+def nap(seconds):
+    """Sleep ``seconds``; raise Stop as soon as a stop signal has arrived (within 0.1 s)."""
+    deadline = time.monotonic() + seconds
+    while not STOPPING:
+        left = deadline - time.monotonic()
+        if left <= 0:
+            return
+        time.sleep(min(0.1, left))
+    raise Stop(STOPPING[0])
 
 
 class Restarts:
@@ -311,7 +330,7 @@ def supervise(worker_child, web_child, watchdog, convert_child=None, bulk_child=
     restarted at once; meanwhile the web server serves those requests itself."""
     restarts = Restarts()
     while True:
-        time.sleep(0.5)
+        nap(0.5)
         for child in (convert_child, bulk_child):
             if child is not None and child.exited() is not None:
                 restart_at_once(child)
@@ -341,7 +360,7 @@ def restart(worker_child, pause):
         say(f"the worker was restarted {RESTARTS_IN_WINDOW} times within "
             f"{RESTART_WINDOW:.0f} s; waiting {pause:.0f} s before restarting it "
             "(the web server keeps serving)")
-        time.sleep(pause)
+        nap(pause)
     say("restarting the worker")
     worker_child.start()
     say(f"worker restarted, pid {worker_child.proc.pid}")

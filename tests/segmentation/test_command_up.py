@@ -160,6 +160,24 @@ def test_it_serves_the_demo_survives_a_dead_worker_stops_on_ctrl_c_and_runs_agai
     assert again.ctrl_c() == 0
 
 
+def test_a_stop_signal_is_noted_where_it_lands_and_raised_at_the_next_nap():
+    # Raised from the handler, a Ctrl-C landing inside Django's first import (just after
+    # the banner) became a RuntimeError and up.py exited 1 with a traceback.
+    script = up_script()
+    script.on_signal(signal.SIGINT, None)  # returns wherever it lands
+    script.on_signal(signal.SIGTERM, None)
+    assert script.STOPPING == ["SIGINT", "SIGTERM"]
+    with pytest.raises(script.Stop, match="SIGINT"):
+        script.nap(60)  # at once, not after the minute
+
+
+def test_a_nap_without_a_stop_signal_sleeps_its_time():
+    script = up_script()
+    started = time.monotonic()
+    script.nap(0.25)
+    assert time.monotonic() - started >= 0.25
+
+
 def mark_processing(database, capture_id):
     """What a worker's claim leaves on a capture row (written straight to the SQLite file)."""
     with sqlite3.connect(database, timeout=20) as db:
