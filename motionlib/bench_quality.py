@@ -22,8 +22,9 @@ settings chosen from ``tuning.GRID`` without the take scored, the default adapte
 other takes of the same label source (``motionlib.adapt``, starting from those settings
 chosen without the take, since the shipped ones were chosen on it too), and ruptures with its
 penalty chosen without the take; the out-of-sample score of every option of every
-setting, and two short-activity checks, on synthetic takes and on the real takes with
-one activity cut short (``real_short_activity_check``), follow the tables. Each take is
+setting, and three short-activity checks, on synthetic takes, on the real takes with
+one activity cut short (``real_short_activity_check``) and with the first or last one cut
+short (``edge_activity_check``), follow the tables. Each take is
 scored separately and the means are given per kind of take and over all.
 
 Leave-one-take-out chooses on all the labelled material there is, not only on the takes
@@ -329,6 +330,7 @@ def main(root: Path | None = None, only: list[str] | None = None, out=None, *,
     if not only or "default" in only:
         print("\n" + short_activity_check(), file=out)
         print("\n" + real_short_activity_check(list(takes.values())), file=out)
+        print("\n" + edge_activity_check(list(takes.values())), file=out)
     if (not only or "joint_distance_pca" in only) and "13_30" in takes:
         print("\n" + patent_comparison(folder), file=out)
     print(f"\nwhole benchmark: {time.perf_counter() - started:.0f} s, load average "
@@ -457,6 +459,40 @@ def real_short_activity_check(takes: list, seconds=SHORT_REAL_S) -> str:
                         for d, (b, s, f) in rows.items())
         lines.append(f"  {name:<34}{cells}")
     return "\n".join(lines)
+
+
+EDGE_REAL_S = (1.5, 1.8, 2.5)
+
+
+def edge_activity_check(takes: list, seconds=EDGE_REAL_S) -> str:
+    """Short activities at the ends of real takes: the first and the last activity of each
+    full-skeleton take cut down to ``seconds`` (``benchdata.trimmed``), and whether the
+    zero-shot detector then finds its boundary within 1 s, and how many false cuts it
+    makes. The novelty windows there see the take mirrored at its end.
+    """
+    read = [(t, t.read()) for t in takes if t.kind == "skeleton"]
+    if not read:
+        return "short activities at the ends of a take: no full-skeleton take"
+    cells = []
+    for duration in seconds:
+        found = cases = false = 0
+        for t, take in read:
+            for side, index in (("first", 0), ("last", -1)):
+                cut = benchdata.trimmed(take, t.truth, side, duration)
+                if cut is None:
+                    continue
+                short, truth = cut
+                cuts = adapt.detect(short).cuts
+                ci, _ = metrics.match(cuts, truth, tolerance=int(round(short.fps)))
+                cases += 1
+                found += bool(len(cuts)) and \
+                    np.abs(cuts - truth[index, 1]).min() <= round(short.fps)
+                false += len(cuts) - len(ci)
+        cells.append(f"{duration:g} s {found}/{cases} (false cuts {false})")
+    return (f"short activities at the ends of a take, real motion: the first and the last "
+            f"activity of each of the {len(read)} full-skeleton takes cut down by dropping "
+            f"the take's first or last frames; its boundary found within 1 s, zero-shot: "
+            + ", ".join(cells))
 
 
 def out_of_sample_table(tried: tuning.Selection) -> str:

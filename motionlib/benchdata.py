@@ -301,3 +301,32 @@ def shortened(take, truth: np.ndarray, activity: int, seconds: float):
     if hasattr(take, "positions"):
         changes["positions"] = None
     return replace(take, **changes), out
+
+
+def trimmed(take, truth: np.ndarray, side: str, seconds: float):
+    """``take`` with its first (``side`` "first") or last ("last") activity cut down to
+    ``seconds`` by dropping frames at that end of the take: real motion whose take starts
+    or ends with a short activity.
+
+    Returns
+    -------
+    (take, truth) : the shorter take (same type, ``positions`` dropped) and its true cuts
+        (moved back by the frames dropped at the start), the windows clipped to the take;
+        None when that activity (to or from the best estimate) is not longer than
+        ``seconds``.
+    """
+    truth = np.asarray(truth, dtype=np.int64)
+    if side not in ("first", "last"):
+        raise InputError(f"side: expected 'first' or 'last', got {side!r}")
+    if len(truth) == 0:
+        raise InputError("a take with no cuts has no first or last activity to trim")
+    keep = int(round(seconds * take.fps))
+    start, stop = (int(truth[0, 1]) - keep, take.n_frames) if side == "first" else \
+        (0, int(truth[-1, 1]) + keep)
+    if (start if side == "first" else take.n_frames - stop) <= 0:
+        return None
+    out = np.clip(truth - start, 0, stop - start - 1)
+    changes = {"channels": np.array(take.channels[start:stop])}
+    if hasattr(take, "positions"):
+        changes["positions"] = None
+    return replace(take, **changes), out

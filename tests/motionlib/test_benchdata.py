@@ -2,6 +2,7 @@ import numpy as np
 import pytest
 
 from motionlib import benchdata, synth
+from motionlib.errors import InputError
 
 DATA = benchdata.data_dir()
 needs_data = pytest.mark.skipif(not DATA.is_dir(), reason=f"benchmark data not found at {DATA}")
@@ -99,3 +100,39 @@ def test_a_four_channel_take_is_shortened_the_same_way():
     assert isinstance(short, benchdata.ChannelTake) and short.n_frames == 200
     np.testing.assert_array_equal(short.channels[125], channels[225])
     np.testing.assert_array_equal(moved[:, 1], [20, 100, 150])
+
+
+def _windows(seed=3):
+    take, segments = synth.generate(seed=seed, fps=60.0, duration=40.0)
+    truth = np.repeat(np.asarray([s[0] for s in segments[1:]])[:, None], 3, axis=1)
+    truth[:, 0] -= 60
+    truth[:, 2] += 60
+    return take, truth
+
+
+def test_a_take_trimmed_at_its_start_begins_its_first_activity_the_seconds_asked_before_its_cut():
+    take, truth = _windows()
+    short, moved = benchdata.trimmed(take, truth, "first", 1.5)
+    dropped = truth[0, 1] - 90  # 1.5 s at 60 fps is left before the first cut
+    assert short.n_frames == take.n_frames - dropped
+    np.testing.assert_array_equal(short.channels, take.channels[dropped:])
+    assert moved[0, 1] == 90
+    np.testing.assert_array_equal(moved[1:], truth[1:] - dropped)
+    assert moved[0, 0] == max(0, truth[0, 0] - dropped)
+
+
+def test_a_take_trimmed_at_its_end_stops_the_seconds_asked_after_its_last_cut():
+    take, truth = _windows()
+    short, moved = benchdata.trimmed(take, truth, "last", 1.8)
+    assert short.n_frames == truth[-1, 1] + 108
+    np.testing.assert_array_equal(short.channels, take.channels[:short.n_frames])
+    np.testing.assert_array_equal(moved[:-1], truth[:-1])
+    assert moved[-1, 1] == truth[-1, 1] and moved[-1, 2] <= short.n_frames - 1
+
+
+def test_an_end_activity_already_as_short_is_not_trimmed_and_a_wrong_side_is_named():
+    take, truth = _windows()
+    assert benchdata.trimmed(take, truth, "first", truth[0, 1] / take.fps) is None
+    assert benchdata.trimmed(take, truth, "last", 1000.0) is None
+    with pytest.raises(InputError, match="side: expected 'first' or 'last', got 'middle'"):
+        benchdata.trimmed(take, truth, "middle", 1.5)
