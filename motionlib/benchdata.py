@@ -297,10 +297,15 @@ def shortened(take, truth: np.ndarray, activity: int, seconds: float):
     out[activity + 1:] -= resume - join
     out[activity, 2] = min(out[activity, 2], join - 1)
     out[activity + 1, 0] = max(out[activity + 1, 0], join)
+    return _with_channels(take, channels), out
+
+
+def _with_channels(take, channels: np.ndarray):
+    """``take`` (same type) with other channel rows; cached positions dropped."""
     changes = {"channels": channels}
     if hasattr(take, "positions"):
         changes["positions"] = None
-    return replace(take, **changes), out
+    return replace(take, **changes)
 
 
 def trimmed(take, truth: np.ndarray, side: str, seconds: float):
@@ -326,7 +331,4 @@ def trimmed(take, truth: np.ndarray, side: str, seconds: float):
     if (start if side == "first" else take.n_frames - stop) <= 0:
         return None
     out = np.clip(truth - start, 0, stop - start - 1)
-    changes = {"channels": np.array(take.channels[start:stop])}
-    if hasattr(take, "positions"):
-        changes["positions"] = None
-    return replace(take, **changes), out
+    return _with_channels(take, np.array(take.channels[start:stop])), out
