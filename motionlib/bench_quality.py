@@ -30,8 +30,9 @@ scored separately and the means are given per kind of take and over all.
 Leave-one-take-out chooses on all the labelled material there is, not only on the takes
 scored: ``--pool DIR`` adds the labelled takes under DIR to what settings and penalties
 are chosen on and what the adaptation learns from, without scoring them. By default the
-pool is the folder the shipped settings were chosen on (``benchdata.DEFAULT_DATA_DIR``)
-when the takes scored are elsewhere, so that a few new takes are scored with settings
+pool is the shared data the shipped settings were chosen on (``default_pool``:
+``$CUTROOM_BENCH_DATA`` or ``shared/data`` beside the repository) when the takes scored
+are elsewhere, so that a few new takes are scored with settings
 chosen on everything else, as the shipped ones were; a pool take with the name and kind
 of a take scored is not added twice. A take with no other capture to choose on gets NaN
 in the /loo rows.
@@ -173,10 +174,14 @@ def pool_cache(folders, scored, log=None) -> list[tuning.TakeCache]:
 
 
 def default_pool(folder: Path) -> list[Path]:
-    """The folder the shipped settings were chosen on, unless it is ``folder`` itself or
-    missing."""
-    shipped = benchdata.DEFAULT_DATA_DIR.resolve()
-    return [shipped] if shipped.is_dir() and shipped != Path(folder).resolve() else []
+    """The shared data the shipped settings were chosen on: ``benchdata.data_dir()``
+    (``$CUTROOM_BENCH_DATA`` where it is set, e.g. to a copy elsewhere), else the shared
+    folder beside the repository; none that is ``folder`` itself or missing."""
+    folder = Path(folder).resolve()
+    for shared in (benchdata.data_dir(), benchdata.DEFAULT_DATA_DIR.resolve()):
+        if shared.is_dir() and shared != folder:
+            return [shared]
+    return []
 
 
 LOO_ROWS = {

@@ -168,3 +168,21 @@ def test_the_cli_says_so_when_a_pool_folder_is_missing(layout, tmp_path, capsys)
     assert bench_quality.main(layout, ["bone_angle"], loo=True,
                               pool=[tmp_path / "nowhere"]) == 2
     assert f"benchmark data folder not found: {tmp_path / 'nowhere'}" in capsys.readouterr().err
+
+
+def test_the_default_pool_is_the_shared_data_wherever_it_is_set_and_never_the_folder_scored(
+        tmp_path, monkeypatch):
+    from motionlib import bench_quality
+
+    copy, scored = tmp_path / "shared-copy", tmp_path / "new"
+    copy.mkdir()
+    scored.mkdir()
+    monkeypatch.setenv("CUTROOM_BENCH_DATA", str(copy))
+    assert bench_quality.default_pool(scored) == [copy.resolve()]
+    # Scoring the shared data itself: the pool is the shared folder beside the repository,
+    # if it is there and another folder, else nothing.
+    beside = benchdata.DEFAULT_DATA_DIR.resolve()
+    assert bench_quality.default_pool(copy) == ([beside] if beside.is_dir() else [])
+    monkeypatch.setenv("CUTROOM_BENCH_DATA", str(tmp_path / "missing"))
+    assert bench_quality.default_pool(scored) == ([beside] if beside.is_dir() else [])
+    assert bench_quality.default_pool(beside) == []
