@@ -123,11 +123,14 @@ def _timed_row(detect, take, truth) -> dict:
 
 
 def run(root: Path | None = None, only: list[str] | None = None, *, loo: bool = False,
-        log=None, selection_out: list | None = None, pool=()) -> dict[str, dict]:
+        log=None, selection_out: list | None = None, pool=(),
+        cache_out: list | None = None) -> dict[str, dict]:
     """Evaluate every method on every labelled take under ``root``.
 
     With ``loo``, four more rows are scored leave-one-take-out (see ``LOO_ROWS``), chosen
     on the other takes under ``root`` and the labelled takes under the ``pool`` folders.
+    ``cache_out`` receives each take scored, read (``tuning.TakeCache``), for the checks
+    that follow the tables.
 
     Returns
     -------
@@ -138,6 +141,8 @@ def run(root: Path | None = None, only: list[str] | None = None, *, loo: bool = 
     for line in skipped:
         print(line, file=log or sys.stderr)
     cache = [tuning.TakeCache(t, t.read()) for t in takes]
+    if cache_out is not None:
+        cache_out.extend(cache)
     results: dict[str, dict] = {}
     for c in cache:
         results[title(c.labelled)] = {
@@ -317,7 +322,9 @@ def main(root: Path | None = None, only: list[str] | None = None, out=None, *,
     started = time.perf_counter()
     takes = {title(t): t for t in benchdata.discover(folder)[0]}
     selections: list = []
-    results = run(folder, only, loo=loo, log=out, selection_out=selections, pool=pool)
+    cache: list = []
+    results = run(folder, only, loo=loo, log=out, selection_out=selections, pool=pool,
+                  cache_out=cache)
     pooled = sum(c.pool for c in selections[0].cache) if selections else 0
     print(_legend(loo, pool if pooled else [], pooled), file=out)
     for name, rows in results.items():
@@ -334,8 +341,9 @@ def main(root: Path | None = None, only: list[str] | None = None, out=None, *,
         print("\n" + out_of_sample_table(selections[0]), file=out)
     if not only or "default" in only:
         print("\n" + short_activity_check(), file=out)
-        print("\n" + real_short_activity_check(list(takes.values())), file=out)
-        print("\n" + edge_activity_check(list(takes.values())), file=out)
+        read = [(c.labelled, c.take) for c in cache]
+        print("\n" + real_short_activity_check(read), file=out)
+        print("\n" + edge_activity_check(read), file=out)
     if (not only or "joint_distance_pca" in only) and "13_30" in takes:
         print("\n" + patent_comparison(folder), file=out)
     print(f"\nwhole benchmark: {time.perf_counter() - started:.0f} s, load average "
@@ -409,10 +417,16 @@ def short_activity_check(seeds: int = 6) -> str:
 SHORT_REAL_S = (1.8, 2.5)
 
 
-def real_short_activity_check(takes: list, seconds=SHORT_REAL_S) -> str:
+def _skeletons(read: list) -> list:
+    """The (labelled take, motion) pairs of full-skeleton takes."""
+    return [(t, take) for t, take in read if t.kind == "skeleton"]
+
+
+def real_short_activity_check(read: list, seconds=SHORT_REAL_S) -> str:
     """Short activities in real motion: each inner activity of each full-skeleton take cut
     down to ``seconds`` (``benchdata.shortened``), and whether the detector then finds both
     of its boundaries within 1 s, how many of them, and how many false cuts it makes.
+    ``read``: (labelled take, its motion) pairs, as the bench read them.
 
     Rows: zero-shot; the optional short-activity step as the default's docstring
     suggests it (``short_activity`` 4, ``short_uniformity`` 0.3); the shorter windows
@@ -423,7 +437,7 @@ def real_short_activity_check(takes: list, seconds=SHORT_REAL_S) -> str:
     construction and they have no transitions. With a single full-skeleton take there is
     no adapted row.
     """
-    read = [(t, t.read()) for t in takes if t.kind == "skeleton"]
+    read = _skeletons(read)
     if not read:
         return "short activities, real motion: no full-skeleton take"
     options = {"zero-shot": {}, "short_activity=4/uniformity=0.3":
@@ -469,13 +483,14 @@ def real_short_activity_check(takes: list, seconds=SHORT_REAL_S) -> str:
 EDGE_REAL_S = (1.5, 1.8, 2.5)
 
 
-def edge_activity_check(takes: list, seconds=EDGE_REAL_S) -> str:
+def edge_activity_check(read: list, seconds=EDGE_REAL_S) -> str:
     """Short activities at the ends of real takes: the first and the last activity of each
     full-skeleton take cut down to ``seconds`` (``benchdata.trimmed``), and whether the
     zero-shot detector then finds its boundary within 1 s, and how many false cuts it
-    makes. The novelty windows there see the take mirrored at its end.
+    makes. The novelty windows there see the take mirrored at its end. ``read`` as in
+    ``real_short_activity_check``.
     """
-    read = [(t, t.read()) for t in takes if t.kind == "skeleton"]
+    read = _skeletons(read)
     if not read:
         return "short activities at the ends of a take: no full-skeleton take"
     cells = []

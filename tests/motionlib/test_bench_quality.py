@@ -129,9 +129,14 @@ class _Labelled:
         return self.take
 
 
+def _read(takes):
+    """The (labelled take, motion) pairs the bench hands the checks."""
+    return [(t, t.read()) for t in takes]
+
+
 def test_the_real_short_activity_check_shortens_every_inner_activity_of_each_skeleton_take():
     takes = [_Labelled(1), _Labelled(2), _Labelled(3, kind="channels")]
-    text = bench_quality.real_short_activity_check(takes, seconds=(1.8, 2.5))
+    text = bench_quality.real_short_activity_check(_read(takes), seconds=(1.8, 2.5))
     expected = {d: sum(benchdata.shortened(t.take, t.truth, k, d) is not None
                        for t in takes[:2] for k in range(len(t.truth) - 1)) for d in (1.8, 2.5)}
     lines = text.splitlines()
@@ -146,19 +151,19 @@ def test_the_real_short_activity_check_shortens_every_inner_activity_of_each_ske
 
 
 def test_the_real_short_activity_check_says_so_without_a_skeleton_take():
-    text = bench_quality.real_short_activity_check([_Labelled(1, kind="channels")])
+    text = bench_quality.real_short_activity_check(_read([_Labelled(1, kind="channels")]))
     assert text == "short activities, real motion: no full-skeleton take"
 
 
 def test_the_real_short_activity_check_has_no_adapted_row_with_one_skeleton_take():
-    text = bench_quality.real_short_activity_check([_Labelled(1)], seconds=(1.8,))
+    text = bench_quality.real_short_activity_check(_read([_Labelled(1)]), seconds=(1.8,))
     rows = [line.split("  ")[1].strip() for line in text.splitlines()[2:]]
     assert rows == ["zero-shot", "short_activity=4/uniformity=0.3", "windows 2-4 s"]
 
 
 def test_the_edge_activity_check_finds_the_boundary_of_a_short_first_or_last_activity():
     takes = [_Labelled(1), _Labelled(2), _Labelled(3, kind="channels")]
-    text = bench_quality.edge_activity_check(takes, seconds=(2.5, 60.0))
+    text = bench_quality.edge_activity_check(_read(takes), seconds=(2.5, 60.0))
     cases = sum(benchdata.trimmed(t.take, t.truth, side, 2.5) is not None
                 for t in takes[:2] for side in ("first", "last"))
     assert "each of the 2 full-skeleton takes" in text
@@ -166,5 +171,5 @@ def test_the_edge_activity_check_finds_the_boundary_of_a_short_first_or_last_act
     # Synthetic activities differ by construction: at 2.5 s every boundary is found.
     assert f"2.5 s {found}/{cases} (false cuts" in text and found == cases > 0
     assert "60 s 0/0 (false cuts 0)" in text  # no activity is that long: no case
-    assert bench_quality.edge_activity_check([takes[2]]) == \
+    assert bench_quality.edge_activity_check(_read([takes[2]])) == \
         "short activities at the ends of a take: no full-skeleton take"
