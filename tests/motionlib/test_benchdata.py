@@ -60,11 +60,17 @@ def test_it_lists_the_three_labelled_takes_with_their_cuts():
     assert all(t.path.is_file() for t in takes.values())
 
 
-def test_a_shortened_take_keeps_the_activity_ends_and_moves_the_later_cuts_back():
-    take, segments = synth.generate(seed=3, fps=60.0, duration=40.0)
+def _windows(seed=3):
+    """A synthetic take and its true cuts as 2 s transition windows."""
+    take, segments = synth.generate(seed=seed, fps=60.0, duration=40.0)
     truth = np.repeat(np.asarray([s[0] for s in segments[1:]])[:, None], 3, axis=1)
     truth[:, 0] -= 60
     truth[:, 2] += 60
+    return take, truth
+
+
+def test_a_shortened_take_keeps_the_activity_ends_and_moves_the_later_cuts_back():
+    take, truth = _windows()
     start, stop = truth[1, 1], truth[2, 1]
     short, moved = benchdata.shortened(take, truth, 1, 1.8)
     removed = take.n_frames - short.n_frames
@@ -100,14 +106,6 @@ def test_a_four_channel_take_is_shortened_the_same_way():
     assert isinstance(short, benchdata.ChannelTake) and short.n_frames == 200
     np.testing.assert_array_equal(short.channels[125], channels[225])
     np.testing.assert_array_equal(moved[:, 1], [20, 100, 150])
-
-
-def _windows(seed=3):
-    take, segments = synth.generate(seed=seed, fps=60.0, duration=40.0)
-    truth = np.repeat(np.asarray([s[0] for s in segments[1:]])[:, None], 3, axis=1)
-    truth[:, 0] -= 60
-    truth[:, 2] += 60
-    return take, truth
 
 
 def test_a_take_trimmed_at_its_start_begins_its_first_activity_the_seconds_asked_before_its_cut():
