@@ -61,12 +61,15 @@ def test_it_names_the_line_of_a_bad_four_channel_row(tmp_path):
         benchdata.read_channels(path)
 
 
-def test_it_chooses_settings_without_the_take_scored_or_its_other_views():
-    class View:
-        def __init__(self, name):
-            self.labelled = type("L", (), {"name": name})()
-            self.key = name
+class View:
+    """A scored view of a capture, as tuning.Selection sees it."""
 
+    def __init__(self, name):
+        self.labelled = type("L", (), {"name": name})()
+        self.key, self.pool = name, False
+
+
+def test_it_chooses_settings_without_the_take_scored_or_its_other_views():
     cache = [View("a"), View("a"), View("b")]
     good = {"f1@1s": 1.0, "edits_per_cut": 0.0}
     bad = {"f1@1s": 0.0, "edits_per_cut": 1.0}
@@ -107,11 +110,6 @@ def test_it_finds_the_shipped_grid_inside_the_tried_one():
 
 
 def test_it_makes_no_leave_one_take_out_choice_for_a_take_with_no_other_capture():
-    class View:
-        def __init__(self, name):
-            self.labelled = type("L", (), {"name": name})()
-            self.key, self.pool = name, False
-
     good = {"f1@1s": 1.0, "edits_per_cut": 0.0}
     selection = tuning.Selection([{"c": 0}, {"c": 1}], [View("a"), View("a")],
                                  [[good, good], [good, good]])
