@@ -95,13 +95,23 @@ class LabelledTake:
     truth: np.ndarray
     source: str
     kind: str = "skeleton"
+    labels: Path | None = None  # the label file, named when it does not fit the motion
 
     def read(self):
+        """The motion; LabelError when a labelled cut lies outside it (labels made for
+        another take, or at another frame rate, would otherwise score as misses)."""
         if self.kind == "channels":
-            return read_channels(self.path)
-        import motionlib
+            take = read_channels(self.path)
+        else:
+            import motionlib
 
-        return motionlib.read(self.path, asf=self.asf)
+            take = motionlib.read(self.path, asf=self.asf)
+        outside = [int(f) for f in self.truth[:, 1] if not 0 <= f < take.n_frames]
+        if outside:
+            raise LabelError(f"{self.labels or self.name}: cut at frame {outside[0]} is "
+                             f"outside {self.path} ({take.n_frames} frames): the labels "
+                             f"do not fit this motion")
+        return take
 
 
 def _rows(path: Path, columns: tuple[str, ...]) -> list[tuple[int, dict[str, str]]]:
@@ -235,7 +245,7 @@ def discover(root: Path | None = None, *, channels: bool = True,
             if channels and source == "kruger2017" and found.kind == "skeleton" and \
                     four.is_file():
                 takes.append(LabelledTake(path.stem, four, None, found.truth, source,
-                                          "channels"))
+                                          "channels", path))
     for motion in sorted([*cmu.glob("amc/*.amc"), *cmu.glob("bvh/*.bvh"),
                           *cmu.glob("channels4d/*.4d.txt")]):
         if motion.name.split(".")[0] not in labelled:
@@ -248,12 +258,13 @@ def discover(root: Path | None = None, *, channels: bool = True,
 def _take_of(source: str, path: Path, cmu: Path, bvh: bool) -> LabelledTake | None:
     if source == "mocap6":
         found = _mocap6(path, cmu) if bvh else _mocap6_amc(path, cmu)
-        return None if found is None else LabelledTake(path.stem, *found, source)
+        return None if found is None else LabelledTake(path.stem, *found, source,
+                                                       labels=path)
     found = _kruger(path, cmu)
     if found is None:
         return None
     motion, asf, truth, kind = found
-    return LabelledTake(path.stem, motion, asf, truth, source, kind)
+    return LabelledTake(path.stem, motion, asf, truth, source, kind, path)
 
 
 def _mocap6_amc(path: Path, cmu: Path):

@@ -184,3 +184,23 @@ def test_the_default_pool_is_the_shared_data_wherever_it_is_set_and_never_the_fo
     monkeypatch.setenv("CUTROOM_BENCH_DATA", str(tmp_path / "missing"))
     assert bench_quality.default_pool(scored) == ([beside] if beside.is_dir() else [])
     assert bench_quality.default_pool(beside) == []
+
+
+def test_it_refuses_labels_whose_cuts_lie_outside_the_motion_naming_the_label_file(tmp_path):
+    from motionlib import cli
+
+    for folder in ("cmu/channels4d", "labels/cmu86_kruger2017"):
+        (tmp_path / folder).mkdir(parents=True)
+    np.savetxt(tmp_path / "cmu/channels4d/91_02.4d.txt",
+               np.random.default_rng(0).normal(size=(900, 4)), fmt="%.4f")
+    labels = tmp_path / "labels/cmu86_kruger2017/91_02.csv"
+    # Labels of a longer take: the second cut is past the 900 frames read.
+    labels.write_text(KRUGER + "1,walk,380,400,420\n2,jog,930,950,970\n3,end,1200,1200,1200\n")
+    (take,) = benchdata.discover(tmp_path)[0]
+    with pytest.raises(benchdata.LabelError) as error:
+        take.read()
+    assert str(error.value) == (
+        f"{labels}: cut at frame 950 is outside {tmp_path}/cmu/channels4d/91_02.4d.txt "
+        f"(900 frames): the labels do not fit this motion")
+    # The bench stops with that line, not with figures that count the cut as missed.
+    assert cli.main(["bench", "--data", str(tmp_path), "--method", "bone_angle"]) == 2
