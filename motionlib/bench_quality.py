@@ -50,6 +50,7 @@ from pathlib import Path
 import numpy as np
 
 from motionlib import adapt, benchdata, metrics, tuning
+from motionlib.errors import CaptureError
 from motionlib.segmenters import list_segmenters
 from motionlib.segmenters.default import Default, block_mean, take_features
 
@@ -140,7 +141,7 @@ def run(root: Path | None = None, only: list[str] | None = None, *, loo: bool = 
     takes, skipped = benchdata.discover(root)
     for line in skipped:
         print(line, file=log or sys.stderr)
-    cache = [tuning.TakeCache(t, t.read()) for t in takes]
+    cache = read_takes(takes, log)
     if cache_out is not None:
         cache_out.extend(cache)
     results: dict[str, dict] = {}
@@ -171,10 +172,22 @@ def pool_cache(folders, scored, log=None) -> list[tuning.TakeCache]:
         takes, skipped = benchdata.discover(folder)
         for line in skipped:
             print(f"pool {folder}: {line}", file=log or sys.stderr)
-        for t in takes:
-            if (t.name, t.kind) not in seen:
-                seen.add((t.name, t.kind))
-                out.append(tuning.TakeCache(t, t.read(), pool=True))
+        fresh = [t for t in takes if (t.name, t.kind) not in seen]
+        seen.update((t.name, t.kind) for t in fresh)
+        out += read_takes(fresh, log, pool=True, prefix=f"pool {folder}: ")
+    return out
+
+
+def read_takes(takes, log=None, *, pool: bool = False, prefix: str = "") -> list:
+    """``takes`` read (``tuning.TakeCache``); one whose motion cannot be read or whose
+    labels do not fit it (``benchdata.LabelledTake.read``) is skipped with a line saying
+    so."""
+    out = []
+    for t in takes:
+        try:
+            out.append(tuning.TakeCache(t, t.read(), pool=pool))
+        except (benchdata.LabelError, CaptureError) as exc:
+            print(f"{prefix}skipped {t.name} ({t.path.name}): {exc}", file=log or sys.stderr)
     return out
 
 
@@ -325,6 +338,10 @@ def main(root: Path | None = None, only: list[str] | None = None, out=None, *,
     cache: list = []
     results = run(folder, only, loo=loo, log=out, selection_out=selections, pool=pool,
                   cache_out=cache)
+    if not results:
+        print(f"error: no labelled take to score under {folder} (see the lines above)",
+              file=sys.stderr)
+        return 2
     pooled = sum(c.pool for c in selections[0].cache) if selections else 0
     print(_legend(loo, pool if pooled else [], pooled), file=out)
     for name, rows in results.items():

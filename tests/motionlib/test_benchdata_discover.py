@@ -186,7 +186,8 @@ def test_the_default_pool_is_the_shared_data_wherever_it_is_set_and_never_the_fo
     assert bench_quality.default_pool(beside) == []
 
 
-def test_it_refuses_labels_whose_cuts_lie_outside_the_motion_naming_the_label_file(tmp_path):
+def test_it_skips_a_take_whose_labels_lie_outside_its_motion_naming_the_label_file(
+        tmp_path, capsys):
     from motionlib import cli
 
     for folder in ("cmu/channels4d", "labels/cmu86_kruger2017"):
@@ -202,5 +203,16 @@ def test_it_refuses_labels_whose_cuts_lie_outside_the_motion_naming_the_label_fi
     assert str(error.value) == (
         f"{labels}: cut at frame 950 is outside {tmp_path}/cmu/channels4d/91_02.4d.txt "
         f"(900 frames): the labels do not fit this motion")
-    # The bench stops with that line, not with figures that count the cut as missed.
+    # The bench skips the take with that line instead of counting the cut as missed, and
+    # goes on with the others (here: a take whose motion cannot be read, skipped too);
+    # with nothing left to score it exits 2.
+    (tmp_path / "cmu/amc").mkdir()
+    (tmp_path / "cmu/asf").mkdir()
+    (tmp_path / "cmu/amc/91_03.amc").write_text(":FULLY-SPECIFIED\n:DEGREES\n1\nroot x\n")
+    (tmp_path / "cmu/asf/91.asf").write_text(":version 1.10\n")
+    (tmp_path / "labels/cmu86_kruger2017/91_03.csv").write_text(KRUGER + "1,a,5,5,5\n")
     assert cli.main(["bench", "--data", str(tmp_path), "--method", "bone_angle"]) == 2
+    out = capsys.readouterr()
+    assert f"skipped 91_02 (91_02.4d.txt): {error.value}\n" in out.out
+    assert "skipped 91_03 (91_03.amc): 91.asf:1: missing :root section" in out.out
+    assert out.err == f"error: no labelled take to score under {tmp_path} (see the lines above)\n"
