@@ -234,13 +234,13 @@ Takes made of short activities throughout are where fixed 3-6 s windows cost mos
 every inner activity of the three full-skeleton takes cut down the same way, mean F1@1 s
 0.58 at 2.5 s, 0.74 at 3 s and 0.90 at 4 s, where windows of 2-4 s get 0.69, 0.90 and
 0.97 (on the takes as they are 2-4 s windows score 0.898, table above). Tried, not kept:
-choosing the windows per take, 2-4 s when the cuts they add each lower the within-
-segment kernel cost (mean over the take's novelty blocks) by more than a level. 13_29 as
-it is, which must keep 3-6 s, gains 0.017 per added cut; the shortened 86_01 and 13_29
-at 3 s, which need 2-4 s, gain 0.020 and 0.027; 13_29 with only its first activity cut
-to 2.5 s gains 0.019 and loses F1 with 2-4 s (0.89 -> 0.50). No level separates them
-with any margin, and on the four-channel takes the gains are another scale
-(0.001-0.012), so the windows stay fixed.
+choosing the windows per take, 2-4 s when the cuts they add each lower the
+within-segment kernel cost (mean over the take's novelty blocks) by more than a level.
+13_29 as it is, which must keep 3-6 s, gains 0.017 per added cut; the shortened 86_01
+and 13_29 at 3 s, which need 2-4 s, gain 0.020 and 0.027; 13_29 with only its first
+activity cut to 2.5 s gains 0.019 and loses F1 with 2-4 s (0.89 -> 0.50). No level
+separates them with any margin, and on the four-channel takes the gains are another
+scale (0.001-0.012), so the windows stay fixed.
 
 At the start or end of a take a short activity has one boundary, and that one is found:
 with the first or last activity of the three full-skeleton takes cut down by dropping the
