@@ -360,6 +360,7 @@ def main(root: Path | None = None, only: list[str] | None = None, out=None, *,
         print("\n" + short_activity_check(), file=out)
         read = [(c.labelled, c.take) for c in cache]
         print("\n" + real_short_activity_check(read), file=out)
+        print("\n" + short_takes_check(read), file=out)
         print("\n" + edge_activity_check(read), file=out)
     if (not only or "joint_distance_pca" in only) and "13_30" in takes:
         print("\n" + patent_comparison(folder), file=out)
@@ -494,6 +495,46 @@ def real_short_activity_check(read: list, seconds=SHORT_REAL_S) -> str:
         cells = "".join(f"{f'{b}/{len(cases[d])}':>14}{f'{s}/{2 * len(cases[d])}':>8}{f:>7}"
                         for d, (b, s, f) in rows.items())
         lines.append(f"  {name:<34}{cells}")
+    return "\n".join(lines)
+
+
+THROUGHOUT_S = (2.5, 3.0, 4.0)
+
+
+def short_takes_check(read: list, seconds=THROUGHOUT_S) -> str:
+    """Takes made of short activities throughout: every inner activity of each
+    full-skeleton take cut down to ``seconds`` (``benchdata.shortened_throughout``), and
+    the mean F1@1 s and edits per true cut of the zero-shot detector and of the adapted
+    one, fitted on the other takes cut down the same way (a studio whose reviewed takes
+    are like that). ``read`` as in ``real_short_activity_check``; with a single
+    full-skeleton take there is no adapted row.
+    """
+    read = _skeletons(read)
+    if not read:
+        return "short activities throughout a take: no full-skeleton take"
+    rows = {"zero-shot": [], **({"adapted": []} if len(read) > 1 else {})}
+    for duration in seconds:
+        built = [benchdata.shortened_throughout(take, t.truth, duration) for t, take in read]
+        scores = {name: [] for name in rows}
+        for i, (take, truth) in enumerate(built):
+            examples = [(other, cuts[:, 1]) for j, (other, cuts) in enumerate(built) if j != i]
+            models = {"zero-shot": None, "adapted": adapt.fit_cut_model(examples)
+                      if "adapted" in rows else None}
+            for name in rows:
+                cuts = adapt.detect(take, models[name]).cuts
+                scores[name].append(metrics.evaluate(cuts, truth, fps=take.fps))
+        for name in rows:
+            rows[name].append([np.mean([r[key] for r in scores[name]])
+                               for key in ("f1@1s", "edits_per_cut")])
+    head = "".join(f"{f'{d:g} s: F1@1s':>16}{'edits':>7}" for d in seconds)
+    lines = [f"short activities throughout a take, real motion: every inner activity of the "
+             f"{len(read)} full-skeleton takes cut down to "
+             f"{' / '.join(f'{d:g}' for d in seconds)} s by removing its middle; mean F1@1 s "
+             f"and edits per true cut (adapted: fitted on the other takes cut down the same "
+             f"way):", f"  {'':<12}{head}"]
+    for name, cells in rows.items():
+        lines.append(f"  {name:<12}" + "".join(f"{f1:>16.3f}{edits:>7.2f}"
+                                               for f1, edits in cells))
     return "\n".join(lines)
 
 

@@ -311,6 +311,20 @@ def shortened(take, truth: np.ndarray, activity: int, seconds: float):
     return _with_channels(take, channels), out
 
 
+def shortened_throughout(take, truth: np.ndarray, seconds: float):
+    """``take`` with every inner activity longer than ``seconds`` cut down to ``seconds``
+    (``shortened``, last first): real motion made of short activities throughout.
+
+    Returns (take, truth) as ``shortened``; the take itself when no activity is longer.
+    """
+    truth = np.asarray(truth, dtype=np.int64)
+    for activity in range(len(truth) - 2, -1, -1):
+        cut = shortened(take, truth, activity, seconds)
+        if cut is not None:
+            take, truth = cut
+    return take, truth
+
+
 def _with_channels(take, channels: np.ndarray):
     """``take`` (same type) with other channel rows; cached positions dropped."""
     changes = {"channels": channels}

@@ -173,3 +173,23 @@ def test_the_edge_activity_check_finds_the_boundary_of_a_short_first_or_last_act
     assert "60 s 0/0 (false cuts 0)" in text  # no activity is that long: no case
     assert bench_quality.edge_activity_check(_read([takes[2]])) == \
         "short activities at the ends of a take: no full-skeleton take"
+
+
+def test_the_short_takes_check_scores_zero_shot_and_adapted_on_takes_cut_down_throughout():
+    takes = [_Labelled(1), _Labelled(2), _Labelled(3, kind="channels")]
+    text = bench_quality.short_takes_check(_read(takes), seconds=(2.5, 60.0))
+    lines = text.splitlines()
+    assert "every inner activity of the 2 full-skeleton takes cut down to 2.5 / 60 s" in lines[0]
+    assert [line.split()[0] for line in lines[2:]] == ["zero-shot", "adapted"]
+    # At 60 s no activity is cut down: the takes as they are, whose synthetic activities
+    # the zero-shot detector finds.
+    zero = [float(v) for v in lines[2].split()[1:]]
+    expected = np.mean([metrics.evaluate(
+        bench_quality.adapt.detect(t.take).cuts, t.truth, fps=t.take.fps)["f1@1s"]
+        for t in takes[:2]])
+    assert zero[2] == pytest.approx(expected, abs=5e-4) and zero[2] > 0.8
+    assert all(0 <= v <= 1 for v in zero[::2])
+    one = bench_quality.short_takes_check(_read([takes[0]]), seconds=(2.5,))
+    assert [line.split()[0] for line in one.splitlines()[2:]] == ["zero-shot"]
+    assert bench_quality.short_takes_check(_read([takes[2]])) == \
+        "short activities throughout a take: no full-skeleton take"

@@ -98,6 +98,22 @@ def test_an_activity_already_as_short_is_not_shortened_and_a_wrong_index_is_name
         benchdata.shortened(take, truth, len(cuts) - 1, 1.8)
 
 
+def test_a_take_shortened_throughout_has_every_inner_activity_cut_down_and_its_ends_kept():
+    channels = np.arange(1200, dtype=float).reshape(300, 4)
+    take = benchdata.ChannelTake(name="t", fps=10.0, channels=channels)
+    # Inner activities of 8, 2 and 9 s; the first (3 s) and the last (6 s) are not inner.
+    truth = np.repeat(np.asarray([30, 110, 130, 220])[:, None], 3, axis=1)
+    short, moved = benchdata.shortened_throughout(take, truth, 4.0)
+    np.testing.assert_array_equal(moved[:, 1], [30, 70, 90, 130])
+    assert short.n_frames == 300 - 40 - 50
+    np.testing.assert_array_equal(short.channels[:50], channels[:50])  # up to the first join
+    np.testing.assert_array_equal(short.channels[-60:], channels[-60:])  # the last activity
+    # Nothing longer: the take itself.
+    same, kept = benchdata.shortened_throughout(take, truth, 9.0)
+    assert same is take
+    np.testing.assert_array_equal(kept, truth)
+
+
 def test_a_four_channel_take_is_shortened_the_same_way():
     channels = np.arange(1200, dtype=float).reshape(300, 4)
     take = benchdata.ChannelTake(name="t", fps=10.0, channels=channels)
