@@ -123,8 +123,9 @@ UNUSUAL = _peaks([0.5, 0.15, 0.15, 0.15, 0.15], [100])
 def test_one_unusual_example_among_several_does_not_move_the_count():
     from motionlib.adapt import _count
 
-    # Summed over the four examples a prominence above 0.15 scores best (3.38 against
-    # 3.33), but only because of the unusual one: chosen without it, the others keep 0.1.
+    # Summed over the four examples a prominence above 0.15 scores best (3.0 against 0:
+    # the unusual one's four false peaks are four deletes), but only because of the
+    # unusual one: chosen without it, the others keep 0.1.
     assert _count([USUAL, USUAL, USUAL, UNUSUAL], 0.1)[1] == 0.1
 
 
@@ -142,6 +143,19 @@ def test_examples_move_the_count_from_a_zero_shot_without_the_prominence_test():
         assert _count([UNUSUAL, UNUSUAL, UNUSUAL], 0.0)[1] > 0.15
         # The usual examples' false peak (0.05) goes, their weakest cut (0.12) stays.
         assert 0.05 < _count([USUAL, USUAL, USUAL], 0.0)[1] <= 0.12
+
+
+def test_the_count_keeps_weak_peaks_only_if_they_save_a_reviewer_edits():
+    from motionlib.adapt import _count
+
+    # Two strong peaks on cuts; five weak ones (0.2), two of them on the other two cuts.
+    # Keeping the weak ones raises F1 (8/11 against 4/6) but costs three deletes to save
+    # two inserts: the count drops them.
+    example = _peaks([1.0, 1.0, 0.2, 0.2, 0.2, 0.2, 0.2], [100, 200, 300, 400])
+    assert _count([example], 0.2)[1] > 0.2
+    # Three of five true: they save a reviewer one edit, and stay.
+    example = _peaks([1.0, 1.0, 0.2, 0.2, 0.2, 0.2, 0.2], [100, 200, 300, 400, 500])
+    assert _count([example], 0.2)[1] == 0.2
 
 
 def test_two_examples_keep_the_fixed_prior():
