@@ -333,11 +333,11 @@ def main(root: Path | None = None, only: list[str] | None = None, out=None, *,
             print(f"error: benchmark data folder not found: {where}", file=sys.stderr)
             return 2
     started = time.perf_counter()
-    takes = {title(t): t for t in benchdata.discover(folder)[0]}
     selections: list = []
     cache: list = []
     results = run(folder, only, loo=loo, log=out, selection_out=selections, pool=pool,
                   cache_out=cache)
+    takes = {title(c.labelled): c.labelled for c in cache}
     if not results:
         print(f"error: no labelled take to score under {folder} (see the lines above)",
               file=sys.stderr)
