@@ -473,10 +473,9 @@ def _count(per_take, zero: float) -> tuple[float, float]:
     """The prominence of PROMINENCE_GRID whose peaks fit the example cuts best.
 
     The summed example fit (``_fit_by_prominence``) at each prominence, less the prior
-    (``_prior_strength``) times
-    how far (log factor) it lies from ``zero``, the zero-shot prominence. A zero-shot
-    without the prominence test (0) counts as the grid's lowest prominence, the nearest
-    test to none.
+    (``_prior_strength``) times how far (log factor) it lies from ``zero``, the zero-shot
+    prominence. A zero-shot without the prominence test (0) counts as the grid's lowest
+    prominence, the nearest test to none.
 
     Returns (score, prominence): the best score and its prominence.
     """

@@ -6,7 +6,7 @@ import sys
 import numpy as np
 import pytest
 
-from motionlib import bench_quality, benchdata, metrics, synth
+from motionlib import adapt, bench_quality, benchdata, metrics, synth
 from motionlib.segmenters import get_segmenter
 
 DATA = benchdata.data_dir()
@@ -185,7 +185,7 @@ def test_the_short_takes_check_scores_zero_shot_and_adapted_on_takes_cut_down_th
     # the zero-shot detector finds.
     zero = [float(v) for v in lines[2].split()[1:]]
     expected = np.mean([metrics.evaluate(
-        bench_quality.adapt.detect(t.take).cuts, t.truth, fps=t.take.fps)["f1@1s"]
+        adapt.detect(t.take).cuts, t.truth, fps=t.take.fps)["f1@1s"]
         for t in takes[:2]])
     assert zero[2] == pytest.approx(expected, abs=5e-4) and zero[2] > 0.8
     assert all(0 <= v <= 1 for v in zero[::2])
