@@ -546,11 +546,12 @@ def edge_activity_check(read: list, seconds=EDGE_REAL_S) -> str:
     full-skeleton take cut down to ``seconds`` (``benchdata.trimmed``), and whether the
     zero-shot detector then finds its boundary within 1 s, and how many false cuts it
     makes. The novelty windows there see the take mirrored at its end. ``read`` as in
-    ``real_short_activity_check``.
+    ``real_short_activity_check``; a take without a cut has no such boundary and is left
+    out.
     """
-    read = _skeletons(read)
+    read = [(t, take) for t, take in _skeletons(read) if len(t.truth)]
     if not read:
-        return "short activities at the ends of a take: no full-skeleton take"
+        return "short activities at the ends of a take: no full-skeleton take with a cut"
     cells = []
     for duration in seconds:
         found = cases = false = 0

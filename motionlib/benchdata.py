@@ -115,13 +115,17 @@ class LabelledTake:
 
 
 def _rows(path: Path, columns: tuple[str, ...]) -> list[tuple[int, dict[str, str]]]:
-    """CSV rows with their line numbers; LabelError if a column is missing."""
-    with open(path, newline="", encoding="utf-8") as fh:
-        reader = csv.DictReader(fh)
-        missing = [c for c in columns if c not in (reader.fieldnames or [])]
-        if missing:
-            raise LabelError(f"{path}: line 1: missing column {missing[0]!r}")
-        return [(reader.line_num, row) for row in reader]
+    """CSV rows with their line numbers; LabelError if a column is missing or the file
+    cannot be read as UTF-8 text."""
+    try:
+        with open(path, newline="", encoding="utf-8") as fh:
+            reader = csv.DictReader(fh)
+            missing = [c for c in columns if c not in (reader.fieldnames or [])]
+            if missing:
+                raise LabelError(f"{path}: line 1: missing column {missing[0]!r}")
+            return [(reader.line_num, row) for row in reader]
+    except (OSError, UnicodeDecodeError, csv.Error) as exc:
+        raise LabelError(f"{path}: cannot read the labels: {exc}") from None
 
 
 def _int(path: Path, line: int, row: dict[str, str], column: str) -> int:
@@ -222,7 +226,8 @@ def discover(root: Path | None = None, *, channels: bool = True,
     """Every labelled take under ``root``, and one line per file that was skipped.
 
     A take with labels but no motion, or motion but no labels, is skipped with a line
-    saying so. With ``channels``, each subject-86 take that has four-channel data is
+    saying so; so is one whose label file cannot be read (the line names the row and
+    value). With ``channels``, each subject-86 take that has four-channel data is
     listed as a four-channel take too (also when its full AMC is there); with ``bvh``
     false, an AMC is preferred to a BVH.
     """
@@ -236,7 +241,12 @@ def discover(root: Path | None = None, *, channels: bool = True,
     for source, folder in LABEL_SOURCES:
         for path in sorted((labels / folder).glob("*.csv")):
             labelled.add(path.stem)
-            found = _take_of(source, path, cmu, bvh)
+            try:
+                found = _take_of(source, path, cmu, bvh)
+            except LabelError as exc:  # the others are still worth scoring
+                reason = str(exc).removeprefix(f"{path}: ")
+                skipped.append(f"skipped {path.relative_to(root)}: {reason}")
+                continue
             if found is None:
                 skipped.append(f"skipped {path.relative_to(root)}: labels but no motion")
                 continue

@@ -172,7 +172,23 @@ def test_the_edge_activity_check_finds_the_boundary_of_a_short_first_or_last_act
     assert f"2.5 s {found}/{cases} (false cuts" in text and found == cases > 0
     assert "60 s 0/0 (false cuts 0)" in text  # no activity is that long: no case
     assert bench_quality.edge_activity_check(_read([takes[2]])) == \
-        "short activities at the ends of a take: no full-skeleton take"
+        "short activities at the ends of a take: no full-skeleton take with a cut"
+
+
+def test_the_short_activity_checks_run_beside_a_take_labelled_as_one_activity():
+    # A take whose labels hold no cut (one activity throughout) has no boundary to shorten
+    # or trim; the checks go on with the others instead of stopping the benchmark.
+    whole = _Labelled(4)
+    whole.truth = np.zeros((0, 3), dtype=np.int64)
+    takes = _read([_Labelled(1), whole])
+    edge = bench_quality.edge_activity_check(takes, seconds=(2.5,))
+    assert "each of the 1 full-skeleton takes" in edge and "2.5 s " in edge
+    assert bench_quality.edge_activity_check(takes[1:]) == \
+        "short activities at the ends of a take: no full-skeleton take with a cut"
+    inner = bench_quality.real_short_activity_check(takes, seconds=(2.5,))
+    assert inner.splitlines()[-1].split()[0] == "adapted"
+    throughout = bench_quality.short_takes_check(takes, seconds=(2.5,))
+    assert [line.split()[0] for line in throughout.splitlines()[2:]] == ["zero-shot", "adapted"]
 
 
 def test_the_short_takes_check_scores_zero_shot_and_adapted_on_takes_cut_down_throughout():

@@ -216,3 +216,24 @@ def test_it_skips_a_take_whose_labels_lie_outside_its_motion_naming_the_label_fi
     assert f"skipped 91_02 (91_02.4d.txt): {error.value}\n" in out.out
     assert "skipped 91_03 (91_03.amc): 91.asf:1: missing :root section" in out.out
     assert out.err == f"error: no labelled take to score under {tmp_path} (see the lines above)\n"
+
+
+def test_it_skips_a_label_file_it_cannot_read_naming_the_row_and_goes_on(tmp_path):
+    for folder in ("cmu/channels4d", "cmu/bvh", "labels/cmu86_kruger2017",
+                   "labels/mocap6/segments"):
+        (tmp_path / folder).mkdir(parents=True)
+    write_bvh(synth.generate(seed=1, fps=30.0, duration=4.0)[0], tmp_path / "cmu/bvh/77_05.bvh")
+    for name in ("91_02", "91_04"):
+        np.savetxt(tmp_path / f"cmu/channels4d/{name}.4d.txt",
+                   np.random.default_rng(0).normal(size=(900, 4)), fmt="%.4f")
+    kruger = tmp_path / "labels/cmu86_kruger2017"
+    (kruger / "91_02.csv").write_text(KRUGER + "1,walk,380,4OO,420\n2,end,900,900,900\n")
+    (kruger / "91_04.csv").write_text(KRUGER + "1,walk,380,400,420\n2,end,900,900,900\n")
+    (tmp_path / "labels/mocap6/segments/77_05.csv").write_bytes(
+        SEGMENTS.encode() + b"1,50,1,600,1,Jump\xff\n")
+    takes, skipped = benchdata.discover(tmp_path)
+    assert [t.name for t in takes] == ["91_04"]
+    assert skipped[0].startswith("skipped labels/mocap6/segments/77_05.csv: cannot read the "
+                                 "labels: 'utf-8' codec can't decode byte 0xff")
+    assert skipped[1:] == ["skipped labels/cmu86_kruger2017/91_02.csv: line 2: end_mid is "
+                           "not an integer: '4OO'"]
