@@ -158,6 +158,21 @@ def test_the_count_keeps_weak_peaks_only_if_they_save_a_reviewer_edits():
     assert _count([example], 0.2)[1] == 0.2
 
 
+def test_a_take_of_one_activity_weighs_its_false_peak_like_any_other_example():
+    from motionlib.adapt import _count
+
+    # A reviewed take labelled as one activity (no cut) where the detector found one peak,
+    # beside a take of five cuts whose weakest true peak is 0.2. Counted per cut of its own
+    # take, the one false peak would weigh as much as five of the other take's cuts and
+    # push the count above 0.3, losing that cut everywhere; counted like any other edit it
+    # weighs less than the cut.
+    cuts = _peaks([0.5, 0.5, 0.5, 0.5, 0.2], [100, 200, 300, 400, 500])
+    whole = _peaks([0.3], [])
+    assert _count([cuts, whole], 0.1)[1] == 0.1
+    # Three false peaks in it outweigh the one cut.
+    assert _count([cuts, _peaks([0.3, 0.3, 0.3], [])], 0.1)[1] > 0.3
+
+
 def test_two_examples_keep_the_fixed_prior():
     from motionlib.adapt import _count
 
