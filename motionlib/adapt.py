@@ -413,6 +413,12 @@ def _window_options(zero_windows: tuple[float, float],
     On the three full-skeleton takes with every inner activity cut down to 3 s
     (``benchdata.shortened``), each fitted on the other two, mean F1@1 s 0.795 -> 0.830
     but edits per true cut 0.61 -> 0.68; at 4 s and on the takes as they are no change.
+    Also tried, not kept: from three examples on, the windows chosen by how well the
+    count chosen on the other examples fits each one left out (as the prior's strength
+    is chosen). With one inner activity cut down to 2.5 s (``bench_quality``'s real
+    short-activity check) both boundaries found in 5 of 12 cases instead of 3, false cuts
+    12 alike; 1.8 s, the synthetic check (30/35) and the takes as they are unchanged: too
+    little for a second nested leave-one-out in every refit.
     """
     if shortest is None or shortest >= zero_windows[0]:
         return [zero_windows]
