@@ -95,7 +95,7 @@ def op_read(request):
     try:
         result = _import(request["path"])
     except RuntimeError as exc:
-        raise InputProblem(_import_error(exc)) from None
+        raise InputProblem(_import_error(exc, request["path"])) from None
     if "FINISHED" not in result:
         raise InputProblem("Blender's FBX importer gave up on the file (corrupt or truncated?)")
     scene = bpy.context.scene
@@ -133,12 +133,16 @@ def _import(path):
                                     use_custom_props=False)
 
 
-def _import_error(exc):
+def _import_error(exc, path):
+    """Blender's complaint, without the folder the file is stored in (the message names the
+    file already). Only binary FBX reaches Blender (``fbx.check_fbx_header``), so its "ASCII
+    FBX" is a binary file whose start it could not read: cut short or damaged."""
     text = str(exc).strip().splitlines()
     last = text[-1] if text else type(exc).__name__
     if "ASCII" in str(exc):
-        return ("ASCII FBX is not supported (Blender reads binary FBX only); export the take "
-                "again as binary FBX")
+        last = "the start of the file does not read as binary FBX"
+    last = last.replace(os.path.abspath(path), os.path.basename(path)).replace(
+        os.fspath(path), os.path.basename(path))
     return f"Blender's FBX importer could not read the file (corrupt or truncated?): {last}"
 
 

@@ -115,8 +115,22 @@ def test_it_refuses_a_truncated_file(tmp_path):
     path = tmp_path / "cut.fbx"
     path.write_bytes(data[: len(data) // 2])
     with pytest.raises(CaptureError, match=r"cut.fbx: Blender's FBX importer could not read the "
-                                           r"file \(corrupt or truncated\?\)"):
+                                           r"file \(corrupt or truncated\?\)") as error:
         motionlib.read(path)
+    # Blender names the file by its full path; the message keeps only its name (a server
+    # stores originals in folders its users have no business seeing).
+    assert str(tmp_path) not in str(error.value)
+    assert "'cut.fbx'" in str(error.value)
+
+
+def test_it_calls_a_binary_fbx_cut_short_in_its_header_truncated_not_ascii(tmp_path):
+    path = tmp_path / "stub.fbx"
+    path.write_bytes(shared_fbx("flair.fbx").read_bytes()[:27])
+    with pytest.raises(CaptureError) as error:
+        motionlib.read(path)
+    assert str(error.value) == (
+        "stub.fbx: Blender's FBX importer could not read the file (corrupt or truncated?): the "
+        "start of the file does not read as binary FBX")
 
 
 def test_it_refuses_an_ascii_fbx_with_what_to_do(tmp_path):
