@@ -72,6 +72,23 @@ class DetectionWithModelTestCase(ReviewedTakesTestCase):
         self.assertEqual((run.status, run.model_version), ("ready", None), run.error)
 
 
+class TrainingErrorTestCase(ReviewedTakesTestCase):
+    def test_a_reviewed_take_whose_stored_file_is_gone_fails_the_training_by_name(self):
+        capture = self.ingested(seed=97)
+        self.review_to_the_truth(capture, 97)
+        storage = capture.original.storage
+        for name in (capture.original.name, *takecache.cache_names(capture)):
+            storage.delete(name)
+        job = ProjectCutModel.objects.get(project=self.project, status="queued")
+        tasks.retrain(job.pk)
+        job.refresh_from_db()
+        self.assertEqual(job.status, "failed")
+        self.assertEqual(job.error, f"training: reviewed capture {capture.pk} ('take_97.bvh') "
+                                    f"cannot be read: take_97.bvh: no such file")
+        # Annotators read this on the review page: no server folder in it.
+        self.assertNotIn(capture.original.name, job.error)
+
+
 class StoredStudiesTestCase(ReviewedTakesTestCase):
     """What a training learnt from each reviewed take is stored, so a retraining after
     one more submit reads and analyses only what changed, and learns the same model."""
