@@ -16,8 +16,8 @@ so, because one or two reviewed takes are all a new project has:
    once, each zero-shot cut counted where the detector places it; the ``prominence`` from
    :data:`PROMINENCE_GRID` whose peaks match the human cuts with the fewest review edits
    the count decides (deletes and inserts, one-to-one within 1 s, summed over the
-   examples, each edit weighing the same), less a prior cost of moving away from the zero-shot
-   prominence, is kept. Prominence, not height, is what separated true from false peaks
+   examples, each edit weighing the same), less a prior cost of moving away from the
+   zero-shot prominence, is kept. Prominence, not height, is what separated true from false peaks
    out of sample (``segmenters.default``). How strong that prior is depends on how many
    examples there are: with one or two, a fixed :data:`PROMINENCE_PRIOR`; from
    :data:`PRIOR_CV_TAKES` on, the strength of :data:`PRIOR_OPTIONS` (from weak to "keep
@@ -100,7 +100,8 @@ Per cut of its own, a reviewed take of one activity (no cut) weighed each false 
 it like all the cuts of another take: 13_29 with its longest activity (9.2 s, where the
 detector finds one peak) as a second example moved the prominence from 0.1 to 0.25, and
 the model made 3, 1 and 4 cuts on the three full-skeleton takes instead of 5, 4 and 6
-(their true counts); now it stays at 0.1. Every table of the benchmark and the synthetic seeds score the same either way.
+(their true counts); now it stays at 0.1. Every table of the benchmark and the synthetic
+seeds score the same either way.
 
 Pure numpy/scipy, no Django; the service stores ``CutModel.to_json()``.
 """
