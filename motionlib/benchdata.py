@@ -153,6 +153,34 @@ def mocap6_truth(path: Path, *, frame_offset: int = 0) -> np.ndarray:
     return np.repeat(cuts[:, None], 3, axis=1)
 
 
+MOCAP6_BLOCK = 12  # AMC frames per label of a mocap6 block file (10 fps blocks of 120 fps)
+
+
+def mocap6_block_truth(path: Path) -> np.ndarray:
+    """True cuts from an original mocap6 ``<seq>.txt``: one activity id per 12-frame block
+    of the AMC (block i covers 1-based AMC frames 12(i-1)+1 .. 12i), so a new activity
+    that starts in block i (1-based) starts at 0-based AMC frame 12(i-1). The same cuts as
+    ``segments/<seq>.csv``, which lists those blocks as runs.
+    """
+    path = Path(path)
+    try:
+        words = path.read_text(encoding="utf-8").split()
+    except (OSError, UnicodeDecodeError) as exc:
+        raise LabelError(f"{path}: cannot read the labels: {exc}") from None
+    labels = []
+    for block, word in enumerate(words, start=1):
+        try:
+            labels.append(int(word))
+        except ValueError:
+            raise LabelError(f"{path}: block {block}: activity id is not an integer: "
+                             f"{word!r}") from None
+    if not labels:
+        raise LabelError(f"{path}: no blocks")
+    starts = np.flatnonzero(np.diff(labels)) + 1  # 0-based blocks where a new run starts
+    cuts = MOCAP6_BLOCK * starts.astype(np.int64)
+    return np.repeat(cuts[:, None], 3, axis=1)
+
+
 def kruger_truth(path: Path) -> np.ndarray:
     """True cuts from a subject-86 ``cmu86_kruger2017/86_XX.csv``.
 
@@ -225,9 +253,11 @@ def discover(root: Path | None = None, *, channels: bool = True,
              bvh: bool = True) -> tuple[list[LabelledTake], list[str]]:
     """Every labelled take under ``root``, and one line per file that was skipped.
 
-    A take with labels but no motion, or motion but no labels, is skipped with a line
-    saying so; so is one whose label file cannot be read (the line names the row and
-    value). With ``channels``, each subject-86 take that has four-channel data is
+    Labels are read from ``labels/mocap6/segments/<take>.csv`` and
+    ``labels/cmu86_kruger2017/<take>.csv``; a mocap6 take without a segments CSV is read
+    from its original block file ``labels/mocap6/<take>.txt`` (with its AMC). A take with
+    labels but no motion, or motion but no labels, is skipped with a line saying so; so
+    is one whose label file cannot be read (the line names the row and value). With ``channels``, each subject-86 take that has four-channel data is
     listed as a four-channel take too (also when its full AMC is there); with ``bvh``
     false, an AMC is preferred to a BVH.
     """
@@ -256,6 +286,28 @@ def discover(root: Path | None = None, *, channels: bool = True,
                     four.is_file():
                 takes.append(LabelledTake(path.stem, four, None, found.truth, source,
                                           "channels", path))
+    # The original mocap6 block files, for a take without a segments CSV: their blocks are
+    # AMC frames, so they need the AMC (a converted BVH may add lines before the motion, and
+    # the block count fixes the AMC's length only to within a block).
+    for path in sorted((labels / "mocap6").glob("*.txt")):
+        if path.stem in labelled:
+            continue
+        labelled.add(path.stem)
+        amc, asf = cmu / "amc" / f"{path.stem}.amc", \
+            cmu / "asf" / f"{path.stem.split('_')[0]}.asf"
+        if not (amc.is_file() and asf.is_file()):
+            bvh_only = (cmu / "bvh" / f"{path.stem}.bvh").is_file()
+            skipped.append(f"skipped {path.relative_to(root)}: " + (
+                "block labels count AMC frames; add the AMC and its ASF, or "
+                f"segments/{path.stem}.csv" if bvh_only else "labels but no motion"))
+            continue
+        try:
+            truth = mocap6_block_truth(path)
+        except LabelError as exc:
+            skipped.append(f"skipped {path.relative_to(root)}: "
+                           f"{str(exc).removeprefix(f'{path}: ')}")
+            continue
+        takes.append(LabelledTake(path.stem, amc, asf, truth, "mocap6", labels=path))
     for motion in sorted([*cmu.glob("amc/*.amc"), *cmu.glob("bvh/*.bvh"),
                           *cmu.glob("channels4d/*.4d.txt")]):
         if motion.name.split(".")[0] not in labelled:

@@ -237,3 +237,36 @@ def test_it_skips_a_label_file_it_cannot_read_naming_the_row_and_goes_on(tmp_pat
                                  "labels: 'utf-8' codec can't decode byte 0xff")
     assert skipped[1:] == ["skipped labels/cmu86_kruger2017/91_02.csv: line 2: end_mid is "
                            "not an integer: '4OO'"]
+
+
+SHARED = benchdata.data_dir()
+
+
+@pytest.mark.skipif(not SHARED.is_dir(), reason=f"CMU benchmark data not found at {SHARED}")
+def test_the_original_mocap6_block_files_give_the_cuts_of_their_segments_csv():
+    for name in ("13_29", "13_30"):
+        blocks = benchdata.mocap6_block_truth(SHARED / f"labels/mocap6/{name}.txt")
+        runs = benchdata.mocap6_truth(SHARED / f"labels/mocap6/segments/{name}.csv")
+        assert blocks.tolist() == runs.tolist() and len(runs) >= 4
+
+
+@pytest.mark.skipif(not SHARED.is_dir(), reason=f"CMU benchmark data not found at {SHARED}")
+def test_a_mocap6_take_with_only_its_block_file_is_found_with_its_amc(tmp_path):
+    for folder in ("cmu/amc", "cmu/asf", "cmu/bvh", "labels/mocap6"):
+        (tmp_path / folder).mkdir(parents=True)
+    (tmp_path / "cmu/amc/13_30.amc").symlink_to(SHARED / "cmu/amc/13_30.amc")
+    (tmp_path / "cmu/asf/13.asf").symlink_to(SHARED / "cmu/asf/13.asf")
+    (tmp_path / "labels/mocap6/13_30.txt").symlink_to(SHARED / "labels/mocap6/13_30.txt")
+    (tmp_path / "cmu/bvh/13_31.bvh").write_text("HIERARCHY\n")
+    (tmp_path / "labels/mocap6/13_31.txt").write_text("1 1 2 2\n")
+    (tmp_path / "cmu/amc/13_32.amc").symlink_to(SHARED / "cmu/amc/13_30.amc")
+    (tmp_path / "labels/mocap6/13_32.txt").write_text("1 1 x 2\n")
+    takes, skipped = benchdata.discover(tmp_path)
+    assert [(t.name, t.source, t.path.name) for t in takes] == [("13_30", "mocap6", "13_30.amc")]
+    expected = benchdata.mocap6_truth(SHARED / "labels/mocap6/segments/13_30.csv")
+    assert takes[0].truth.tolist() == expected.tolist()
+    assert takes[0].read().n_frames == 2465
+    assert skipped == [
+        "skipped labels/mocap6/13_31.txt: block labels count AMC frames; add the AMC and its "
+        "ASF, or segments/13_31.csv",
+        "skipped labels/mocap6/13_32.txt: block 3: activity id is not an integer: 'x'"]
