@@ -221,29 +221,44 @@ def bvh_frames(path: Path) -> int:
     raise LabelError(f"{path}: no Frames: line")
 
 
+def _amc_asf(name: str, cmu: Path) -> tuple[Path, Path] | None:
+    """The take's AMC and its subject's ASF, when both are there."""
+    amc, asf = cmu / "amc" / f"{name}.amc", cmu / "asf" / f"{name.split('_')[0]}.asf"
+    return (amc, asf) if amc.is_file() and asf.is_file() else None
+
+
 def _mocap6(path: Path, cmu: Path) -> tuple[Path, Path | None, np.ndarray] | None:
     """Motion and truth of a mocap6 take: its BVH where present, else its AMC."""
-    name, subject = path.stem, path.stem.split("_")[0]
-    bvh, amc, asf = cmu / "bvh" / f"{name}.bvh", cmu / "amc" / f"{name}.amc", \
-        cmu / "asf" / f"{subject}.asf"
+    bvh = cmu / "bvh" / f"{path.stem}.bvh"
     if bvh.is_file():
         # The label's last end_frame is the AMC's length; a converted BVH may add lines
         # before it (cgspeed: one T-pose line).
         rows = _rows(path, ("end_frame",))
         n_amc = _int(path, *rows[-1], "end_frame") if rows else 0
         return bvh, None, mocap6_truth(path, frame_offset=max(0, bvh_frames(bvh) - n_amc))
-    if amc.is_file() and asf.is_file():
-        return amc, asf, mocap6_truth(path)
-    return None
+    files = _amc_asf(path.stem, cmu)
+    return None if files is None else (*files, mocap6_truth(path))
+
+
+def _mocap6_blocks(path: Path, cmu: Path) -> LabelledTake | None:
+    """A mocap6 take labelled by its original block file: its blocks are AMC frames, so it
+    needs the AMC (a converted BVH may add lines before the motion, and the block count
+    fixes the AMC's length only to within a block)."""
+    files = _amc_asf(path.stem, cmu)
+    if files is None:
+        if (cmu / "bvh" / f"{path.stem}.bvh").is_file():
+            raise LabelError(f"{path}: block labels count AMC frames; add the AMC and its "
+                             f"ASF, or segments/{path.stem}.csv")
+        return None
+    return LabelledTake(path.stem, *files, mocap6_block_truth(path), "mocap6", labels=path)
 
 
 def _kruger(path: Path, cmu: Path) -> tuple[Path, Path | None, np.ndarray, str] | None:
     """Motion and truth of a subject-86 take: its AMC, else its four channels."""
-    name, subject = path.stem, path.stem.split("_")[0]
-    amc, asf = cmu / "amc" / f"{name}.amc", cmu / "asf" / f"{subject}.asf"
-    four = cmu / "channels4d" / f"{name}.4d.txt"
-    if amc.is_file() and asf.is_file():
-        return amc, asf, kruger_truth(path), "skeleton"
+    files = _amc_asf(path.stem, cmu)
+    four = cmu / "channels4d" / f"{path.stem}.4d.txt"
+    if files is not None:
+        return *files, kruger_truth(path), "skeleton"
     if four.is_file():
         return four, None, kruger_truth(path), "channels"
     return None
@@ -257,9 +272,10 @@ def discover(root: Path | None = None, *, channels: bool = True,
     ``labels/cmu86_kruger2017/<take>.csv``; a mocap6 take without a segments CSV is read
     from its original block file ``labels/mocap6/<take>.txt`` (with its AMC). A take with
     labels but no motion, or motion but no labels, is skipped with a line saying so; so
-    is one whose label file cannot be read (the line names the row and value). With ``channels``, each subject-86 take that has four-channel data is
-    listed as a four-channel take too (also when its full AMC is there); with ``bvh``
-    false, an AMC is preferred to a BVH.
+    is one whose label file cannot be read (the line names the row and value). With
+    ``channels``, each subject-86 take that has four-channel data is listed as a
+    four-channel take too (also when its full AMC is there); with ``bvh`` false, an AMC
+    is preferred to a BVH.
     """
     root = Path(root) if root is not None else data_dir()
     if not root.is_dir():
@@ -268,46 +284,23 @@ def discover(root: Path | None = None, *, channels: bool = True,
     takes: list[LabelledTake] = []
     skipped: list[str] = []
     labelled: set[str] = set()
-    for source, folder in LABEL_SOURCES:
-        for path in sorted((labels / folder).glob("*.csv")):
-            labelled.add(path.stem)
-            try:
-                found = _take_of(source, path, cmu, bvh)
-            except LabelError as exc:  # the others are still worth scoring
-                reason = str(exc).removeprefix(f"{path}: ")
-                skipped.append(f"skipped {path.relative_to(root)}: {reason}")
-                continue
-            if found is None:
-                skipped.append(f"skipped {path.relative_to(root)}: labels but no motion")
-                continue
-            takes.append(found)
-            four = cmu / "channels4d" / f"{path.stem}.4d.txt"
-            if channels and source == "kruger2017" and found.kind == "skeleton" and \
-                    four.is_file():
-                takes.append(LabelledTake(path.stem, four, None, found.truth, source,
-                                          "channels", path))
-    # The original mocap6 block files, for a take without a segments CSV: their blocks are
-    # AMC frames, so they need the AMC (a converted BVH may add lines before the motion, and
-    # the block count fixes the AMC's length only to within a block).
-    for path in sorted((labels / "mocap6").glob("*.txt")):
-        if path.stem in labelled:
-            continue
+    for source, path in _label_files(labels):
         labelled.add(path.stem)
-        amc, asf = cmu / "amc" / f"{path.stem}.amc", \
-            cmu / "asf" / f"{path.stem.split('_')[0]}.asf"
-        if not (amc.is_file() and asf.is_file()):
-            bvh_only = (cmu / "bvh" / f"{path.stem}.bvh").is_file()
-            skipped.append(f"skipped {path.relative_to(root)}: " + (
-                "block labels count AMC frames; add the AMC and its ASF, or "
-                f"segments/{path.stem}.csv" if bvh_only else "labels but no motion"))
-            continue
         try:
-            truth = mocap6_block_truth(path)
-        except LabelError as exc:
-            skipped.append(f"skipped {path.relative_to(root)}: "
-                           f"{str(exc).removeprefix(f'{path}: ')}")
+            found = _take_of(source, path, cmu, bvh)
+        except LabelError as exc:  # the others are still worth scoring
+            reason = str(exc).removeprefix(f"{path}: ")
+            skipped.append(f"skipped {path.relative_to(root)}: {reason}")
             continue
-        takes.append(LabelledTake(path.stem, amc, asf, truth, "mocap6", labels=path))
+        if found is None:
+            skipped.append(f"skipped {path.relative_to(root)}: labels but no motion")
+            continue
+        takes.append(found)
+        four = cmu / "channels4d" / f"{path.stem}.4d.txt"
+        if channels and source == "kruger2017" and found.kind == "skeleton" and \
+                four.is_file():
+            takes.append(LabelledTake(path.stem, four, None, found.truth, source,
+                                      "channels", path))
     for motion in sorted([*cmu.glob("amc/*.amc"), *cmu.glob("bvh/*.bvh"),
                           *cmu.glob("channels4d/*.4d.txt")]):
         if motion.name.split(".")[0] not in labelled:
@@ -317,7 +310,22 @@ def discover(root: Path | None = None, *, channels: bool = True,
     return takes, skipped
 
 
+def _label_files(labels: Path):
+    """(source, label file) of each labelled take: the CSVs of ``LABEL_SOURCES``, then the
+    original mocap6 block files of takes that have no CSV."""
+    stems = set()
+    for source, folder in LABEL_SOURCES:
+        for path in sorted((labels / folder).glob("*.csv")):
+            stems.add(path.stem)
+            yield source, path
+    for path in sorted((labels / "mocap6").glob("*.txt")):
+        if path.stem not in stems:
+            yield "mocap6", path
+
+
 def _take_of(source: str, path: Path, cmu: Path, bvh: bool) -> LabelledTake | None:
+    if path.suffix == ".txt":
+        return _mocap6_blocks(path, cmu)
     if source == "mocap6":
         found = _mocap6(path, cmu) if bvh else _mocap6_amc(path, cmu)
         return None if found is None else LabelledTake(path.stem, *found, source,
@@ -330,10 +338,10 @@ def _take_of(source: str, path: Path, cmu: Path, bvh: bool) -> LabelledTake | No
 
 
 def _mocap6_amc(path: Path, cmu: Path):
-    name, subject = path.stem, path.stem.split("_")[0]
-    amc, asf = cmu / "amc" / f"{name}.amc", cmu / "asf" / f"{subject}.asf"
-    if amc.is_file() and asf.is_file():
-        return amc, asf, mocap6_truth(path)
+    """As ``_mocap6``, the AMC first."""
+    files = _amc_asf(path.stem, cmu)
+    if files is not None:
+        return *files, mocap6_truth(path)
     return _mocap6(path, cmu)
 
 
