@@ -17,9 +17,9 @@ so, because one or two reviewed takes are all a new project has:
    :data:`PROMINENCE_GRID` whose peaks match the human cuts with the fewest review edits
    the count decides (deletes and inserts, one-to-one within 1 s, summed over the
    examples, each edit weighing the same), less a prior cost of moving away from the
-   zero-shot prominence, is kept. Prominence, not height, is what separated true from false peaks
-   out of sample (``segmenters.default``). How strong that prior is depends on how many
-   examples there are: with one or two, a fixed :data:`PROMINENCE_PRIOR`; from
+   zero-shot prominence, is kept. Prominence, not height, is what separated true from
+   false peaks out of sample (``segmenters.default``). How strong that prior is depends
+   on how many examples there are: with one or two, a fixed :data:`PROMINENCE_PRIOR`; from
    :data:`PRIOR_CV_TAKES` on, the strength of :data:`PRIOR_OPTIONS` (from weak to "keep
    the zero-shot prominence") that predicts each example best when the count is chosen
    on the others (leave-one-example-take-out). So examples that agree move the count,
@@ -517,7 +517,7 @@ def _fit_by_prominence(per_take) -> np.ndarray:
     whichever example it is in, so an example with few or no cuts (a take of one
     activity) does not outweigh the others."""
     per_cut = 1 / max(float(np.mean([len(t[2]) for t in per_take])), 1.0)
-    out = np.ones((len(per_take), len(PROMINENCE_GRID)))
+    out = np.empty((len(per_take), len(PROMINENCE_GRID)))
     for i, (frames, prom, cuts, tol, _) in enumerate(per_take):
         for j, prominence in enumerate(PROMINENCE_GRID):
             kept = frames[prom >= prominence]

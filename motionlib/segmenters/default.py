@@ -231,8 +231,9 @@ neighbouring activity's whole distribution, the short one only the short activit
 better: over the three full-skeleton takes their peaks inside activities have median 0.44
 MMD², 90th percentile 0.75, and at the 13 boundaries of 1.8 s activities that the
 detector misses they reach 0.40-0.80. Real activities change inside at the 1-2 s scale
-(sides alternate, a repetition pauses) as much as at their ends. So an activity shorter than about 3 s between two others loses
-one of its boundaries here; that is a known limit of this detector.
+(sides alternate, a repetition pauses) as much as at their ends. So an activity shorter
+than about 3 s between two others loses one of its boundaries here; that is a known limit
+of this detector.
 
 Takes made of short activities throughout are where fixed 3-6 s windows cost most: with
 every inner activity of the three full-skeleton takes cut down the same way, mean F1@1 s
