@@ -32,6 +32,7 @@ GRID = {
     "prominence": (0.0, 0.05, 0.1, 0.15),
     "min_segment_s": (1.5, 2.0),
     "onset": (False, True),
+    "short_unmatched": (0.0, 1.0),
 }
 
 # Options scored out of sample beside GRID but not shipped: adding them to the choice

@@ -30,6 +30,15 @@ repeats every second or so; a boundary is where that distribution changes. So:
       a shoulder of a kept peak at most ``scale_min_s`` away also becomes a cut when
       windows of ``min_segment_s`` show prominent peaks at both
       (``short_activity_peaks``).
+   c. *Short activities, by unmatched poses* (``short_unmatched``, on; see "Short
+      activities: unmatched poses" below). Inside a repeating activity, some pose a
+      cycle or two away always looks like the pose at hand; inside an activity shorter
+      than about 3 s between two others, every pose ``min_segment_s`` to 8 s away
+      belongs to the neighbours, and none does. Where the poses of a 1.2 s stretch near
+      a kept peak are that unlike everything around them, the long windows have seen a
+      short activity as one peak, and the peak becomes the activity's two sides, 1.25 s
+      either side of the stretch's middle, each then placed by step 5
+      (``unmatched_peaks``).
 5. Placement, coarse to fine. The novelty peak locates a change only to within a
    block and a window; an annotator cuts at "the moment the motion changes": the end
    of the last movement of the old activity, where the body is momentarily still, or,
@@ -55,29 +64,36 @@ repeats every second or so; a boundary is where that distribution changes. So:
 How the settings were chosen, and how each choice scores out of sample
 ----------------------------------------------------------------------
 Every setting of ``tuning.GRID`` (windows, threshold, prominence, minimum segment,
-onset; 320 combinations of principled options) was scored on all 11 labelled takes
-under ``shared/data`` (13_29 BVH, 13_30 and 86_01 AMC, and the eight subject-86
-four-channel takes, 86_01's counted as the same take as its AMC), and the defaults are
-the combination with the best mean F1 at 1 s (ties: fewer edits per true cut). Scored
-leave-one-take-out, i.e. each take with the combination chosen without it
+onset, the unmatched-poses step; 640 combinations of principled options) was scored on
+all 11 labelled takes under ``shared/data`` (13_29 BVH, 13_30 and 86_01 AMC, and the
+eight subject-86 four-channel takes, 86_01's counted as the same take as its AMC), and
+the defaults are the combination with the best mean F1 at 1 s (ties: fewer edits per
+true cut): mean F1@1 s 0.965 and 0.370 edits per true cut on those takes (in-sample).
+Scored leave-one-take-out, i.e. each take with the combination chosen without it
 (``python -m motionlib bench-quality --loo``), that choice gets mean F1@1 s 0.957 and 0.41
 edits per true cut (the earlier defaults, threshold 0.25 and no prominence test: 0.862
 and 0.60, chosen on 3 takes). Each option with the others still chosen without the take
 scored, mean F1@1 s / edits per true cut:
 
-=============  ==========================================================
-windows        1.5-3 s 0.863/0.69, 1.5-6 s 0.839/0.73, 2-4 s 0.898/0.55,
-               **3-6 s 0.957/0.41**
-threshold      **0.1** and 0.15 0.957/0.41, 0.2 0.918/0.46, 0.25 0.882/0.53,
-               0.3 0.795/0.73
-prominence     0 (off) 0.862/0.60, 0.05 0.909/0.49, **0.1 0.957/0.41**,
-               0.15 0.916/0.47
-min_segment_s  **1.5** and 2 s alike (0.957/0.41); 1.5 s kept so that activities
-               of 1.5 s can be cut at both ends
-onset          off 0.957/0.41, **on 0.957/0.39** (few of these takes pause
-               between activities; on synthetic takes with a pause it puts
-               the cut within 0.1 s of the onset, off leaves it 0.3-1 s early)
-=============  ==========================================================
+===============  ========================================================
+windows          1.5-3 s 0.863/0.69, 1.5-6 s 0.839/0.73, 2-4 s 0.889/0.57,
+                 **3-6 s 0.957/0.41**
+threshold        **0.1** and 0.15 0.957/0.41, 0.2 0.933/0.44, 0.25
+                 0.891/0.52, 0.3 0.751/0.85
+prominence       0 (off) 0.849/0.64, 0.05 0.927/0.44, **0.1 0.957/0.41**,
+                 0.15 0.942/0.40
+min_segment_s    **1.5** and 2 s alike (0.957/0.41); 1.5 s kept so that
+                 activities of 1.5 s can be cut at both ends
+onset            off 0.957/0.41, **on 0.957/0.39** (few of these takes pause
+                 between activities; on synthetic takes with a pause it puts
+                 the cut within 0.1 s of the onset, off leaves it 0.3-1 s
+                 early)
+short_unmatched  0 (off) 0.957/0.41, **1 0.965/0.39**: it changes one take,
+                 86_14, whose 1.6 s activity it finds; with that take left out
+                 the others tie and the first option (off) is chosen, so the
+                 leave-one-take-out mean does not move (its level and half-width
+                 are chosen on cut-down takes, below)
+===============  ========================================================
 
 The prominence is the sensitive setting: on the three full-skeleton takes 0.1 to 0.13
 all score F1@1 s 1.0, while 0.07 loses a cut of 13_29 (0.83-0.91) and 0.15 one of 13_30
@@ -127,8 +143,63 @@ to a neighbour: four-channel 0.33 s and 0.40 edits per true cut (0.39 s and 0.43
 shipped), full-skeleton 0.12 s and 0.33 (0.09 s and 0.27), capped at 4-10 s alike or
 worse: it trades the takes with a skeleton for those without.
 
-Short activities: tried, not shipped
-------------------------------------
+Short activities: unmatched poses (step 4c)
+-------------------------------------------
+Windows of 3-6 s see an activity shorter than about 3 s between two longer ones as one
+broad peak, and one of its two boundaries is lost. What a short activity has that the
+inside of a long one lacks: a long activity repeats, so each of its poses has a look-
+alike a cycle or two away (1.5-8 s), while inside an activity shorter than twice
+``min_segment_s`` every pose that far away belongs to the neighbours. ``unmatched_poses``
+measures, per 10 Hz block, gamma (the novelty kernel's) times the squared distance to
+the most similar block ``min_segment_s`` to 8 s away; ``unmatched_sides`` looks, within
+1.5 s of each kept peak, for the 1.2 s stretch with the highest mean, and at
+``short_unmatched`` or more replaces the peak by two, 1.25 s either side of the
+stretch's middle, unless kept peaks already lie on both sides of it within
+``scale_min_s``. In kernel units the level needs no per-take scale: 1 means that, on
+average, no pose around looks as alike as e^-1 by the kernel that finds the peaks.
+
+How it was chosen. The 8 s context, the 1.2 s stretch and the 1.5 s reach (half the
+shortest window) were set before scoring; the level and the half-width were chosen from
+0.5, 1, 1.5, 2, 3 (or off) and 0.75, 1, 1.25 s leave-one-take-out on cut-down takes
+(``bench_quality.unmatched_choice_check``, in the bench output): each full-skeleton
+take left out in turn, the setting chosen on the other takes as they are (four-channel
+ones included), with one inner activity cut down to 1.5-3 s and with all cut down to
+2.5-5 s, and scored on the take left out. Every fold chose level 1 (half-width 1.25 s
+twice, 1 s once); over the three takes left out, both boundaries of the one short
+activity were found in 37 of 60 cases against 8 with the step off, mean F1@1 s 0.948
+against 0.869 with one activity cut down and 0.892 against 0.789 with all cut down, the
+takes as they are unchanged (1.0). Chosen on all: level 1, 1.25 s, shipped. The rule
+about kept peaks on both sides was added after seeing takes cut down to 4 s throughout,
+where slow exercises that do not repeat within 4 s looked unmatched (mean F1@1 s 0.674
+without it, 0.903 with it, 0.896 with the step off). The other constants barely matter
+there: a context of 6 or 12 s and a stretch of 1.5 s score the same on the takes as they
+are and cut down (1.5 s: 0.970 instead of 0.903 at 4 s throughout); a stretch of 0.8 s
+or a reach of 1 s lose 0.06 at 4 s throughout; a reach of 2 s reaches into the
+neighbours (8-11 false cuts in the 12 cases of each length, mean F1@1 s 0.929 over the
+11 takes).
+
+What it does, beside the step off (``python -m motionlib bench --loo``): on the 11
+takes as they are it changes 86_14 alone, whose 1.6 s activity it finds (F1@1 s 0.91 ->
+1.0; mean 0.957 -> 0.965, edits per true cut 0.386 -> 0.370); with one inner activity of
+the full-skeleton takes cut down to 1.8 s or 2.5 s both of its boundaries are found in
+5 and 9 of 12 cases instead of 0 and 2 (false cuts 3 and 3 against 3 and 4); with every
+inner activity cut down to 2.5, 3, 3.5 and 4 s mean F1@1 s 0.896, 0.915, 0.886 and
+0.903 instead of 0.579, 0.743, 0.849 and 0.896, at 4.5 and 5 s 0.939 and 0.914 instead
+of 0.970 and 0.939 (there a slow exercise cut down to its first and last seconds can
+still look unmatched); on the synthetic takes with 1.5-6 s activities 27 of the 35
+boundaries beside an activity under 2.5 s instead of 21. The four-channel takes other
+than 86_14 get no cut from it; in their four angles the passage between two exercises is
+as unmatched as a short activity in the poses of a full skeleton, so a level relative to
+the take's own median (tried first: 4-8 times) fired at almost every peak there (mean
+F1@1 s 0.84-0.94 over the 11 takes). Also tried, not kept: moving to the top of the
+hill of the best stretch in reach (so that two peaks beside one stretch agree on its
+middle), which walks into unmatched moments inside the neighbours (mean F1@1 s 0.935).
+
+Short activities: tried before step 4c, not shipped
+---------------------------------------------------
+The figures of this section were measured without step 4c (``short_unmatched`` 0); at
+the ends of a take (its last paragraph) step 4c changes nothing.
+
 Windows of 3-6 s see an activity shorter than about 2.5 s between two long ones as one
 broad peak, so one of its two boundaries is often lost: on synthetic takes with 1.5-6 s
 activities (``bench_quality.short_activity_check``) 21 of the 35 boundaries beside an
@@ -231,9 +302,10 @@ neighbouring activity's whole distribution, the short one only the short activit
 better: over the three full-skeleton takes their peaks inside activities have median 0.44
 MMD², 90th percentile 0.75, and at the 13 boundaries of 1.8 s activities that the
 detector misses they reach 0.40-0.80. Real activities change inside at the 1-2 s scale
-(sides alternate, a repetition pauses) as much as at their ends. So an activity shorter
-than about 3 s between two others loses one of its boundaries here; that is a known limit
-of this detector.
+(sides alternate, a repetition pauses) as much as at their ends: the novelty of
+short windows cannot tell the two apart. Whether a pose recurs can (step 4c above): a
+short activity's middle is unlike everything around it, the inside of a long activity
+is not.
 
 Takes made of short activities throughout are where fixed 3-6 s windows cost most: with
 every inner activity of the three full-skeleton takes cut down the same way, mean F1@1 s
@@ -701,7 +773,7 @@ class Analysis:
     gamma: float
     novelty: np.ndarray
     timings: dict[str, float]
-    _short: dict = field(default_factory=dict, repr=False)
+    _short: dict = field(default_factory=dict, repr=False)  # curves computed once
 
     @property
     def rate(self) -> float:
@@ -716,6 +788,14 @@ class Analysis:
             self._short[w] = mirrored_novelties(blocks, [w], self.gamma)[0] \
                 if len(blocks) >= 4 else np.zeros(len(blocks))
         return self._short[w]
+
+    def unmatched(self, nearest_s: float) -> np.ndarray:
+        """(n // step,) ``unmatched_poses`` of the novelty blocks (computed once)."""
+        key = ("unmatched", nearest_s)
+        if key not in self._short:
+            self._short[key] = unmatched_poses(block_mean(self.x, self.step), self.rate,
+                                               self.gamma, nearest_s)
+        return self._short[key]
 
     def with_windows(self, *windows: tuple[float, float]) -> list[Analysis]:
         """The same pose stream and kernel with the novelty at other window lengths.
@@ -814,6 +894,12 @@ class Default(Segmenter):
             "differ at most this fraction as much as it differs from its neighbours "
             "(0 = no test).",
         ),
+        "short_unmatched": Param(
+            "float", 1.0, 0.0, 100.0,
+            "Cut both sides of a short activity where the poses near a cut are this far "
+            "(squared kernel widths) from every pose min_segment_s to 8 s around them "
+            "(0 = off).",
+        ),
     }
 
     @classmethod
@@ -883,7 +969,16 @@ class Default(Segmenter):
 
     @classmethod
     def choose_peaks(cls, analysis: Analysis, p: dict) -> tuple[np.ndarray, np.ndarray]:
-        """The novelty peaks that become cuts (``select_peaks``, then, with
+        """The novelty peaks that become cuts (``window_peaks``, then, with
+        ``short_unmatched``, both sides of short activities), and their evidence."""
+        peaks, strength = cls.window_peaks(analysis, p)
+        if p["short_unmatched"] > 0:
+            peaks, strength = unmatched_peaks(analysis, peaks, strength, p)
+        return peaks, strength
+
+    @classmethod
+    def window_peaks(cls, analysis: Analysis, p: dict) -> tuple[np.ndarray, np.ndarray]:
+        """The peaks the novelty windows choose (``select_peaks``, then, with
         ``short_activity``, the far sides of short activities), and their evidence."""
         peaks, strength = cls.select_peaks(analysis.novelty, analysis.rate, p)
         if p["short_activity"] > 0:
@@ -976,6 +1071,118 @@ def short_activity_peaks(analysis: Analysis, peaks: np.ndarray, strength: np.nda
     order = np.argsort(np.concatenate([peaks, added]), kind="stable")
     evidence = np.concatenate([strength, np.full(len(added), p["prominence"])])
     return np.concatenate([peaks, added])[order], evidence[order]
+
+
+# Step 4c: how far around a pose (s) its look-alikes are sought, the stretch (s) whose
+# poses must all be unmatched, how far from a kept peak (s) that stretch may lie, and
+# how far (s) each side of the stretch's middle its two cuts are placed from.
+UNMATCHED_CONTEXT_S = 8.0
+UNMATCHED_STRETCH_S = 1.2
+UNMATCHED_REACH_S = 1.5
+UNMATCHED_HALF_S = 1.25
+
+
+def unmatched_poses(blocks: np.ndarray, rate: float, gamma: float, nearest_s: float,
+                    context_s: float = UNMATCHED_CONTEXT_S) -> np.ndarray:
+    """How unlike every pose around it each pose is.
+
+    For each block, ``gamma`` times the squared distance to the most similar block
+    ``nearest_s`` to ``context_s`` seconds before or after it (in squared kernel widths:
+    1 is a kernel similarity of e^-1). Inside a repeating activity some pose a cycle or
+    two away always looks alike (near 0); inside an activity shorter than twice
+    ``nearest_s`` between two others, every pose the search reaches belongs to the
+    neighbours, and none looks alike.
+
+    Returns
+    -------
+    (n_blocks,) float; 0 for a block with nothing in reach (a take too short to say).
+    """
+    n = len(blocks)
+    out = np.full(n, np.inf)
+    lo = max(1, int(np.ceil(nearest_s * rate - 1e-9)))
+    hi = min(n - 1, int(np.floor(context_s * rate + 1e-9)))
+    for lag in range(lo, hi + 1):
+        diff = blocks[lag:] - blocks[:-lag]
+        d = np.einsum("ij,ij->i", diff, diff)
+        np.minimum(out[lag:], d, out=out[lag:])
+        np.minimum(out[:-lag], d, out=out[:-lag])
+    out[~np.isfinite(out)] = 0.0
+    return gamma * out
+
+
+def unmatched_peaks(analysis: Analysis, peaks: np.ndarray, strength: np.ndarray,
+                    p: dict, half_s: float = UNMATCHED_HALF_S) -> tuple[np.ndarray, np.ndarray]:
+    """Both sides of a short activity the long windows see as one peak (step 4c).
+
+    Each kept peak that ``unmatched_sides`` finds beside a short activity is replaced by
+    that activity's two sides. Where two cuts end up closer than ``min_segment_s``, the
+    earlier is kept.
+
+    Returns
+    -------
+    peaks, evidence : as ``Default.select_peaks``, sorted; both sides keep the evidence
+        of the peak they replace.
+    """
+    sides = unmatched_sides(analysis, peaks, p, half_s)
+    out = sorted((side, evidence) for peak, evidence in zip(peaks.tolist(), strength.tolist(),
+                                                            strict=True)
+                 for side in sides.get(peak, (peak,)))
+    kept: list[tuple[int, float]] = []
+    for peak, evidence in out:
+        if not kept or peak - kept[-1][0] >= p["min_segment_s"] * analysis.rate - 1e-9:
+            kept.append((peak, evidence))
+    return (np.asarray([k for k, _ in kept], dtype=peaks.dtype),
+            np.asarray([e for _, e in kept], dtype=float))
+
+
+def unmatched_sides(analysis: Analysis, peaks: np.ndarray, p: dict,
+                    half_s: float = UNMATCHED_HALF_S) -> dict[int, tuple[int, int]]:
+    """The kept peaks that stand for a short activity of their own, and its two sides.
+
+    Near each kept peak (``UNMATCHED_REACH_S``), the stretch of ``UNMATCHED_STRETCH_S``
+    whose poses are, on average, least like any pose ``min_segment_s`` to
+    ``UNMATCHED_CONTEXT_S`` around them (``unmatched_poses``). When that average is at
+    least ``short_unmatched``, the stretch is the middle of an activity of its own, too
+    short to hold a look-alike of its own poses: its sides are at the stretch's middle
+    ± ``half_s`` (placement then moves each to its boundary). Not when kept peaks lie on
+    both sides of the stretch within ``scale_min_s``: the long windows have found that
+    activity's two sides already, and a longer activity that does not repeat within a
+    few seconds (a slow exercise) looks unmatched too. Not either when a side would lie
+    closer than ``min_segment_s / 2`` to an end of the take.
+
+    Returns
+    -------
+    kept peak (novelty sample) -> (first side, second side), novelty samples.
+    """
+    if len(peaks) == 0 or p["short_unmatched"] <= 0:
+        return {}
+    rate = analysis.rate
+    unmatched = analysis.unmatched(p["min_segment_s"])
+    w = max(1, int(round(UNMATCHED_STRETCH_S * rate)))
+    if len(unmatched) < w:
+        return {}
+    sums = np.concatenate([[0.0], np.cumsum(unmatched)])
+    stretch = (sums[w:] - sums[:-w]) / w  # mean over blocks i .. i + w - 1
+    reach, half = UNMATCHED_REACH_S * rate, half_s * rate
+    edge = p["min_segment_s"] * rate / 2
+    out = {}
+    for peak in peaks.tolist():
+        lo = max(0, int(peak - reach) - w // 2)
+        hi = min(len(stretch), int(peak + reach) - w // 2 + 1)
+        if hi <= lo:
+            continue
+        start = lo + int(np.argmax(stretch[lo:hi]))
+        middle = start + w // 2
+        # Kept peaks on both sides within the shortest window: the long windows have
+        # found this activity's two sides already.
+        near = np.abs(peaks - middle) <= p["scale_min_s"] * rate
+        found = (near & (peaks < middle)).any() and (near & (peaks > middle)).any()
+        if stretch[start] < p["short_unmatched"] or found:
+            continue
+        sides = (int(round(middle - half)), int(round(middle + half)))
+        if edge <= sides[0] and sides[1] <= len(unmatched) - edge:
+            out[int(peak)] = sides
+    return out
 
 
 def mixing(analysis: Analysis, a: int, b: int, context: int) -> float:

@@ -38,9 +38,10 @@ def test_it_cuts_both_sides_of_a_short_activity_between_two_long_ones(seed, acti
 
 @pytest.mark.parametrize("seed, actions", SHORT_BETWEEN_LONG)
 def test_it_finds_one_side_only_with_the_long_windows_alone(seed, actions):
-    # The limit the step addresses, and why the shipped default (off) still has it.
+    # The limit the step addresses (the unmatched-poses step, on by default, is another
+    # answer to it: test_default_unmatched).
     take, truth = _short_between_long(seed, actions)
-    assert _found(Default().fit_predict(take).cuts, truth) == 1
+    assert _found(Default(short_unmatched=0.0).fit_predict(take).cuts, truth) == 1
 
 
 def test_it_ships_off_and_is_scored_as_a_tried_option():
@@ -57,8 +58,8 @@ def test_it_adds_no_cut_where_every_activity_is_long(seed):
 
 def test_it_rates_an_added_cut_as_the_weakest_peak_kept_on_its_own():
     take, _ = _short_between_long(*SHORT_BETWEEN_LONG[0])
-    result = Default(short_activity=4.0).fit_predict(take)
-    added = ~np.isin(result.cuts, Default().fit_predict(take).cuts)
+    result = Default(short_activity=4.0, short_unmatched=0.0).fit_predict(take)
+    added = ~np.isin(result.cuts, Default(short_unmatched=0.0).fit_predict(take).cuts)
     assert added.sum() == 1
     assert result.confidence[added] == pytest.approx([0.5])  # prominence at the setting
 
