@@ -247,3 +247,24 @@ def test_it_starts_from_the_settings_it_is_given():
     assert model.min_segment_s <= 1.0  # never longer than where it started
     zero_shot = fit_cut_model([_take(1), _take(2)])
     assert (zero_shot.threshold, zero_shot.min_segment_s) == (0.1, 1.5)
+
+
+def test_an_example_counts_both_sides_of_a_short_activity_the_detector_cuts():
+    # 6 s, 1.8 s, 6 s: the long windows see the short activity as one peak, and the
+    # detector's unmatched-poses step makes it two cuts; the study the count is learnt
+    # from must hold both, where the detector places them, at the zero-shot prominence.
+    from motionlib.adapt import Example, MemoryStudies, matched_count
+    from motionlib.segmenters.default import Default
+
+    take, segments = synth.generate(seed=1, fps=FPS, plan=[("idle", 6.0), ("kick", 1.8),
+                                                           ("walk", 6.0)])
+    cuts = np.asarray([start for start, _, _ in segments[1:]], dtype=np.int64)
+    assert matched_count(detect(take).cuts, cuts, int(FPS)) == 2
+    studies = MemoryStudies()
+    fit_cut_model([Example(name="short", cuts=cuts, fps=FPS, n_frames=take.n_frames,
+                           read=lambda: take, key="short")], studies=studies)
+    study = studies.items["short"][1]
+    kept = study["placed_frames"][study["placed_prominence"] >=
+                                  Default.params["prominence"].default]
+    assert matched_count(kept, cuts, int(FPS)) == 2
+    assert len(kept) == 2
