@@ -24,7 +24,8 @@ chosen without the take, since the shipped ones were chosen on it too), and rupt
 penalty chosen without the take; the out-of-sample score of every option of every
 setting, and three short-activity checks, on synthetic takes, on the real takes with
 one activity cut short (``real_short_activity_check``) and with the first or last one cut
-short (``edge_activity_check``), follow the tables. Each take is
+short (``edge_activity_check``), and the leave-one-take-out choice of the unmatched-poses
+step's settings on such takes (``unmatched_choice_check``), follow the tables. Each take is
 scored separately and the means are given per kind of take and over all.
 
 Leave-one-take-out chooses on all the labelled material there is, not only on the takes
@@ -362,6 +363,7 @@ def main(root: Path | None = None, only: list[str] | None = None, out=None, *,
         print("\n" + real_short_activity_check(read), file=out)
         print("\n" + short_takes_check(read), file=out)
         print("\n" + edge_activity_check(read), file=out)
+        print("\n" + unmatched_choice_check(read), file=out)
     if (not only or "joint_distance_pca" in only) and "13_30" in takes:
         print("\n" + patent_comparison(folder), file=out)
     print(f"\nwhole benchmark: {time.perf_counter() - started:.0f} s, load average "
@@ -397,7 +399,8 @@ SHORT_S = 2.5
 
 def short_activity_check(seeds: int = 6) -> str:
     """Recall of boundaries beside short activities on synthetic takes: zero-shot (the
-    shipped settings), zero-shot with each ``short_activity`` option of ``tuning.GRID``,
+    shipped settings), without its unmatched-poses step (``short_unmatched`` 0), with
+    each ``short_activity`` option of ``tuning.TRIED``,
     and adapted (each take's model fitted on the other seeds' takes)."""
     from motionlib import synth
 
@@ -413,6 +416,7 @@ def short_activity_check(seeds: int = 6) -> str:
                {"short_activity": k, "short_uniformity": u}
                for k in tuning.TRIED["short_activity"]
                for u in (0.0, *tuning.TRIED["short_uniformity"])}
+    options = {"short_unmatched=0": {"short_unmatched": 0.0}, **options}
     found = {name: [0, 0] for name in ["zero-shot", *options, "adapted"]}
     for i, (take, cuts, short) in enumerate(takes):
         model = adapt.fit_cut_model([(t, c) for j, (t, c, _) in enumerate(takes) if j != i])
@@ -446,7 +450,8 @@ def real_short_activity_check(read: list, seconds=SHORT_REAL_S) -> str:
     of its boundaries within 1 s, how many of them, and how many false cuts it makes.
     ``read``: (labelled take, its motion) pairs, as the bench read them.
 
-    Rows: zero-shot; the optional short-activity step as the default's docstring
+    Rows: zero-shot; zero-shot without its unmatched-poses step (``short_unmatched`` 0,
+    as before that step); the optional short-activity step as the default's docstring
     suggests it (``short_activity`` 4, ``short_uniformity`` 0.3); the shorter windows
     (2-4 s) the adaptation may choose; adapted, each take's model fitted on the other
     full-skeleton takes, as they are and with each of their activities shortened the same
@@ -458,7 +463,8 @@ def real_short_activity_check(read: list, seconds=SHORT_REAL_S) -> str:
     read = _skeletons(read)
     if not read:
         return "short activities, real motion: no full-skeleton take"
-    options = {"zero-shot": {}, "short_activity=4/uniformity=0.3":
+    options = {"zero-shot": {}, "short_unmatched=0": {"short_unmatched": 0.0},
+               "short_activity=4/uniformity=0.3":
                {"short_activity": 4.0, "short_uniformity": 0.3},
                "windows 2-4 s": {"scale_min_s": 2.0, "scale_max_s": 4.0}}
     cases = {duration: [(i, k, *cut) for i, (t, take) in enumerate(read)
@@ -499,6 +505,116 @@ def real_short_activity_check(read: list, seconds=SHORT_REAL_S) -> str:
 
 
 THROUGHOUT_S = (2.5, 3.0, 4.0)
+# How step 4c's settings (``short_unmatched`` and the half-width of its two cuts) are
+# chosen: the options, and the cut-down takes they are chosen and scored on.
+UNMATCHED_LEVELS = (0.0, 0.5, 1.0, 1.5, 2.0, 3.0)
+UNMATCHED_HALVES = (0.75, 1.0, 1.25)
+UNMATCHED_INNER_S = (1.5, 1.8, 2.2, 2.5, 3.0)
+UNMATCHED_THROUGHOUT_S = (2.5, 3.0, 4.0, 5.0)
+
+
+def unmatched_choice_check(read: list) -> str:
+    """How the unmatched-poses step's settings (``segmenters.default`` step 4c) are
+    chosen, and how that choice scores on takes it was not chosen on.
+
+    Material: every take as it is (full-skeleton and four-channel), and each
+    full-skeleton take with each inner activity cut down to ``UNMATCHED_INNER_S``
+    (``benchdata.shortened``, one at a time) and with all of them cut down to
+    ``UNMATCHED_THROUGHOUT_S`` (``benchdata.shortened_throughout``). A setting's score
+    on some material is the mean over the three families (as they are, one cut down,
+    all cut down) of the mean F1@1 s; the first of equal settings (off first) wins.
+    Each full-skeleton capture is left out in turn (its four-channel view with it): the
+    setting is chosen on everything else, and scored on the left-out take's material,
+    beside the step off. ``read``: (labelled take, motion) pairs, as the bench read them.
+    """
+    from motionlib.segmenters.default import (
+        UNMATCHED_HALF_S,
+        Default,
+        place_stages,
+        unmatched_peaks,
+    )
+
+    skeletons = _skeletons(read)
+    if not skeletons:
+        return "unmatched-poses step: no full-skeleton take to choose its settings on"
+    material = [(t.name, "as is", take, t.truth, None) for t, take in read if len(t.truth)]
+    for t, take in skeletons:
+        for k in range(len(t.truth) - 1):
+            for seconds in UNMATCHED_INNER_S:
+                cut = benchdata.shortened(take, t.truth, k, seconds)
+                if cut is not None:
+                    material.append((t.name, "one cut down", *cut, k))
+        for seconds in UNMATCHED_THROUGHOUT_S:
+            material.append((t.name, "all cut down",
+                             *benchdata.shortened_throughout(take, t.truth, seconds), None))
+    settings = [(0.0, UNMATCHED_HALF_S)] + [(level, half) for level in UNMATCHED_LEVELS
+                                            if level > 0 for half in UNMATCHED_HALVES]
+    p = Default.validate_params({})
+    scores = {}  # (setting, material index) -> (F1@1 s, both sides of the short one found)
+    for i, (_, _, take, truth, k) in enumerate(material):
+        analysis = Default.analyse(take, p)
+        if analysis is None:
+            continue
+        peaks, strength = Default.select_peaks(analysis.novelty, analysis.rate, p)
+        for level, half in settings:
+            kept = peaks if level == 0 else unmatched_peaks(
+                analysis, peaks, strength, {**p, "short_unmatched": level}, half_s=half)[0]
+            stages, _ = place_stages(analysis.x, analysis.peak_frames(kept), analysis.fps,
+                                     analysis.gamma, p)
+            cuts = stages["onset" if p["onset"] else "pause"] + analysis.first
+            _, ti = metrics.match(cuts, truth, tolerance=int(round(take.fps)))
+            scores[(level, half), i] = (
+                metrics.evaluate(cuts, truth, fps=take.fps)["f1@1s"],
+                k is not None and k in ti and k + 1 in ti)
+
+    def score(setting, used) -> float:
+        families: dict[str, list[float]] = {}
+        for i in used:
+            if (setting, i) in scores:
+                families.setdefault(material[i][1], []).append(scores[setting, i][0])
+        return round(float(np.mean([np.mean(v) for v in families.values()])), 9) \
+            if families else -math.inf
+
+    def family(setting, used, name) -> tuple[float, int, int]:
+        rows = [scores[setting, i] for i in used
+                if material[i][1] == name and (setting, i) in scores]
+        return (float(np.mean([r[0] for r in rows])) if rows else math.nan,
+                sum(r[1] for r in rows), len(rows))
+
+    def label(setting) -> str:
+        return "off" if setting[0] == 0 else f"{setting[0]:g} / {setting[1]:g} s"
+
+    everything = range(len(material))
+    lines = [f"unmatched-poses step (short_unmatched / half-width of its two cuts), chosen "
+             f"leave-one-take-out: each full-skeleton take left out, the setting chosen on "
+             f"the other takes as they are, with one inner activity cut down to "
+             f"{' / '.join(f'{s:g}' for s in UNMATCHED_INNER_S)} s and with all cut down to "
+             f"{' / '.join(f'{s:g}' for s in UNMATCHED_THROUGHOUT_S)} s (mean of the three "
+             f"families' mean F1@1 s), and scored on the take left out:",
+             f"  {'left out':<10}{'chosen':>14}  {'as is F1':>9}{'one cut down: F1':>18}"
+             f"{'both':>8}{'all cut down F1':>17}"]
+    totals = {"chosen": [], "off": []}
+    for t, _ in skeletons:
+        used = [i for i in everything if material[i][0] != t.name]
+        held = [i for i in everything if material[i][0] == t.name]
+        best = max(settings, key=lambda s: score(s, used))
+        for name, setting in (("chosen", best), ("off", settings[0])):
+            cells = (family(setting, held, "as is")[0], *family(setting, held, "one cut down"),
+                     family(setting, held, "all cut down")[0])
+            totals[name].append(cells)
+            if name == "chosen" or setting != best:
+                lines.append(_unmatched_row(t.name if name == "chosen" else "",
+                                            label(setting), cells))
+    for name, rows in totals.items():
+        lines.append(_unmatched_row("all" if name == "chosen" else "", name, (
+            float(np.mean([r[0] for r in rows])), float(np.mean([r[1] for r in rows])),
+            sum(r[2] for r in rows), sum(r[3] for r in rows),
+            float(np.mean([r[4] for r in rows])))))
+    best = max(settings, key=lambda s: score(s, everything))
+    lines.append(f"  chosen on all: {label(best)}; shipped: short_unmatched "
+                 f"{Default.params['short_unmatched'].default:g}, half-width "
+                 f"{UNMATCHED_HALF_S:g} s")
+    return "\n".join(lines)
 
 
 def short_takes_check(read: list, seconds=THROUGHOUT_S) -> str:
@@ -536,6 +652,12 @@ def short_takes_check(read: list, seconds=THROUGHOUT_S) -> str:
         lines.append(f"  {name:<12}" + "".join(f"{f1:>16.3f}{edits:>7.2f}"
                                                for f1, edits in cells))
     return "\n".join(lines)
+
+
+def _unmatched_row(name: str, setting: str, cells: tuple) -> str:
+    as_is, f1, both, n, all_cut = cells
+    return (f"  {name:<10}{setting:>14}  {as_is:>9.3f}{f1:>18.3f}{f'{both}/{n}':>8}"
+            f"{all_cut:>17.3f}")
 
 
 EDGE_REAL_S = (1.5, 1.8, 2.5)

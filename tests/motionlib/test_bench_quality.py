@@ -142,7 +142,8 @@ def test_the_real_short_activity_check_shortens_every_inner_activity_of_each_ske
     lines = text.splitlines()
     assert f"({expected[1.8]} / {expected[2.5]} cases)" in lines[0]
     assert [line.split("  ")[1].strip() for line in lines[2:]] == [
-        "zero-shot", "short_activity=4/uniformity=0.3", "windows 2-4 s", "adapted"]
+        "zero-shot", "short_unmatched=0", "short_activity=4/uniformity=0.3", "windows 2-4 s",
+        "adapted"]
     for line in lines[2:]:
         both, sides, _, both2, sides2, _ = line.split()[-6:]
         assert both.endswith(f"/{expected[1.8]}") and sides.endswith(f"/{2 * expected[1.8]}")
@@ -158,7 +159,8 @@ def test_the_real_short_activity_check_says_so_without_a_skeleton_take():
 def test_the_real_short_activity_check_has_no_adapted_row_with_one_skeleton_take():
     text = bench_quality.real_short_activity_check(_read([_Labelled(1)]), seconds=(1.8,))
     rows = [line.split("  ")[1].strip() for line in text.splitlines()[2:]]
-    assert rows == ["zero-shot", "short_activity=4/uniformity=0.3", "windows 2-4 s"]
+    assert rows == ["zero-shot", "short_unmatched=0", "short_activity=4/uniformity=0.3",
+                    "windows 2-4 s"]
 
 
 def test_the_edge_activity_check_finds_the_boundary_of_a_short_first_or_last_activity():
@@ -209,3 +211,29 @@ def test_the_short_takes_check_scores_zero_shot_and_adapted_on_takes_cut_down_th
     assert [line.split()[0] for line in one.splitlines()[2:]] == ["zero-shot"]
     assert bench_quality.short_takes_check(_read([takes[2]])) == \
         "short activities throughout a take: no full-skeleton take"
+
+
+def test_the_unmatched_choice_check_leaves_out_each_skeleton_take_and_scores_it():
+    from motionlib.segmenters.default import UNMATCHED_HALF_S, Default
+
+    takes = [_Labelled(1), _Labelled(2), _Labelled(3, kind="channels")]
+    lines = bench_quality.unmatched_choice_check(_read(takes)).splitlines()
+    assert "chosen leave-one-take-out" in lines[0]
+    named = [line[2:12].strip() for line in lines[2:-1] if line[2:12].strip()]
+    assert named == ["seed 1", "seed 2", "all"]  # each skeleton take left out, then totals
+    cases = sum(benchdata.shortened(t.take, t.truth, k, s) is not None
+                for t in takes[:2] for k in range(len(t.truth) - 1)
+                for s in bench_quality.UNMATCHED_INNER_S)
+    chosen, off = lines[-3], lines[-2]
+    assert chosen.split()[:2] == ["all", "chosen"] and off.split()[0] == "off"
+    for line in (chosen, off):  # both sides counted over every case left out
+        assert line.split()[-2].endswith(f"/{cases}")
+    assert lines[-1].startswith("  chosen on all: ")
+    assert lines[-1].endswith(f"shipped: short_unmatched "
+                              f"{Default.params['short_unmatched'].default:g}, half-width "
+                              f"{UNMATCHED_HALF_S:g} s")
+
+
+def test_the_unmatched_choice_check_says_so_without_a_skeleton_take():
+    text = bench_quality.unmatched_choice_check(_read([_Labelled(1, kind="channels")]))
+    assert text == "unmatched-poses step: no full-skeleton take to choose its settings on"
