@@ -25,3 +25,14 @@ def bvh_13_29() -> Path:
 @pytest.fixture
 def amc_13_29() -> tuple[Path, Path]:
     return cmu_file("amc", "13_29.amc"), cmu_file("asf", "13.asf")
+
+
+def skeleton_takes() -> list:
+    """The full-skeleton labelled takes (``benchdata.discover``), read; skipped when the
+    shared data is absent."""
+    from motionlib.benchdata import discover
+
+    takes = [t for t in discover()[0] if t.kind == "skeleton"]
+    if not takes:
+        pytest.skip("labelled CMU takes are not available (needs ../shared/data)")
+    return [(t, t.read()) for t in takes]

@@ -4,8 +4,9 @@ of an activity too short for the 3-6 s windows, confirmed by windows of min_segm
 import numpy as np
 import pytest
 
-from motionlib import benchdata, metrics, synth, tuning
+from motionlib import metrics, synth, tuning
 from motionlib.segmenters.default import Analysis, Default, mixing
+from tests.motionlib.conftest import skeleton_takes
 
 FPS = 60.0
 # A 1.8 s activity between two of 6 s: the 3-6 s windows see one broad peak.
@@ -66,11 +67,7 @@ def test_it_rates_an_added_cut_as_the_weakest_peak_kept_on_its_own():
 
 @pytest.mark.slow
 def test_it_adds_no_cut_to_the_real_full_skeleton_takes():
-    takes = [t for t in benchdata.discover()[0] if t.kind == "skeleton"]
-    if not takes:
-        pytest.skip("labelled CMU takes are not available (needs ../shared/data)")
-    for labelled in takes:
-        take = labelled.read()
+    for _, take in skeleton_takes():
         np.testing.assert_array_equal(Default(short_activity=4.0).fit_predict(take).cuts,
                                       Default().fit_predict(take).cuts)
 

@@ -13,6 +13,7 @@ from motionlib.segmenters.default import (
     unmatched_peaks,
     unmatched_poses,
 )
+from tests.motionlib.conftest import skeleton_takes
 
 RATE = 10.0
 
@@ -150,10 +151,6 @@ def test_it_finds_the_real_1_6_s_activity_of_a_four_channel_take():
 
 @pytest.mark.slow
 def test_it_adds_no_cut_to_the_real_full_skeleton_takes_as_they_are():
-    takes = [t for t in benchdata.discover()[0] if t.kind == "skeleton"]
-    if not takes:
-        pytest.skip("labelled CMU takes are not available (needs ../shared/data)")
-    for labelled in takes:
-        take = labelled.read()
+    for _, take in skeleton_takes():
         np.testing.assert_array_equal(Default().fit_predict(take).cuts,
                                       Default(short_unmatched=0.0).fit_predict(take).cuts)
