@@ -46,36 +46,37 @@ changes the minimum segment (step 1), and with it every study.
 
 Scored on the 11 labelled takes under ``shared/data`` with the other takes of the same
 label source as examples, each take's adaptation starting from the zero-shot settings
-chosen without it (``python -m motionlib bench --loo``, row ``adapted/loo``): mean F1@1 s
-0.957 and 0.406 edits per true cut, the same as the zero-shot ``default/loo``: on these
-takes the examples confirm the zero-shot settings. With a fixed prior of 0.05 at any
-number of examples (the earlier design) it was 0.947 and 0.421: the subject-86 takes
+chosen without it (``python -m motionlib bench --loo``, row ``adapted/loo``): mean
+F1@1 s 0.957 and 0.406 edits per true cut, the same as the zero-shot ``default/loo``: on
+these takes the examples confirm the zero-shot settings. With a fixed prior of 0.05 at
+any number of examples (the earlier design) it was 0.947 and 0.421: the subject-86 takes
 taught a prominence of 0.14, pulled up by one take (86_10, where the zero-shot
 prominence gives four false cuts), and with it 86_14 lost a cut; with the strength
-chosen by leave-one-example-take-out the count stays. (Started from the settings
-then shipped, before step 4c, which were chosen on all 11 takes, the scored one too:
-0.957 and 0.386, fixed prior 0.947 and 0.401.) The leave-one-example-take-out design was made after the fixed
-prior's 0.401 was seen, so it is not a blind choice. On synthetic takes, where every
-example comes from one generator and they agree by construction, it costs a little:
-each of six seeds scored with the other five as examples, mean F1@1 s (fixed prior ->
-chosen) 0.967 -> 0.923 on seeds 0-5 with 1.5-6 s activities, 0.940 -> 0.931, 0.984 ->
-0.965 and 0.922 -> 0.937 on seeds 100-105, 200-205 and 300-305, and 0.932 -> 0.910, 1.0
--> 1.0 and 0.991 -> 0.991 with the generator's usual 4-8 s activities; boundaries beside
-activities under 2.5 s found 32/35 -> 30/35. It is kept because a studio's takes are not
-alike the way generated ones are: a single odd reviewed take should not change the
-count for all.
+chosen by leave-one-example-take-out the count stays. (Started from the settings then
+shipped, before step 4c, which were chosen on all 11 takes, the scored one too: 0.957
+and 0.386, fixed prior 0.947 and 0.401.) The leave-one-example-take-out design was made
+after the fixed prior's 0.401 was seen, so it is not a blind choice. On synthetic takes,
+where every example comes from one generator and they agree by construction, it costs a
+little: each of six seeds scored with the other five as examples, mean F1@1 s (fixed
+prior -> chosen) 0.967 -> 0.923 on seeds 0-5 with 1.5-6 s activities, 0.940 -> 0.931,
+0.984 -> 0.965 and 0.922 -> 0.937 on seeds 100-105, 200-205 and 300-305, and 0.932 ->
+0.910, 1.0 -> 1.0 and 0.991 -> 0.991 with the generator's usual 4-8 s activities;
+boundaries beside activities under 2.5 s found 32/35 -> 30/35. It is kept because a
+studio's takes are not alike the way generated ones are: a single odd reviewed take
+should not change the count for all.
 
 The count is chosen by the review edits it decides (deletes and inserts), not by F1@1 s
-as in the figures above (those of this paragraph measured before step 4c): F1 takes a weak peak in when it is true more often than half
-the F1 of the time, a reviewer gains from it only when it is true more often than not.
-On the 11 labelled takes this changes nothing (``adapted/loo`` 0.957 and 0.406 either
-way); the choice rests on the review cost the product exists to lower and on takes made
-from them by cutting activities down, F1@1 s / edits per true cut with F1 -> with edits:
-every inner activity of the full-skeleton takes cut down to 2.5 s
-(``bench_quality.short_takes_check``) 0.600/1.12 -> 0.719/0.61 (3 s and 4 s: no change);
-one inner activity cut down to 2.5 s 0.854/0.64 -> 0.830/0.62 (1.8 s: no change); the
-synthetic seeds above (60 s at 60 fps) 0.923/0.216 -> 0.929/0.205 on seeds 0-5 and
-0.937/0.231 -> 0.937/0.243 on seeds 300-305, the other sets unchanged.
+as in the figures above (those of this paragraph measured before step 4c): F1 takes a
+weak peak in when it is true more often than half the F1 of the time, a reviewer gains
+from it only when it is true more often than not. On the 11 labelled takes this changes
+nothing (``adapted/loo`` 0.957 and 0.406 either way); the choice rests on the review
+cost the product exists to lower and on takes made from them by cutting activities down,
+F1@1 s / edits per true cut with F1 -> with edits: every inner activity of the
+full-skeleton takes cut down to 2.5 s (``bench_quality.short_takes_check``) 0.600/1.12
+-> 0.719/0.61 (3 s and 4 s: no change); one inner activity cut down to 2.5 s 0.854/0.64
+-> 0.830/0.62 (1.8 s: no change); the synthetic seeds above (60 s at 60 fps) 0.923/0.216
+-> 0.929/0.205 on seeds 0-5 and 0.937/0.231 -> 0.937/0.243 on seeds 300-305, the other
+sets unchanged.
 
 On synthetic takes whose annotators cut 0.6 s after the change, or that hold activities
 of 1.5-2.5 s throughout, the adapted model follows them where the zero-shot one cannot
@@ -425,15 +426,16 @@ def _window_options(zero_windows: tuple[float, float],
     Shorter windows are tried only when an example activity is shorter than the shortest
     zero-shot window: otherwise they only add cuts inside activities (out of sample).
     Tried before the detector's step 4c (unmatched poses), not kept: trying them when
-    one is shorter than the longest zero-shot window. On the three full-skeleton takes with every inner activity cut down to 3 s
-    (``benchdata.shortened``), each fitted on the other two, mean F1@1 s 0.795 -> 0.830
-    but edits per true cut 0.61 -> 0.68; at 4 s and on the takes as they are no change.
-    Also tried then, not kept: from three examples on, the windows chosen by how well the
-    count chosen on the other examples fits each one left out (as the prior's strength
-    is chosen). With one inner activity cut down to 2.5 s (``bench_quality``'s real
-    short-activity check) both boundaries found in 5 of 12 cases instead of 3, false cuts
-    12 alike; 1.8 s, the synthetic check (30/35) and the takes as they are unchanged: too
-    little for a second nested leave-one-out in every refit.
+    one is shorter than the longest zero-shot window. On the three full-skeleton takes
+    with every inner activity cut down to 3 s (``benchdata.shortened``), each fitted on
+    the other two, mean F1@1 s 0.795 -> 0.830 but edits per true cut 0.61 -> 0.68; at 4
+    s and on the takes as they are no change. Also tried then, not kept: from three
+    examples on, the windows chosen by how well the count chosen on the other examples
+    fits each one left out (as the prior's strength is chosen). With one inner activity
+    cut down to 2.5 s (``bench_quality``'s real short-activity check) both boundaries
+    found in 5 of 12 cases instead of 3, false cuts 12 alike; 1.8 s, the synthetic check
+    (30/35) and the takes as they are unchanged: too little for a second nested
+    leave-one-out in every refit.
     """
     if shortest is None or shortest >= zero_windows[0]:
         return [zero_windows]
