@@ -498,16 +498,17 @@ def _all_peaks(label: str, analysis, p: dict, placed: dict,
     peaks, prominence = Default.select_peaks(analysis.novelty, analysis.rate,
                                              {**p, "prominence": 0.0})
     sides = sides or {}
-    entries = []  # (frame counted, prominence, own frame)
-    for k, q in zip(peaks.tolist(), prominence.tolist(), strict=True):
-        for index in sides.get(k, (k,)):
-            if index != k and placed and index not in placed:
+    index, of = [], []  # novelty sample counted, and the peak whose prominence it has
+    for i, k in enumerate(peaks.tolist()):
+        for counted in sides.get(k, (k,)):
+            if counted != k and placed and counted not in placed:
                 continue  # a side the detector drops (closer than min_segment_s to a cut)
-            own = int(analysis.peak_frames([index])[0]) + analysis.first
-            entries.append((placed.get(index, own), q, own))
-    table = np.asarray(entries, dtype=float).reshape(-1, 3)
-    frames, prominence, raw = table[:, 0].astype(np.int64), table[:, 1], \
-        table[:, 2].astype(np.int64)
+            index.append(counted)
+            of.append(i)
+    raw = analysis.peak_frames(index) + analysis.first
+    frames = np.asarray([placed.get(k, f) for k, f in zip(index, raw.tolist(), strict=True)],
+                        dtype=np.int64)
+    prominence = prominence[np.asarray(of, dtype=np.int64)]
     order = np.argsort(frames, kind="stable")
     return {f"{label}_frames": frames[order], f"{label}_prominence": prominence[order],
             f"{label}_raw": raw[order]}

@@ -555,7 +555,7 @@ def unmatched_choice_check(read: list) -> str:
         analysis = Default.analyse(take, p)
         if analysis is None:
             continue
-        peaks, strength = Default.select_peaks(analysis.novelty, analysis.rate, p)
+        peaks, strength = Default.window_peaks(analysis, p)
         for level, half in settings:
             kept = peaks if level == 0 else unmatched_peaks(
                 analysis, peaks, strength, {**p, "short_unmatched": level}, half_s=half)[0]

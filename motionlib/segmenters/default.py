@@ -773,18 +773,27 @@ class Analysis:
     gamma: float
     novelty: np.ndarray
     timings: dict[str, float]
-    _short: dict = field(default_factory=dict, repr=False)  # curves computed once
+    # Curves of the pose blocks and kernel, computed once; none depends on the novelty
+    # windows, so ``with_windows`` shares them.
+    _short: dict = field(default_factory=dict, repr=False)
 
     @property
     def rate(self) -> float:
         """Novelty samples per second."""
         return self.fps / self.step
 
+    @property
+    def blocks(self) -> np.ndarray:
+        """(n // step, d) the poses averaged into novelty blocks (computed once)."""
+        if "blocks" not in self._short:
+            self._short["blocks"] = block_mean(self.x, self.step)
+        return self._short["blocks"]
+
     def short_novelty(self, window_s: float) -> np.ndarray:
         """(n // step,) MMD² with one window of ``window_s`` seconds (computed once)."""
         w = max(1, int(round(window_s * self.rate)))
         if w not in self._short:
-            blocks = block_mean(self.x, self.step)
+            blocks = self.blocks
             self._short[w] = mirrored_novelties(blocks, [w], self.gamma)[0] \
                 if len(blocks) >= 4 else np.zeros(len(blocks))
         return self._short[w]
@@ -793,8 +802,7 @@ class Analysis:
         """(n // step,) ``unmatched_poses`` of the novelty blocks (computed once)."""
         key = ("unmatched", nearest_s)
         if key not in self._short:
-            self._short[key] = unmatched_poses(block_mean(self.x, self.step), self.rate,
-                                               self.gamma, nearest_s)
+            self._short[key] = unmatched_poses(self.blocks, self.rate, self.gamma, nearest_s)
         return self._short[key]
 
     def with_windows(self, *windows: tuple[float, float]) -> list[Analysis]:
@@ -805,9 +813,9 @@ class Analysis:
         """
         widths = [window_widths(lo, hi, self.rate) for lo, hi in windows]
         union = sorted({w for ws in widths for w in ws})
-        blocks = block_mean(self.x, self.step)
-        curves = dict(zip(union, mirrored_novelties(blocks, union, self.gamma), strict=True))
-        return [replace(self, novelty=np.mean([curves[w] for w in ws], axis=0), _short={})
+        curves = dict(zip(union, mirrored_novelties(self.blocks, union, self.gamma),
+                          strict=True))
+        return [replace(self, novelty=np.mean([curves[w] for w in ws], axis=0))
                 for ws in widths]
 
     def peak_frames(self, peaks: np.ndarray) -> np.ndarray:
@@ -948,7 +956,8 @@ class Default(Segmenter):
         novelty = cls._novelty(blocks, fps / step, gamma, p)
         t2 = time.perf_counter()
         return Analysis(x=x, fps=fps, step=step, first=first, gamma=gamma, novelty=novelty,
-                        timings={"kinematics": t1 - t0, "novelty": t2 - t1})
+                        timings={"kinematics": t1 - t0, "novelty": t2 - t1},
+                        _short={"blocks": blocks})
 
     @staticmethod
     def _place(x: np.ndarray, peaks: np.ndarray, fps: float, gamma: float, p: dict):
@@ -1195,7 +1204,7 @@ def mixing(analysis: Analysis, a: int, b: int, context: int) -> float:
     its neighbours (near 1 and above). NaN when a part is too short to compare.
     """
     lo, hi = sorted((a, b))
-    blocks = block_mean(analysis.x, analysis.step)
+    blocks = analysis.blocks
     middle, before, after = blocks[lo:hi], blocks[max(0, lo - context):lo], blocks[hi:hi + context]
     if len(middle) < 4 or min(len(before), len(after)) < 2:
         return float("nan")
