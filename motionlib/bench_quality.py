@@ -25,8 +25,10 @@ penalty chosen without the take; the out-of-sample score of every option of ever
 setting, and three short-activity checks, on synthetic takes, on the real takes with
 one activity cut short (``real_short_activity_check``) and with the first or last one cut
 short (``edge_activity_check``), and the leave-one-take-out choice of the unmatched-poses
-step's settings on such takes (``unmatched_choice_check``), follow the tables. Each take is
-scored separately and the means are given per kind of take and over all.
+step's settings on such takes (``unmatched_choice_check``), follow the tables, and what
+that step does on the full-skeleton takes without segment labels, which are not scored
+(``unmatched_guard_check``). Each take is scored separately and the means are given per
+kind of take and over all.
 
 Leave-one-take-out chooses on all the labelled material there is, not only on the takes
 scored: ``--pool DIR`` adds the labelled takes under DIR to what settings and penalties
@@ -364,6 +366,7 @@ def main(root: Path | None = None, only: list[str] | None = None, out=None, *,
         print("\n" + short_takes_check(read), file=out)
         print("\n" + edge_activity_check(read), file=out)
         print("\n" + unmatched_choice_check(read), file=out)
+        print("\n" + unmatched_guard_check(folder), file=out)
     if (not only or "joint_distance_pca" in only) and "13_30" in takes:
         print("\n" + patent_comparison(folder), file=out)
     print(f"\nwhole benchmark: {time.perf_counter() - started:.0f} s, load average "
@@ -550,12 +553,14 @@ def unmatched_choice_check(read: list) -> str:
     settings = [(0.0, UNMATCHED_HALF_S)] + [(level, half) for level in UNMATCHED_LEVELS
                                             if level > 0 for half in UNMATCHED_HALVES]
     p = Default.validate_params({})
+    ratios: list[float] = []  # each firing's level / take median, without the guard
     scores = {}  # (setting, material index) -> (F1@1 s, both sides of the short one found)
     for i, (_, _, take, truth, k) in enumerate(material):
         analysis = Default.analyse(take, p)
         if analysis is None:
             continue
         peaks, strength = Default.window_peaks(analysis, p)
+        ratios += unmatched_ratios(analysis, peaks, p)
         for level, half in settings:
             kept = peaks if level == 0 else unmatched_peaks(
                 analysis, peaks, strength, {**p, "short_unmatched": level}, half_s=half)[0]
@@ -614,7 +619,79 @@ def unmatched_choice_check(read: list) -> str:
     lines.append(f"  chosen on all: {label(best)}; shipped: short_unmatched "
                  f"{Default.params['short_unmatched'].default:g}, half-width "
                  f"{UNMATCHED_HALF_S:g} s")
+    lines.append(f"  {_guard_line(ratios)}")
     return "\n".join(lines)
+
+
+def unmatched_ratios(analysis, peaks: np.ndarray, p: dict) -> list[float]:
+    """For each kept peak the unmatched-poses step (at the shipped settings) replaces
+    without its take-median guard, the level of the stretch it fires on over the take's
+    median (``segmenters.default.unmatched_sides``)."""
+    from motionlib.segmenters.default import (
+        UNMATCHED_STRETCH_S,
+        unmatched_sides,
+        unmatched_stretches,
+    )
+
+    sides = unmatched_sides(analysis, peaks, p, relative=0.0)
+    if not sides:
+        return []
+    stretch, median = unmatched_stretches(analysis, p)
+    w = max(1, int(round(UNMATCHED_STRETCH_S * analysis.rate)))
+    return [float(stretch[(a + b) // 2 - w // 2]) / max(median, 1e-12)
+            for a, b in sides.values()]
+
+
+def _guard_line(ratios: list[float]) -> str:
+    from motionlib.segmenters.default import UNMATCHED_RELATIVE
+
+    if not ratios:
+        return "take-median guard: the step fires nowhere on this material"
+    kept = sum(r >= UNMATCHED_RELATIVE for r in ratios)
+    return (f"take-median guard (stretch at least {UNMATCHED_RELATIVE:g} x the take's median "
+            f"as well): of the {len(ratios)} firings on this material without it, {kept} "
+            f"kept; level / take median from {min(ratios):.1f} (median "
+            f"{float(np.median(ratios)):.1f})")
+
+
+def unmatched_guard_check(folder: Path) -> str:
+    """The unmatched-poses step on the full-skeleton takes without segment labels
+    (``benchdata.unlabelled_motion``): the default detector's number of cuts as shipped
+    and with the step off, and, for each stretch the step would fire on without its
+    take-median guard, its level over the take's median (the guard keeps it from
+    ``UNMATCHED_RELATIVE`` on). Nothing is scored (there are no labels): a take that does
+    not repeat itself (boxing, dance) is where the guard acts, and these show where it
+    does."""
+    from motionlib.segmenters.default import UNMATCHED_RELATIVE
+
+    takes = benchdata.unlabelled_motion(folder)
+    if not takes:
+        return "unmatched-poses step on takes without labels: none under the data folder"
+    p = Default.validate_params({})
+    rows = []
+    for path, asf in takes:
+        try:
+            import motionlib
+
+            take = motionlib.read(path, asf=asf)
+        except CaptureError as exc:
+            rows.append(f"  {path.stem:<10} skipped: {exc}")
+            continue
+        counts = [len(Default(**params).fit_predict(take).cuts) for params in
+                  ({}, {"short_unmatched": 0.0})]
+        analysis = Default.analyse(take, p)
+        ratios = [] if analysis is None else unmatched_ratios(
+            analysis, Default.window_peaks(analysis, p)[0], p)
+        firings = ", ".join(f"{r:.1f}x ({'kept' if r >= UNMATCHED_RELATIVE else 'not'})"
+                            for r in ratios)
+        rows.append(f"  {path.stem:<10}{take.n_frames / take.fps:>7.1f}{counts[0]:>9}"
+                    f"{counts[1]:>10}   {firings or '-'}")
+    return "\n".join([
+        f"unmatched-poses step on the full-skeleton takes without segment labels (not "
+        f"scored): cuts as shipped and with the step off; each stretch the step fires on "
+        f"without its take-median guard, its level / the take's median, kept from "
+        f"{UNMATCHED_RELATIVE:g}x:",
+        f"  {'take':<10}{'s':>7}{'shipped':>9}{'step off':>10}   firings", *rows])
 
 
 def short_takes_check(read: list, seconds=THROUGHOUT_S) -> str:

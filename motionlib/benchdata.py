@@ -310,6 +310,27 @@ def discover(root: Path | None = None, *, channels: bool = True,
     return takes, skipped
 
 
+def unlabelled_motion(root: Path | None = None) -> list[tuple[Path, Path | None]]:
+    """The full-skeleton takes under ``root`` that have no segment labels: (motion, ASF)
+    of each AMC whose subject's ASF is there and each BVH without an AMC of its name
+    among them (``discover`` skips them). Not scored; the bench shows what the default
+    detector makes of them."""
+    root = Path(root) if root is not None else data_dir()
+    cmu = root / "cmu"
+    labelled = {t.name for t in discover(root, channels=False)[0]}
+    labelled |= {path.stem for _, path in _label_files(root / "labels")}
+    out: list[tuple[Path, Path | None]] = []
+    for amc in sorted(cmu.glob("amc/*.amc")):
+        files = _amc_asf(amc.stem, cmu)
+        if amc.stem not in labelled and files is not None:
+            out.append(files)
+    names = {amc.stem for amc, _ in out}
+    for bvh in sorted(cmu.glob("bvh/*.bvh")):
+        if bvh.stem not in labelled and bvh.stem not in names:
+            out.append((bvh, None))
+    return out
+
+
 def _label_files(labels: Path):
     """(source, label file) of each labelled take: the CSVs of ``LABEL_SOURCES``, then the
     original mocap6 block files of takes that have no CSV."""

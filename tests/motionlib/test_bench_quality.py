@@ -219,19 +219,45 @@ def test_the_unmatched_choice_check_leaves_out_each_skeleton_take_and_scores_it(
     takes = [_Labelled(1), _Labelled(2), _Labelled(3, kind="channels")]
     lines = bench_quality.unmatched_choice_check(_read(takes)).splitlines()
     assert "chosen leave-one-take-out" in lines[0]
-    named = [line[2:12].strip() for line in lines[2:-1] if line[2:12].strip()]
+    named = [line[2:12].strip() for line in lines[2:-2] if line[2:12].strip()]
     assert named == ["seed 1", "seed 2", "all"]  # each skeleton take left out, then totals
     cases = sum(benchdata.shortened(t.take, t.truth, k, s) is not None
                 for t in takes[:2] for k in range(len(t.truth) - 1)
                 for s in bench_quality.UNMATCHED_INNER_S)
-    chosen, off = lines[-3], lines[-2]
+    chosen, off = lines[-4], lines[-3]
     assert chosen.split()[:2] == ["all", "chosen"] and off.split()[0] == "off"
     for line in (chosen, off):  # both sides counted over every case left out
         assert line.split()[-2].endswith(f"/{cases}")
-    assert lines[-1].startswith("  chosen on all: ")
-    assert lines[-1].endswith(f"shipped: short_unmatched "
+    assert lines[-2].startswith("  chosen on all: ")
+    assert lines[-2].endswith(f"shipped: short_unmatched "
                               f"{Default.params['short_unmatched'].default:g}, half-width "
                               f"{UNMATCHED_HALF_S:g} s")
+    assert lines[-1].startswith("  take-median guard")  # what the guard keeps of the firings
+
+
+def test_the_guard_line_counts_the_firings_it_keeps():
+    from motionlib.segmenters.default import UNMATCHED_RELATIVE
+
+    line = bench_quality._guard_line([UNMATCHED_RELATIVE - 1, UNMATCHED_RELATIVE, 9.0])
+    assert "of the 3 firings on this material without it, 2 kept" in line
+    assert line.endswith(f"from {UNMATCHED_RELATIVE - 1:.1f} (median {UNMATCHED_RELATIVE:.1f})")
+    assert bench_quality._guard_line([]) == \
+        "take-median guard: the step fires nowhere on this material"
+
+
+def test_the_guard_check_runs_on_the_takes_without_labels(tmp_path):
+    (tmp_path / "cmu/bvh").mkdir(parents=True)
+    (tmp_path / "labels").mkdir()
+    take, _ = synth.generate(seed=3, fps=60.0, duration=20.0)
+    from motionlib import write_bvh
+
+    write_bvh(take, tmp_path / "cmu/bvh/55_01.bvh")
+    lines = bench_quality.unmatched_guard_check(tmp_path).splitlines()
+    assert lines[1].split() == ["take", "s", "shipped", "step", "off", "firings"]
+    assert lines[2].split()[:2] == ["55_01", "20.0"]
+    (tmp_path / "empty").mkdir()
+    assert bench_quality.unmatched_guard_check(tmp_path / "empty") == \
+        "unmatched-poses step on takes without labels: none under the data folder"
 
 
 def test_the_unmatched_choice_check_says_so_without_a_skeleton_take():

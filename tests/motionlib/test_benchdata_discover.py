@@ -47,6 +47,21 @@ def test_it_shifts_mocap6_cuts_by_the_lines_a_bvh_adds_before_the_motion(layout)
     assert take.truth[:, 1].tolist() == [600]
 
 
+def test_it_lists_the_full_skeleton_takes_without_labels(layout):
+    # The AMC has no ASF of its subject, so it cannot be read; the labelled BVH is listed
+    # by discover instead.
+    assert benchdata.unlabelled_motion(layout) == []
+    (layout / "cmu/asf").mkdir(exist_ok=True)
+    (layout / "cmu/asf/12.asf").write_text(":version 1.10\n")
+    (layout / "cmu/bvh/12_34.bvh").write_text("")
+    try:
+        assert benchdata.unlabelled_motion(layout) == [
+            (layout / "cmu/amc/12_34.amc", layout / "cmu/asf/12.asf")]  # AMC first
+    finally:
+        (layout / "cmu/asf/12.asf").unlink()
+        (layout / "cmu/bvh/12_34.bvh").unlink()
+
+
 def test_it_reads_a_four_channel_take_as_angles_at_the_cmu_rate(layout):
     take = benchdata.discover(layout)[0][1]
     read = take.read()

@@ -8,10 +8,12 @@ import pytest
 from motionlib import benchdata, metrics, tuning
 from motionlib.segmenters.default import (
     UNMATCHED_HALF_S,
+    UNMATCHED_RELATIVE,
     Analysis,
     Default,
     unmatched_peaks,
     unmatched_poses,
+    unmatched_sides,
 )
 from tests.motionlib.conftest import skeleton_takes
 
@@ -101,6 +103,27 @@ def test_a_stretch_with_kept_peaks_on_both_sides_keeps_them():
     assert _peaks(x, [98, 121]) == ([98, 121], [0.3, 0.3])
 
 
+def test_in_a_take_that_never_repeats_itself_an_unmatched_stretch_says_nothing():
+    # Poses drifting along a line at 1 unit a second: nothing 1.5 s away or more looks
+    # alike anywhere (2.25 everywhere, above the level 1), so the stretch near the peak
+    # is no more unmatched than the rest of the take.
+    x = np.column_stack([np.arange(200) / RATE, np.zeros(200)])
+    assert _peaks(x, [104]) == ([104], [0.3])
+    # The absolute level alone would split the peak.
+    p = Default.validate_params({"short_unmatched": 1.0})
+    out, _ = unmatched_peaks(_analysis(x), np.asarray([104]), np.asarray([0.3]), p,
+                             relative=0.0)
+    assert len(out) == 2
+
+
+def test_a_short_activity_stands_out_of_a_take_that_repeats_itself_by_far_more():
+    # The held stretch among cycles: its level (9) against a take median near 0.
+    x = np.concatenate([_cycles(10), _still(2, (4.0, 0.0)), _cycles(10, phase=1.0)])
+    score = unmatched_poses(x, RATE, gamma=1.0, nearest_s=1.5)
+    assert 9.0 > 10 * UNMATCHED_RELATIVE * np.median(score)
+    assert len(_peaks(x, [104])[0]) == 2
+
+
 def test_it_ships_on_and_is_chosen_from_the_grid():
     assert Default.params["short_unmatched"].default == 1.0
     assert tuning.GRID["short_unmatched"] == (0.0, 1.0)
@@ -154,3 +177,24 @@ def test_it_adds_no_cut_to_the_real_full_skeleton_takes_as_they_are():
     for _, take in skeleton_takes():
         np.testing.assert_array_equal(Default().fit_predict(take).cuts,
                                       Default(short_unmatched=0.0).fit_predict(take).cuts)
+
+
+@pytest.mark.slow
+def test_the_take_median_guard_keeps_it_out_of_a_boxing_take():
+    # CMU 13_17, boxing throughout (no segment labels): punches and footwork that never
+    # repeat exactly, so poses are half as unmatched anywhere as the level; the stretch
+    # the absolute level alone would split sits at 1.7 times the take's median.
+    found = [(path, asf) for path, asf in benchdata.unlabelled_motion()
+             if path.stem == "13_17"]
+    if not found:
+        pytest.skip("CMU take 13_17 is not available (needs ../shared/data)")
+    import motionlib
+
+    take = motionlib.read(found[0][0], asf=found[0][1])
+    p = Default.validate_params({})
+    analysis = Default.analyse(take, p)
+    peaks, _ = Default.window_peaks(analysis, p)
+    assert unmatched_sides(analysis, peaks, p, relative=0.0)  # the level alone fires
+    assert unmatched_sides(analysis, peaks, p) == {}
+    np.testing.assert_array_equal(Default().fit_predict(take).cuts,
+                                  Default(short_unmatched=0.0).fit_predict(take).cuts)
