@@ -293,7 +293,7 @@ class MemoryStudies:
 
 # Bump when what a study holds, or how the detector computes it, changes: every stored
 # study then misses once and is made again.
-STUDY_VERSION = 2
+STUDY_VERSION = 3
 
 
 def fit_cut_model(examples: Sequence, *, studies: Studies | None = None,
