@@ -209,7 +209,8 @@ short activities is itself less repetitive, so its median is higher; the median 
 of the 45 firings there is 12.4, 86_14's four-channel stretch 173), and it changes no
 cut there: every table of ``python -m motionlib bench --loo`` is the same with and
 without it. Of the other takes without labels, 02_07 (swordplay) keeps its firing (4.7
-times, around a lunge that stands out of the take); the two 4-6 s clips have none.
+times, at 15-17 s, where a foot swings high and the hips dip as nowhere else in the
+take); the two 4-6 s clips have none.
 
 Short activities: tried before step 4c, not shipped
 ---------------------------------------------------
