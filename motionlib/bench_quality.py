@@ -626,20 +626,14 @@ def unmatched_choice_check(read: list) -> str:
 def unmatched_ratios(analysis, peaks: np.ndarray, p: dict) -> list[float]:
     """For each kept peak the unmatched-poses step (at the shipped settings) replaces
     without its take-median guard, the level of the stretch it fires on over the take's
-    median (``segmenters.default.unmatched_sides``)."""
-    from motionlib.segmenters.default import (
-        UNMATCHED_STRETCH_S,
-        unmatched_sides,
-        unmatched_stretches,
-    )
+    median (``segmenters.default.unmatched_firings``)."""
+    from motionlib.segmenters.default import unmatched_firings
 
-    sides = unmatched_sides(analysis, peaks, p, relative=0.0)
-    if not sides:
+    if p["short_unmatched"] <= 0:
         return []
-    stretch, median = unmatched_stretches(analysis, p)
-    w = max(1, int(round(UNMATCHED_STRETCH_S * analysis.rate)))
-    return [float(stretch[(a + b) // 2 - w // 2]) / max(median, 1e-12)
-            for a, b in sides.values()]
+    firings, median = unmatched_firings(analysis, peaks, p)
+    return [at / max(median, 1e-12) for _, at in firings.values()
+            if at >= p["short_unmatched"]]
 
 
 def _guard_line(ratios: list[float]) -> str:

@@ -1189,15 +1189,26 @@ def unmatched_sides(analysis: Analysis, peaks: np.ndarray, p: dict,
     """
     if len(peaks) == 0 or p["short_unmatched"] <= 0:
         return {}
-    rate = analysis.rate
-    stretch, median = unmatched_stretches(analysis, p)
-    if len(stretch) == 0:
-        return {}
-    w = max(1, int(round(UNMATCHED_STRETCH_S * rate)))
+    firings, median = unmatched_firings(analysis, peaks, p, half_s)
     level = max(p["short_unmatched"], relative * median)
+    return {peak: sides for peak, (sides, at) in firings.items() if at >= level}
+
+
+def unmatched_firings(analysis: Analysis, peaks: np.ndarray, p: dict,
+                      half_s: float = UNMATCHED_HALF_S
+                      ) -> tuple[dict[int, tuple[tuple[int, int], float]], float]:
+    """``unmatched_sides`` before its level test: each kept peak whose most unmatched
+    stretch in reach passes the other tests, with its two sides and the stretch's mean
+    ``unmatched_poses``; and the take's median of ``unmatched_poses`` per block."""
+    rate = analysis.rate
+    unmatched = analysis.unmatched(p["min_segment_s"])
+    w = max(1, int(round(UNMATCHED_STRETCH_S * rate)))
+    if len(unmatched) < w:
+        return {}, 0.0
+    sums = np.concatenate([[0.0], np.cumsum(unmatched)])
+    stretch = (sums[w:] - sums[:-w]) / w  # mean over blocks i .. i + w - 1
     reach, half = UNMATCHED_REACH_S * rate, half_s * rate
     edge = p["min_segment_s"] * rate / 2
-    n_blocks = len(stretch) + w - 1
     out = {}
     for peak in peaks.tolist():
         lo = max(0, int(peak - reach) - w // 2)
@@ -1209,25 +1220,12 @@ def unmatched_sides(analysis: Analysis, peaks: np.ndarray, p: dict,
         # Kept peaks on both sides within the shortest window: the long windows have
         # found this activity's two sides already.
         near = np.abs(peaks - middle) <= p["scale_min_s"] * rate
-        found = (near & (peaks < middle)).any() and (near & (peaks > middle)).any()
-        if stretch[start] < level or found:
+        if (near & (peaks < middle)).any() and (near & (peaks > middle)).any():
             continue
         sides = (int(round(middle - half)), int(round(middle + half)))
-        if edge <= sides[0] and sides[1] <= n_blocks - edge:
-            out[int(peak)] = sides
-    return out
-
-
-def unmatched_stretches(analysis: Analysis, p: dict) -> tuple[np.ndarray, float]:
-    """Mean ``unmatched_poses`` over every stretch of ``UNMATCHED_STRETCH_S`` (item i:
-    blocks i to i + w - 1; empty for a take shorter than one stretch), and the take's
-    median per block."""
-    unmatched = analysis.unmatched(p["min_segment_s"])
-    w = max(1, int(round(UNMATCHED_STRETCH_S * analysis.rate)))
-    if len(unmatched) < w:
-        return np.zeros(0), 0.0
-    sums = np.concatenate([[0.0], np.cumsum(unmatched)])
-    return (sums[w:] - sums[:-w]) / w, float(np.median(unmatched))
+        if edge <= sides[0] and sides[1] <= len(unmatched) - edge:
+            out[int(peak)] = (sides, float(stretch[start]))
+    return out, float(np.median(unmatched))
 
 
 def mixing(analysis: Analysis, a: int, b: int, context: int) -> float:
