@@ -142,6 +142,7 @@ from motionlib.segmenters.default import (
     confidence,
     empty_segmentation,
     place_stages,
+    shipped_stage,
     unmatched_sides,
 )
 
@@ -358,7 +359,7 @@ def fit_cut_model(examples: Sequence, *, studies: Studies | None = None,
         windows = max(options, key=lambda w: scores[w])
     _, prominence = _count(peaks["placed"] if windows == zero_windows else peaks[windows],
                            p["prominence"])
-    placement, offset = _placement(residuals, "onset" if p["onset"] else "pause")
+    placement, offset = _placement(residuals, shipped_stage(p))
     return CutModel(n_takes=len(checked), n_cuts=int(sum(len(c) for _, c in checked)),
                     threshold=p["threshold"], prominence=prominence,
                     min_segment_s=p["min_segment_s"], scale_min_s=windows[0],
@@ -611,7 +612,7 @@ def _residuals(cuts: np.ndarray, analysis, p: dict) -> tuple[dict, dict[int, int
         placed = placed + analysis.first
         ci, ti = metrics.match(placed, cuts, tolerance=int(round(MATCH_S * analysis.fps)))
         arrays[f"residual_{name}"] = (cuts[ti] - placed[ci]) / analysis.fps
-    zero_shot = stages["onset" if p["onset"] else "pause"] + analysis.first
+    zero_shot = stages[shipped_stage(p)] + analysis.first
     return arrays, dict(zip(peaks.tolist(), zero_shot.tolist(), strict=True)), sides
 
 

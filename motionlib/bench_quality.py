@@ -534,6 +534,7 @@ def unmatched_choice_check(read: list) -> str:
         UNMATCHED_HALF_S,
         Default,
         place_stages,
+        shipped_stage,
         unmatched_peaks,
     )
 
@@ -566,7 +567,7 @@ def unmatched_choice_check(read: list) -> str:
                 analysis, peaks, strength, {**p, "short_unmatched": level}, half_s=half)[0]
             stages, _ = place_stages(analysis.x, analysis.peak_frames(kept), analysis.fps,
                                      analysis.gamma, p)
-            cuts = stages["onset" if p["onset"] else "pause"] + analysis.first
+            cuts = stages[shipped_stage(p)] + analysis.first
             _, ti = metrics.match(cuts, truth, tolerance=int(round(take.fps)))
             scores[(level, half), i] = (
                 metrics.evaluate(cuts, truth, fps=take.fps)["f1@1s"],

@@ -23,7 +23,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from motionlib import metrics
-from motionlib.segmenters.default import Default, place_stages
+from motionlib.segmenters.default import Default, place_stages, shipped_stage
 
 # The options the defaults are chosen from. Windows: (shortest, longest) in seconds.
 GRID = {
@@ -99,7 +99,7 @@ class TakeCache:
         key = (id(a), p["refine_s"], tuple(peaks))
         if key not in self.placed:
             self.placed[key] = place_stages(a.x, a.peak_frames(peaks), a.fps, a.gamma, p)[0]
-        return self.placed[key]["onset" if p["onset"] else "pause"] + a.first
+        return self.placed[key][shipped_stage(p)] + a.first
 
 
 def score_rows(cache: Sequence[TakeCache], params: dict) -> list[dict]:

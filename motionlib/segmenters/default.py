@@ -733,6 +733,12 @@ def nearest(points: np.ndarray, target: int, radius: int) -> int:
 PLACEMENTS = ("split", "turn", "pause", "onset")
 
 
+def shipped_stage(p: dict) -> str:
+    """The placement step (of ``PLACEMENTS``) whose estimate the detector cuts at:
+    ``onset`` with ``p["onset"]``, else ``pause``."""
+    return "onset" if p["onset"] else "pause"
+
+
 def place_stages(x: np.ndarray, peaks: np.ndarray, fps: float, gamma: float, p: dict):
     """Each placement step's estimate of every cut (see the module docstring, step 5).
 
@@ -983,7 +989,7 @@ class Default(Segmenter):
         Returns the placed cuts (frames of ``x``) and the 1 Hz pose speed.
         """
         stages, speed = place_stages(x, peaks, fps, gamma, p)
-        return stages["onset" if p["onset"] else "pause"], speed
+        return stages[shipped_stage(p)], speed
 
     @staticmethod
     def _novelty(x: np.ndarray, rate: float, gamma: float, p: dict) -> np.ndarray:
