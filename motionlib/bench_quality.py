@@ -788,6 +788,10 @@ def out_of_sample_table(tried: tuning.Selection) -> str:
     grid = tuning.tried_grid()
     for key, value, f1, edits in tuning.out_of_sample(tried, {k: grid[k] for k in tuning.TRIED}):
         lines.append(f"  {key:<15}{str(value):>12}{f1:>9.3f}{edits:>11.3f}")
+    lines.append("  how the choice is made (every setting chosen the same way):")
+    for name, f1, edits in tuning.objectives(selection):
+        shipped = " (shipped)" if name == "F1@1s first" else ""
+        lines.append(f"  {'objective':<15}{name:>12}{f1:>9.3f}{edits:>11.3f}{shipped}")
     return "\n".join(lines)
 
 

@@ -95,6 +95,20 @@ def test_it_chooses_settings_without_the_take_scored_or_its_other_views():
     assert chosen == [1, 1, 0]
 
 
+def test_it_scores_choosing_by_f1_first_and_by_edits_first_leave_one_take_out():
+    cache = [View("a"), View("b"), View("c")]
+    # Choice 0 finds every cut with many false ones, choice 1 fewer cuts and fewer edits:
+    # F1 first picks 0, edits first picks 1, on whichever two takes the choice is made.
+    many = {"f1@1s": 0.9, "edits_per_cut": 0.6}
+    few = {"f1@1s": 0.8, "edits_per_cut": 0.4}
+    selection = tuning.Selection([{"c": 0}, {"c": 1}], cache, [[many] * 3, [few] * 3])
+    assert [c["c"] for c, _ in selection.leave_one_out()] == [0, 0, 0]
+    assert [c["c"] for c, _ in selection.leave_one_out(tuning.edits_objective)] == [1, 1, 1]
+    (first, f1, edits), (other, f1_e, edits_e) = tuning.objectives(selection)
+    assert (first, other) == ("F1@1s first", "edits first")
+    assert np.allclose([f1, edits, f1_e, edits_e], [0.9, 0.6, 0.8, 0.4])
+
+
 def test_it_prints_leave_one_take_out_rows_beside_the_others(layout, capsys):
     from motionlib import bench_quality
 
@@ -105,6 +119,7 @@ def test_it_prints_leave_one_take_out_rows_beside_the_others(layout, capsys):
         assert out.count(f"\n{row} ") == 2 + 3  # two takes, three mean tables
     assert "mean over 1 full-skeleton takes" in out and "mean over 2 labelled takes" in out
     assert "out of sample (leave-one-take-out)" in out
+    assert "objective       F1@1s first" in out and "objective       edits first" in out
 
 
 def test_it_keeps_the_shipped_value_first_among_the_tried_options():
