@@ -672,9 +672,9 @@ def unmatched_guard_check(folder: Path) -> str:
         except CaptureError as exc:
             rows.append(f"  {path.stem:<10} skipped: {exc}")
             continue
-        counts = [len(Default(**params).fit_predict(take).cuts) for params in
-                  ({}, {"short_unmatched": 0.0})]
-        analysis = Default.analyse(take, p)
+        cache = tuning.TakeCache(None, take)  # one analysis for the three questions
+        counts = [len(cache.cuts(params)) for params in ({}, {"short_unmatched": 0.0})]
+        analysis = cache.analysis(p)
         ratios = [] if analysis is None else unmatched_ratios(
             analysis, Default.window_peaks(analysis, p)[0], p)
         firings = ", ".join(f"{r:.1f}x ({'kept' if r >= UNMATCHED_RELATIVE else 'not'})"
