@@ -27,12 +27,18 @@ def amc_13_29() -> tuple[Path, Path]:
     return cmu_file("amc", "13_29.amc"), cmu_file("asf", "13.asf")
 
 
-def skeleton_takes() -> list:
-    """The full-skeleton labelled takes (``benchdata.discover``), read; skipped when the
-    shared data is absent."""
+def labelled_takes(kind: str = "skeleton", name: str | None = None) -> list:
+    """The labelled takes of ``kind`` (``benchdata.discover``), only those called ``name``
+    when given, not read; skipped when the shared data does not hold them."""
     from motionlib.benchdata import discover
 
-    takes = [t for t in discover()[0] if t.kind == "skeleton"]
+    takes = [t for t in discover()[0] if t.kind == kind and name in (None, t.name)]
     if not takes:
-        pytest.skip("labelled CMU takes are not available (needs ../shared/data)")
-    return [(t, t.read()) for t in takes]
+        pytest.skip(f"labelled CMU takes ({kind}{', ' + name if name else ''}) are not "
+                    f"available (needs ../shared/data)")
+    return takes
+
+
+def skeleton_takes() -> list:
+    """The full-skeleton labelled takes with their motion, read."""
+    return [(t, t.read()) for t in labelled_takes()]

@@ -15,7 +15,7 @@ from motionlib.segmenters.default import (
     unmatched_poses,
     unmatched_sides,
 )
-from tests.motionlib.conftest import skeleton_takes
+from tests.motionlib.conftest import labelled_takes, skeleton_takes
 
 RATE = 10.0
 
@@ -135,13 +135,6 @@ def test_it_ships_on_and_is_chosen_from_the_grid():
 REAL_CASES = [("13_30", 1), ("86_01", 2)]
 
 
-def _labelled(name: str, kind: str = "skeleton"):
-    takes = [t for t in benchdata.discover()[0] if t.name == name and t.kind == kind]
-    if not takes:
-        pytest.skip(f"labelled CMU take {name} is not available (needs ../shared/data)")
-    return takes[0]
-
-
 def _sides_found(cuts, truth, k, fps) -> int:
     _, ti = metrics.match(cuts, truth, tolerance=int(round(fps)))  # within 1 s
     return int(k in ti) + int(k + 1 in ti)
@@ -150,7 +143,7 @@ def _sides_found(cuts, truth, k, fps) -> int:
 @pytest.mark.slow
 @pytest.mark.parametrize("name, activity", REAL_CASES)
 def test_it_finds_both_sides_of_a_real_activity_cut_down_to_1_8_s(name, activity):
-    labelled = _labelled(name)
+    labelled = labelled_takes(name=name)[0]
     take, truth = benchdata.shortened(labelled.read(), labelled.truth, activity, 1.8)
     cuts = Default().fit_predict(take).cuts
     assert _sides_found(cuts, truth, activity, take.fps) == 2
@@ -162,7 +155,7 @@ def test_it_finds_both_sides_of_a_real_activity_cut_down_to_1_8_s(name, activity
 @pytest.mark.slow
 def test_it_finds_the_real_1_6_s_activity_of_a_four_channel_take():
     # 86_14's "through_ball" between two "walk_lead_ball" stretches lasts 1.6 s.
-    labelled = _labelled("86_14", kind="channels")
+    labelled = labelled_takes("channels", "86_14")[0]
     take = labelled.read()
     truth = labelled.truth
     short = int(np.argmin(np.diff(truth[:, 1])))
