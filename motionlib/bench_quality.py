@@ -792,6 +792,22 @@ def out_of_sample_table(tried: tuning.Selection) -> str:
     for name, f1, edits in tuning.objectives(selection):
         shipped = " (shipped)" if name == "F1@1s first" else ""
         lines.append(f"  {'objective':<15}{name:>12}{f1:>9.3f}{edits:>11.3f}{shipped}")
+    return "\n".join(lines + ["", source_table(selection)])
+
+
+def source_table(selection: tuning.Selection) -> str:
+    """The default's settings chosen on the other label sources only, scored on each
+    source, beside leave-one-take-out (which chooses on the same source's other takes
+    too)."""
+    rows = tuning.by_source(selection)
+    lines = ["settings chosen on the other label sources only (leave-one-source-out) and "
+             "leave-one-take-out, mean over each source's takes:",
+             f"  {'source':<12}{'takes':>6}{'other sources: F1@1s':>22}{'edits':>7}"
+             f"{'med err':>8}{'loo: F1@1s':>12}{'edits':>7}{'med err':>8}"]
+    for source, n, other, loo in rows:
+        lines.append(f"  {source:<12}{n:>6}{other['f1@1s']:>22.3f}{other['edits_per_cut']:>7.3f}"
+                     f"{other['median_error_s']:>8.3f}{loo['f1@1s']:>12.3f}"
+                     f"{loo['edits_per_cut']:>7.3f}{loo['median_error_s']:>8.3f}")
     return "\n".join(lines)
 
 

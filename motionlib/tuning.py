@@ -14,6 +14,13 @@ on the 11 labelled takes under ``shared/data``: leave-one-take-out mean F1@1 s 0
 takes the higher prominence (0.15) that a few takes gain from and loses cuts on the others
 (13_30, 86_03, 86_08, 86_11, 86_14). The benchmark prints both (``objective`` lines).
 
+Leave-one-take-out still chooses on takes of the scored take's own label source. How the
+choice transfers to a source it never saw is measured too (:func:`by_source`): the two
+mocap6 takes scored with settings chosen on the nine subject-86 (Krüger) takes only, mean
+F1@1 s 1.000, 0.325 edits per true cut, median error 0.096 s (the same as
+leave-one-take-out); the nine subject-86 takes with settings chosen on the two mocap6
+takes only, 0.947, 0.424 and 0.337 s (leave-one-take-out 0.947, 0.424 and 0.353 s).
+
 Options that were tried and not shipped (:data:`TRIED`) are scored the same way, with
 the choice made from :func:`tried_grid`, so that the record of why they are not shipped
 can be re-run (``python -m motionlib bench-quality --loo``).
@@ -170,6 +177,16 @@ class Selection:
         return out
 
 
+    def leave_source_out(self) -> list[tuple[dict, dict] | None]:
+        """Per take: the choice made on the takes of the other label sources only, and its
+        row there; None when every take has the same source."""
+        out = []
+        for j, c in enumerate(self.cache):
+            i = self.best([other.labelled.source != c.labelled.source for other in self.cache])
+            out.append(None if i is None else (self.choices[i], self.rows[i][j]))
+        return out
+
+
 def select(cache: Sequence[TakeCache], choices: list[dict] | None = None) -> Selection:
     """Score every choice (default: the whole :data:`GRID`) on every take."""
     choices = grid_choices() if choices is None else choices
@@ -207,6 +224,24 @@ def objectives(selection: Selection) -> list[tuple[str, float, float]]:
     made by the shipped :func:`objective` and by :func:`edits_objective`."""
     return [(name, *_loo_means(selection, score)) for name, score in
             (("F1@1s first", objective), ("edits first", edits_objective))]
+
+
+def by_source(selection: Selection) -> list[tuple[str, int, dict, dict]]:
+    """How the choice transfers between label sources: per source, its number of scored
+    takes (not ``pool``), and their mean row (F1@1 s, edits per true cut, median error)
+    when the settings are chosen on the other sources only and leave-one-take-out."""
+    out = []
+    sources = dict.fromkeys(c.labelled.source for c in selection.cache if not c.pool)
+    for source in sources:
+        means = []
+        for chosen in (selection.leave_source_out(), selection.leave_one_out()):
+            rows = [found[1] for found, c in zip(chosen, selection.cache, strict=True)
+                    if found is not None and not c.pool and c.labelled.source == source]
+            means.append({key: _mean([r[key] for r in rows]) for key in
+                          ("f1@1s", "edits_per_cut", "median_error_s")})
+        n = sum(not c.pool and c.labelled.source == source for c in selection.cache)
+        out.append((source, n, *means))
+    return out
 
 
 def _loo_means(selection: Selection, score=None) -> tuple[float, float]:

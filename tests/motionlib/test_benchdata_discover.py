@@ -79,9 +79,9 @@ def test_it_names_the_line_of_a_bad_four_channel_row(tmp_path):
 class View:
     """A scored view of a capture, as tuning.Selection sees it."""
 
-    def __init__(self, name):
-        self.labelled = type("L", (), {"name": name})()
-        self.key, self.pool = name, False
+    def __init__(self, name, source="mocap6", pool=False):
+        self.labelled = type("L", (), {"name": name, "source": source})()
+        self.key, self.pool = name, pool
 
 
 def test_it_chooses_settings_without_the_take_scored_or_its_other_views():
@@ -109,6 +109,26 @@ def test_it_scores_choosing_by_f1_first_and_by_edits_first_leave_one_take_out():
     assert np.allclose([f1, edits, f1_e, edits_e], [0.9, 0.6, 0.8, 0.4])
 
 
+def test_it_chooses_settings_on_the_other_label_sources_only_to_show_their_transfer():
+    cache = [*(View(name, "mocap6") for name in "abcd"), View("e", "kruger2017"),
+             View("f", "kruger2017", pool=True)]
+    good = {"f1@1s": 1.0, "edits_per_cut": 0.0, "median_error_s": 0.1}
+    bad = {"f1@1s": 0.5, "edits_per_cut": 1.0, "median_error_s": 0.5}
+    # Choice 0 is best on the four mocap6 takes, choice 1 on the two kruger2017 ones.
+    selection = tuning.Selection([{"c": 0}, {"c": 1}], cache,
+                                 [[good] * 4 + [bad] * 2, [bad] * 4 + [good] * 2])
+    assert [c["c"] for c, _ in selection.leave_source_out()] == [1, 1, 1, 1, 0, 0]
+    # Leave-one-take-out chooses on the other mocap6 takes too, so the majority wins.
+    assert [c["c"] for c, _ in selection.leave_one_out()] == [0] * 6
+    (m, m_n, m_other, m_loo), (k, k_n, k_other, k_loo) = tuning.by_source(selection)
+    assert (m, m_n, k, k_n) == ("mocap6", 4, "kruger2017", 1)  # a pool take is not scored
+    assert m_other == {"f1@1s": 0.5, "edits_per_cut": 1.0, "median_error_s": 0.5}
+    assert m_loo == {"f1@1s": 1.0, "edits_per_cut": 0.0, "median_error_s": 0.1}
+    assert k_other == k_loo == {"f1@1s": 0.5, "edits_per_cut": 1.0, "median_error_s": 0.5}
+    single = tuning.Selection([{"c": 0}], cache[:2], [[good, good]])
+    assert single.leave_source_out() == [None, None]  # no other source to choose on
+
+
 def test_it_prints_leave_one_take_out_rows_beside_the_others(layout, capsys):
     from motionlib import bench_quality
 
@@ -120,6 +140,7 @@ def test_it_prints_leave_one_take_out_rows_beside_the_others(layout, capsys):
     assert "mean over 1 full-skeleton takes" in out and "mean over 2 labelled takes" in out
     assert "out of sample (leave-one-take-out)" in out
     assert "objective       F1@1s first" in out and "objective       edits first" in out
+    assert "(leave-one-source-out)" in out
 
 
 def test_it_keeps_the_shipped_value_first_among_the_tried_options():
