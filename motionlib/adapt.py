@@ -687,7 +687,8 @@ def read_examples(path) -> list[tuple[object, np.ndarray]]:
 
     path = Path(path)
     try:
-        with open(path, newline="", encoding="utf-8") as fh:
+        # utf-8-sig: a spreadsheet's "CSV UTF-8" starts with a byte-order mark.
+        with open(path, newline="", encoding="utf-8-sig") as fh:
             rows = list(csv.reader(fh))
     except (OSError, UnicodeDecodeError) as exc:
         raise ExampleError(f"{path}: cannot read examples: {exc}") from None

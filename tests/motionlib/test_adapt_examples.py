@@ -37,6 +37,15 @@ def test_it_reads_example_takes_relative_to_the_csv(takes):
     assert [ex[0].n_frames for ex in examples] == [n for _, _, n in rows]
 
 
+def test_it_reads_a_spreadsheet_csv_with_a_byte_order_mark_and_crlf_lines(takes):
+    folder, rows = takes
+    path = folder / "excel.csv"
+    text = "file,asf,cuts\r\n" + f"{rows[0][0]},,{' '.join(map(str, rows[0][1]))}\r\n"
+    path.write_bytes(b"\xef\xbb\xbf" + text.encode())
+    [(take, cuts)] = read_examples(path)
+    assert cuts.tolist() == rows[0][1] and take.n_frames == rows[0][2]
+
+
 def test_it_names_the_line_of_a_cut_that_is_not_a_number(takes):
     folder, rows = takes
     path = _csv(folder, f"file,asf,cuts\n{rows[0][0]},,120 2x0\n")
