@@ -286,7 +286,8 @@ def read_amc(path: str | os.PathLike, asf: str | os.PathLike | Asf, *,
     Parameters
     ----------
     path : str or PathLike
-        The ``.amc`` file; frame numbers must run 1, 2, … N.
+        The ``.amc`` file; frame numbers must run 1, 2, … N, and every frame list the
+        bones of the first (a file cut off part-way through a frame is refused).
     asf : str, PathLike or Asf
         Its skeleton.
     limits : Limits, optional
@@ -403,6 +404,7 @@ def _amc_lines(body: str, first_line: int, asf: Asf, path, bounds: np.ndarray | 
     starts = sk.channel_starts
     frames: list[np.ndarray] = []
     seen: set[str] = set()
+    bones: set[str] = set()  # those of frame 1
     frame_line = first_line
     for n, line in enumerate(body.split("\n"), first_line):
         tokens = line.split()
@@ -410,6 +412,10 @@ def _amc_lines(body: str, first_line: int, asf: Asf, path, bounds: np.ndarray | 
             continue
         if tokens[0].lstrip("-").isdigit() and len(tokens) == 1:
             _check_frame_start(frames, seen, tokens[0], n, frame_line, path, max_frames, sk)
+            if len(frames) == 1:
+                bones = seen
+            elif frames:
+                _check_same_bones(bones, seen, len(frames), frame_line, path)
             frames.append(np.zeros(sk.n_channels))
             seen, frame_line = set(), n
             continue
@@ -439,7 +445,23 @@ def _amc_lines(body: str, first_line: int, asf: Asf, path, bounds: np.ndarray | 
         frames[-1][starts[j]:starts[j] + count] = values
     if frames and not seen:
         raise CaptureError(f"frame {len(frames)} lists no bones", path=path, line=frame_line)
+    if len(frames) > 1:
+        _check_same_bones(bones, seen, len(frames), frame_line, path)
     return np.array(frames).reshape(len(frames), sk.n_channels)
+
+
+def _check_same_bones(bones: set[str], seen: set[str], frame: int, line: int, path) -> None:
+    """Every frame lists the bones of the first one: a frame with fewer is cut off (a file
+    that ends part-way through a frame), and its other bones would read as zero angles."""
+    if seen == bones:
+        return
+    missing, extra = sorted(bones - seen), sorted(seen - bones)
+    if missing:
+        more = f" and {len(missing) - 1} more" if len(missing) > 1 else ""
+        what = f"lacks bone {missing[0]!r}{more} that frame 1 lists: a cut-off or damaged file"
+    else:
+        what = f"lists bone {extra[0]!r}, which frame 1 does not: a damaged file"
+    raise CaptureError(f"frame {frame} {what}", path=path, line=line)
 
 
 def _check_frame_start(frames, seen, token: str, n: int, frame_line: int, path,

@@ -90,6 +90,27 @@ def test_it_refuses_a_last_amc_frame_that_lists_no_bones(tmp_path):
         motionlib.read(amc, asf=asf)
 
 
+def test_it_refuses_an_amc_cut_off_part_way_through_its_last_frame(tmp_path):
+    # An interrupted copy or upload: the last frame's other bones would read as zeros.
+    frames = AMC_FRAME.format(n=1) + AMC_FRAME.format(n=2) + "3\nroot 0 0 0 0 0 0\n"
+    amc, asf = amc_pair(tmp_path, frames)
+    with pytest.raises(CaptureError, match=r"bad\.amc:7: frame 3 lacks bone 'lowerback' "
+                                           r"that frame 1 lists: a cut-off or damaged file"):
+        motionlib.read(amc, asf=asf)
+
+
+def test_it_refuses_an_amc_frame_that_lists_other_bones_than_the_first(tmp_path):
+    frames = ("1\nroot 0 0 0 0 0 0\n" + AMC_FRAME.format(n=2) + AMC_FRAME.format(n=3))
+    amc, asf = amc_pair(tmp_path, frames)
+    with pytest.raises(CaptureError, match=r"bad\.amc:3: frame 2 lists bone 'lowerback', "
+                                           r"which frame 1 does not"):
+        motionlib.read(amc, asf=asf)
+    middle = AMC_FRAME.format(n=1) + "2\nroot 0 0 0 0 0 0\n" + AMC_FRAME.format(n=3)
+    amc, asf = amc_pair(tmp_path, middle)
+    with pytest.raises(CaptureError, match=r"bad\.amc:4: frame 2 lacks bone 'lowerback'"):
+        motionlib.read(amc, asf=asf)
+
+
 def test_it_reads_a_bvh_with_cr_only_line_ends_like_lf(tmp_path):
     text = HEADER + "Frames: 2\nFrame Time: 0.01\n" + FRAME * 2
     lf = motionlib.read(write(tmp_path, text, "lf.bvh"))
