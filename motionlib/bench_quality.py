@@ -367,6 +367,7 @@ def main(root: Path | None = None, only: list[str] | None = None, out=None, *,
         print("\n" + edge_activity_check(read), file=out)
         print("\n" + unmatched_choice_check(read), file=out)
         print("\n" + unmatched_guard_check(folder), file=out)
+        print("\n" + long_take_check(folder), file=out)
     if (not only or "joint_distance_pca" in only) and "13_30" in takes:
         print("\n" + patent_comparison(folder), file=out)
     print(f"\nwhole benchmark: {time.perf_counter() - started:.0f} s, load average "
@@ -687,6 +688,91 @@ def unmatched_guard_check(folder: Path) -> str:
         f"without its take-median guard, its level / the take's median, kept from "
         f"{UNMATCHED_RELATIVE:g}x:",
         f"  {'take':<10}{'s':>7}{'shipped':>9}{'step off':>10}   firings", *rows])
+
+
+# Cuts and true cuts this close (s) to a join of two takes are not scored: what lies
+# there (the end of one take, the start of the other) is neither take's activity.
+JOIN_S = 2.0
+
+
+def long_take_check(folder: Path) -> str:
+    """Long takes made of several: the full-skeleton AMC takes of one skeleton (ASF), with
+    labels and without, joined end to end two at a time in both orders and all together;
+    each labelled part scored in its own span against its own cuts, beside the take on its
+    own, both without what lies within ``JOIN_S`` of a join. The detector's kernel width
+    and levels are the take's, so what else a take holds can change its cuts; this shows
+    how much (a studio's takes are long and mixed, the labelled ones here 20-40 s)."""
+    import motionlib
+
+    labelled = [t for t in benchdata.discover(folder, channels=False, bvh=False)[0]
+                if t.asf is not None and t.path.suffix == ".amc"]
+    groups: dict[Path, list] = {}
+    for t in labelled:
+        groups.setdefault(Path(t.asf).resolve(), []).append((t.name, t.path, t))
+    for path, asf in benchdata.unlabelled_motion(folder):
+        if asf is not None and Path(asf).resolve() in groups:
+            groups[Path(asf).resolve()].append((path.stem, path, None))
+    lines, joined_rows, alone_rows = [], [], []
+    for asf, members in groups.items():
+        if len(members) < 2:
+            continue
+        try:
+            parts = [(name, motionlib.read(path, asf=asf), t) for name, path, t in members]
+        except CaptureError as exc:
+            lines.append(f"  skipped {asf.name}: {exc}")
+            continue
+        joins = [[a, b] for a in parts for b in parts if a is not b]
+        if len(parts) > 2:
+            joins.append(list(parts))
+        alone = {name: Default().fit_predict(take).cuts for name, take, t in parts if t}
+        for join in joins:
+            for name, joined, own in _part_rows(join, alone):
+                lines.append(f"  {' + '.join(n for n, _, _ in join):<26}{name:<8}"
+                             f"{joined['f1@1s']:>7.3f}{joined['edits_per_cut']:>7.2f}"
+                             f"{own['f1@1s']:>13.3f}{own['edits_per_cut']:>7.2f}")
+                joined_rows.append(joined)
+                alone_rows.append(own)
+    if not joined_rows:
+        return "long takes: no skeleton with two AMC takes, one of them labelled, here"
+    mean = mean_rows({i: {"joined": j, "alone": a}
+                      for i, (j, a) in enumerate(zip(joined_rows, alone_rows, strict=True))})
+    return "\n".join([
+        "long takes, real motion: the full-skeleton AMC takes of one skeleton joined end to "
+        "end (two at a time in both orders, and all); each labelled part scored in its own "
+        f"span, beside the take alone, both without cuts and true cuts within {JOIN_S:g} s "
+        "of a join:",
+        f"  {'joined':<26}{'part':<8}{'F1@1s':>7}{'edits':>7}{'alone: F1@1s':>13}{'edits':>7}",
+        *lines,
+        f"  mean over {len(joined_rows)} parts: joined F1@1s {mean['joined']['f1@1s']:.3f}, "
+        f"edits {mean['joined']['edits_per_cut']:.2f}; alone {mean['alone']['f1@1s']:.3f}, "
+        f"{mean['alone']['edits_per_cut']:.2f}"])
+
+
+def _part_rows(parts, alone: dict) -> list[tuple[str, dict, dict]]:
+    """The default detector on ``parts`` (name, take, labelled take or None) joined end to
+    end. Per labelled part, ``metrics.evaluate`` of the joined take's cuts in its span and
+    of its cuts alone (``alone[name]``), both against its own cuts and without what lies
+    within ``JOIN_S`` of a join at its ends."""
+    from dataclasses import replace
+
+    first = parts[0][1]
+    joined = replace(first, channels=np.concatenate([take.channels for _, take, _ in parts]),
+                     positions=None)
+    cuts = Default().fit_predict(joined).cuts
+    out, start = [], 0
+    for i, (name, take, labelled) in enumerate(parts):
+        n = take.n_frames
+        if labelled is not None:
+            gap = int(round(JOIN_S * take.fps))
+            lo, hi = (gap if i else 0), (n - gap if i + 1 < len(parts) else n)
+            truth = labelled.truth[(labelled.truth[:, 1] >= lo) & (labelled.truth[:, 1] < hi)]
+            rows = []
+            for found in (cuts - start, alone[name]):
+                found = found[(found >= lo) & (found < hi)]
+                rows.append(metrics.evaluate(found, truth, fps=take.fps))
+            out.append((name, *rows))
+        start += n
+    return out
 
 
 def short_takes_check(read: list, seconds=THROUGHOUT_S) -> str:

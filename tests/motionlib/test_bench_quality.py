@@ -263,3 +263,38 @@ def test_the_guard_check_runs_on_the_takes_without_labels(tmp_path):
 def test_the_unmatched_choice_check_says_so_without_a_skeleton_take():
     text = bench_quality.unmatched_choice_check(_read([_Labelled(1, kind="channels")]))
     assert text == "unmatched-poses step: no full-skeleton take to choose its settings on"
+
+
+def test_the_long_take_check_scores_each_labelled_part_without_what_lies_by_a_join():
+    fps = 60.0
+    first, _ = synth.generate(seed=4, fps=fps, duration=20.0)
+    second, _ = synth.generate(seed=5, fps=fps, duration=20.0)
+    n, gap = first.n_frames, int(bench_quality.JOIN_S * fps)
+    # True cuts of the first take: one in its span, one within JOIN_S of its end (a join).
+    truth = np.repeat(np.array([[300], [n - gap // 2]]), 3, axis=1)
+    labelled = benchdata.LabelledTake("a", None, None, truth, "mocap6")
+    # Alone: the first true cut found, and a cut by the join that is not scored either.
+    alone = {"a": np.array([300, n - gap // 4])}
+    [(name, joined, own)] = bench_quality._part_rows(
+        [("a", first, labelled), ("b", second, None)], alone)
+    assert name == "a"
+    assert own["f1@1s"] == 1.0 and own["edits_per_cut"] == 0.0
+    assert 0.0 <= joined["f1@1s"] <= 1.0
+    # Last in the joined take, the same part keeps a true cut near its end: that is the
+    # take's end, not a join.
+    [(_, _, own_last)] = bench_quality._part_rows(
+        [("b", second, None), ("a", first, labelled)], alone)
+    assert own_last["f1@1s"] == 1.0
+
+
+@pytest.mark.slow
+def test_the_long_take_check_joins_the_takes_of_one_skeleton_both_ways():
+    if not (DATA / "cmu/amc/13_30.amc").is_file():
+        pytest.skip("labelled CMU takes are not available (needs ../shared/data)")
+    lines = bench_quality.long_take_check(DATA).splitlines()
+    assert lines[0].startswith("long takes, real motion")
+    joined = {tuple(line.split()[:4:2]) for line in lines[2:-1]}
+    assert {("13_29", "13_30"), ("13_30", "13_29"), ("13_17", "13_29")} <= joined
+    assert lines[-1].startswith("  mean over ")
+    assert bench_quality.long_take_check(DATA / "cmu") == \
+        "long takes: no skeleton with two AMC takes, one of them labelled, here"
