@@ -10,8 +10,8 @@ The score of a setting over some takes is the mean F1 at 1 s, ties broken by few
 edits per true cut (``metrics``). Choosing by fewer edits first, ties broken by F1
 (:func:`edits_objective`, the criterion ``adapt`` counts cuts by), was scored the same way
 on the 11 labelled takes under ``shared/data``: leave-one-take-out mean F1@1 s 0.916 and
-0.468 edits per true cut, against 0.957 and 0.406 with F1 first, on review cost too. It
-takes the higher prominence (0.15) that a few takes gain from and loses cuts on the others
+0.468 edits per true cut, against 0.957 and 0.406 with F1 first: worse on review cost
+too. It takes the higher prominence (0.15) that a few takes gain from and loses cuts on the others
 (13_30, 86_03, 86_08, 86_11, 86_14). The benchmark prints both (``objective`` lines).
 
 Leave-one-take-out still chooses on takes of the scored take's own label source. How the
@@ -170,19 +170,20 @@ class Selection:
         """Per take: the choice made without it (and its other views) by ``score``
         (default :func:`objective`), and its row there; None for a take with no other
         capture to choose on."""
-        out = []
-        for j, c in enumerate(self.cache):
-            i = self.best([other.key != c.key for other in self.cache], score)
-            out.append(None if i is None else (self.choices[i], self.rows[i][j]))
-        return out
-
+        return self._chosen_without(lambda other, c: other.key != c.key, score)
 
     def leave_source_out(self) -> list[tuple[dict, dict] | None]:
         """Per take: the choice made on the takes of the other label sources only, and its
         row there; None when every take has the same source."""
+        return self._chosen_without(
+            lambda other, c: other.labelled.source != c.labelled.source)
+
+    def _chosen_without(self, usable, score=None) -> list[tuple[dict, dict] | None]:
+        """Per take ``c``: the best choice on the takes ``other`` where ``usable(other, c)``,
+        and its row on ``c``."""
         out = []
         for j, c in enumerate(self.cache):
-            i = self.best([other.labelled.source != c.labelled.source for other in self.cache])
+            i = self.best([usable(other, c) for other in self.cache], score)
             out.append(None if i is None else (self.choices[i], self.rows[i][j]))
         return out
 
@@ -232,9 +233,10 @@ def by_source(selection: Selection) -> list[tuple[str, int, dict, dict]]:
     when the settings are chosen on the other sources only and leave-one-take-out."""
     out = []
     sources = dict.fromkeys(c.labelled.source for c in selection.cache if not c.pool)
+    ways = (selection.leave_source_out(), selection.leave_one_out())
     for source in sources:
         means = []
-        for chosen in (selection.leave_source_out(), selection.leave_one_out()):
+        for chosen in ways:
             rows = [found[1] for found, c in zip(chosen, selection.cache, strict=True)
                     if found is not None and not c.pool and c.labelled.source == source]
             means.append({key: _mean([r[key] for r in rows]) for key in
