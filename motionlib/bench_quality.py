@@ -721,7 +721,7 @@ def long_take_check(folder: Path) -> str:
         except CaptureError as exc:
             lines.append(f"  skipped {asf.name}: {exc}")
             continue
-        joins = [[a, b] for a in parts for b in parts if a is not b]
+        joins = [[a, b] for a in parts for b in parts if a is not b and (a[2] or b[2])]
         if len(parts) > 2:
             joins.append(list(parts))
         alone = {name: Default().fit_predict(take).cuts for name, take, t in parts if t}
