@@ -157,7 +157,16 @@ other takes of their skeleton (``bench_quality.long_take_check``: 13_29 and 13_3
 labelled parts score in their own spans mean F1@1 s 0.982 and 0.43 edits per true cut,
 against 1.000 and 0.35 alone (cuts within 2 s of a join not scored): with another take
 before it, 13_29 gains a false cut 1.3 s before its end, in its last squat (it stands
-still for the last 0.8 s), and one cut moves 0.6 s. A kernel width per stretch of the take would remove that; not tried.
+still for the last 0.8 s), and one cut moves 0.6 s. Tried, not kept: a kernel width per
+stretch of the take (the poses scaled so that the median squared distance within ±20 s,
+or ±30 s, of each block is the take's). At ±20 s the joined takes score as alone (1.000
+and 0.35), and leave-one-take-out over the 11 labelled takes 0.951 and 0.406 (86_03 gains
+a cut; as shipped 0.957 and 0.406); at ±30 s 0.991 and 0.39 joined, 0.944 and 0.439
+leave-one-take-out; widening only (never sharper than the take's kernel), 1.000 and 0.35,
+0.938 and 0.439 at ±20 s, 0.982 and 0.43, 0.951 and 0.416 at ±30 s. None is better out of
+sample, and a width from ±20 s would, inside a minute of one activity (walking on), come
+from that activity alone and cut its every variation, which no take here can show or
+rule out.
 
 Short activities: unmatched poses (step 4c)
 -------------------------------------------
