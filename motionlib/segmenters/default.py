@@ -144,9 +144,9 @@ shipped), full-skeleton 0.12 s and 0.33 (0.09 s and 0.27), capped at 4-10 s alik
 worse: it trades the takes with a skeleton for those without. A softer pause (step c's
 and d's level at 0.6, 0.7, 0.8 or 0.9 of the typical speed instead of half; at 0.7 it
 moves 13_29's cut placed 0.8 s early to the shallow slowdown where the annotators cut,
-and five others of the full-skeleton takes further from theirs, to 0.2-0.6 s) does the same: four-channel 0.36, 0.36, 0.34 and 0.35 s (0.38 as
-shipped), full-skeleton 0.23, 0.17, 0.17 and 0.27 s (0.09), the edits per true cut there
-0.34-0.48 (0.27).
+and five others of the full-skeleton takes further from theirs, to 0.2-0.6 s) does the
+same: four-channel 0.36, 0.36, 0.34 and 0.35 s (0.38 as shipped), full-skeleton 0.23,
+0.17, 0.17 and 0.27 s (0.09), the edits per true cut there 0.33-0.48 (0.27).
 
 Long takes
 ----------
