@@ -658,6 +658,7 @@ def unmatched_guard_check(folder: Path) -> str:
     ``UNMATCHED_RELATIVE`` on). Nothing is scored (there are no labels): a take that does
     not repeat itself (boxing, dance) is where the guard acts, and these show where it
     does."""
+    import motionlib
     from motionlib.segmenters.default import UNMATCHED_RELATIVE
 
     takes = benchdata.unlabelled_motion(folder)
@@ -667,8 +668,6 @@ def unmatched_guard_check(folder: Path) -> str:
     rows = []
     for path, asf in takes:
         try:
-            import motionlib
-
             take = motionlib.read(path, asf=asf)
         except CaptureError as exc:
             rows.append(f"  {path.stem:<10} skipped: {exc}")

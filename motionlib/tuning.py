@@ -11,8 +11,9 @@ edits per true cut (``metrics``). Choosing by fewer edits first, ties broken by 
 (:func:`edits_objective`, the criterion ``adapt`` counts cuts by), was scored the same way
 on the 11 labelled takes under ``shared/data``: leave-one-take-out mean F1@1 s 0.916 and
 0.468 edits per true cut, against 0.957 and 0.406 with F1 first: worse on review cost
-too. It takes the higher prominence (0.15) that a few takes gain from and loses cuts on the others
-(13_30, 86_03, 86_08, 86_11, 86_14). The benchmark prints both (``objective`` lines).
+too. It takes the higher prominence (0.15) that a few takes gain from and loses cuts on
+the others (13_30, 86_03, 86_08, 86_11, 86_14). The benchmark prints both (``objective``
+lines).
 
 Leave-one-take-out still chooses on takes of the scored take's own label source. How the
 choice transfers to a source it never saw is measured too (:func:`by_source`): the two
@@ -237,8 +238,7 @@ def by_source(selection: Selection) -> list[tuple[str, int, dict, dict]]:
     for source in sources:
         means = []
         for chosen in ways:
-            rows = [found[1] for found, c in zip(chosen, selection.cache, strict=True)
-                    if found is not None and not c.pool and c.labelled.source == source]
+            rows = _scored_rows(chosen, selection.cache, source)
             means.append({key: _mean([r[key] for r in rows]) for key in
                           ("f1@1s", "edits_per_cut", "median_error_s")})
         n = sum(not c.pool and c.labelled.source == source for c in selection.cache)
@@ -249,10 +249,16 @@ def by_source(selection: Selection) -> list[tuple[str, int, dict, dict]]:
 def _loo_means(selection: Selection, score=None) -> tuple[float, float]:
     """Mean F1@1 s and edits per true cut, leave-one-take-out, over the takes scored (not
     ``pool``) that have another capture to choose on."""
-    rows = [found[1] for found, c in zip(selection.leave_one_out(score), selection.cache,
-                                         strict=True)
-            if found is not None and not c.pool]
+    rows = _scored_rows(selection.leave_one_out(score), selection.cache)
     return _mean([r["f1@1s"] for r in rows]), _mean([r["edits_per_cut"] for r in rows])
+
+
+def _scored_rows(chosen: list, cache: Sequence, source: str | None = None) -> list[dict]:
+    """The rows of ``chosen`` (per take of ``cache``: a choice and its row, or None) on
+    the takes scored (not ``pool``) that had something to choose on, of ``source`` only
+    when given."""
+    return [found[1] for found, c in zip(chosen, cache, strict=True)
+            if found is not None and not c.pool and source in (None, c.labelled.source)]
 
 
 def _mean(values: list[float]) -> float:

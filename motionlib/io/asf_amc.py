@@ -414,7 +414,7 @@ def _amc_lines(body: str, first_line: int, asf: Asf, path, bounds: np.ndarray | 
             _check_frame_start(frames, seen, tokens[0], n, frame_line, path, max_frames, sk)
             if len(frames) == 1:
                 bones = seen
-            elif frames:
+            elif len(frames) > 1:
                 _check_same_bones(bones, seen, len(frames), frame_line, path)
             frames.append(np.zeros(sk.n_channels))
             seen, frame_line = set(), n
