@@ -64,3 +64,22 @@ def test_it_places_cuts_on_the_labelled_takes_within_0_15_s_median(takes):
     assert mean["median_error_s"] <= 0.15
     assert mean["f1@1s"] >= 0.9
     assert mean["edits_per_cut"] <= 0.5
+
+
+def test_its_cuts_hold_when_the_same_motion_plays_on_another_subjects_skeleton(takes):
+    """Takes come from many subjects: bone lengths must not change where the cuts go.
+    The same AMC angles on three CMU skeletons (13, 14 and 86; their bones differ in length by up
+    to a quarter) give the same cuts within two frames."""
+    from motionlib import read
+
+    asfs = sorted((DATA / "cmu" / "asf").glob("*.asf"))
+    others = [a for a in asfs if a.stem in ("13", "14", "86")]
+    if len(others) < 2:
+        pytest.skip("fewer than two of the subject 13, 14, 86 skeletons are available")
+    for name in ("13_30", "86_01"):
+        amc = takes[name][0].path
+        cuts = [get_segmenter("default")().fit_predict(read(amc, asf=asf)).cuts
+                for asf in others]
+        for other, asf in zip(cuts[1:], others[1:], strict=True):
+            assert len(other) == len(cuts[0]), (name, asf.name)
+            assert np.abs(other - cuts[0]).max() <= 2, (name, asf.name)
