@@ -11,7 +11,7 @@ from rest_framework.response import Response
 from rest_framework.views import APIView
 
 from segmentation.api.captures import capture_for
-from segmentation.api.params import int_param
+from segmentation.api.params import body, int_param
 from segmentation.api.projects import project_for
 from segmentation.api.serializers import NamedRefSerializer, ReviewSerializer
 from segmentation.models import Assignment, Project
@@ -89,12 +89,6 @@ def assigning_project(request, pk):
     if not project.can_see_all_reviews(request.user):
         raise PermissionDenied("Only the project's reviewers and admins assign captures.")
     return project
-
-
-def body(request, serializer_class):
-    serializer = serializer_class(data=request.data)
-    serializer.is_valid(raise_exception=True)
-    return serializer.validated_data
 
 
 class AssignmentsView(APIView):

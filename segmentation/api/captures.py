@@ -16,7 +16,7 @@ from rest_framework.response import Response
 
 from segmentation import services, storage
 from segmentation.api.heavy import immutable
-from segmentation.api.params import int_param
+from segmentation.api.params import body, int_param
 from segmentation.api.projects import project_for
 from segmentation.api.serializers import (
     CaptureListSerializer,
@@ -111,12 +111,12 @@ class CaptureViewSet(
             raise Invalid(f"encoding: must be one of {', '.join(SIGNAL_ENCODINGS)}, got "
                           f"{encoding[:40]!r}")
         run = capture.latest_finished_run()
-        body = {"run": run.pk if run else None, "fps": capture.fps, "n_frames": capture.n_frames}
+        out = {"run": run.pk if run else None, "fps": capture.fps, "n_frames": capture.n_frames}
         signals = storage.load_npz(run.signals) if run and run.signals else {}
-        body["signals"] = [SIGNAL_ENCODINGS[encoding](name, values, max_points)
+        out["signals"] = [SIGNAL_ENCODINGS[encoding](name, values, max_points)
                            for name, values in signals.items()]
         answer = SignalsSerializer if encoding == "json" else PackedSignalsSerializer
-        return Response(answer(body).data)
+        return Response(answer(out).data)
 
     @extend_schema(
         parameters=[OpenApiParameter(p, int) for p in ("start", "stop", "step")],
@@ -173,9 +173,7 @@ class CaptureViewSet(
         capture = self.get_object()
         if request.method == "GET":
             return Response(RunSerializer(capture.runs.all(), many=True).data)
-        body = RunRequestSerializer(data=request.data)
-        body.is_valid(raise_exception=True)
-        run = services.do_start_run(capture, request.user, **body.validated_data)
+        run = services.do_start_run(capture, request.user, **body(request, RunRequestSerializer))
         return Response(RunSerializer(run).data, status=202)
 
 

@@ -26,7 +26,7 @@ from rest_framework.views import APIView
 
 from segmentation import agreement, dashboard, exports, search
 from segmentation.api.captures import capture_for
-from segmentation.api.params import bool_param, float_param, int_param
+from segmentation.api.params import body, bool_param, float_param, int_param
 from segmentation.api.projects import project_for
 from segmentation.api.serializers import (
     DetailSerializer,
@@ -105,9 +105,9 @@ class SegmentPagination(PageNumberPagination):
                          "results": data})
 
     def get_paginated_response_schema(self, schema):
-        body = super().get_paginated_response_schema(schema)
-        body["properties"]["count_capped"] = {"type": "boolean"}
-        return body
+        page = super().get_paginated_response_schema(schema)
+        page["properties"]["count_capped"] = {"type": "boolean"}
+        return page
 
 
 class SegmentSerializer(serializers.ModelSerializer):
@@ -478,9 +478,7 @@ class AdjudicationView(APIView):
     @extend_schema(request=GoldSerializer, responses={200: AdjudicationSerializer, 409: StaleGoldSerializer})
     def put(self, request, pk):
         capture = staff_capture(request.user, pk)
-        body = GoldSerializer(data=request.data)
-        body.is_valid(raise_exception=True)
-        data = body.validated_data
+        data = body(request, GoldSerializer)
         source = None
         if data.get("source_review") is not None:
             source = Review.objects.filter(pk=data["source_review"], capture=capture,

@@ -1,5 +1,6 @@
-"""Query-string parameters. Each parser raises ``Invalid`` (a 400) whose message names
-the parameter and the value at fault."""
+"""Query-string parameters and request bodies. Each parser raises ``Invalid`` (a 400)
+whose message names the parameter and the value at fault; a body that its serializer
+refuses is a 400 naming each field."""
 
 import math
 
@@ -51,3 +52,10 @@ def _number(request, name, default, convert, kind, low, high):
         shown = raw if len(raw) <= 40 else shorten(raw)
         raise Invalid(f"{name}: must be between {low} and {high}, got {shown}")
     return value
+
+
+def body(request, serializer_class) -> dict:
+    """The request body as ``serializer_class`` validates it (a 400 naming each bad field)."""
+    serializer = serializer_class(data=request.data)
+    serializer.is_valid(raise_exception=True)
+    return serializer.validated_data

@@ -11,6 +11,7 @@ from rest_framework.views import APIView
 from motionlib.segmenters import list_segmenters
 from segmentation import services, storage
 from segmentation.api.invitations import InvitationSerializer, InvitedSerializer, invited_response
+from segmentation.api.params import body
 from segmentation.api.serializers import (
     CutModelSerializer,
     LabelSerializer,
@@ -56,9 +57,7 @@ class ProjectViewSet(
         project = self._admin_project()
         if request.method == "GET":
             return Response(LabelSerializer(project.labels.all(), many=True).data)
-        serializer = LabelSerializer(data=request.data)
-        serializer.is_valid(raise_exception=True)
-        label = services.do_add_label(project, **serializer.validated_data)
+        label = services.do_add_label(project, **body(request, LabelSerializer))
         return Response(LabelSerializer(label).data, status=201)
 
     @extend_schema(methods=["GET"], responses=MemberSerializer(many=True))
@@ -72,9 +71,7 @@ class ProjectViewSet(
                 raise PermissionDenied("Only the project's reviewers and admins see its members.")
             members = project.memberships.select_related("user").order_by("id")
             return Response(MemberSerializer(members, many=True).data)
-        serializer = MemberSerializer(data=request.data)
-        serializer.is_valid(raise_exception=True)
-        data = serializer.validated_data
+        data = body(request, MemberSerializer)
         added = services.do_add_member(project, request.user, data["user"]["username"], data["role"])
         if isinstance(added, Membership):
             return Response(MemberSerializer(added).data)

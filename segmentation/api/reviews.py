@@ -9,6 +9,7 @@ from rest_framework.views import APIView
 
 from segmentation import services, suggestions
 from segmentation.api.captures import capture_for
+from segmentation.api.params import body
 from segmentation.api.serializers import (
     ChangeCutSerializer,
     EventSerializer,
@@ -27,11 +28,6 @@ class OwnReviewView(APIView):
 
     def review(self, pk):
         return services.get_or_create_review(capture_for(self.request.user, pk), self.request.user)
-
-    def body(self, serializer_class):
-        serializer = serializer_class(data=self.request.data)
-        serializer.is_valid(raise_exception=True)
-        return serializer.validated_data
 
     def reply(self, review, status=200):
         reload(review)
@@ -85,7 +81,7 @@ class SuggestionsView(APIView):
 class CutsView(OwnReviewView):
     @extend_schema(request=InsertCutSerializer, responses=ReviewSerializer)
     def post(self, request, pk):
-        data = self.body(InsertCutSerializer)
+        data = body(request, InsertCutSerializer)
         review = self.review(pk)
         return self.reply(services.do_insert_cut(review, request.user, data["frame"], data["version"]), 201)
 
@@ -93,7 +89,7 @@ class CutsView(OwnReviewView):
 class CutView(OwnReviewView):
     @extend_schema(request=ChangeCutSerializer, responses=ReviewSerializer)
     def patch(self, request, pk, cut_id):
-        data = self.body(ChangeCutSerializer)
+        data = body(request, ChangeCutSerializer)
         review = self.review(pk)
         cut = get_object_or_404(review.cuts, pk=cut_id)
         services.do_change_cut(review, request.user, cut, **data)
@@ -103,7 +99,7 @@ class CutView(OwnReviewView):
 class SegmentView(OwnReviewView):
     @extend_schema(request=LabelSegmentSerializer, responses=ReviewSerializer)
     def patch(self, request, pk, index):
-        data = self.body(LabelSegmentSerializer)
+        data = body(request, LabelSegmentSerializer)
         review = self.review(pk)
         services.do_label_segment(review, request.user, index, data["label"], data["version"])
         return self.reply(review)
@@ -112,7 +108,7 @@ class SegmentView(OwnReviewView):
 class SubmitView(OwnReviewView):
     @extend_schema(request=VersionSerializer, responses=ReviewSerializer)
     def post(self, request, pk):
-        data = self.body(VersionSerializer)
+        data = body(request, VersionSerializer)
         review = self.review(pk)
         return self.reply(services.do_submit_review(review, request.user, data["version"]))
 

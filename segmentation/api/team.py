@@ -13,6 +13,7 @@ from rest_framework.exceptions import PermissionDenied
 from rest_framework.response import Response
 from rest_framework.views import APIView
 
+from segmentation.api.params import body
 from segmentation.api.projects import project_for
 from segmentation.api.serializers import LabelSerializer, MemberSerializer
 from segmentation.models import ROLES
@@ -24,12 +25,6 @@ def admin_project(request, pk):
     if not project.can_manage(request.user):
         raise PermissionDenied("Only the project's admins change its members and labels.")
     return project
-
-
-def body(request, serializer_class):
-    serializer = serializer_class(data=request.data)
-    serializer.is_valid(raise_exception=True)
-    return serializer.validated_data
 
 
 class RoleRequest(serializers.Serializer):
