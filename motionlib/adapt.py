@@ -139,7 +139,7 @@ from typing import Protocol
 import numpy as np
 
 from motionlib import metrics
-from motionlib.errors import InputError, MotionlibError
+from motionlib.errors import InputError, MotionlibError, ParamError
 from motionlib.segmenters.base import Segmentation, _checked
 from motionlib.segmenters.default import (
     PLACEMENTS,
@@ -332,7 +332,7 @@ def fit_cut_model(examples: Sequence, *, studies: Studies | None = None,
     """
     if len(examples) == 0:
         raise ExampleError("no example takes to learn from")
-    p = Default.validate_params(base or {})
+    p = _untempoed(Default.validate_params(base or {}))
     checked = [(example, _checked_cuts(example, example.cuts))
                for example in map(_as_example, examples)]
     shortest = _shortest_segment(checked)
@@ -649,6 +649,15 @@ def _segment(analysis, p: dict, placement: str, offset_s: float) -> Segmentation
     return _checked(result, len(analysis.x) + analysis.first)
 
 
+def _untempoed(p: dict) -> dict:
+    """``p``, refused with the ``tempo`` setting: a model's windows and offsets are
+    learnt in seconds of the examples' own pace."""
+    if p["tempo"]:
+        raise ParamError("tempo: an adapted model learns its windows in seconds and "
+                         "cannot be combined with the tempo setting")
+    return p
+
+
 def detect(take, model: CutModel | None = None, **params) -> Segmentation:
     """Candidate cuts of ``take``; ``model=None`` is the zero-shot default detector.
 
@@ -663,7 +672,7 @@ def detect(take, model: CutModel | None = None, **params) -> Segmentation:
     """
     if model is None:
         return Default(**params).fit_predict(take)
-    p = {**Default.validate_params(params), **model.params()}
+    p = _untempoed({**Default.validate_params(params), **model.params()})
     start = time.perf_counter()
     analysis = Default.analyse(take, p)
     result = empty_segmentation(take) if analysis is None else \

@@ -24,7 +24,8 @@ chosen without the take, since the shipped ones were chosen on it too), and rupt
 penalty chosen without the take; the out-of-sample score of every option of every
 setting, and three short-activity checks, on synthetic takes, on the real takes with
 one activity cut short (``real_short_activity_check``) and with the first or last one cut
-short (``edge_activity_check``), and the leave-one-take-out choice of the unmatched-poses
+short (``edge_activity_check``), every take played slower and quicker (``tempo_check``),
+and the leave-one-take-out choice of the unmatched-poses
 step's settings on such takes (``unmatched_choice_check``), follow the tables, and what
 that step does on the full-skeleton takes without segment labels, which are not scored
 (``unmatched_guard_check``). Each take is scored separately and the means are given per
@@ -365,6 +366,7 @@ def main(root: Path | None = None, only: list[str] | None = None, out=None, *,
         print("\n" + real_short_activity_check(read), file=out)
         print("\n" + short_takes_check(read), file=out)
         print("\n" + edge_activity_check(read), file=out)
+        print("\n" + tempo_check(read), file=out)
         print("\n" + unmatched_choice_check(read), file=out)
         print("\n" + unmatched_guard_check(folder), file=out)
         print("\n" + long_take_check(folder), file=out)
@@ -815,6 +817,46 @@ def _unmatched_row(name: str, setting: str, cells: tuple) -> str:
     as_is, f1, both, n, all_cut = cells
     return (f"  {name:<10}{setting:>14}  {as_is:>9.3f}{f1:>18.3f}{f'{both}/{n}':>8}"
             f"{all_cut:>17.3f}")
+
+
+TEMPO_SPEEDS = (0.8, 0.9, 1.0, 1.1, 1.25)
+
+
+def tempo_check(read: list, speeds=TEMPO_SPEEDS) -> str:
+    """Takes played slower and quicker (``benchdata.played_at``): each labelled take as if
+    performed at ``speeds`` times its pace, its true cuts moved with it, scored as
+    shipped and with the ``tempo`` setting (time settings scaled by the take's own
+    movement cycle). A studio's performers do not all move at the pace of the takes the
+    settings were chosen on; this shows how much that costs."""
+    if not read:
+        return "tempo: no labelled take"
+    kinds = [("full-skeleton", "skeleton"), ("four-channel", "channels")]
+    rows = {}
+    for t, take in read:
+        for speed in speeds:
+            played, truth = (take, t.truth) if speed == 1.0 else \
+                benchdata.played_at(take, t.truth, speed)
+            for setting, params in (("shipped", {}), ("tempo", {"tempo": True})):
+                cuts = Default(**params).fit_predict(played).cuts
+                row = metrics.evaluate(cuts, truth, fps=take.fps)
+                rows.setdefault((t.kind, setting, speed), []).append(row)
+    head = "".join(f"{f'x{s:g}: F1@1s':>14}{'edits':>7}{'err s':>7}" for s in speeds)
+    lines = [f"tempo: each labelled take played at {' / '.join(f'{s:g}' for s in speeds)} "
+             f"times its pace (its cuts moved with it); mean F1@1 s, edits per true cut and "
+             f"median placement error, as shipped and with tempo on:",
+             f"  {'':<28}{head}"]
+    for group, kind in kinds:
+        for setting in ("shipped", "tempo"):
+            if (kind, setting, speeds[0]) not in rows:
+                continue
+            cells = ""
+            for speed in speeds:
+                mean = mean_rows({i: {"m": r} for i, r in
+                                  enumerate(rows[(kind, setting, speed)])})["m"]
+                cells += (f"{mean['f1@1s']:>14.3f}{mean['edits_per_cut']:>7.2f}"
+                          f"{mean['median_error_s']:>7.2f}")
+            lines.append(f"  {group + ', ' + setting:<28}{cells}")
+    return "\n".join(lines)
 
 
 EDGE_REAL_S = (1.5, 1.8, 2.5)

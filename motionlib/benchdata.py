@@ -416,6 +416,26 @@ def shortened_throughout(take, truth: np.ndarray, seconds: float):
     return take, truth
 
 
+def played_at(take, truth: np.ndarray, speed: float):
+    """``take`` as if performed ``speed`` times as fast (0.8: 25 % longer), its channels
+    resampled linearly (angles through their shortest turn; no channel moves by half a
+    turn, 180 units, between two frames, so positions pass unchanged), and its true cuts
+    moved with the motion: the same take by a slower or quicker performer.
+
+    Returns (take, truth) as ``shortened``.
+    """
+    if not speed > 0:
+        raise InputError(f"speed: must be above 0, got {speed}")
+    channels = np.asarray(take.channels, dtype=float)
+    n = len(channels)
+    source = np.linspace(0, n - 1, max(2, int(round(n / speed))))
+    turned = np.unwrap(channels, period=360.0, axis=0)
+    resampled = np.stack([np.interp(source, np.arange(n), turned[:, j])
+                          for j in range(channels.shape[1])], axis=1)
+    moved = np.round(np.asarray(truth, dtype=float) / speed).astype(np.int64)
+    return _with_channels(take, resampled), moved
+
+
 def _with_channels(take, channels: np.ndarray):
     """``take`` (same type) with other channel rows; cached positions dropped."""
     changes = {"channels": channels}

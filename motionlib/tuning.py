@@ -54,6 +54,7 @@ GRID = {
 TRIED = {
     "short_activity": (4.0, 8.0),
     "short_uniformity": (0.2, 0.3),
+    "tempo": (True,),
 }
 
 
@@ -97,7 +98,7 @@ class TakeCache:
 
     def analysis(self, p: dict):
         windows = (p["scale_min_s"], p["scale_max_s"], p["bandwidth"], p["rate_hz"],
-                   p["velocity_s"])
+                   p["velocity_s"], p["tempo"])
         if windows not in self.analyses:
             self.analyses[windows] = Default.analyse(self.take, p)
         return self.analyses[windows]
@@ -108,6 +109,7 @@ class TakeCache:
         a = self.analysis(p)
         if a is None:
             return np.zeros(0, dtype=np.int64)
+        p = a.params(p)
         peaks, _ = Default.choose_peaks(a, p)
         key = (id(a), p["refine_s"], tuple(peaks))
         if key not in self.placed:

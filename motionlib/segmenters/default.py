@@ -168,6 +168,30 @@ sample, and a width from ±20 s would, inside a minute of one activity (walking 
 from that activity alone and cut its every variation, which no take here can show or
 rule out.
 
+Tempo
+-----
+The time settings (windows, minimum segment, placement reach) are in seconds, chosen on
+performers of one pace. Each labelled take played slower and quicker
+(``bench_quality.tempo_check``, ``benchdata.played_at``: channels resampled, true cuts
+moved with the motion) shows what another pace costs: on the full-skeleton takes mean
+F1@1s / edits per true cut 0.889/0.54 at 0.8 times the pace, 0.889/0.61 at 0.9, 1.000/0.27
+as recorded, 1.000/0.22 at 1.1 and 0.889/0.38 at 1.25 (four-channel 0.903/0.53,
+0.940/0.41, 0.952/0.41, 0.980/0.26, 0.952/0.29). Played 10 % slower, 13_29 gets seven cuts
+for five (one inside its arm circles, one in its last squat, and one that lands 1.03 s
+from its boundary): the windows then span fewer cycles of each activity, and the phases
+inside an activity show. Tried, not kept: the ``tempo`` setting, which scales the time
+settings by the take's own movement cycle (``movement_period``: over poses, the median lag
+at which a pose first comes back, 1.0-1.7 s on these takes) over ``TEMPO_REFERENCE_S``
+(1.3 s, the median of the ten captures; leaving one out moves it by at most 0.04 s). It
+holds the slower takes (full-skeleton 0.933/0.34 at 0.8 and 0.933/0.28 at 0.9), but the
+cycle a take shows depends on which activities it holds as much as on the performer's
+pace: 13_30, slow exercises of 4-5 s, gets windows a fifth longer and loses two of its
+four cuts as recorded (full-skeleton 0.889/0.30 at 1.0). Leave-one-take-out with tempo
+imposed, mean F1@1 s 0.925 and 0.406 edits per true cut (shipped 0.957 and 0.406; with
+1.33 s as the reference 0.925 and 0.439), and the full-skeleton takes as recorded
+0.952/0.30 with 1.33 s: the setting hangs on a constant the takes cannot pin down, and
+loses cuts at the pace the settings were chosen for.
+
 Short activities: unmatched poses (step 4c)
 -------------------------------------------
 Windows of 3-6 s see an activity shorter than about 3 s between two longer ones as one
@@ -452,6 +476,69 @@ def take_features(take, *, velocity_s: float = 0.0) -> tuple[np.ndarray, int]:
                         left_hip=joints["left_hip"], right_hip=joints["right_hip"], first=first)
     x[:, -1] -= np.median(x[:, -1])
     return _with_velocities(x, fps=float(take.fps), velocity_s=velocity_s), first
+
+
+# Tempo: the movement cycle (s) the time settings are chosen for, how far a take's own
+# cycle may scale them, the lags (s) a pose's look-alike is sought at and the pose rate
+# (Hz) it is sought on, and how many poses are sampled for it at most.
+TEMPO_REFERENCE_S = 1.3
+TEMPO_SCALE = (0.5, 2.0)
+TEMPO_LAGS_S = (0.3, 6.0)
+TEMPO_RATE_HZ = 30.0
+TEMPO_SAMPLES = 3000
+TIME_SETTINGS = ("scale_min_s", "scale_max_s", "min_segment_s", "refine_s")
+
+
+def movement_period(x: np.ndarray, fps: float) -> float | None:
+    """The take's typical movement cycle (s): over poses, the median lag at which a pose
+    first comes back, i.e. the first local minimum of its squared distance to the poses
+    ``TEMPO_LAGS_S`` later that falls below half the largest distance before it (the
+    body has moved away and returned). A performer moving 10 % slower has a 10 % longer
+    cycle. None when fewer than a tenth of the sampled poses come back (a take too short
+    or without repetition)."""
+    step = max(1, int(round(fps / TEMPO_RATE_HZ)))
+    blocks = block_mean(x, step)
+    rate = fps / step
+    lags = np.arange(max(1, int(round(TEMPO_LAGS_S[0] * rate))),
+                     int(round(TEMPO_LAGS_S[1] * rate)) + 1)
+    n = len(blocks) - lags[-1]
+    if n < 10:
+        return None
+    rows = np.arange(0, n, max(1, n // TEMPO_SAMPLES))
+    d = np.empty((len(rows), len(lags)))
+    for j, lag in enumerate(lags):
+        diff = blocks[rows + lag] - blocks[rows]
+        d[:, j] = np.einsum("ij,ij->i", diff, diff)
+    low = np.zeros_like(d, dtype=bool)
+    low[:, 1:-1] = (d[:, 1:-1] <= d[:, :-2]) & (d[:, 1:-1] <= d[:, 2:])
+    back = low & (d < 0.5 * np.maximum.accumulate(d, axis=1))
+    found = back.any(axis=1)
+    if found.sum() < max(1, len(rows) // 10):
+        return None
+    return float(np.median(lags[np.argmax(back[found], axis=1)]) / rate)
+
+
+def tempo_scale(x: np.ndarray, fps: float) -> float:
+    """How much slower than ``TEMPO_REFERENCE_S`` the take moves (``movement_period``),
+    within ``TEMPO_SCALE``; 1 when its cycle cannot be told."""
+    period = movement_period(x, fps)
+    if period is None:
+        return 1.0
+    return float(np.clip(period / TEMPO_REFERENCE_S, *TEMPO_SCALE))
+
+
+def scaled_times(p: dict, scale: float) -> dict:
+    """``p`` with ``TIME_SETTINGS`` times ``scale``, kept within their bounds."""
+    if scale == 1.0:
+        return p
+    out = dict(p)
+    for key in TIME_SETTINGS:
+        param = Default.params[key]
+        out[key] = float(np.clip(p[key] * scale, param.min, param.max))
+    if out["rate_hz"] * out["scale_max_s"] > MAX_WINDOW_SAMPLES:
+        out["scale_max_s"] = MAX_WINDOW_SAMPLES / out["rate_hz"]
+        out["scale_min_s"] = min(out["scale_min_s"], out["scale_max_s"])
+    return out
 
 
 def block_mean(x: np.ndarray, step: int) -> np.ndarray:
@@ -821,9 +908,15 @@ class Analysis:
     gamma: float
     novelty: np.ndarray
     timings: dict[str, float]
+    # The factor the time settings were scaled by (``tempo``; 1: as given).
+    tempo: float = 1.0
     # Curves of the pose blocks and kernel, computed once; none depends on the novelty
     # windows, so ``with_windows`` shares them.
     _short: dict = field(default_factory=dict, repr=False)
+
+    def params(self, p: dict) -> dict:
+        """``p`` with its time settings scaled as this analysis's windows were."""
+        return scaled_times(p, self.tempo)
 
     @property
     def rate(self) -> float:
@@ -956,6 +1049,11 @@ class Default(Segmenter):
             "(squared kernel widths) from every pose min_segment_s to 8 s around them "
             "(0 = off).",
         ),
+        "tempo": Param(
+            "bool", False, 0, 1,
+            "Scale the windows, the minimum segment and the placement reach by the "
+            "take's movement cycle (a slower performer gets longer windows).",
+        ),
     }
 
     @classmethod
@@ -972,6 +1070,7 @@ class Default(Segmenter):
         analysis = self.analyse(take, p)
         if analysis is None:
             return empty_segmentation(take)
+        p = analysis.params(p)
         t0 = time.perf_counter()
         peaks, strength = self.choose_peaks(analysis, p)
         cuts, speed = self._place(analysis.x, analysis.peak_frames(peaks), analysis.fps,
@@ -998,6 +1097,8 @@ class Default(Segmenter):
         step = max(1, int(round(fps / p["rate_hz"])))
         if len(x) < 2 * step:  # too short to compare anything: no cuts
             return None
+        scale = tempo_scale(x, fps) if p.get("tempo") else 1.0
+        p = scaled_times(p, scale)
         blocks = block_mean(x, step)
         # One kernel for detection and placement, its width from the median heuristic.
         gamma = 1.0 / max(p["bandwidth"] * median_sq_distance(blocks), 1e-12)
@@ -1005,7 +1106,7 @@ class Default(Segmenter):
         t2 = time.perf_counter()
         return Analysis(x=x, fps=fps, step=step, first=first, gamma=gamma, novelty=novelty,
                         timings={"kinematics": t1 - t0, "novelty": t2 - t1},
-                        _short={"blocks": blocks})
+                        tempo=scale, _short={"blocks": blocks})
 
     @staticmethod
     def _place(x: np.ndarray, peaks: np.ndarray, fps: float, gamma: float, p: dict):

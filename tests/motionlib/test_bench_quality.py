@@ -298,3 +298,21 @@ def test_the_long_take_check_joins_the_takes_of_one_skeleton_both_ways():
     assert lines[-1].startswith("  mean over ")
     assert bench_quality.long_take_check(DATA / "cmu") == \
         "long takes: no skeleton with two AMC takes, one of them labelled, here"
+
+
+def test_the_tempo_check_scores_each_kind_of_take_played_slower_and_quicker():
+    takes = [_Labelled(1), _Labelled(2, kind="channels")]
+    text = bench_quality.tempo_check(_read(takes), speeds=(0.8, 1.0))
+    lines = text.splitlines()
+    assert "played at 0.8 / 1 times its pace" in lines[0]
+    assert [line[:30].strip() for line in lines[2:]] == [
+        "full-skeleton, shipped", "full-skeleton, tempo", "four-channel, shipped",
+        "four-channel, tempo"]
+    # At its own pace, the shipped row scores the take as the detector does.
+    take = takes[0]
+    expected = metrics.evaluate(get_segmenter("default")().fit_predict(take.take).cuts,
+                                take.truth, fps=take.take.fps)
+    cells = lines[2][30:].split()
+    assert float(cells[3]) == pytest.approx(expected["f1@1s"], abs=5e-4)
+    assert float(cells[4]) == pytest.approx(expected["edits_per_cut"], abs=5e-3)
+    assert bench_quality.tempo_check([]) == "tempo: no labelled take"
