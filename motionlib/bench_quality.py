@@ -754,11 +754,8 @@ def _part_rows(parts, alone: dict) -> list[tuple[str, dict, dict]]:
     end. Per labelled part, ``metrics.evaluate`` of the joined take's cuts in its span and
     of its cuts alone (``alone[name]``), both against its own cuts and without what lies
     within ``JOIN_S`` of a join at its ends."""
-    from dataclasses import replace
-
-    first = parts[0][1]
-    joined = replace(first, channels=np.concatenate([take.channels for _, take, _ in parts]),
-                     positions=None)
+    joined = benchdata.with_channels(
+        parts[0][1], np.concatenate([take.channels for _, take, _ in parts]))
     cuts = Default().fit_predict(joined).cuts
     out, start = [], 0
     for i, (name, take, labelled) in enumerate(parts):
@@ -830,31 +827,29 @@ def tempo_check(read: list, speeds=TEMPO_SPEEDS) -> str:
     settings were chosen on; this shows how much that costs."""
     if not read:
         return "tempo: no labelled take"
-    kinds = [("full-skeleton", "skeleton"), ("four-channel", "channels")]
-    rows = {}
+    settings = (("shipped", {}), ("tempo", {"tempo": True}))
+    per_take: dict[tuple, dict] = {}  # (kind, name) -> (setting, speed) -> row
     for t, take in read:
+        rows = per_take.setdefault((t.kind, t.name), {})
         for speed in speeds:
             played, truth = (take, t.truth) if speed == 1.0 else \
                 benchdata.played_at(take, t.truth, speed)
-            for setting, params in (("shipped", {}), ("tempo", {"tempo": True})):
+            for setting, params in settings:
                 cuts = Default(**params).fit_predict(played).cuts
-                row = metrics.evaluate(cuts, truth, fps=take.fps)
-                rows.setdefault((t.kind, setting, speed), []).append(row)
+                rows[(setting, speed)] = metrics.evaluate(cuts, truth, fps=take.fps)
     head = "".join(f"{f'x{s:g}: F1@1s':>14}{'edits':>7}{'err s':>7}" for s in speeds)
     lines = [f"tempo: each labelled take played at {' / '.join(f'{s:g}' for s in speeds)} "
              f"times its pace (its cuts moved with it); mean F1@1 s, edits per true cut and "
              f"median placement error, as shipped and with tempo on:",
              f"  {'':<28}{head}"]
-    for group, kind in kinds:
-        for setting in ("shipped", "tempo"):
-            if (kind, setting, speeds[0]) not in rows:
-                continue
-            cells = ""
-            for speed in speeds:
-                mean = mean_rows({i: {"m": r} for i, r in
-                                  enumerate(rows[(kind, setting, speed)])})["m"]
-                cells += (f"{mean['f1@1s']:>14.3f}{mean['edits_per_cut']:>7.2f}"
-                          f"{mean['median_error_s']:>7.2f}")
+    for group, kind in (("full-skeleton", "skeleton"), ("four-channel", "channels")):
+        mean = mean_rows({key: rows for key, rows in per_take.items() if key[0] == kind})
+        if not mean:
+            continue
+        for setting, _ in settings:
+            cells = "".join(f"{m['f1@1s']:>14.3f}{m['edits_per_cut']:>7.2f}"
+                            f"{m['median_error_s']:>7.2f}"
+                            for m in (mean[(setting, speed)] for speed in speeds))
             lines.append(f"  {group + ', ' + setting:<28}{cells}")
     return "\n".join(lines)
 

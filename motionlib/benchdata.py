@@ -399,7 +399,7 @@ def shortened(take, truth: np.ndarray, activity: int, seconds: float):
     out[activity + 1:] -= resume - join
     out[activity, 2] = min(out[activity, 2], join - 1)
     out[activity + 1, 0] = max(out[activity + 1, 0], join)
-    return _with_channels(take, channels), out
+    return with_channels(take, channels), out
 
 
 def shortened_throughout(take, truth: np.ndarray, seconds: float):
@@ -433,10 +433,10 @@ def played_at(take, truth: np.ndarray, speed: float):
     resampled = np.stack([np.interp(source, np.arange(n), turned[:, j])
                           for j in range(channels.shape[1])], axis=1)
     moved = np.round(np.asarray(truth, dtype=float) / speed).astype(np.int64)
-    return _with_channels(take, resampled), moved
+    return with_channels(take, resampled), moved
 
 
-def _with_channels(take, channels: np.ndarray):
+def with_channels(take, channels: np.ndarray):
     """``take`` (same type) with other channel rows; cached positions dropped."""
     changes = {"channels": channels}
     if hasattr(take, "positions"):
@@ -467,4 +467,4 @@ def trimmed(take, truth: np.ndarray, side: str, seconds: float):
     if (start if side == "first" else take.n_frames - stop) <= 0:
         return None
     out = np.clip(truth - start, 0, stop - start - 1)
-    return _with_channels(take, np.array(take.channels[start:stop])), out
+    return with_channels(take, np.array(take.channels[start:stop])), out
