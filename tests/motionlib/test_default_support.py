@@ -85,14 +85,18 @@ def _analysis(x: np.ndarray, novelty: np.ndarray) -> Analysis:
     return Analysis(x=x, fps=RATE, step=1, first=0, gamma=1.0, novelty=novelty, timings={})
 
 
-def test_window_peaks_drops_the_unsupported_peak_only():
-    # Three stretches: a circle, the same circle at an uneven speed, another circle. The
-    # novelty (given) has a peak at both joins; only the second is a boundary.
+def _two_joins() -> Analysis:
+    """Three stretches: a circle, the same circle at an uneven speed, another circle. The
+    novelty (given) has a peak at both joins; only the second is a boundary."""
     x = np.concatenate([_circle(10, period=2.0), _uneven(10), _circle(10, centre=(3.0, 0.0))])
     novelty = np.zeros(len(x))
     novelty[95:106] = np.hanning(11)
     novelty[195:206] = np.hanning(11)
-    analysis = _analysis(x, novelty)
+    return _analysis(x, novelty)
+
+
+def test_window_peaks_drops_the_unsupported_peak_only():
+    analysis = _two_joins()
     on = Default.validate_params({})
     off = Default.validate_params({"support": 0.0})
     assert Default.window_peaks(analysis, off)[0].tolist() == [100, 200]
@@ -104,11 +108,7 @@ def test_window_peaks_drops_the_unsupported_peak_only():
 def test_an_adapted_count_cannot_bring_back_a_dropped_peak():
     # The examples' study holds every peak at every prominence, but not one the support
     # test drops: no prominence the count is learnt at can cut there.
-    x = np.concatenate([_circle(10, period=2.0), _uneven(10), _circle(10, centre=(3.0, 0.0))])
-    novelty = np.zeros(len(x))
-    novelty[95:106] = np.hanning(11)
-    novelty[195:206] = np.hanning(11)
-    analysis = _analysis(x, novelty)
+    analysis = _two_joins()
     on = Default.validate_params({})
     off = Default.validate_params({"support": 0.0})
     assert adapt._all_peaks("zero", analysis, off, {})["zero_raw"].tolist() == [100, 200]
