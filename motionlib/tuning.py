@@ -135,7 +135,6 @@ class TakeCache:
                                             self.speeds[id(a)])[0]
         return self.placed[key][shipped_stage(p)] + a.first
 
-
     def score(self, params: dict) -> dict:
         """``metrics.evaluate`` of the cuts with ``params`` (computed once per set of cuts:
         many choices of a grid make the same cuts)."""
