@@ -152,6 +152,7 @@ from motionlib.segmenters.default import (
     empty_segmentation,
     place_stages,
     shipped_stage,
+    supported_peaks,
     unmatched_sides,
 )
 
@@ -508,9 +509,10 @@ def _all_peaks(label: str, analysis, p: dict, placed: dict,
     peaks, prominence = Default.select_peaks(analysis.novelty, analysis.rate,
                                              {**p, "prominence": 0.0})
     sides = sides or {}
-    if p["support"] > 0:  # as Default.window_peaks, whatever the prominence chosen
-        keep = analysis.supported(peaks, p["support"]) | np.isin(peaks, list(sides))
-        peaks, prominence = peaks[keep], prominence[keep]
+    # As Default.window_peaks, whatever the prominence chosen; the short activities are
+    # those the zero-shot detector finds beside its kept peaks.
+    keep = supported_peaks(analysis, peaks, p, short=sides)
+    peaks, prominence = peaks[keep], prominence[keep]
     index, of = [], []  # novelty sample counted, and the peak whose prominence it has
     for i, k in enumerate(peaks.tolist()):
         for counted in sides.get(k, (k,)):

@@ -40,7 +40,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from motionlib import metrics
-from motionlib.segmenters.default import Default, place_stages, pose_speeds, shipped_stage
+from motionlib.segmenters.default import Default, place_stages, shipped_stage
 
 # The options the defaults are chosen from. Windows: (shortest, longest) in seconds.
 GRID = {
@@ -100,7 +100,6 @@ class TakeCache:
     pool: bool = False
     analyses: dict = field(default_factory=dict)
     peaks: dict = field(default_factory=dict)
-    speeds: dict = field(default_factory=dict)
     placed: dict = field(default_factory=dict)
     scores: dict = field(default_factory=dict)
 
@@ -129,10 +128,8 @@ class TakeCache:
         peaks = self.peaks[chosen]
         key = (id(a), p["refine_s"], tuple(peaks))
         if key not in self.placed:
-            if id(a) not in self.speeds:
-                self.speeds[id(a)] = pose_speeds(a.x, a.fps)
             self.placed[key] = place_stages(a.x, a.peak_frames(peaks), a.fps, a.gamma, p,
-                                            self.speeds[id(a)])[0]
+                                            a.speeds)[0]
         return self.placed[key][shipped_stage(p)] + a.first
 
     def score(self, params: dict) -> dict:

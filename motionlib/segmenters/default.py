@@ -1047,11 +1047,19 @@ class Analysis:
         """(len(peaks),) bool: the peaks whose ``cross_support`` reaches ``level`` (each
         peak's computed once)."""
         known = self._short.setdefault("support", {})
-        new = [k for k in dict.fromkeys(np.asarray(peaks).tolist()) if k not in known]
+        peaks = np.asarray(peaks).tolist()
+        new = [k for k in dict.fromkeys(peaks) if k not in known]
         if new:
             known.update(zip(new, cross_support(self.blocks, np.asarray(new), self.rate,
                                                 self.gamma).tolist(), strict=True))
-        return np.asarray([known[k] >= level for k in np.asarray(peaks).tolist()], dtype=bool)
+        return np.asarray([known[k] >= level for k in peaks], dtype=bool)
+
+    @property
+    def speeds(self) -> tuple[np.ndarray, np.ndarray]:
+        """``pose_speeds`` of the pose stream (computed once)."""
+        if "speeds" not in self._short:
+            self._short["speeds"] = pose_speeds(self.x, self.fps)
+        return self._short["speeds"]
 
     def with_windows(self, *windows: tuple[float, float]) -> list[Analysis]:
         """The same pose stream and kernel with the novelty at other window lengths.
@@ -1252,9 +1260,8 @@ class Default(Segmenter):
         """The peaks the novelty windows choose (``select_peaks``, then, with
         ``short_activity``, the far sides of short activities), and their evidence."""
         peaks, strength = cls.select_peaks(analysis.novelty, analysis.rate, p)
-        if p["support"] > 0:
-            keep = supported_peaks(analysis, peaks, p)
-            peaks, strength = peaks[keep], strength[keep]
+        keep = supported_peaks(analysis, peaks, p)
+        peaks, strength = peaks[keep], strength[keep]
         if p["short_activity"] > 0:
             peaks, strength = short_activity_peaks(analysis, peaks, strength, p)
         return peaks, strength
@@ -1384,15 +1391,20 @@ def cross_support(blocks: np.ndarray, peaks: np.ndarray, rate: float, gamma: flo
     return out
 
 
-def supported_peaks(analysis: Analysis, peaks: np.ndarray, p: dict) -> np.ndarray:
-    """(len(peaks),) bool: the peaks the support test keeps (step 4a): those whose
-    ``cross_support`` reaches ``p["support"]``, and, with ``short_unmatched``, those the
-    unmatched-poses step reads as a short activity (step 4c): one between two alike
+def supported_peaks(analysis: Analysis, peaks: np.ndarray, p: dict,
+                    short: dict | None = None) -> np.ndarray:
+    """(len(peaks),) bool: the peaks the support test keeps (step 4a; all of them with
+    ``support`` 0): those whose ``cross_support`` reaches ``p["support"]``, and those the
+    unmatched-poses step reads as a short activity (step 4c; ``short``, its
+    ``unmatched_sides``, computed on ``peaks`` when not given): one between two alike
     activities straddles the peak, each side holds part of it, and every pose is matched
     across."""
+    if p["support"] <= 0:
+        return np.ones(len(peaks), dtype=bool)
     keep = analysis.supported(peaks, p["support"])
-    if p["short_unmatched"] > 0 and not keep.all():
-        keep |= np.isin(peaks, list(unmatched_sides(analysis, peaks, p)))
+    if not keep.all():
+        short = unmatched_sides(analysis, peaks, p) if short is None else short
+        keep |= np.isin(peaks, list(short))
     return keep
 
 
