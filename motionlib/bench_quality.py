@@ -29,7 +29,9 @@ and the leave-one-take-out choice of the unmatched-poses
 step's settings on such takes (``unmatched_choice_check``), follow the tables, and what
 that step does on the full-skeleton takes without segment labels, which are not scored
 (``unmatched_guard_check``). Each take is scored separately and the means are given per
-kind of take and over all.
+kind of take and over all, with the placement error by kind of take
+(``placement_summary``) and how close oracles that see the human cuts could place them
+with what each kind of take holds (``placement_bound_check``).
 
 Leave-one-take-out chooses on all the labelled material there is, not only on the takes
 scored: ``--pool DIR`` adds the labelled takes under DIR to what settings and penalties
@@ -55,8 +57,16 @@ import numpy as np
 
 from motionlib import adapt, benchdata, metrics, tuning
 from motionlib.errors import CaptureError
+from motionlib.features import local_extrema
 from motionlib.segmenters import list_segmenters
-from motionlib.segmenters.default import Default, block_mean, take_features
+from motionlib.segmenters.default import (
+    PLACEMENTS,
+    Default,
+    block_mean,
+    place_stages,
+    shipped_stage,
+    take_features,
+)
 
 RUPTURES_PENALTY = 3.0
 
@@ -358,6 +368,8 @@ def main(root: Path | None = None, only: list[str] | None = None, out=None, *,
             mean = mean_rows({n: results[n] for n in names})
             print(format_table(f"\nmean over {len(names)} {group} takes", mean), file=out)
     print("\n" + placement_summary(results, groups), file=out)
+    if not only or "default" in only:
+        print("\n" + placement_bound_check([(c.labelled, c.take) for c in cache]), file=out)
     if selections:
         print("\n" + out_of_sample_table(selections[0]), file=out)
     if not only or "default" in only:
@@ -397,6 +409,61 @@ def placement_summary(results: dict[str, dict], groups: list[tuple[str, list[str
             parts.append(f"{group} {error:.3f} s{share}")
         if parts:
             lines.append(f"  {name:<12} " + "; ".join(parts))
+    return "\n".join(lines)
+
+
+def placement_bound_check(read: list) -> str:
+    """How close placement could come with what each kind of take holds: for every cut of
+    the shipped detector matched to a human cut (within 1 s), the error of the cut as
+    placed; of the best of the detector's own five estimates (peak, split, turning point,
+    pause, onset: step 5), picked by an oracle that sees the human cut; and of the
+    turning point (local minimum of the 3 Hz pose speed, where step 5b cuts) nearest the
+    human cut among those within 1 s of the placed cut, also picked by that oracle. Each
+    the mean over takes of the median |cut - best estimate|, as in the placement summary;
+    with how far apart the turning points lie (median gap). Where even the oracles stay
+    far from the human cuts, the motion does not hold the moment the annotators cut at.
+    ``read`` as in ``real_short_activity_check``."""
+    per_kind: dict[str, list] = {}
+    for t, take in read:
+        p = Default.validate_params({})
+        a = Default.analyse(take, p)
+        if a is None:
+            continue
+        p = a.params(p)
+        peaks = a.peak_frames(Default.choose_peaks(a, p)[0])
+        stages, _ = place_stages(a.x, peaks, a.fps, a.gamma, p, a.speeds)
+        estimates = np.stack([peaks, *(stages[k] for k in PLACEMENTS)]) + a.first
+        cuts = stages[shipped_stage(p)] + a.first
+        frames, is_max = local_extrema(a.speeds[1])
+        turns = frames[~is_max] + a.first
+        truth = metrics.as_windows(t.truth)
+        ci, ti = metrics.match(cuts, truth, tolerance=int(round(take.fps)))
+        if not len(ci):
+            continue
+        mids = truth[ti, 1]
+        placed = np.abs(cuts[ci] - mids)
+        best = np.abs(estimates[:, ci] - mids).min(axis=0)
+        oracle = []
+        for cut, mid in zip(cuts[ci], mids, strict=True):
+            near = turns[np.abs(turns - cut) <= round(take.fps)]
+            oracle.append(np.abs(near - mid).min() if len(near) else abs(cut - mid))
+        gap = float(np.median(np.diff(turns))) if len(turns) > 1 else float("nan")
+        per_kind.setdefault(t.kind, []).append(
+            [float(np.median(e)) / take.fps for e in (placed, best, oracle)]
+            + [gap / take.fps])
+    if not per_kind:
+        return "placement bound: no labelled take with a matched cut"
+    lines = ["placement bound (mean over takes of the median |cut - best estimate|; the "
+             "oracles see the human cut): as placed; best of the detector's five "
+             "estimates; best turning point within 1 s of the placed cut; median gap "
+             "between turning points:"]
+    for group, kind in (("full-skeleton", "skeleton"), ("four-channel", "channels")):
+        if kind in per_kind:
+            placed, best, oracle, gap = np.nanmean(per_kind[kind], axis=0)
+            n = len(per_kind[kind])
+            lines.append(f"  {group:<14}({n} take{'s' if n > 1 else ''}) as placed "
+                         f"{placed:.3f} s, best estimate {best:.3f} s, best turning point "
+                         f"{oracle:.3f} s, turning points {gap:.2f} s apart")
     return "\n".join(lines)
 
 

@@ -167,6 +167,22 @@ and five others of the full-skeleton takes further from theirs, to 0.2-0.6 s) do
 same: four-channel 0.36, 0.36, 0.34 and 0.35 s (0.38 as shipped), full-skeleton 0.23,
 0.17, 0.17 and 0.27 s (0.09), the edits per true cut there 0.33-0.48 (0.27).
 
+How close placement could come with four angles (the bench's placement bound,
+``bench_quality.placement_bound_check``, shipped settings, mean over takes of the median
+error): an oracle that sees the human cut and picks the best of the detector's five
+estimates of each cut (peak and steps a-d) gets 0.183 s on the four-channel takes
+(0.069 s with a skeleton), and one that picks the turning point nearest the human cut
+among those within 1 s of the placed cut (turning points lie 0.43 s apart there) gets
+0.145 s (0.083 s). Without the oracle, a selector learnt to pick that turning point
+(a conditional logit over the turning points within 1 s and the placed cut, on their
+distances to the peak, the split and the placed cut, the depth of the speed minimum, the
+speed before against after, and whether the pose looks like the poses 1-3 s before the
+peak or 1-3 s after; trained per kind of take, leave-one-take-out, L2 weight 3-3,000)
+gets 0.29-0.38 s on the four-channel takes and leaves the full-skeleton cuts where they
+are; trained on both kinds (L2 weight 0.1-10), 0.27-0.34 s, and 0.21-0.32 s on the
+full-skeleton takes. Only
+an oracle comes near 0.15 s there, so no placement rule of four angles was added.
+
 Support (step 4a)
 -----------------
 Why. Before the test, the false cuts left out of sample were mostly on the four-channel

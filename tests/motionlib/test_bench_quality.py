@@ -316,3 +316,27 @@ def test_the_tempo_check_scores_each_kind_of_take_played_slower_and_quicker():
     assert float(cells[3]) == pytest.approx(expected["f1@1s"], abs=5e-4)
     assert float(cells[4]) == pytest.approx(expected["edits_per_cut"], abs=5e-3)
     assert bench_quality.tempo_check([]) == "tempo: no labelled take"
+
+
+def _figures(line):
+    """The seconds of a placement-bound line, in order."""
+    return [float(word) for word in line.replace(",", " ").split()
+            if word.replace(".", "").isdigit() and "." in word]
+
+
+def test_the_placement_bound_scores_the_cuts_as_placed_and_what_oracles_could_pick():
+    takes = [_Labelled(1), _Labelled(2), _Labelled(3, kind="channels")]
+    lines = bench_quality.placement_bound_check(_read(takes)).splitlines()
+    assert lines[0].startswith("placement bound")
+    assert lines[1].split()[0] == "full-skeleton" and "(2 takes)" in lines[1]
+    assert lines[2].split()[0] == "four-channel" and "(1 take)" in lines[2]
+    # "as placed" is the bench's median placement error of the shipped cuts.
+    errors = [metrics.median_error_s(get_segmenter("default")().fit_predict(t.take).cuts,
+                                     t.truth, fps=t.take.fps) for t in takes[:2]]
+    placed, best, turning, gap = _figures(lines[1])
+    assert placed == pytest.approx(np.mean(errors), abs=5e-4)
+    # The placed cut is one of the five estimates, so the best of them is no further off.
+    assert best <= placed
+    assert 0 < gap < 2
+    assert bench_quality.placement_bound_check([]) == \
+        "placement bound: no labelled take with a matched cut"
