@@ -425,32 +425,9 @@ def placement_bound_check(read: list) -> str:
     ``read`` as in ``real_short_activity_check``."""
     per_kind: dict[str, list] = {}
     for t, take in read:
-        p = Default.validate_params({})
-        a = Default.analyse(take, p)
-        if a is None:
-            continue
-        p = a.params(p)
-        peaks = a.peak_frames(Default.choose_peaks(a, p)[0])
-        stages, _ = place_stages(a.x, peaks, a.fps, a.gamma, p, a.speeds)
-        estimates = np.stack([peaks, *(stages[k] for k in PLACEMENTS)]) + a.first
-        cuts = stages[shipped_stage(p)] + a.first
-        frames, is_max = local_extrema(a.speeds[1])
-        turns = frames[~is_max] + a.first
-        truth = metrics.as_windows(t.truth)
-        ci, ti = metrics.match(cuts, truth, tolerance=int(round(take.fps)))
-        if not len(ci):
-            continue
-        mids = truth[ti, 1]
-        placed = np.abs(cuts[ci] - mids)
-        best = np.abs(estimates[:, ci] - mids).min(axis=0)
-        oracle = []
-        for cut, mid in zip(cuts[ci], mids, strict=True):
-            near = turns[np.abs(turns - cut) <= round(take.fps)]
-            oracle.append(np.abs(near - mid).min() if len(near) else abs(cut - mid))
-        gap = float(np.median(np.diff(turns))) if len(turns) > 1 else float("nan")
-        per_kind.setdefault(t.kind, []).append(
-            [float(np.median(e)) / take.fps for e in (placed, best, oracle)]
-            + [gap / take.fps])
+        errors = _placement_bound(t.truth, take)
+        if errors is not None:
+            per_kind.setdefault(t.kind, []).append(errors)
     if not per_kind:
         return "placement bound: no labelled take with a matched cut"
     lines = ["placement bound (mean over takes of the median |cut - best estimate|; the "
@@ -465,6 +442,35 @@ def placement_bound_check(read: list) -> str:
                          f"{placed:.3f} s, best estimate {best:.3f} s, best turning point "
                          f"{oracle:.3f} s, turning points {gap:.2f} s apart")
     return "\n".join(lines)
+
+
+def _placement_bound(truth: np.ndarray, take) -> list[float] | None:
+    """One take's medians for ``placement_bound_check`` (s): as placed, best estimate,
+    best turning point; and the median gap between turning points. None without a
+    matched cut."""
+    p = Default.validate_params({})
+    a = Default.analyse(take, p)
+    if a is None:
+        return None
+    p = a.params(p)
+    peaks = a.peak_frames(Default.choose_peaks(a, p)[0])
+    stages, _ = place_stages(a.x, peaks, a.fps, a.gamma, p, a.speeds)
+    estimates = np.stack([peaks, *(stages[k] for k in PLACEMENTS)]) + a.first
+    cuts = stages[shipped_stage(p)] + a.first
+    frames, is_max = local_extrema(a.speeds[1])
+    turns = frames[~is_max] + a.first
+    windows = metrics.as_windows(truth)
+    ci, ti = metrics.match(cuts, windows, tolerance=int(round(take.fps)))
+    if not len(ci):
+        return None
+    mids = windows[ti, 1]
+    oracle = []
+    for cut, mid in zip(cuts[ci], mids, strict=True):
+        near = turns[np.abs(turns - cut) <= round(take.fps)]
+        oracle.append(np.abs(near - mid).min() if len(near) else abs(cut - mid))
+    errors = (np.abs(cuts[ci] - mids), np.abs(estimates[:, ci] - mids).min(axis=0), oracle)
+    gap = float(np.median(np.diff(turns))) if len(turns) > 1 else float("nan")
+    return [float(np.median(e)) / take.fps for e in errors] + [gap / take.fps]
 
 
 SHORT_S = 2.5
