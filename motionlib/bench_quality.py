@@ -57,7 +57,6 @@ import numpy as np
 
 from motionlib import adapt, benchdata, metrics, tuning
 from motionlib.errors import CaptureError
-from motionlib.features import local_extrema
 from motionlib.segmenters import list_segmenters
 from motionlib.segmenters.default import (
     PLACEMENTS,
@@ -65,6 +64,7 @@ from motionlib.segmenters.default import (
     block_mean,
     place_stages,
     shipped_stage,
+    speed_minima,
     take_features,
 )
 
@@ -457,8 +457,7 @@ def _placement_bound(truth: np.ndarray, take) -> list[float] | None:
     stages, _ = place_stages(a.x, peaks, a.fps, a.gamma, p, a.speeds)
     estimates = np.stack([peaks, *(stages[k] for k in PLACEMENTS)]) + a.first
     cuts = stages[shipped_stage(p)] + a.first
-    frames, is_max = local_extrema(a.speeds[1])
-    turns = frames[~is_max] + a.first
+    turns = speed_minima(a.speeds[1]) + a.first
     windows = metrics.as_windows(truth)
     ci, ti = metrics.match(cuts, windows, tolerance=int(round(take.fps)))
     if not len(ci):

@@ -933,7 +933,13 @@ def turning_points(x: np.ndarray, *, fps: float) -> np.ndarray:
     -------
     (n_points,) int frames, increasing.
     """
-    frames, is_max = features.local_extrema(fine_speed(x, fps=fps))
+    return speed_minima(fine_speed(x, fps=fps))
+
+
+def speed_minima(speed: np.ndarray) -> np.ndarray:
+    """The frames of the local minima of ``speed``: the turning points when it is
+    ``fine_speed`` (already computed, as ``pose_speeds`` gives it)."""
+    frames, is_max = features.local_extrema(speed)
     return frames[~is_max]
 
 
@@ -976,8 +982,7 @@ def place_stages(x: np.ndarray, peaks: np.ndarray, fps: float, gamma: float, p: 
     """
     speed, fine = pose_speeds(x, fps) if speeds is None else speeds
     step = max(1, int(round(fps / SPLIT_RATE_HZ)))
-    frames, is_max = features.local_extrema(fine)
-    turns = frames[~is_max]
+    turns = speed_minima(fine)
     radius = int(round(p["refine_s"] * fps))
     context = int(round(p["scale_min_s"] * fps))
     onset_radius = int(round(ONSET_MAX_S * fps))
