@@ -21,7 +21,7 @@ install: $(STAMP)
 $(STAMP): pyproject.toml setup.py motionlib/io/_parse.c motionlib/_kinematics.c
 	test -x $(PY) || python3 -m venv .venv
 	$(PIP) install -q --upgrade pip
-	$(PIP) install -q -e ".[dev,bench]"
+	$(PIP) install -q -e ".[dev,bench,plot]"
 	touch $(STAMP)
 
 # Blender as a module (FBX) in a virtualenv of its own: bpy pins numpy<2 (see the file).
