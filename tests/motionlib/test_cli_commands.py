@@ -22,3 +22,21 @@ def test_it_refuses_the_benchmark_commands_it_used_to_have():
                               capture_output=True, text=True)
         assert done.returncode == 2
         assert f"invalid choice: '{old}'" in done.stderr
+
+
+# What a fresh interpreter has imported once the command line is built, as every
+# `python -m motionlib` command builds it before running.
+LOADED = r"""
+import sys
+from motionlib.cli import build_parser
+build_parser()
+print("\n".join(sorted(sys.modules)))
+"""
+
+
+def test_building_it_imports_no_benchmark_tuning_or_plotting_module():
+    done = subprocess.run([sys.executable, "-c", LOADED], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    loaded = done.stdout.split()
+    assert [m for m in loaded if re.search(r"bench|tuning", m)] == []
+    assert [m for m in loaded if m.split(".")[0] in ("matplotlib", "ruptures", "claspy")] == []
