@@ -57,18 +57,19 @@ def test_it_ships_no_benchmark_or_tuning_module():
 
 
 def imported(name: str, known: set[str]) -> set[str]:
-    """The modules ``name``'s source imports: every import statement, at module level or
-    deferred inside a function (a deferred import is still a dependency; deferring it only
-    hides a circle from the interpreter). ``from package import name`` counts as an import
-    of the submodule when ``name`` is one of ``known``, else of the package; a package
-    imported on the way to its submodule is not counted. Compiled modules import nothing
-    of motionlib."""
+    """The modules ``name``'s source imports when it runs: every import statement, at
+    module level or deferred inside a function (a deferred import is still a dependency;
+    deferring it only hides a circle from the interpreter), but not those under ``if
+    TYPE_CHECKING:``, which never run (they name types for annotations). ``from package
+    import name`` counts as an import of the submodule when ``name`` is one of ``known``,
+    else of the package; a package imported on the way to its submodule is not counted.
+    Compiled modules import nothing of motionlib."""
     spec = importlib.util.find_spec(name)
     path, is_package = Path(spec.origin), spec.submodule_search_locations is not None
     if path.suffix != ".py":
         return set()
     found = set()
-    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+    for node in _run_nodes(ast.parse(path.read_text(encoding="utf-8"))):
         if isinstance(node, ast.Import):
             found.update(alias.name for alias in node.names)
         elif isinstance(node, ast.ImportFrom):
@@ -79,6 +80,23 @@ def imported(name: str, known: set[str]) -> set[str]:
                          else module for alias in node.names)
     found.discard(name)
     return found
+
+
+def _run_nodes(tree: ast.AST):
+    """Every node of ``tree`` but those only type checkers see (``if TYPE_CHECKING:``)."""
+    pending = [tree]
+    while pending:
+        node = pending.pop()
+        yield node
+        if isinstance(node, ast.If) and _type_checking(node.test):
+            pending.extend(node.orelse)
+        else:
+            pending.extend(ast.iter_child_nodes(node))
+
+
+def _type_checking(test: ast.expr) -> bool:
+    return (isinstance(test, ast.Name) and test.id == "TYPE_CHECKING") or \
+        (isinstance(test, ast.Attribute) and test.attr == "TYPE_CHECKING")
 
 
 def import_circles(graph: dict[str, set[str]]) -> list[list[str]]:
@@ -117,6 +135,15 @@ def test_no_two_motionlib_modules_import_each_other_even_through_others():
     modules = set(motionlib_modules())
     graph = {name: imported(name, modules) & modules for name in modules}
     assert import_circles(graph) == []
+
+
+def test_imports_only_type_checkers_see_are_not_counted(tmp_path, monkeypatch):
+    (tmp_path / "typed_only.py").write_text(
+        "from typing import TYPE_CHECKING\nimport json\n"
+        "if TYPE_CHECKING:\n    import csv\nelse:\n    import os\n"
+        "def late():\n    import re\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    assert imported("typed_only", set()) == {"typing", "json", "os", "re"}
 
 
 def test_the_circle_finder_finds_circles():
