@@ -58,15 +58,9 @@ import numpy as np
 from motionlib import adapt, benchdata, metrics, tuning
 from motionlib.errors import CaptureError
 from motionlib.segmenters import list_segmenters
-from motionlib.segmenters.default import (
-    PLACEMENTS,
-    Default,
-    block_mean,
-    place_stages,
-    shipped_stage,
-    speed_minima,
-    take_features,
-)
+from motionlib.segmenters.default import PLACEMENTS, Default, shipped_stage, take_features
+from motionlib.segmenters.default._features import block_mean
+from motionlib.segmenters.default._placement import place_stages, speed_minima
 
 RUPTURES_PENALTY = 3.0
 
@@ -453,7 +447,7 @@ def _placement_bound(truth: np.ndarray, take) -> list[float] | None:
     if a is None:
         return None
     p = a.params(p)
-    peaks = a.peak_frames(Default.choose_peaks(a, p)[0])
+    peaks = a.peak_frames(Default.peaks(a, p).samples)
     stages, _ = place_stages(a.x, peaks, a.fps, a.gamma, p, a.speeds)
     estimates = np.stack([peaks, *(stages[k] for k in PLACEMENTS)]) + a.first
     cuts = stages[shipped_stage(p)] + a.first
@@ -605,13 +599,7 @@ def unmatched_choice_check(read: list) -> str:
     setting is chosen on everything else, and scored on the left-out take's material,
     beside the step off. ``read``: (labelled take, motion) pairs, as the bench read them.
     """
-    from motionlib.segmenters.default import (
-        UNMATCHED_HALF_S,
-        Default,
-        place_stages,
-        shipped_stage,
-        unmatched_peaks,
-    )
+    from motionlib.segmenters.default._unmatched import UNMATCHED_HALF_S, unmatched_peaks
 
     skeletons = _skeletons(read)
     if not skeletons:
@@ -703,7 +691,7 @@ def unmatched_ratios(analysis, peaks: np.ndarray, p: dict) -> list[float]:
     """For each kept peak the unmatched-poses step (at the shipped settings) replaces
     without its take-median guard, the level of the stretch it fires on over the take's
     median (``segmenters.default.unmatched_firings``)."""
-    from motionlib.segmenters.default import unmatched_firings
+    from motionlib.segmenters.default._unmatched import unmatched_firings
 
     if p["short_unmatched"] <= 0:
         return []
@@ -713,7 +701,7 @@ def unmatched_ratios(analysis, peaks: np.ndarray, p: dict) -> list[float]:
 
 
 def _guard_line(ratios: list[float]) -> str:
-    from motionlib.segmenters.default import UNMATCHED_RELATIVE
+    from motionlib.segmenters.default._unmatched import UNMATCHED_RELATIVE
 
     if not ratios:
         return "take-median guard: the step fires nowhere on this material"
@@ -733,7 +721,7 @@ def unmatched_guard_check(folder: Path) -> str:
     not repeat itself (boxing, dance) is where the guard acts, and these show where it
     does."""
     import motionlib
-    from motionlib.segmenters.default import UNMATCHED_RELATIVE
+    from motionlib.segmenters.default._unmatched import UNMATCHED_RELATIVE
 
     takes = benchdata.unlabelled_motion(folder)
     if not takes:

@@ -40,7 +40,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from motionlib import metrics
-from motionlib.segmenters.default import Default, place_stages, shipped_stage
+from motionlib.segmenters.default import Default, shipped_stage
 
 # The options the defaults are chosen from. Windows: (shortest, longest) in seconds.
 GRID = {
@@ -124,12 +124,11 @@ class TakeCache:
         p = a.params(p)
         chosen = (id(a), *sorted((k, v) for k, v in p.items() if k not in PLACEMENT_ONLY))
         if chosen not in self.peaks:
-            self.peaks[chosen] = Default.choose_peaks(a, p)[0]
-        peaks = self.peaks[chosen]
-        key = (id(a), p["refine_s"], tuple(peaks))
+            self.peaks[chosen] = Default.peaks(a, p)
+        found = self.peaks[chosen]
+        key = (id(a), p["refine_s"], tuple(found.samples))
         if key not in self.placed:
-            self.placed[key] = place_stages(a.x, a.peak_frames(peaks), a.fps, a.gamma, p,
-                                            a.speeds)[0]
+            self.placed[key] = Default.place(a, found, p).stages
         return self.placed[key][shipped_stage(p)] + a.first
 
     def score(self, params: dict) -> dict:

@@ -214,7 +214,8 @@ def test_the_short_takes_check_scores_zero_shot_and_adapted_on_takes_cut_down_th
 
 
 def test_the_unmatched_choice_check_leaves_out_each_skeleton_take_and_scores_it():
-    from motionlib.segmenters.default import UNMATCHED_HALF_S, Default
+    from motionlib.segmenters.default import Default
+    from motionlib.segmenters.default._unmatched import UNMATCHED_HALF_S
 
     takes = [_Labelled(1), _Labelled(2), _Labelled(3, kind="channels")]
     lines = bench_quality.unmatched_choice_check(_read(takes)).splitlines()
@@ -236,7 +237,7 @@ def test_the_unmatched_choice_check_leaves_out_each_skeleton_take_and_scores_it(
 
 
 def test_the_guard_line_counts_the_firings_it_keeps():
-    from motionlib.segmenters.default import UNMATCHED_RELATIVE
+    from motionlib.segmenters.default._unmatched import UNMATCHED_RELATIVE
 
     line = bench_quality._guard_line([UNMATCHED_RELATIVE - 1, UNMATCHED_RELATIVE, 9.0])
     assert "of the 3 firings on this material without it, 2 kept" in line

@@ -5,7 +5,8 @@ import numpy as np
 import pytest
 
 from motionlib import metrics, synth, tuning
-from motionlib.segmenters.default import Analysis, Default, mixing
+from motionlib.segmenters.default import Analysis, Default
+from motionlib.segmenters.default._short_activity import mixing
 from tests.motionlib.conftest import skeleton_takes
 
 FPS = 60.0

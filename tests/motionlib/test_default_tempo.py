@@ -5,13 +5,12 @@ import pytest
 
 from motionlib import benchdata, synth
 from motionlib.errors import InputError
-from motionlib.segmenters.default import (
+from motionlib.segmenters.default import Default, take_features
+from motionlib.segmenters.default._tempo import (
     TEMPO_REFERENCE_S,
     TEMPO_SCALE,
-    Default,
     movement_period,
     scaled_times,
-    take_features,
 )
 
 FPS = 60.0

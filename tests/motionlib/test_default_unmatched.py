@@ -6,11 +6,10 @@ import numpy as np
 import pytest
 
 from motionlib import benchdata, metrics, tuning
-from motionlib.segmenters.default import (
+from motionlib.segmenters.default import Analysis, Default
+from motionlib.segmenters.default._unmatched import (
     UNMATCHED_HALF_S,
     UNMATCHED_RELATIVE,
-    Analysis,
-    Default,
     unmatched_peaks,
     unmatched_poses,
     unmatched_sides,
