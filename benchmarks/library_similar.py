@@ -31,7 +31,6 @@ REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
 import motionlib  # noqa: E402
-from motionlib.benchdata import data_dir  # noqa: E402
 from motionlib.similarity import (  # noqa: E402
     PROFILE_ROWS,
     body_scale,
@@ -39,6 +38,7 @@ from motionlib.similarity import (  # noqa: E402
     segment_descriptor,
 )
 from motionlib.vector_index import IvfIndex  # noqa: E402
+from segmentation.shared_data import data_dir  # noqa: E402
 
 DATA = data_dir()
 

@@ -44,7 +44,7 @@ def base_descriptors(rng, per_take=400):
     synthetic takes."""
     import motionlib
     from motionlib import similarity, synth
-    from motionlib.benchdata import data_dir
+    from segmentation.shared_data import data_dir
 
     takes, data = [], data_dir()
     for seq, subject in CMU:

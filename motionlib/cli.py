@@ -11,8 +11,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from motionlib.bench_quality import add_bench_quality
-from motionlib.bench_speed import add_bench_speed
+from motionlib.arguments import add_animation, animation_arg
 from motionlib.errors import CaptureError
 from motionlib.segmenters.command import add_segment
 
@@ -27,16 +26,6 @@ def add_info(subparsers) -> None:
     p.add_argument("--asf", help="the ASF skeleton of an .amc file")
     add_animation(p)
     p.set_defaults(handler=run_info)
-
-
-def add_animation(p) -> None:
-    p.add_argument("--animation", help="which animation of an FBX file with several (its name "
-                                       "or 0-based number; default: the first)")
-
-
-def animation_arg(value: str | None) -> str | int | None:
-    """``--animation``: a number picks by position, anything else by name."""
-    return int(value) if value is not None and value.isdigit() else value
 
 
 def run_info(args) -> int:
@@ -106,7 +95,7 @@ def run_convert(args) -> int:
     return 0
 
 
-COMMANDS = [add_info, add_convert, add_segment, add_bench_quality, add_bench_speed]
+COMMANDS = [add_info, add_convert, add_segment]
 
 
 class _Parser(argparse.ArgumentParser):
@@ -118,7 +107,7 @@ class _Parser(argparse.ArgumentParser):
 
 def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="python -m motionlib",
-                     description="Motion-capture takes: inspect, convert, segment, benchmark.")
+                     description="Motion-capture takes: inspect, convert, segment.")
     subparsers = parser.add_subparsers(dest="command", required=True, metavar="command")
     for add in COMMANDS:
         add(subparsers)

@@ -28,7 +28,7 @@ def add_segment(subparsers) -> None:
 
 
 def run_segment(args) -> int:
-    from motionlib.cli import animation_arg
+    from motionlib.arguments import animation_arg
     from motionlib.io import read
     from motionlib.segmenters import ParamError, get_segmenter, parse_param_args
 

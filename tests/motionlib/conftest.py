@@ -4,7 +4,7 @@ from pathlib import Path
 
 import pytest
 
-from motionlib.benchdata import data_dir
+from segmentation.shared_data import data_dir
 
 DATA = data_dir()
 CMU = DATA / "cmu"
@@ -28,9 +28,9 @@ def amc_13_29() -> tuple[Path, Path]:
 
 
 def labelled_takes(kind: str = "skeleton", name: str | None = None) -> list:
-    """The labelled takes of ``kind`` (``benchdata.discover``), only those called ``name``
+    """The labelled takes of ``kind`` (``benchmarks.quality.data.discover``), only those called ``name``
     when given, not read; skipped when the shared data does not hold them."""
-    from motionlib.benchdata import discover
+    from benchmarks.quality.data import discover
 
     takes = [t for t in discover()[0] if t.kind == kind and name in (None, t.name)]
     if not takes:

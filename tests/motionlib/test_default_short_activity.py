@@ -4,7 +4,8 @@ of an activity too short for the 3-6 s windows, confirmed by windows of min_segm
 import numpy as np
 import pytest
 
-from motionlib import metrics, synth, tuning
+from benchmarks.quality import tuning
+from motionlib import metrics, synth
 from motionlib.segmenters.default import Analysis, Default
 from motionlib.segmenters.default._short_activity import mixing
 from tests.motionlib.conftest import skeleton_takes

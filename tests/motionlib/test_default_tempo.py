@@ -3,7 +3,8 @@
 import numpy as np
 import pytest
 
-from motionlib import benchdata, synth
+from benchmarks.quality import variants
+from motionlib import synth
 from motionlib.errors import InputError
 from motionlib.segmenters.default import Default, take_features
 from motionlib.segmenters.default._tempo import (
@@ -23,7 +24,7 @@ def _take(seed=2):
 def test_a_take_played_slower_has_more_frames_and_its_cuts_move_with_the_motion():
     take, segments = _take()
     truth = np.asarray([start for start, _, _ in segments[1:]])
-    slow, moved = benchdata.played_at(take, truth, 0.8)
+    slow, moved = variants.played_at(take, truth, 0.8)
     assert slow.n_frames == round(take.n_frames / 0.8)
     assert np.array_equal(moved, np.round(truth / 0.8).astype(np.int64))
     # The same pose at the moved frame as at the original one.
@@ -35,7 +36,7 @@ def test_an_angle_crossing_half_a_turn_is_resampled_through_its_shortest_turn():
     channels = np.array(take.channels, dtype=float)
     channels[:, 5] = np.where(np.arange(len(channels)) % 2 == 0, 179.0, -179.0)
     take.channels = channels
-    slow, _ = benchdata.played_at(take, np.zeros(0, np.int64), 0.5)
+    slow, _ = variants.played_at(take, np.zeros(0, np.int64), 0.5)
     # Half-way between 179 and -179 is 180 (or -180), never 0.
     assert np.all(np.abs(np.abs(slow.channels[:, 5]) - 180.0) <= 1.0 + 1e-9)
 
@@ -43,14 +44,14 @@ def test_an_angle_crossing_half_a_turn_is_resampled_through_its_shortest_turn():
 def test_it_refuses_a_speed_that_is_not_above_zero():
     take, _ = _take()
     with pytest.raises(InputError, match="speed: must be above 0, got 0"):
-        benchdata.played_at(take, np.zeros(0, np.int64), 0)
+        variants.played_at(take, np.zeros(0, np.int64), 0)
 
 
 def test_the_movement_cycle_lengthens_as_the_performer_slows_down():
     take, _ = _take()
     periods = {}
     for speed in (0.8, 1.0, 1.25):
-        played, _ = benchdata.played_at(take, np.zeros(0, np.int64), speed)
+        played, _ = variants.played_at(take, np.zeros(0, np.int64), speed)
         x, _ = take_features(played)
         periods[speed] = movement_period(x, FPS)
     for speed in (0.8, 1.25):

@@ -5,7 +5,8 @@ look like nothing 1.5-8 s around them."""
 import numpy as np
 import pytest
 
-from motionlib import benchdata, metrics, tuning
+from benchmarks.quality import data, tuning, variants
+from motionlib import metrics
 from motionlib.segmenters.default import Analysis, Default
 from motionlib.segmenters.default._unmatched import (
     UNMATCHED_HALF_S,
@@ -143,7 +144,7 @@ def _sides_found(cuts, truth, k, fps) -> int:
 @pytest.mark.parametrize("name, activity", REAL_CASES)
 def test_it_finds_both_sides_of_a_real_activity_cut_down_to_1_8_s(name, activity):
     labelled = labelled_takes(name=name)[0]
-    take, truth = benchdata.shortened(labelled.read(), labelled.truth, activity, 1.8)
+    take, truth = variants.shortened(labelled.read(), labelled.truth, activity, 1.8)
     cuts = Default().fit_predict(take).cuts
     assert _sides_found(cuts, truth, activity, take.fps) == 2
     # Without the step, the long windows see one peak and one side is lost.
@@ -176,7 +177,7 @@ def test_the_take_median_guard_keeps_it_out_of_a_boxing_take():
     # CMU 13_17, boxing throughout (no segment labels): punches and footwork that never
     # repeat exactly, so the median pose is already 0.62 unmatched; the stretch the
     # absolute level (1) alone would split sits at 1.7 times the take's median.
-    found = [(path, asf) for path, asf in benchdata.unlabelled_motion()
+    found = [(path, asf) for path, asf in data.unlabelled_motion()
              if path.stem == "13_17"]
     if not found:
         pytest.skip("CMU take 13_17 is not available (needs ../shared/data)")

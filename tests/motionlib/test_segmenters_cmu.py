@@ -3,10 +3,12 @@
 import numpy as np
 import pytest
 
-from motionlib import benchdata, metrics
+from benchmarks.quality import data
+from motionlib import metrics
 from motionlib.segmenters import get_segmenter
+from segmentation.shared_data import data_dir
 
-DATA = benchdata.data_dir()
+DATA = data_dir()
 pytestmark = [
     pytest.mark.slow,
     pytest.mark.skipif(not DATA.is_dir(), reason=f"CMU benchmark data not found at {DATA}"),
@@ -19,7 +21,7 @@ PATENT_FINAL = [1, 208, 803, 1364, 1949, 2384, 2465]
 
 @pytest.fixture(scope="module")
 def takes():
-    return {t.name: (t, t.read()) for t in benchdata.labelled_takes()}
+    return {t.name: (t, t.read()) for t in data.labelled_takes()}
 
 
 def test_it_reproduces_the_patent_run_on_13_30_within_30_frames(takes):

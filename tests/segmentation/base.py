@@ -13,9 +13,9 @@ from django.core.files.uploadedfile import SimpleUploadedFile
 from django.test import TestCase
 from rest_framework.test import APIClient
 
-from motionlib.benchdata import data_dir
 from segmentation import services, storage, tasks
 from segmentation.models import Capture, DetectionRun
+from segmentation.shared_data import data_dir
 
 SHARED_DATA = data_dir()
 

@@ -9,9 +9,9 @@ from django.core.management.base import BaseCommand
 from django.db import transaction
 
 from motionlib import synth, write_bvh
-from motionlib.benchdata import data_dir
 from segmentation import importing, services
 from segmentation.models import Project
+from segmentation.shared_data import data_dir
 
 PROJECT = "Demo studio"
 PASSWORD = "cutroom-demo"

@@ -3,7 +3,9 @@
 import numpy as np
 import pytest
 
-from motionlib import benchdata, synth, tuning, write_bvh
+from benchmarks.quality import bench, cli, data, tuning
+from motionlib import synth, write_bvh
+from segmentation import shared_data
 
 SEGMENTS = "start_block,end_block,start_frame,end_frame,label_id,action_name\n"
 KRUGER = "segment,label,end_lo,end_mid,end_hi\n"
@@ -30,19 +32,19 @@ def layout(tmp_path_factory):
 
 
 def test_it_finds_labelled_takes_by_their_files_not_their_names(layout):
-    takes, _ = benchdata.discover(layout)
+    takes, _ = data.discover(layout)
     assert [(t.name, t.kind, t.source) for t in takes] == [
         ("77_05", "skeleton", "mocap6"), ("91_02", "channels", "kruger2017")]
 
 
 def test_it_says_which_files_it_skipped_and_why(layout):
-    _, skipped = benchdata.discover(layout)
+    _, skipped = data.discover(layout)
     assert skipped == ["skipped labels/mocap6/segments/77_09.csv: labels but no motion",
                        "skipped cmu/amc/12_34.amc: motion but no labels"]
 
 
 def test_it_shifts_mocap6_cuts_by_the_lines_a_bvh_adds_before_the_motion(layout):
-    take = benchdata.discover(layout)[0][0]
+    take = data.discover(layout)[0][0]
     # The BVH has as many frames as the labels: no added T-pose line, no shift.
     assert take.truth[:, 1].tolist() == [600]
 
@@ -50,12 +52,12 @@ def test_it_shifts_mocap6_cuts_by_the_lines_a_bvh_adds_before_the_motion(layout)
 def test_it_lists_the_full_skeleton_takes_without_labels(layout):
     # The AMC has no ASF of its subject, so it cannot be read; the labelled BVH is listed
     # by discover instead.
-    assert benchdata.unlabelled_motion(layout) == []
+    assert data.unlabelled_motion(layout) == []
     (layout / "cmu/asf").mkdir(exist_ok=True)
     (layout / "cmu/asf/12.asf").write_text(":version 1.10\n")
     (layout / "cmu/bvh/12_34.bvh").write_text("")
     try:
-        assert benchdata.unlabelled_motion(layout) == [
+        assert data.unlabelled_motion(layout) == [
             (layout / "cmu/amc/12_34.amc", layout / "cmu/asf/12.asf")]  # AMC first
     finally:
         (layout / "cmu/asf/12.asf").unlink()
@@ -63,7 +65,7 @@ def test_it_lists_the_full_skeleton_takes_without_labels(layout):
 
 
 def test_it_reads_a_four_channel_take_as_angles_at_the_cmu_rate(layout):
-    take = benchdata.discover(layout)[0][1]
+    take = data.discover(layout)[0][1]
     read = take.read()
     assert (read.n_frames, read.channels.shape[1], read.fps) == (900, 4, 120.0)
     assert take.truth.tolist() == [[380, 400, 420]]
@@ -72,8 +74,8 @@ def test_it_reads_a_four_channel_take_as_angles_at_the_cmu_rate(layout):
 def test_it_names_the_line_of_a_bad_four_channel_row(tmp_path):
     path = tmp_path / "x.4d.txt"
     path.write_text("1 2 3 4\n1 2 x 4\n")
-    with pytest.raises(benchdata.LabelError, match=r"x\.4d\.txt: line 2: not numbers"):
-        benchdata.read_channels(path)
+    with pytest.raises(data.LabelError, match=r"x\.4d\.txt: line 2: not numbers"):
+        data.read_channels(path)
 
 
 class View:
@@ -130,9 +132,8 @@ def test_it_chooses_settings_on_the_other_label_sources_only_to_show_their_trans
 
 
 def test_it_prints_leave_one_take_out_rows_beside_the_others(layout, capsys):
-    from motionlib import bench_quality
 
-    assert bench_quality.main(layout, ["bone_angle"], loo=True, pool=[]) == 0
+    assert bench.main(layout, ["bone_angle"], loo=True, pool=[]) == 0
     out = capsys.readouterr().out
     assert "Rows ending in /loo were scored leave-one-take-out" in out
     for row in ("default/loo", "adapted/loo", "ruptures/loo"):
@@ -184,17 +185,16 @@ def _mocap6_folder(root, seeds, names):
 
 def test_leave_one_take_out_also_chooses_on_and_learns_from_the_pool_without_scoring_it(
         tmp_path):
-    from motionlib import bench_quality
 
     scored = _mocap6_folder(tmp_path / "new", [3], ["40_01"])
     # The pool holds two other takes and one with the scored take's name and kind.
     pool = _mocap6_folder(tmp_path / "pool", [4, 5, 6], ["40_02", "40_03", "40_01"])
-    alone = bench_quality.run(scored, ["default"], loo=True)
+    alone = bench.run(scored, ["default"], loo=True)
     assert np.isnan(alone["40_01"]["default/loo"]["f1@1s"])  # nothing else to choose on
     assert np.isnan(alone["40_01"]["adapted/loo"]["f1@1s"])  # nothing to learn from
 
     selections = []
-    results = bench_quality.run(scored, ["default"], loo=True, pool=[pool],
+    results = bench.run(scored, ["default"], loo=True, pool=[pool],
                                 selection_out=selections)
     assert list(results) == ["40_01"]  # the pool is not scored
     cache = selections[0].cache
@@ -202,7 +202,7 @@ def test_leave_one_take_out_also_chooses_on_and_learns_from_the_pool_without_sco
         ("40_01", False), ("40_02", True), ("40_03", True)]
     # The scored take's settings are the ones chosen on the two pool takes.
     on_pool = tuning.select(cache[1:]).chosen()
-    expected = bench_quality.metrics.evaluate(
+    expected = bench.metrics.evaluate(
         cache[0].cuts(on_pool), cache[0].labelled.truth, fps=cache[0].take.fps)
     row = results["40_01"]["default/loo"]
     assert (row["f1@1s"], row["edits_per_cut"]) == (expected["f1@1s"],
@@ -212,34 +212,31 @@ def test_leave_one_take_out_also_chooses_on_and_learns_from_the_pool_without_sco
 
 
 def test_the_cli_says_so_when_a_pool_folder_is_missing(layout, tmp_path, capsys):
-    from motionlib import bench_quality
 
-    assert bench_quality.main(layout, ["bone_angle"], loo=True,
+    assert bench.main(layout, ["bone_angle"], loo=True,
                               pool=[tmp_path / "nowhere"]) == 2
     assert f"benchmark data folder not found: {tmp_path / 'nowhere'}" in capsys.readouterr().err
 
 
 def test_the_default_pool_is_the_shared_data_wherever_it_is_set_and_never_the_folder_scored(
         tmp_path, monkeypatch):
-    from motionlib import bench_quality
 
     copy, scored = tmp_path / "shared-copy", tmp_path / "new"
     copy.mkdir()
     scored.mkdir()
     monkeypatch.setenv("CUTROOM_BENCH_DATA", str(copy))
-    assert bench_quality.default_pool(scored) == [copy.resolve()]
+    assert bench.default_pool(scored) == [copy.resolve()]
     # Scoring the shared data itself: the pool is the shared folder beside the repository,
     # if it is there and another folder, else nothing.
-    beside = benchdata.DEFAULT_DATA_DIR.resolve()
-    assert bench_quality.default_pool(copy) == ([beside] if beside.is_dir() else [])
+    beside = shared_data.DEFAULT_DATA_DIR.resolve()
+    assert bench.default_pool(copy) == ([beside] if beside.is_dir() else [])
     monkeypatch.setenv("CUTROOM_BENCH_DATA", str(tmp_path / "missing"))
-    assert bench_quality.default_pool(scored) == ([beside] if beside.is_dir() else [])
-    assert bench_quality.default_pool(beside) == []
+    assert bench.default_pool(scored) == ([beside] if beside.is_dir() else [])
+    assert bench.default_pool(beside) == []
 
 
 def test_it_skips_a_take_whose_labels_lie_outside_its_motion_naming_the_label_file(
         tmp_path, capsys):
-    from motionlib import cli
 
     for folder in ("cmu/channels4d", "labels/cmu86_kruger2017"):
         (tmp_path / folder).mkdir(parents=True)
@@ -248,8 +245,8 @@ def test_it_skips_a_take_whose_labels_lie_outside_its_motion_naming_the_label_fi
     labels = tmp_path / "labels/cmu86_kruger2017/91_02.csv"
     # Labels of a longer take: the second cut is past the 900 frames read.
     labels.write_text(KRUGER + "1,walk,380,400,420\n2,jog,930,950,970\n3,end,1200,1200,1200\n")
-    (take,) = benchdata.discover(tmp_path)[0]
-    with pytest.raises(benchdata.LabelError) as error:
+    (take,) = data.discover(tmp_path)[0]
+    with pytest.raises(data.LabelError) as error:
         take.read()
     assert str(error.value) == (
         f"{labels}: cut at frame 950 is outside {tmp_path}/cmu/channels4d/91_02.4d.txt "
@@ -262,7 +259,7 @@ def test_it_skips_a_take_whose_labels_lie_outside_its_motion_naming_the_label_fi
     (tmp_path / "cmu/amc/91_03.amc").write_text(":FULLY-SPECIFIED\n:DEGREES\n1\nroot x\n")
     (tmp_path / "cmu/asf/91.asf").write_text(":version 1.10\n")
     (tmp_path / "labels/cmu86_kruger2017/91_03.csv").write_text(KRUGER + "1,a,5,5,5\n")
-    assert cli.main(["bench", "--data", str(tmp_path), "--method", "bone_angle"]) == 2
+    assert cli.main(["--data", str(tmp_path), "--method", "bone_angle"]) == 2
     out = capsys.readouterr()
     assert f"skipped 91_02 (91_02.4d.txt): {error.value}\n" in out.out
     assert "skipped 91_03 (91_03.amc): 91.asf:1: missing :root section" in out.out
@@ -282,7 +279,7 @@ def test_it_skips_a_label_file_it_cannot_read_naming_the_row_and_goes_on(tmp_pat
     (kruger / "91_04.csv").write_text(KRUGER + "1,walk,380,400,420\n2,end,900,900,900\n")
     (tmp_path / "labels/mocap6/segments/77_05.csv").write_bytes(
         SEGMENTS.encode() + b"1,50,1,600,1,Jump\xff\n")
-    takes, skipped = benchdata.discover(tmp_path)
+    takes, skipped = data.discover(tmp_path)
     assert [t.name for t in takes] == ["91_04"]
     assert skipped[0].startswith("skipped labels/mocap6/segments/77_05.csv: cannot read the "
                                  "labels: 'utf-8' codec can't decode byte 0xff")
@@ -290,14 +287,14 @@ def test_it_skips_a_label_file_it_cannot_read_naming_the_row_and_goes_on(tmp_pat
                            "not an integer: '4OO'"]
 
 
-SHARED = benchdata.data_dir()
+SHARED = shared_data.data_dir()
 
 
 @pytest.mark.skipif(not SHARED.is_dir(), reason=f"CMU benchmark data not found at {SHARED}")
 def test_the_original_mocap6_block_files_give_the_cuts_of_their_segments_csv():
     for name in ("13_29", "13_30"):
-        blocks = benchdata.mocap6_block_truth(SHARED / f"labels/mocap6/{name}.txt")
-        runs = benchdata.mocap6_truth(SHARED / f"labels/mocap6/segments/{name}.csv")
+        blocks = data.mocap6_block_truth(SHARED / f"labels/mocap6/{name}.txt")
+        runs = data.mocap6_truth(SHARED / f"labels/mocap6/segments/{name}.csv")
         assert blocks.tolist() == runs.tolist() and len(runs) >= 4
 
 
@@ -312,9 +309,9 @@ def test_a_mocap6_take_with_only_its_block_file_is_found_with_its_amc(tmp_path):
     (tmp_path / "labels/mocap6/13_31.txt").write_text("1 1 2 2\n")
     (tmp_path / "cmu/amc/13_32.amc").symlink_to(SHARED / "cmu/amc/13_30.amc")
     (tmp_path / "labels/mocap6/13_32.txt").write_text("1 1 x 2\n")
-    takes, skipped = benchdata.discover(tmp_path)
+    takes, skipped = data.discover(tmp_path)
     assert [(t.name, t.source, t.path.name) for t in takes] == [("13_30", "mocap6", "13_30.amc")]
-    expected = benchdata.mocap6_truth(SHARED / "labels/mocap6/segments/13_30.csv")
+    expected = data.mocap6_truth(SHARED / "labels/mocap6/segments/13_30.csv")
     assert takes[0].truth.tolist() == expected.tolist()
     assert takes[0].read().n_frames == 2465
     assert skipped == [

@@ -1,7 +1,7 @@
-"""The speed benchmarks, printing tables: ``python -m motionlib bench-speed io|adapt``.
+"""motionlib's speed benchmarks, printing tables: ``python -m benchmarks.quality speed io|adapt``.
 
-How well the segmenters cut is measured by ``python -m motionlib bench-quality``
-(``motionlib.bench_quality``); this module measures only how fast things run.
+How well the segmenters cut is measured by ``python -m benchmarks.quality`` (``bench``);
+this module measures only how fast things run.
 
 ``io``: read + forward kinematics of the CMU take 13_29 as BVH and as AMC + ASF, against the
 PyPI ``bvh`` package's parse of the same BVH (median of several interleaved runs, one process,
@@ -30,7 +30,7 @@ import time
 import tracemalloc
 from pathlib import Path
 
-from motionlib.benchdata import data_dir
+from segmentation.shared_data import data_dir
 
 TARGET_MS, TARGET_SPEEDUP, TARGET_MEMORY = 40.0, 10.0, 5.0
 
@@ -91,7 +91,7 @@ def _synth_case():
 def run_io(args) -> int:
     cmu = Path(args.data) / "cmu"
     if not (cmu / "bvh" / "13_29.bvh").is_file():
-        print(f"motionlib bench-speed io: error: CMU captures not found under {cmu}",
+        print(f"benchmarks.quality speed io: error: CMU captures not found under {cmu}",
               file=sys.stderr)
         return 2
     cases = _cases(cmu)
@@ -192,12 +192,12 @@ def _run_adapt(args) -> int:
     return 0
 
 
-def add_bench_speed(subparsers) -> None:
-    """Register ``python -m motionlib bench-speed io|adapt`` (see ``motionlib.cli``)."""
+def add_speed(subparsers) -> None:
+    """Register ``python -m benchmarks.quality speed io|adapt`` (see ``__main__``)."""
     parser = subparsers.add_parser(
-        "bench-speed", help="benchmark read and detection speed (prints tables)",
+        "speed", help="benchmark read and detection speed (prints tables)",
         description="How fast motionlib reads takes and detects cuts; the segmentation "
-                    "quality is `bench-quality`.")
+                    "quality is the default command.")
     sub = parser.add_subparsers(dest="benchmark", required=True, metavar="benchmark")
     io = sub.add_parser("io", help="read + FK speed and memory on CMU 13_29")
     io.add_argument("--runs", type=int, default=21, help="timed runs per motionlib case")

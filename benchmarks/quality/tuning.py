@@ -1,34 +1,18 @@
 """Choosing the default detector's settings honestly: leave-one-take-out.
 
-The zero-shot defaults of ``segmenters.default`` are chosen from :data:`GRID`, a small set
-of principled options, by the best mean score over labelled takes. To know how that
-*choice* does on a take it has not seen, :func:`leave_one_out` repeats it without each
-take (and without every other view of the same take, e.g. the four-channel extract of a
-full AMC) and scores the result on the take left out.
+The zero-shot defaults of ``motionlib.segmenters.default`` are chosen from :data:`GRID`, a
+small set of principled options, by the best mean score over labelled takes. To know how
+that *choice* does on a take it has not seen, :meth:`Selection.leave_one_out` repeats it
+without each take (and without every other view of the same take, e.g. the four-channel
+extract of a full AMC) and scores the result on the take left out; :func:`by_source`
+does the same with a whole label source left out.
 
-The score of a setting over some takes is the mean F1 at 1 s, ties broken by fewer
-edits per true cut (``metrics``). Choosing by fewer edits first, ties broken by F1
-(:func:`edits_objective`, the criterion ``adapt`` counts cuts by), was scored the same way
-on the 11 labelled takes under ``shared/data``: with the grid before the support test
-(``segmenters.default`` step 4a), leave-one-take-out mean F1@1 s 0.916 and 0.468 edits per
-true cut, against 0.957 and 0.406 with F1 first: worse on review cost too. It took the
-higher prominence (0.15) that a few takes gain from and lost cuts on the others (13_30,
-86_03, 86_08, 86_11, 86_14). With the support test in the grid the two choose alike
-(0.971 and 0.367): the false peaks a higher prominence removed, the test removes. The
-benchmark prints both (``objective`` lines).
-
-Leave-one-take-out still chooses on takes of the scored take's own label source. How the
-choice transfers to a source it never saw is measured too (:func:`by_source`): the two
-mocap6 takes scored with settings chosen on the nine subject-86 (Krüger) takes only, mean
-F1@1 s 1.000, 0.325 edits per true cut, median error 0.096 s (the same as
-leave-one-take-out); the nine subject-86 takes with settings chosen on the two mocap6
-takes only, 0.947, 0.424 and 0.337 s (leave-one-take-out 0.964, 0.377 and 0.353 s). The
-mocap6 takes cannot choose the support test's level: it changes none of their cuts, so
-every level ties and the first (off) is taken.
-
-Options that were tried and not shipped (:data:`TRIED`) are scored the same way, with
-the choice made from :func:`tried_grid`, so that the record of why they are not shipped
-can be re-run (``python -m motionlib bench-quality --loo``).
+The score of a setting over some takes is the mean F1 at 1 s, ties broken by fewer edits
+per true cut (``motionlib.metrics``); :func:`edits_objective` is the other order, scored
+beside it. Options tried and not shipped (:data:`TRIED`) are scored the same way, with the
+choice made from :func:`tried_grid`, so that the record of why they are not shipped can be
+re-run (``python -m benchmarks.quality --loo``). How the objective and the grid were
+settled is in ``docs/detector/tuning.md``.
 """
 
 from __future__ import annotations
@@ -92,10 +76,10 @@ class TakeCache:
     """One labelled take read once, with its novelty analyses by window setting.
 
     A ``pool`` take is labelled material that settings are chosen on (and a model adapted
-    to) but that is not scored itself (``bench_quality``'s ``--pool``).
+    to) but that is not scored itself (the bench's ``--pool``).
     """
 
-    labelled: object  # benchdata.LabelledTake
+    labelled: object  # data.LabelledTake
     take: object
     pool: bool = False
     analyses: dict = field(default_factory=dict)
@@ -153,8 +137,8 @@ def objective(rows: Sequence[dict]) -> tuple[float, float]:
 
 
 def edits_objective(rows: Sequence[dict]) -> tuple[float, float]:
-    """Tried, not shipped: fewer edits per true cut, then mean F1@1 s (see the module
-    docstring for how it scored)."""
+    """Tried, not shipped: fewer edits per true cut, then mean F1@1 s (how it scored:
+    ``docs/detector/tuning.md``)."""
     f1, edits = objective(rows)
     return edits, f1
 

@@ -1,0 +1,55 @@
+"""Command line of the research apparatus: the quality benchmark by default, ``speed`` for
+motionlib's speed tables. Errors a user can fix print one line on stderr, exit status 2."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from benchmarks.quality import bench
+from benchmarks.quality.speed import add_speed
+from motionlib.errors import CaptureError
+
+EXIT_USAGE = 2
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="python -m benchmarks.quality",
+        description="Every segmenter (default parameters) and two change-point peers on "
+                    "every labelled take: a table per take and the mean. `speed` measures "
+                    "how fast motionlib reads and detects instead.")
+    parser.add_argument("--data", help="benchmark data folder (default: $CUTROOM_BENCH_DATA "
+                                       "or ../shared/data)")
+    parser.add_argument("--method", action="append", help="only this row (repeatable)")
+    parser.add_argument("--loo", action="store_true",
+                        help="also score leave-one-take-out: the default settings chosen, "
+                             "the adapted model fitted and the ruptures penalty chosen "
+                             "without the take scored")
+    parser.add_argument("--pool", action="append", metavar="DIR",
+                        help="with --loo, also choose on and learn from the labelled takes "
+                             "under DIR, without scoring them (repeatable; default: the "
+                             "folder the shipped settings were chosen on, when --data is "
+                             "another)")
+    parser.add_argument("--no-pool", action="store_true",
+                        help="with --loo, choose on the other takes under --data only")
+    subparsers = parser.add_subparsers(dest="command", metavar="command")
+    add_speed(subparsers)
+    parser.set_defaults(handler=run_quality, command="quality")  # no command: quality
+    return parser
+
+
+def run_quality(args) -> int:
+    return bench.main(args.data, args.method, loo=args.loo,
+                      pool=[] if args.no_pool else args.pool)
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the command line; return the exit status."""
+    args = build_parser().parse_args(argv)
+    try:
+        return args.handler(args)
+    except (CaptureError, ValueError, OSError) as exc:
+        message = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        print(f"benchmarks.quality {args.command}: error: {message}", file=sys.stderr)
+        return EXIT_USAGE
