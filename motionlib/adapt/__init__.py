@@ -55,7 +55,7 @@ import numpy as np
 
 from motionlib import metrics
 from motionlib.adapt._examples import EXAMPLE_COLUMNS, ExampleError, read_examples
-from motionlib.errors import InputError, ParamError
+from motionlib.errors import InputError
 from motionlib.segmenters import default
 from motionlib.segmenters.base import Segmentation, _checked
 from motionlib.segmenters.default import PLACEMENTS, Default, Peaks, shipped_stage
@@ -249,7 +249,7 @@ def fit_cut_model(examples: Sequence, *, studies: Studies | None = None,
     """
     if len(examples) == 0:
         raise ExampleError("no example takes to learn from")
-    p = _untempoed(Default.validate_params(base or {}))
+    p = Default.validate_params(base or {})
     checked = [(example, _checked_cuts(example, example.cuts))
                for example in map(_as_example, examples)]
     shortest = _shortest_segment(checked)
@@ -549,15 +549,6 @@ def _segment(analysis, p: dict, placement: str, offset_s: float) -> Segmentation
     return _checked(result, len(analysis.x) + analysis.first)
 
 
-def _untempoed(p: dict) -> dict:
-    """``p``, refused with the ``tempo`` setting: a model's windows and offsets are
-    learnt in seconds of the examples' own pace."""
-    if p["tempo"]:
-        raise ParamError("tempo: an adapted model learns its windows in seconds and "
-                         "cannot be combined with the tempo setting")
-    return p
-
-
 def detect(take, model: CutModel | None = None, **params) -> Segmentation:
     """Candidate cuts of ``take``; ``model=None`` is the zero-shot default detector.
 
@@ -572,7 +563,7 @@ def detect(take, model: CutModel | None = None, **params) -> Segmentation:
     """
     if model is None:
         return Default(**params).fit_predict(take)
-    p = _untempoed({**Default.validate_params(params), **model.params()})
+    p = {**Default.validate_params(params), **model.params()}
     start = time.perf_counter()
     analysis = default.analyse(take, p)
     if analysis is None:  # too short to compare anything: no cuts, as the detector says

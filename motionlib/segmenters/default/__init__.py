@@ -35,30 +35,16 @@ import time
 
 import numpy as np
 
-from motionlib.segmenters.base import Param, ParamError, Segmentation, Segmenter
+from motionlib.segmenters.base import Param, Segmentation, Segmenter
+from motionlib.segmenters.default import _analysis, _peaks, _placement
 from motionlib.segmenters.default._analysis import MAX_WINDOW_SAMPLES, Analysis
-from motionlib.segmenters.default._analysis import analyse as _analyse
-from motionlib.segmenters.default._analysis import empty_segmentation as _empty
 from motionlib.segmenters.default._features import take_features
 from motionlib.segmenters.default._peaks import Peaks, candidates
-from motionlib.segmenters.default._peaks import split_short as _split_short
-from motionlib.segmenters.default._peaks import window_peaks as _window_peaks
 from motionlib.segmenters.default._placement import PLACEMENTS, Placement, shipped_stage
-from motionlib.segmenters.default._placement import place as _place
-from motionlib.segmenters.default._short_activity import short_activity_peaks as _short_activity
 
 __all__ = [
-    "PLACEMENTS",
-    "Analysis",
-    "Default",
-    "Peaks",
-    "Placement",
-    "analyse",
-    "candidates",
-    "peaks",
-    "place",
-    "shipped_stage",
-    "take_features",
+    "MAX_WINDOW_SAMPLES", "PLACEMENTS", "Analysis", "Default", "Peaks", "Placement",
+    "analyse", "candidates", "peaks", "place", "shipped_stage", "take_features",
 ]
 
 
@@ -102,18 +88,6 @@ class Default(Segmenter):
             "bool", True, 0, 1,
             "Move a cut that falls in a pause to its end, the onset of the next activity.",
         ),
-        "short_activity": Param(
-            "float", 0.0, 0.0, 100.0,
-            "Also cut the far side of an activity shorter than the shortest window when "
-            "min_segment_s windows show it this many times more clearly than the "
-            "changes inside activities (0 = off).",
-        ),
-        "short_uniformity": Param(
-            "float", 0.0, 0.0, 10.0,
-            "With short_activity: keep such a cut only if the short activity's two halves "
-            "differ at most this fraction as much as it differs from its neighbours "
-            "(0 = no test).",
-        ),
         "short_unmatched": Param(
             "float", 1.0, 0.0, 100.0,
             "Cut both sides of a short activity where the poses near a cut are this far "
@@ -126,28 +100,16 @@ class Default(Segmenter):
             "the other side: the mean squared distance (squared kernel widths) from each "
             "pose to its nearest across the peak stays below this on both sides (0 = off).",
         ),
-        "tempo": Param(
-            "bool", False, 0, 1,
-            "Scale the windows, the minimum segment and the placement reach by the "
-            "take's movement cycle (a slower performer gets longer windows).",
-        ),
     }
 
     @classmethod
     def validate_params(cls, values):
-        p = super().validate_params(values)
-        if p["rate_hz"] * p["scale_max_s"] > MAX_WINDOW_SAMPLES:
-            raise ParamError(
-                f"rate_hz: rate_hz * scale_max_s must be at most {MAX_WINDOW_SAMPLES} poses "
-                f"per window, got {p['rate_hz']:g} * {p['scale_max_s']:g}"
-            )
-        return p
+        return _analysis.within_window_limit(super().validate_params(values))
 
     def _segment(self, take, **p) -> Segmentation:
         analysis = self.analyse(take, p)
         if analysis is None:
-            return _empty(take)
-        p = analysis.params(p)
+            return _analysis.empty_segmentation(take)
         t0 = time.perf_counter()
         found = self.peaks(analysis, p)
         placed = self.place(analysis, found, p)
@@ -160,28 +122,25 @@ class Default(Segmenter):
         """Step 1: pose stream, kernel and novelty curve of ``take`` (None if it is too
         short to compare anything). ``p`` are validated parameters; ParamError names a
         window setting that cannot work."""
-        return _analyse(take, p)
+        return _analysis.analyse(take, p)
 
     @classmethod
     def peaks(cls, analysis: Analysis, p: dict) -> Peaks:
         """Step 2: the novelty peaks that become cuts, with their evidence."""
         found, evidence = cls.window_peaks(analysis, p)
-        return _split_short(analysis, found, evidence, p)
+        return _peaks.split_short(analysis, found, evidence, p)
 
     @classmethod
     def window_peaks(cls, analysis: Analysis, p: dict) -> tuple[np.ndarray, np.ndarray]:
         """The peaks the novelty windows choose and the support test keeps, before the
         short-activity step: novelty samples and their prominence. A subclass that adds
         or drops candidates overrides this."""
-        found, evidence = _window_peaks(analysis, p)
-        if p["short_activity"] > 0:
-            found, evidence = _short_activity(analysis, found, evidence, p)
-        return found, evidence
+        return _peaks.window_peaks(analysis, p)
 
     @classmethod
     def place(cls, analysis: Analysis, found: Peaks, p: dict) -> Placement:
         """Step 3: where each cut of ``found`` goes (frames of ``analysis.x``)."""
-        return _place(analysis, found, p)
+        return _placement.place(analysis, found, p)
 
 
 analyse = Default.analyse

@@ -21,12 +21,22 @@ from motionlib.segmenters.default._features import block_mean, median_sq_distanc
 from motionlib.segmenters.default._novelty import mirrored_novelties, window_widths
 from motionlib.segmenters.default._peaks import cross_support
 from motionlib.segmenters.default._placement import pose_speeds
-from motionlib.segmenters.default._tempo import scaled_times, tempo_scale
 from motionlib.segmenters.default._unmatched import unmatched_poses
 
 # Poses in the longest comparison window (rate_hz * scale_max_s); the cost of a take
 # grows with its square.
 MAX_WINDOW_SAMPLES = 600
+
+
+def within_window_limit(p: dict) -> dict:
+    """``p``, refused with a ParamError when a window would hold more than
+    ``MAX_WINDOW_SAMPLES`` poses."""
+    if p["rate_hz"] * p["scale_max_s"] > MAX_WINDOW_SAMPLES:
+        raise ParamError(
+            f"rate_hz: rate_hz * scale_max_s must be at most {MAX_WINDOW_SAMPLES} poses "
+            f"per window, got {p['rate_hz']:g} * {p['scale_max_s']:g}"
+        )
+    return p
 
 
 @dataclass
@@ -44,15 +54,9 @@ class Analysis:
     gamma: float
     novelty: np.ndarray
     timings: dict[str, float]
-    # The factor the time settings were scaled by (``tempo``; 1: as given).
-    tempo: float = 1.0
     # Curves of the pose blocks and kernel, computed once; none depends on the novelty
     # windows, so ``with_windows`` shares them.
     _short: dict = field(default_factory=dict, repr=False)
-
-    def params(self, p: dict) -> dict:
-        """``p`` with its time settings scaled as this analysis's windows were."""
-        return scaled_times(p, self.tempo)
 
     @property
     def rate(self) -> float:
@@ -154,8 +158,6 @@ def analyse(take, p: dict) -> Analysis | None:
     step = max(1, int(round(fps / p["rate_hz"])))
     if len(x) < 2 * step:  # too short to compare anything: no cuts
         return None
-    scale = tempo_scale(x, fps) if p.get("tempo") else 1.0
-    p = scaled_times(p, scale)
     blocks = block_mean(x, step)
     # One kernel for detection and placement, its width from the median heuristic.
     gamma = 1.0 / max(p["bandwidth"] * median_sq_distance(blocks), 1e-12)
@@ -163,7 +165,7 @@ def analyse(take, p: dict) -> Analysis | None:
     t2 = time.perf_counter()
     return Analysis(x=x, fps=fps, step=step, first=first, gamma=gamma, novelty=novelty,
                     timings={"kinematics": t1 - t0, "novelty": t2 - t1},
-                    tempo=scale, _short={"blocks": blocks})
+                    _short={"blocks": blocks})
 
 
 def _novelty(x: np.ndarray, rate: float, gamma: float, p: dict) -> np.ndarray:
