@@ -18,15 +18,12 @@ is a pipeline of three public steps, each a function of the one before:
    motion, a nearby pause, and after a pause to the onset of the next activity
    (``_placement``), which is where annotators cut.
 
-``Default`` runs the three steps as a registered segmenter; a variant of the detector
-is a subclass overriding a step (``window_peaks`` is the hook between the windows' peaks
-and the short-activity step). ``candidates`` lists every peak any prominence would keep,
-for adapting the count to a studio's cuts (``motionlib.adapt``). Every other name lives
-in a private stage module and may change without notice.
-
-All durations are in seconds, so the same defaults work at any frame rate. Why each
-stage is built as it is, how every setting was chosen and how it scores out of sample,
-and the designs tried and not kept, are recorded in ``docs/detector/``.
+``Default`` runs the three steps as a registered segmenter; a variant is a subclass that
+overrides a step or the hook ``window_peaks`` (the peaks before the short-activity step).
+``candidates`` lists every peak any prominence would keep, for adapting the count to a
+studio's cuts (``motionlib.adapt``). Every other name lives in a private stage module.
+All durations are in seconds, so the same defaults work at any frame rate. How every
+setting was chosen, and the designs tried and not kept, are in ``docs/detector/``.
 """
 
 from __future__ import annotations
@@ -36,7 +33,7 @@ import time
 import numpy as np
 
 from motionlib.segmenters.base import Param, Segmentation, Segmenter
-from motionlib.segmenters.default import _analysis, _peaks, _placement
+from motionlib.segmenters.default import _analysis, _peaks, _placement, _unmatched
 from motionlib.segmenters.default._analysis import MAX_WINDOW_SAMPLES, Analysis
 from motionlib.segmenters.default._features import take_features
 from motionlib.segmenters.default._peaks import Peaks, candidates
@@ -101,6 +98,9 @@ class Default(Segmenter):
             "pose to its nearest across the peak stays below this on both sides (0 = off).",
         ),
     }
+    # The unmatched-poses step's half-width (s) and take-median guard (``_unmatched``).
+    unmatched_half_s = _unmatched.UNMATCHED_HALF_S
+    unmatched_relative = _unmatched.UNMATCHED_RELATIVE
 
     @classmethod
     def validate_params(cls, values):
@@ -128,7 +128,8 @@ class Default(Segmenter):
     def peaks(cls, analysis: Analysis, p: dict) -> Peaks:
         """Step 2: the novelty peaks that become cuts, with their evidence."""
         found, evidence = cls.window_peaks(analysis, p)
-        return _peaks.split_short(analysis, found, evidence, p)
+        return _peaks.split_short(analysis, found, evidence, p, cls.unmatched_half_s,
+                                  cls.unmatched_relative)
 
     @classmethod
     def window_peaks(cls, analysis: Analysis, p: dict) -> tuple[np.ndarray, np.ndarray]:

@@ -19,7 +19,13 @@ import numpy as np
 from scipy.signal import find_peaks
 from scipy.spatial.distance import cdist
 
-from motionlib.segmenters.default._unmatched import unmatched_peaks, unmatched_sides
+from motionlib.segmenters.default._unmatched import (
+    UNMATCHED_HALF_S,
+    UNMATCHED_RELATIVE,
+    unmatched_found,
+    unmatched_peaks,
+    unmatched_sides,
+)
 
 if TYPE_CHECKING:
     from motionlib.segmenters.default._analysis import Analysis
@@ -34,11 +40,14 @@ class Peaks:
     evidence : (n,) float, each cut's prominence (MMD²); ``confidence`` ranks by it.
     sides : the peaks the windows found that the unmatched-poses step replaced by the two
         sides of a short activity: peak sample -> (first side, second side).
+    unmatched : for each peak of ``sides``, how many times the take's median unmatched
+        level the poses between its sides reach (the step's evidence).
     """
 
     samples: np.ndarray
     evidence: np.ndarray
     sides: dict[int, tuple[int, int]] = field(default_factory=dict)
+    unmatched: dict[int, float] = field(default_factory=dict)
 
     def confidence(self, p: dict) -> np.ndarray:
         """(n,) confidence in [0, 1): 0.5 at the ``prominence`` setting."""
@@ -138,12 +147,14 @@ def supported_peaks(analysis: Analysis, peaks: np.ndarray, p: dict,
     return keep
 
 
-def split_short(analysis: Analysis, peaks: np.ndarray, strength: np.ndarray,
-                p: dict) -> Peaks:
+def split_short(analysis: Analysis, peaks: np.ndarray, strength: np.ndarray, p: dict,
+                half_s: float = UNMATCHED_HALF_S, relative: float = UNMATCHED_RELATIVE
+                ) -> Peaks:
     """The cuts of the kept ``peaks`` (evidence ``strength``): with ``short_unmatched``,
     each peak the long windows saw where a short activity lies between two others becomes
-    that activity's two sides (``unmatched_sides``)."""
-    sides = unmatched_sides(analysis, peaks, p)
+    that activity's two sides (``unmatched_sides``, with its half-width and take-median
+    guard)."""
+    sides, levels = unmatched_found(analysis, peaks, p, half_s, relative)
     if p["short_unmatched"] > 0:
         peaks, strength = unmatched_peaks(analysis, peaks, strength, p, sides=sides)
-    return Peaks(peaks, strength, sides)
+    return Peaks(peaks, strength, sides, levels)

@@ -111,11 +111,21 @@ def unmatched_sides(analysis: Analysis, peaks: np.ndarray, p: dict,
     -------
     kept peak (novelty sample) -> (first side, second side), novelty samples.
     """
+    return unmatched_found(analysis, peaks, p, half_s, relative)[0]
+
+
+def unmatched_found(analysis: Analysis, peaks: np.ndarray, p: dict,
+                    half_s: float = UNMATCHED_HALF_S, relative: float = UNMATCHED_RELATIVE
+                    ) -> tuple[dict[int, tuple[int, int]], dict[int, float]]:
+    """``unmatched_sides``, and for each of its peaks how many times the take's median
+    ``unmatched_poses`` its stretch reaches."""
     if len(peaks) == 0 or p["short_unmatched"] <= 0:
-        return {}
+        return {}, {}
     firings, median = unmatched_firings(analysis, peaks, p, half_s)
     level = max(p["short_unmatched"], relative * median)
-    return {peak: sides for peak, (sides, at) in firings.items() if at >= level}
+    found = {peak: firing for peak, firing in firings.items() if firing[1] >= level}
+    return ({peak: sides for peak, (sides, _) in found.items()},
+            {peak: at / max(median, 1e-12) for peak, (_, at) in found.items()})
 
 
 def unmatched_firings(analysis: Analysis, peaks: np.ndarray, p: dict,
