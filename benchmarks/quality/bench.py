@@ -54,11 +54,12 @@ from benchmarks.quality.tables import (
     out_of_sample_table,
     placement_summary,
 )
+from benchmarks.quality.tried import detector
 from benchmarks.quality.unmatched import unmatched_choice_check, unmatched_guard_check
 from motionlib import adapt, metrics
 from motionlib.errors import CaptureError
 from motionlib.segmenters import list_segmenters
-from motionlib.segmenters.default import Default, block_mean, take_features
+from motionlib.segmenters.default import take_features
 from segmentation import shared_data
 
 RUPTURES_PENALTY = 3.0
@@ -67,7 +68,8 @@ RUPTURES_PENALTY = 3.0
 def _peer_pose(take, rate_hz: float) -> tuple[np.ndarray, int, int]:
     x, first = take_features(take)
     step = max(1, int(round(take.fps / rate_hz)))
-    return block_mean(x, step), step, first
+    n = len(x) // step  # the poses averaged over blocks of step frames
+    return x[: n * step].reshape(n, step, -1).mean(axis=1), step, first
 
 
 def ruptures_kernel(take, penalty: float = RUPTURES_PENALTY) -> np.ndarray:
@@ -224,7 +226,7 @@ def loo_rows(cache: list[tuning.TakeCache], tried: tuning.Selection) -> dict[str
     for name, chosen in (("default/loo", shipped), ("tried/loo", tried.leave_one_out())):
         for c, found in _compress(zip(cache, chosen, strict=True), scored):
             out[name].append(_nan_row() if found is None else _timed_row(
-                lambda t, p=found[0]: Default(**p).fit_predict(t).cuts, c.take,
+                lambda t, p=found[0]: detector(p)(**p).fit_predict(t).cuts, c.take,
                 c.labelled.truth))
     # Adaptation starts from the zero-shot settings chosen without the take (those of
     # default/loo), not the shipped ones: they were chosen on every take, this one too.

@@ -16,15 +16,10 @@ import numpy as np
 from benchmarks.quality import tuning, variants
 from benchmarks.quality.data import discover, unlabelled_motion
 from benchmarks.quality.tables import mean_rows
+from benchmarks.quality.tried import Tried, detector
 from motionlib import adapt, metrics
 from motionlib.errors import CaptureError
-from motionlib.segmenters.default import (
-    PLACEMENTS,
-    Default,
-    place_stages,
-    shipped_stage,
-    speed_minima,
-)
+from motionlib.segmenters.default import PLACEMENTS, Default
 
 
 def placement_bound_check(read: list) -> str:
@@ -67,12 +62,12 @@ def _placement_bound(truth: np.ndarray, take) -> list[float] | None:
     a = Default.analyse(take, p)
     if a is None:
         return None
-    p = a.params(p)
-    peaks = a.peak_frames(Default.choose_peaks(a, p)[0])
-    stages, _ = place_stages(a.x, peaks, a.fps, a.gamma, p, a.speeds)
-    estimates = np.stack([peaks, *(stages[k] for k in PLACEMENTS)]) + a.first
-    cuts = stages[shipped_stage(p)] + a.first
-    turns = speed_minima(a.speeds[1]) + a.first
+    found = Default.peaks(a, p)
+    placed = Default.place(a, found, p)
+    peaks = a.peak_frames(found.samples)
+    estimates = np.stack([peaks, *(placed.stages[k] for k in PLACEMENTS)]) + a.first
+    cuts = placed.cuts + a.first
+    turns = placed.turns + a.first
     windows = metrics.as_windows(truth)
     ci, ti = metrics.match(cuts, windows, tolerance=int(round(take.fps)))
     if not len(ci):
@@ -88,6 +83,14 @@ def _placement_bound(truth: np.ndarray, take) -> list[float] | None:
 
 
 SHORT_S = 2.5
+
+
+def _detect(take, model, params: dict) -> np.ndarray:
+    """The cuts of ``take``: adapted with ``model``, else zero-shot with ``params``, which
+    may set the options of ``tried.Tried``."""
+    if model is None:
+        return detector(params)(**params).fit_predict(take).cuts
+    return adapt.detect(take, model, **params).cuts
 
 
 def short_activity_check(seeds: int = 6) -> str:
@@ -117,7 +120,7 @@ def short_activity_check(seeds: int = 6) -> str:
                 *[(name, None, params) for name, params in options.items()],
                 ("adapted", model, {})]
         for name, m, params in runs:
-            detected = adapt.detect(take, m, **params).cuts
+            detected = _detect(take, m, params)
             _, ti = metrics.match(detected, cuts, tolerance=int(take.fps))
             hit = np.zeros(len(cuts), dtype=bool)
             hit[ti] = True
@@ -176,7 +179,7 @@ def real_short_activity_check(read: list, seconds=SHORT_REAL_S) -> str:
             runs = [(name, None, params) for name, params in options.items()]
             runs += [("adapted", models[i], {})] if adapted else []
             for name, model, params in runs:
-                cuts = adapt.detect(take, model, **params).cuts
+                cuts = _detect(take, model, params)
                 ci, ti = metrics.match(cuts, truth, tolerance=int(round(take.fps)))
                 hit = set(ti.tolist())
                 row = found[name][duration]
@@ -338,7 +341,7 @@ def tempo_check(read: list, speeds=TEMPO_SPEEDS) -> str:
             played, truth = (take, t.truth) if speed == 1.0 else \
                 variants.played_at(take, t.truth, speed)
             for setting, params in settings:
-                cuts = Default(**params).fit_predict(played).cuts
+                cuts = Tried(**params).fit_predict(played).cuts
                 rows[(setting, speed)] = metrics.evaluate(cuts, truth, fps=take.fps)
     head = "".join(f"{f'x{s:g}: F1@1s':>14}{'edits':>7}{'err s':>7}" for s in speeds)
     lines = [f"tempo: each labelled take played at {' / '.join(f'{s:g}' for s in speeds)} "

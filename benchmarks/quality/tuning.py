@@ -23,8 +23,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from benchmarks.quality.tried import Tried, detector
 from motionlib import metrics
-from motionlib.segmenters.default import Default, place_stages, shipped_stage
+from motionlib.segmenters.default import shipped_stage
 
 # The options the defaults are chosen from. Windows: (shortest, longest) in seconds.
 GRID = {
@@ -37,10 +38,8 @@ GRID = {
     "support": (0.0, 0.25, 0.5, 1.0),
 }
 
-# Options scored out of sample beside GRID but not shipped (``segmenters.default`` says
-# why each is not: the short-activity options lower the leave-one-take-out score; tempo
-# raises it on the takes as recorded but is a knife edge that gives up short activities).
-# Each setting's shipped value, the ``default`` segmenter's default, stays an option.
+# Options of ``tried.Tried`` scored out of sample beside GRID but not shipped
+# (``docs/detector/`` says why each is not). Each setting's default, off, stays an option.
 TRIED = {
     "short_activity": (4.0, 8.0),
     "short_uniformity": (0.2, 0.3),
@@ -50,7 +49,7 @@ TRIED = {
 
 def tried_grid() -> dict:
     """:data:`GRID` with each :data:`TRIED` setting's shipped value and tried options."""
-    return {**GRID, **{key: (Default.params[key].default, *values)
+    return {**GRID, **{key: (Tried.params[key].default, *values)
                        for key, values in TRIED.items()}}
 
 
@@ -94,26 +93,25 @@ class TakeCache:
 
     def analysis(self, p: dict):
         windows = (p["scale_min_s"], p["scale_max_s"], p["bandwidth"], p["rate_hz"],
-                   p["velocity_s"], p["tempo"])
+                   p["velocity_s"], p.get("tempo", False))
         if windows not in self.analyses:
-            self.analyses[windows] = Default.analyse(self.take, p)
+            self.analyses[windows] = detector(p).analyse(self.take, p)
         return self.analyses[windows]
 
     def cuts(self, params: dict) -> np.ndarray:
         """The default detector's cuts with ``params`` (0-based take frames)."""
-        p = Default.validate_params(params)
+        method = detector(params)
+        p = method.validate_params(params)
         a = self.analysis(p)
         if a is None:
             return np.zeros(0, dtype=np.int64)
-        p = a.params(p)
         chosen = (id(a), *sorted((k, v) for k, v in p.items() if k not in PLACEMENT_ONLY))
         if chosen not in self.peaks:
-            self.peaks[chosen] = Default.choose_peaks(a, p)[0]
-        peaks = self.peaks[chosen]
-        key = (id(a), p["refine_s"], tuple(peaks))
+            self.peaks[chosen] = method.peaks(a, p)
+        found = self.peaks[chosen]
+        key = (id(a), p["refine_s"], tuple(found.samples))
         if key not in self.placed:
-            self.placed[key] = place_stages(a.x, a.peak_frames(peaks), a.fps, a.gamma, p,
-                                            a.speeds)[0]
+            self.placed[key] = method.place(a, found, p).stages
         return self.placed[key][shipped_stage(p)] + a.first
 
     def score(self, params: dict) -> dict:
@@ -154,8 +152,11 @@ class Selection:
 
     def shipped(self) -> Selection:
         """The choices of the shipped grid (:data:`GRID`) inside one made from
-        :func:`tried_grid`: each :data:`TRIED` setting at its shipped value."""
-        return self.subset(**{key: Default.params[key].default for key in TRIED})
+        :func:`tried_grid`: each :data:`TRIED` setting at its default (off), left out of
+        the choice, so that it is a setting of the shipped detector."""
+        shipped = self.subset(**{key: Tried.params[key].default for key in TRIED})
+        choices = [{k: v for k, v in ch.items() if k not in TRIED} for ch in shipped.choices]
+        return Selection(choices, shipped.cache, shipped.rows)
 
     def subset(self, **fixed) -> Selection:
         """The choices whose settings equal ``fixed`` (e.g. the shipped grid inside
@@ -210,8 +211,8 @@ def _value(choice: dict, key: str):
     """A choice's value of a setting of the grid (the shipped value if it sets none)."""
     if key == "windows":
         return (choice["scale_min_s"], choice["scale_max_s"])
-    return choice[key] if key in choice or key not in Default.params \
-        else Default.params[key].default
+    return choice[key] if key in choice or key not in Tried.params \
+        else Tried.params[key].default
 
 
 def out_of_sample(selection: Selection, grid: dict | None = None) -> list[tuple[str, object,

@@ -24,6 +24,29 @@ UNMATCHED_INNER_S = (1.5, 1.8, 2.2, 2.5, 3.0)
 UNMATCHED_THROUGHOUT_S = (2.5, 3.0, 4.0, 5.0)
 
 
+class ShippedWindows(Default):
+    """The default detector whose windows' peaks are those of the shipped settings
+    (the support test spares the short activities the shipped step finds) whatever
+    ``short_unmatched`` is: only the unmatched-poses step itself varies."""
+
+    @classmethod
+    def window_peaks(cls, analysis, p: dict) -> tuple[np.ndarray, np.ndarray]:
+        shipped = Default.params["short_unmatched"].default
+        return super().window_peaks(analysis, {**p, "short_unmatched": shipped})
+
+
+def half_width(half_s: float) -> type[Default]:
+    """``ShippedWindows`` with the unmatched-poses step's two cuts ``half_s`` either side
+    of its stretch's middle."""
+    return type(f"HalfWidth{half_s:g}", (ShippedWindows,), {"unmatched_half_s": half_s})
+
+
+class Unguarded(Default):
+    """The default detector without the unmatched-poses step's take-median guard."""
+
+    unmatched_relative = 0.0
+
+
 def unmatched_choice_check(read: list) -> str:
     """How the unmatched-poses step's settings (``segmenters.default`` step 4c) are
     chosen, and how that choice scores on takes it was not chosen on.
@@ -38,14 +61,6 @@ def unmatched_choice_check(read: list) -> str:
     setting is chosen on everything else, and scored on the left-out take's material,
     beside the step off. ``read``: (labelled take, motion) pairs, as the bench read them.
     """
-    from motionlib.segmenters.default import (
-        UNMATCHED_HALF_S,
-        Default,
-        place_stages,
-        shipped_stage,
-        unmatched_peaks,
-    )
-
     skeletons = skeleton_takes(read)
     if not skeletons:
         return "unmatched-poses step: no full-skeleton take to choose its settings on"
@@ -59,8 +74,9 @@ def unmatched_choice_check(read: list) -> str:
         for seconds in UNMATCHED_THROUGHOUT_S:
             material.append((t.name, "all cut down",
                              *variants.shortened_throughout(take, t.truth, seconds), None))
-    settings = [(0.0, UNMATCHED_HALF_S)] + [(level, half) for level in UNMATCHED_LEVELS
-                                            if level > 0 for half in UNMATCHED_HALVES]
+    settings = [(0.0, Default.unmatched_half_s)] + [
+        (level, half) for level in UNMATCHED_LEVELS if level > 0 for half in UNMATCHED_HALVES]
+    variants_of = {half: half_width(half) for half in {*UNMATCHED_HALVES, settings[0][1]}}
     p = Default.validate_params({})
     ratios: list[float] = []  # each firing's level / take median, without the guard
     scores = {}  # (setting, material index) -> (F1@1 s, both sides of the short one found)
@@ -68,14 +84,11 @@ def unmatched_choice_check(read: list) -> str:
         analysis = Default.analyse(take, p)
         if analysis is None:
             continue
-        peaks, strength = Default.window_peaks(analysis, p)
-        ratios += unmatched_ratios(analysis, peaks, p)
+        ratios += unmatched_ratios(analysis, p)
         for level, half in settings:
-            kept = peaks if level == 0 else unmatched_peaks(
-                analysis, peaks, strength, {**p, "short_unmatched": level}, half_s=half)[0]
-            stages, _ = place_stages(analysis.x, analysis.peak_frames(kept), analysis.fps,
-                                     analysis.gamma, p)
-            cuts = stages[shipped_stage(p)] + analysis.first
+            method = variants_of[half]
+            found = method.peaks(analysis, {**p, "short_unmatched": level})
+            cuts = Default.place(analysis, found, p).cuts + analysis.first
             _, ti = metrics.match(cuts, truth, tolerance=int(round(take.fps)))
             scores[(level, half), i] = (
                 metrics.evaluate(cuts, truth, fps=take.fps)["f1@1s"],
@@ -127,31 +140,25 @@ def unmatched_choice_check(read: list) -> str:
     best = max(settings, key=lambda s: score(s, everything))
     lines.append(f"  chosen on all: {label(best)}; shipped: short_unmatched "
                  f"{Default.params['short_unmatched'].default:g}, half-width "
-                 f"{UNMATCHED_HALF_S:g} s")
+                 f"{Default.unmatched_half_s:g} s")
     lines.append(f"  {_guard_line(ratios)}")
     return "\n".join(lines)
 
 
-def unmatched_ratios(analysis, peaks: np.ndarray, p: dict) -> list[float]:
-    """For each kept peak the unmatched-poses step (at the shipped settings) replaces
+def unmatched_ratios(analysis, p: dict) -> list[float]:
+    """For each kept peak the unmatched-poses step (at the settings ``p``) replaces
     without its take-median guard, the level of the stretch it fires on over the take's
-    median (``segmenters.default.unmatched_firings``)."""
-    from motionlib.segmenters.default import unmatched_firings
-
-    if p["short_unmatched"] <= 0:
-        return []
-    firings, median = unmatched_firings(analysis, peaks, p)
-    return [at / max(median, 1e-12) for _, at in firings.values()
-            if at >= p["short_unmatched"]]
+    median (``Peaks.unmatched`` of ``Unguarded``), in peak order."""
+    found = Unguarded.peaks(analysis, p)
+    return [found.unmatched[peak] for peak in sorted(found.unmatched)]
 
 
 def _guard_line(ratios: list[float]) -> str:
-    from motionlib.segmenters.default import UNMATCHED_RELATIVE
-
+    relative = Default.unmatched_relative
     if not ratios:
         return "take-median guard: the step fires nowhere on this material"
-    kept = sum(r >= UNMATCHED_RELATIVE for r in ratios)
-    return (f"take-median guard (stretch at least {UNMATCHED_RELATIVE:g} x the take's median "
+    kept = sum(r >= relative for r in ratios)
+    return (f"take-median guard (stretch at least {relative:g} x the take's median "
             f"as well): of the {len(ratios)} firings on this material without it, {kept} "
             f"kept; level / take median from {min(ratios):.1f} (median "
             f"{float(np.median(ratios)):.1f})")
@@ -162,11 +169,10 @@ def unmatched_guard_check(folder: Path) -> str:
     (``unlabelled_motion``): the default detector's number of cuts as shipped
     and with the step off, and, for each stretch the step would fire on without its
     take-median guard, its level over the take's median (the guard keeps it from
-    ``UNMATCHED_RELATIVE`` on). Nothing is scored (there are no labels): a take that does
+    ``Default.unmatched_relative`` on). Nothing is scored (there are no labels): a take that does
     not repeat itself (boxing, dance) is where the guard acts, and these show where it
     does."""
     import motionlib
-    from motionlib.segmenters.default import UNMATCHED_RELATIVE
 
     takes = unlabelled_motion(folder)
     if not takes:
@@ -182,9 +188,8 @@ def unmatched_guard_check(folder: Path) -> str:
         cache = tuning.TakeCache(None, take)  # one analysis for the three questions
         counts = [len(cache.cuts(params)) for params in ({}, {"short_unmatched": 0.0})]
         analysis = cache.analysis(p)
-        ratios = [] if analysis is None else unmatched_ratios(
-            analysis, Default.window_peaks(analysis, p)[0], p)
-        firings = ", ".join(f"{r:.1f}x ({'kept' if r >= UNMATCHED_RELATIVE else 'not'})"
+        ratios = [] if analysis is None else unmatched_ratios(analysis, p)
+        firings = ", ".join(f"{r:.1f}x ({'kept' if r >= Default.unmatched_relative else 'not'})"
                             for r in ratios)
         rows.append(f"  {path.stem:<10}{take.n_frames / take.fps:>7.1f}{counts[0]:>9}"
                     f"{counts[1]:>10}   {firings or '-'}")
@@ -192,7 +197,7 @@ def unmatched_guard_check(folder: Path) -> str:
         f"unmatched-poses step on the full-skeleton takes without segment labels (not "
         f"scored): cuts as shipped and with the step off; each stretch the step fires on "
         f"without its take-median guard, its level / the take's median, kept from "
-        f"{UNMATCHED_RELATIVE:g}x:",
+        f"{Default.unmatched_relative:g}x:",
         f"  {'take':<10}{'s':>7}{'shipped':>9}{'step off':>10}   firings", *rows])
 
 

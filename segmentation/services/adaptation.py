@@ -273,14 +273,12 @@ def detect(run, take):
     """(segmentation, run fields) of ``take`` for ``run``.
 
     A ``default`` run in a project with a trained model detects with its newest version
-    and records it; anything else runs the registry's segmenter as before, and so does a
-    run asking for the ``tempo`` setting, which a model (its windows learnt in seconds)
-    cannot take.
+    and records it; anything else runs the registry's segmenter as before.
     """
     segmenter = get_segmenter(run.method)
     params = segmenter.validate_params(run.params)
     newest = None
-    if run.method == "default" and not params.get("tempo"):
+    if run.method == "default":
         newest = ProjectCutModel.objects.newest(run.capture.project_id)
     model = _loaded(newest.pk, newest.version) if newest is not None else None
     if model is None:

@@ -10,6 +10,7 @@ import pytest
 from benchmarks.quality import bench, checks, data, tables, tuning, unmatched, variants
 from motionlib import adapt, metrics, synth
 from motionlib.segmenters import get_segmenter
+from motionlib.segmenters.default import Default
 from segmentation import shared_data
 
 DATA = shared_data.data_dir()
@@ -218,8 +219,6 @@ def test_the_short_takes_check_scores_zero_shot_and_adapted_on_takes_cut_down_th
 
 
 def test_the_unmatched_choice_check_leaves_out_each_skeleton_take_and_scores_it():
-    from motionlib.segmenters.default import UNMATCHED_HALF_S, Default
-
     takes = [_Labelled(1), _Labelled(2), _Labelled(3, kind="channels")]
     lines = unmatched.unmatched_choice_check(_read(takes)).splitlines()
     assert "chosen leave-one-take-out" in lines[0]
@@ -235,16 +234,16 @@ def test_the_unmatched_choice_check_leaves_out_each_skeleton_take_and_scores_it(
     assert lines[-2].startswith("  chosen on all: ")
     assert lines[-2].endswith(f"shipped: short_unmatched "
                               f"{Default.params['short_unmatched'].default:g}, half-width "
-                              f"{UNMATCHED_HALF_S:g} s")
+                              f"{Default.unmatched_half_s:g} s")
     assert lines[-1].startswith("  take-median guard")  # what the guard keeps of the firings
 
 
 def test_the_guard_line_counts_the_firings_it_keeps():
-    from motionlib.segmenters.default import UNMATCHED_RELATIVE
+    relative = Default.unmatched_relative
 
-    line = unmatched._guard_line([UNMATCHED_RELATIVE - 1, UNMATCHED_RELATIVE, 9.0])
+    line = unmatched._guard_line([relative - 1, relative, 9.0])
     assert "of the 3 firings on this material without it, 2 kept" in line
-    assert line.endswith(f"from {UNMATCHED_RELATIVE - 1:.1f} (median {UNMATCHED_RELATIVE:.1f})")
+    assert line.endswith(f"from {relative - 1:.1f} (median {relative:.1f})")
     assert unmatched._guard_line([]) == \
         "take-median guard: the step fires nowhere on this material"
 

@@ -5,6 +5,7 @@ import pytest
 
 from benchmarks.quality import bench, cli, data, tuning
 from motionlib import synth, write_bvh
+from motionlib.segmenters.default import Default
 from segmentation import shared_data
 
 SEGMENTS = "start_block,end_block,start_frame,end_frame,label_id,action_name\n"
@@ -147,7 +148,7 @@ def test_it_prints_leave_one_take_out_rows_beside_the_others(layout, capsys):
 def test_it_keeps_the_shipped_value_first_among_the_tried_options():
     grid = tuning.tried_grid()
     for key, values in tuning.TRIED.items():
-        assert grid[key][0] == tuning.Default.params[key].default
+        assert grid[key][0] == tuning.Tried.params[key].default
         assert set(values) <= set(grid[key])
     assert {k: v for k, v in grid.items() if k not in tuning.TRIED} == tuning.GRID
 
@@ -159,6 +160,16 @@ def test_it_finds_the_shipped_grid_inside_the_tried_one():
     shipped = tuning.Selection(choices, [None], rows).subset(short_activity=0.0)
     # A choice that does not set it has the shipped value.
     assert shipped.choices == [choices[0], choices[2]]
+
+
+def test_the_shipped_choices_inside_the_tried_grid_are_settings_of_the_shipped_detector():
+    choices = [{"threshold": 0.1, "short_activity": 0.0, "short_uniformity": 0.0, "tempo": False},
+               {"threshold": 0.1, "short_activity": 4.0, "short_uniformity": 0.0, "tempo": False}]
+    rows = [[{"f1@1s": 0.0, "edits_per_cut": 0.0}]] * 2
+    shipped = tuning.Selection(choices, [None], rows).shipped()
+    assert shipped.choices == [{"threshold": 0.1}]
+    assert tuning.detector(shipped.choices[0]) is Default
+    assert tuning.detector(choices[1]) is tuning.Tried
 
 
 def test_it_makes_no_leave_one_take_out_choice_for_a_take_with_no_other_capture():

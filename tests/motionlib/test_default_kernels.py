@@ -5,8 +5,8 @@ heuristic's squared distance."""
 import numpy as np
 import pytest
 
-from motionlib.segmenters import default
-from motionlib.segmenters.default import LAG_GROUP, LAG_ROWS, lag_kernel, multi_mmd_novelty
+from motionlib.segmenters.default import _features, _novelty, _placement
+from motionlib.segmenters.default._novelty import LAG_GROUP, LAG_ROWS, lag_kernel, multi_mmd_novelty
 
 
 def _samples(n, d=5, seed=0):
@@ -64,7 +64,7 @@ def test_the_median_squared_distance_is_over_the_distinct_pairs_of_the_subsample
     x = _samples(2500, d=3, seed=2)
     sub = x[::2]  # 2500 // 1000 = 2
     pairs = [((sub[i] - sub[j]) ** 2).sum() for i in range(len(sub)) for j in range(i + 1, len(sub))]
-    assert default.median_sq_distance(x) == pytest.approx(np.median(pairs), rel=1e-9)
+    assert _features.median_sq_distance(x) == pytest.approx(np.median(pairs), rel=1e-9)
 
 
 def test_the_novelty_of_one_width_is_the_same_alone_or_with_others():
@@ -72,7 +72,7 @@ def test_the_novelty_of_one_width_is_the_same_alone_or_with_others():
     [alone] = multi_mmd_novelty(x, [40], gamma)
     together = multi_mmd_novelty(x, [12, 40, 70], gamma)[1]
     np.testing.assert_allclose(alone, together, rtol=1e-12, atol=1e-14)
-    np.testing.assert_allclose(default.mmd_novelty(x, 40, gamma), alone, rtol=1e-12,
+    np.testing.assert_allclose(_novelty.mmd_novelty(x, 40, gamma), alone, rtol=1e-12,
                                atol=1e-14)
 
 
@@ -80,7 +80,7 @@ def test_the_split_gain_sums_the_kernel_inside_each_side_of_the_split():
     x, gamma = _samples(90, d=4, seed=4), 0.2
     k = np.exp(-gamma * ((x[:, None, :] - x[None, :, :]) ** 2).sum(axis=2))
     expected = [k[:t, :t].sum() / t + k[t:, t:].sum() / (90 - t) for t in range(1, 90)]
-    gains = default.split_gains(x, gamma)
+    gains = _placement.split_gains(x, gamma)
     np.testing.assert_allclose(gains, expected, rtol=1e-10)
     assert np.argmax(gains) + 1 == 45  # the regimes change half-way
 
@@ -88,7 +88,7 @@ def test_the_split_gain_sums_the_kernel_inside_each_side_of_the_split():
 def test_a_long_input_takes_its_lags_in_smaller_groups_with_the_same_novelty(monkeypatch):
     x, gamma = _samples(300, seed=5), 0.3
     whole = multi_mmd_novelty(x, [10, 25], gamma)
-    monkeypatch.setattr(default, "LAG_ELEMENTS", 300 * 7)  # 7 lags at a time
+    monkeypatch.setattr(_novelty, "LAG_ELEMENTS", 300 * 7)  # 7 lags at a time
     grouped = multi_mmd_novelty(x, [10, 25], gamma)
     for a, b in zip(whole, grouped, strict=True):
         np.testing.assert_allclose(a, b, rtol=1e-12, atol=1e-14)
@@ -98,12 +98,12 @@ def test_a_long_input_takes_its_lags_in_smaller_groups_with_the_same_novelty(mon
 def test_the_squared_distances_are_those_between_every_pair_of_rows(n, d):
     x = np.random.default_rng(n).normal(size=(n, d))
     expected = ((x[:, None, :] - x[None, :, :]) ** 2).sum(axis=2)
-    d2 = default.sq_distances(x)
+    d2 = _novelty.sq_distances(x)
     assert (d2 >= 0).all()
     np.testing.assert_allclose(d2, expected, rtol=1e-10, atol=1e-10)
 
 
 def test_products_stay_small_enough_for_one_thread():
-    assert default._small_rows(180, 180, 31) * 180 * 31 <= default.SMALL_PRODUCT
-    assert default._small_rows(10, 5, 3) == 10  # a small matrix in one product
-    assert default._small_rows(500, 100_000, 31) == 1  # never no rows at all
+    assert _novelty._small_rows(180, 180, 31) * 180 * 31 <= _novelty.SMALL_PRODUCT
+    assert _novelty._small_rows(10, 5, 3) == 10  # a small matrix in one product
+    assert _novelty._small_rows(500, 100_000, 31) == 1  # never no rows at all

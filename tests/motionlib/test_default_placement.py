@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 
 from motionlib import synth
-from motionlib.segmenters.default import Default, onset_frame
+from motionlib.segmenters.default import Default
+from motionlib.segmenters.default._placement import onset_frame
 
 FPS = 60.0
 

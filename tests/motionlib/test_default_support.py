@@ -5,13 +5,8 @@ import numpy as np
 import pytest
 
 from motionlib import adapt, metrics
-from motionlib.segmenters.default import (
-    SUPPORT_GAP_S,
-    SUPPORT_SIDE_S,
-    Analysis,
-    Default,
-    cross_support,
-)
+from motionlib.segmenters.default import Analysis, Default, candidates
+from motionlib.segmenters.default._peaks import SUPPORT_GAP_S, SUPPORT_SIDE_S, cross_support
 from tests.motionlib.conftest import labelled_takes, skeleton_takes
 
 RATE = 10.0
@@ -111,8 +106,11 @@ def test_an_adapted_count_cannot_bring_back_a_dropped_peak():
     analysis = _two_joins()
     on = Default.validate_params({})
     off = Default.validate_params({"support": 0.0})
-    assert adapt._all_peaks("zero", analysis, off, {})["zero_raw"].tolist() == [100, 200]
-    assert adapt._all_peaks("zero", analysis, on, {})["zero_raw"].tolist() == [200]
+    for p, kept in ((off, [100, 200]), (on, [200])):
+        peaks, _ = candidates(analysis, Default.peaks(analysis, p), p)
+        assert peaks.tolist() == kept
+        study = adapt._all_peaks("zero", analysis, Default.peaks(analysis, p), p, {})
+        assert study["zero_raw"].tolist() == analysis.peak_frames(kept).tolist()
 
 
 def test_the_four_channel_cuts_it_drops_are_far_from_every_true_cut():
@@ -155,6 +153,6 @@ def test_a_short_activity_between_two_alike_ones_is_kept():
     assert cross_support(x, np.array([106]), RATE, gamma=1.0)[0] < 0.5
     on = Default.validate_params({})
     assert Default.window_peaks(analysis, on)[0].tolist() == [106]
-    assert len(Default.choose_peaks(analysis, on)[0]) == 2
+    assert len(Default.peaks(analysis, on).samples) == 2
     without = Default.validate_params({"short_unmatched": 0.0})
     assert Default.window_peaks(analysis, without)[0].tolist() == []

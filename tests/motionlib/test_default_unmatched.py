@@ -7,11 +7,10 @@ import pytest
 
 from benchmarks.quality import data, tuning, variants
 from motionlib import metrics
-from motionlib.segmenters.default import (
+from motionlib.segmenters.default import Analysis, Default
+from motionlib.segmenters.default._unmatched import (
     UNMATCHED_HALF_S,
     UNMATCHED_RELATIVE,
-    Analysis,
-    Default,
     unmatched_peaks,
     unmatched_poses,
     unmatched_sides,
@@ -192,3 +191,26 @@ def test_the_take_median_guard_keeps_it_out_of_a_boxing_take():
     assert unmatched_sides(analysis, peaks, p) == {}
     np.testing.assert_array_equal(Default().fit_predict(take).cuts,
                                   Default(short_unmatched=0.0).fit_predict(take).cuts)
+
+
+def test_a_subclass_sets_the_half_width_and_the_guard_of_the_step():
+    x = np.concatenate([_cycles(10), _still(2, (4.0, 0.0)), _cycles(10, phase=1.0)])
+    analysis, p = _analysis(x), Default.validate_params({})
+    novelty = np.zeros(len(x))
+    novelty[99:110] = np.hanning(11)  # one broad peak inside the held stretch, at 104
+    analysis.novelty = novelty
+    shipped = Default.peaks(analysis, p)
+    wider = type("Wider", (Default,), {"unmatched_half_s": UNMATCHED_HALF_S + 0.5})
+    found = wider.peaks(analysis, p)
+    assert shipped.sides.keys() == found.sides.keys() == {104}
+    middle, half = np.mean(shipped.sides[104]), (UNMATCHED_HALF_S + 0.5) * RATE
+    np.testing.assert_allclose(found.sides[104], [middle - half, middle + half], atol=1)
+    assert found.samples.tolist() == list(found.sides[104])
+    # The evidence of the step: the stretch's level over the take's median, far above the
+    # guard, which a subclass can also lower (here to nothing but the level itself).
+    assert shipped.unmatched[104] > 10 * UNMATCHED_RELATIVE
+    guardless = type("Guardless", (Default,), {"unmatched_relative": 0.0})
+    line = Analysis(x=np.column_stack([np.arange(200) / RATE, np.zeros(200)]), fps=RATE,
+                    step=1, first=0, gamma=1.0, novelty=novelty[:200], timings={})
+    assert Default.peaks(line, p).sides == {}
+    assert guardless.peaks(line, p).sides.keys() == {104}

@@ -159,7 +159,7 @@ def test_it_rejects_scales_in_the_wrong_order(synth_takes):
 
 
 def test_it_moves_a_cut_to_a_nearby_pause():
-    from motionlib.segmenters.default import settle_frame
+    from motionlib.segmenters.default._placement import settle_frame
 
     speed = np.full(1000, 10.0)
     speed[530] = 1.0
@@ -167,7 +167,7 @@ def test_it_moves_a_cut_to_a_nearby_pause():
 
 
 def test_it_leaves_a_cut_where_nothing_pauses():
-    from motionlib.segmenters.default import settle_frame
+    from motionlib.segmenters.default._placement import settle_frame
 
     speed = 10.0 + np.sin(np.arange(1000) / 10.0)  # slows a little, never stops
     assert settle_frame(speed, 500, radius=60, context=300) == 500
@@ -184,7 +184,7 @@ def test_it_handles_takes_too_short_to_cut(name, n_frames, synth_takes):
 
 
 def test_it_scores_every_split_by_the_kernel_variance_it_leaves():
-    from motionlib.segmenters.default import split_gains
+    from motionlib.segmenters.default._placement import split_gains
 
     x = np.random.default_rng(0).standard_normal((23, 4))
     gamma = 0.3
@@ -202,7 +202,7 @@ def test_it_scores_every_split_by_the_kernel_variance_it_leaves():
 
 @pytest.mark.parametrize("step", [1, 4])
 def test_it_splits_two_pose_distributions_where_they_meet(step):
-    from motionlib.segmenters.default import best_split
+    from motionlib.segmenters.default._placement import best_split
 
     rng = np.random.default_rng(1)
     x = np.concatenate([rng.normal(0.0, 1.0, (400, 3)), rng.normal(1.5, 1.0, (400, 3))])
@@ -211,7 +211,7 @@ def test_it_splits_two_pose_distributions_where_they_meet(step):
 
 
 def test_it_searches_for_the_split_only_within_the_radius():
-    from motionlib.segmenters.default import best_split
+    from motionlib.segmenters.default._placement import best_split
 
     x = np.concatenate([np.zeros((100, 2)), np.ones((100, 2))])
     assert best_split(x, 150, 0, 200, step=1, radius=20, gamma=1.0) == 130
@@ -219,7 +219,7 @@ def test_it_searches_for_the_split_only_within_the_radius():
 
 
 def test_it_finds_the_turning_points_of_a_periodic_movement():
-    from motionlib.segmenters.default import turning_points
+    from motionlib.segmenters.default._placement import turning_points
 
     fps = 120.0
     t = np.arange(int(4 * fps)) / fps
@@ -229,7 +229,7 @@ def test_it_finds_the_turning_points_of_a_periodic_movement():
 
 
 def test_it_moves_a_cut_to_the_nearest_turning_point_within_reach():
-    from motionlib.segmenters.default import nearest
+    from motionlib.segmenters.default._placement import nearest
 
     points = np.array([100, 180, 260])
     assert nearest(points, 200, radius=30) == 180

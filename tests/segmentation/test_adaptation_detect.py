@@ -72,16 +72,6 @@ class DetectionWithModelTestCase(ReviewedTakesTestCase):
         self.assertEqual((run.status, run.model_version), ("ready", None), run.error)
 
 
-    def test_a_run_asking_for_the_tempo_setting_detects_without_the_model(self):
-        self.train([95])
-        capture = self.ingested(seed=96)
-        run = services.do_start_run(capture, self.alice, "default", {"tempo": True})
-        tasks.detect(run.pk)
-        run = DetectionRun.objects.get(pk=run.pk)
-        self.assertEqual((run.status, run.model_version), ("ready", None), run.error)
-        self.assertTrue(run.candidates)
-
-
 class TrainingErrorTestCase(ReviewedTakesTestCase):
     def test_a_reviewed_take_whose_stored_file_is_gone_fails_the_training_by_name(self):
         capture = self.ingested(seed=97)

@@ -14,6 +14,17 @@ class RunsTestCase(BaseTestCase):
         param = methods["bone_angle"]["params"]["param"]
         self.assertEqual((param["type"], param["default"], param["min"], param["max"]), ("float", 0.5, 0.0, 1.0))
 
+    def test_it_no_longer_lists_the_default_options_that_lost_out_of_sample(self):
+        methods = {m["name"]: m for m in self.client.get("/api/methods/").json()}
+        params = methods["default"]["params"]
+        self.assertIn("support", params)
+        self.assertFalse({"tempo", "short_activity", "short_uniformity"} & set(params))
+
+    def test_it_refuses_a_default_run_asking_for_a_removed_option_by_name(self):
+        r = self.client.post(self.url, {"method": "default", "params": {"tempo": True}}, format="json")
+        self.assertEqual(r.status_code, 400)
+        self.assertIn("unknown parameter for method 'default'", r.json()["params"]["tempo"][0])
+
     def test_it_queues_a_run_with_validated_params(self):
         r = self.client.post(self.url, {"method": "bone_angle", "params": {"param": "0.3"}}, format="json")
         self.assertEqual(r.status_code, 202)

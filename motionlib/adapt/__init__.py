@@ -3,7 +3,8 @@
 A studio's annotators have a convention: what counts as a boundary, how many there are,
 where exactly the cut goes. Given example takes with their human cuts,
 :func:`fit_cut_model` learns that convention as a :class:`CutModel`, and :func:`detect`
-runs the default detector with it.
+runs the default detector with it. It uses only the detector's public pipeline
+(``segmenters.default``: ``analyse``, ``peaks``, ``candidates``, ``place``).
 
 What is learnt, step by step (each from all examples together, never per take); every
 step starts from the zero-shot setting and leaves it only when the examples clearly say
@@ -11,125 +12,36 @@ so, because one or two reviewed takes are all a new project has:
 
 1. *Minimum segment.* The shortest human segment bounds how close two cuts may be:
    ``min_segment_s`` becomes 0.75 x the shortest example segment when that is shorter
-   than the zero-shot 1.5 s (never below 0.5 s, never longer than zero-shot).
-2. *How many cuts, and at which scale.* The novelty peaks of every example are computed
-   once, each zero-shot cut counted where the detector places it; the ``prominence`` from
-   :data:`PROMINENCE_GRID` whose peaks match the human cuts with the fewest review edits
-   the count decides (deletes and inserts, one-to-one within 1 s, summed over the
-   examples, each edit weighing the same), less a prior cost of moving away from the
-   zero-shot prominence, is kept. Prominence, not height, is what separated true from
-   false peaks out of sample (``segmenters.default``). How strong that prior is depends
-   on how many examples there are: with one or two, a fixed :data:`PROMINENCE_PRIOR`; from
-   :data:`PRIOR_CV_TAKES` on, the strength of :data:`PRIOR_OPTIONS` (from weak to "keep
-   the zero-shot prominence") that predicts each example best when the count is chosen
-   on the others (leave-one-example-take-out). So examples that agree move the count,
-   and a single example that alone wants another count (a take with unusual
-   activities) does not move it for all. When an example activity is shorter than the
-   zero-shot shortest window (3 s), the shorter windows of :data:`WINDOW_OPTIONS` are
-   scored the same way (all windows on unplaced peaks) and kept if they beat the
-   zero-shot windows by :data:`WINDOW_PRIOR`.
-3. *Where.* Each placement step of the detector (best split, turning point, pause,
-   onset; see ``segmenters.default``) is an anchor; for each, the signed offsets from the
-   zero-shot cut to the human cut it matches within 1 s, and their median as a shift. The
-   anchor and shift with the smallest median error replace the zero-shot placement only
-   when at least 6 example cuts matched and the error drops by 20 % and 0.03 s
-   (annotators who mark the onset of the next activity cut a steady time after the
-   statistical change; a handful of cuts cannot show that). Choosing the anchor instead
-   by the review edits it leaves on the examples (no shift; each of the 11 labelled
-   takes under ``shared/data`` placed by the anchor with the fewest edits summed over the
-   other takes of its label source, peaks as in ``default/loo``) raises the mean edits
-   per true cut from 0.406 to 0.436 (before the detector's support test): the
-   four-channel takes favour the best split, which does not carry from one take to the
-   next.
+   than the zero-shot one (never below 0.5 s).
+2. *How many cuts, and at which scale.* Every novelty peak of every example is computed
+   once (``candidates``; a zero-shot cut counted where the detector places it), and the
+   ``prominence`` of :data:`PROMINENCE_GRID` whose peaks match the human cuts with the
+   fewest review edits (deletes and inserts, one-to-one within 1 s; every edit weighs
+   the same in every example) is kept, less a prior cost of moving away from the
+   zero-shot prominence. The prior's strength is fixed with one or two examples and,
+   from :data:`PRIOR_CV_TAKES` on, chosen by leave-one-example-take-out, so examples that
+   agree move the count and a single odd take does not. The count is chosen by review
+   edits, not F1, because a reviewer gains from a weak candidate only when it is true
+   more often than not. When an example activity is shorter than the zero-shot shortest
+   window, the shorter windows of :data:`WINDOW_OPTIONS` compete the same way.
+3. *Where.* Each placement step of the detector is an anchor; the anchor and median
+   shift that fit the human cuts best replace the zero-shot placement only when enough
+   example cuts matched and the error drops clearly (:data:`PLACEMENT_MIN_CUTS`,
+   :data:`PLACEMENT_GAIN`): annotators who mark the onset of the next activity cut a
+   steady time after the statistical change, and a handful of cuts cannot show that.
 
 Each example take is analysed once and then dropped (only its peaks and offsets are
 kept), so a project's examples can be read one at a time. What is kept of an example, its
 *study*, can be stored (``fit_cut_model(..., studies=...)``, :class:`Example` with a key):
 refitting after one more reviewed take then reads and analyses that take only, and
-learns the same model. A study holds for the example's cuts and the detector settings it
-was made with; an example whose activity is shorter than every other one and than 2 s
-changes the minimum segment (step 1), and with it every study.
-
-Scored on the 11 labelled takes under ``shared/data`` with the other takes of the same
-label source as examples, each take's adaptation starting from the zero-shot settings
-chosen without it (``python -m motionlib bench --loo``, row ``adapted/loo``): mean
-F1@1 s 0.971 and 0.367 edits per true cut, the same as the zero-shot ``default/loo``: on
-these takes the examples confirm the zero-shot settings (before the detector's support
-test, step 4a, 0.957 and 0.406, also the same as zero-shot; the figures below were
-measured then). The count is learnt on the peaks that pass the support test: a peak it
-drops is not a candidate at any prominence. With a fixed prior of 0.05 at
-any number of examples (the earlier design) it was 0.947 and 0.421: the subject-86 takes
-taught a prominence of 0.14, pulled up by one take (86_10, where the zero-shot
-prominence gives four false cuts), and with it 86_14 lost a cut; with the strength
-chosen by leave-one-example-take-out the count stays. (Started from the settings then
-shipped, before step 4c, which were chosen on all 11 takes, the scored one too: 0.957
-and 0.386, fixed prior 0.947 and 0.401.) The leave-one-example-take-out design was made
-after the fixed prior's 0.401 was seen, so it is not a blind choice. On synthetic takes,
-where every example comes from one generator and they agree by construction, it costs a
-little: each of six seeds scored with the other five as examples, mean F1@1 s (fixed
-prior -> chosen) 0.967 -> 0.923 on seeds 0-5 with 1.5-6 s activities, 0.940 -> 0.931,
-0.984 -> 0.965 and 0.922 -> 0.937 on seeds 100-105, 200-205 and 300-305, and 0.932 ->
-0.910, 1.0 -> 1.0 and 0.991 -> 0.991 with the generator's usual 4-8 s activities;
-boundaries beside activities under 2.5 s found 32/35 -> 30/35. It is kept because a
-studio's takes are not alike the way generated ones are: a single odd reviewed take
-should not change the count for all.
-
-The count is chosen by the review edits it decides (deletes and inserts), not by F1@1 s
-as in the figures above (those of this paragraph measured before step 4c): F1 takes a
-weak peak in when it is true more often than half the F1 of the time, a reviewer gains
-from it only when it is true more often than not. On the 11 labelled takes this changes
-nothing (``adapted/loo`` 0.957 and 0.406 either way); the choice rests on the review
-cost the product exists to lower and on takes made from them by cutting activities down,
-F1@1 s / edits per true cut with F1 -> with edits: every inner activity of the
-full-skeleton takes cut down to 2.5 s (``bench_quality.short_takes_check``) 0.600/1.12
--> 0.719/0.61 (3 s and 4 s: no change); one inner activity cut down to 2.5 s 0.854/0.64
--> 0.830/0.62 (1.8 s: no change); the synthetic seeds above (60 s at 60 fps) 0.923/0.216
--> 0.929/0.205 on seeds 0-5 and 0.937/0.231 -> 0.937/0.243 on seeds 300-305, the other
-sets unchanged.
-
-On synthetic takes whose annotators cut 0.6 s after the change, or that hold activities
-of 1.5-2.5 s throughout, the adapted model follows them where the zero-shot one cannot
-(tests). A short activity between two long ones the zero-shot detector finds by itself
-(``segmenters.default`` step 4c, unmatched poses); the examples' studies count a kept peak
-that step 4c replaces by a short activity's two sides as those two sides, so the count
-is learnt on the cuts the detector really makes. With one inner activity of the
-full-skeleton takes cut down (``bench_quality.real_short_activity_check``), a model
-fitted on the other takes, as they are and shortened, finds both boundaries in 5 of 12
-cases at 1.8 s (zero-shot 5; false cuts 3 and 3) and 10 of 12 at 2.5 s (zero-shot 9),
-where it switches to 2-4 s windows at the price of false cuts (11 against 3). With every
-inner activity cut down to 2.5, 3 and 4 s, fitted on the other two takes cut down the
-same way (``bench_quality.short_takes_check``), mean F1@1 s 0.800, 0.915 and 0.822
-against zero-shot 0.896, 0.915 and 0.903: two such examples move the count (prominence
-0.071 and 0.089 instead of 0.1 on 13_29 at 2.5 s and 86_01 at 4 s), and on these takes
-the zero-shot count was right. Counted without the sides (each such peak at its own
-frame, as before step 4c) the same checks gave 10 of 12 at 2.5 s, and 0.867, 0.861 and
-0.833 all cut down: no better overall, and the synthetic check (1.5-6 s activities, each
-seed fitted on the other five) then switched windows and found 32 of 35 boundaries
-beside short activities against 27 now (zero-shot 27).
-
-Before step 4c, tried and not kept: the adapted model's cuts plus the peaks of shorter
-windows (2-4, 1.5-3 or 1-2 s) that lie more than 1 or 1.5 s from every one of them and
-whose prominence clears a level chosen on the examples by the same edits (from 0.1 to
-"none"), instead of switching windows. With every inner activity cut down to 2.5, 3 and
-4 s (each take fitted on the other two), edits per true cut 0.61, 0.61 and 0.58 as then
-shipped, 0.61-0.81, 0.61-0.74 and 0.58-0.85 with it (F1@1 s at most 0.06 higher): the
-examples choose "none" or a level whose added peaks are as often false as true.
-
-An edit weighs the same in every example: the count's fit of an example is its (human
-cuts - deletes - inserts) per human cut of an average example, not per cut of its own.
-Per cut of its own, a reviewed take of one activity (no cut) weighed each false peak in
-it like all the cuts of another take: 13_29 with its longest activity (9.2 s, where the
-detector finds one peak) as a second example moved the prominence from 0.1 to 0.25, and
-the model made 3, 1 and 4 cuts on the three full-skeleton takes instead of 5, 4 and 6
-(their true counts); now it stays at 0.1. Every table of the benchmark and the synthetic
-seeds score the same either way.
+learns the same model. How each choice was made and how it scores is recorded in
+``docs/detector/adaptation.md``.
 
 Pure numpy/scipy, no Django; the service stores ``CutModel.to_json()``.
 """
 
 from __future__ import annotations
 
-import csv
 import hashlib
 import json
 import math
@@ -137,24 +49,28 @@ import os
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass
-from pathlib import Path
 from typing import Protocol
 
 import numpy as np
 
 from motionlib import metrics
-from motionlib.errors import InputError, MotionlibError, ParamError
+from motionlib.adapt._examples import EXAMPLE_COLUMNS, ExampleError, read_examples
+from motionlib.errors import InputError
+from motionlib.segmenters import default
 from motionlib.segmenters.base import Segmentation, _checked
-from motionlib.segmenters.default import (
-    PLACEMENTS,
-    Default,
-    confidence,
-    empty_segmentation,
-    place_stages,
-    shipped_stage,
-    supported_peaks,
-    unmatched_sides,
-)
+from motionlib.segmenters.default import PLACEMENTS, Default, Peaks, shipped_stage
+
+__all__ = [
+    "EXAMPLE_COLUMNS",
+    "CutModel",
+    "Example",
+    "ExampleError",
+    "MemoryStudies",
+    "Studies",
+    "detect",
+    "fit_cut_model",
+    "read_examples",
+]
 
 FORMAT = 1
 # Fields added to format 1 after its first models were stored, with the value that keeps
@@ -168,10 +84,6 @@ MIN_SEGMENT_FACTOR = 0.75
 PLACEMENT_MIN_CUTS = 6
 PLACEMENT_GAIN = (0.2, 0.03)
 MATCH_S = 1.0
-
-
-class ExampleError(MotionlibError):
-    """An example take or its cuts cannot be learnt from; the message names it."""
 
 
 @dataclass(frozen=True)
@@ -337,7 +249,7 @@ def fit_cut_model(examples: Sequence, *, studies: Studies | None = None,
     """
     if len(examples) == 0:
         raise ExampleError("no example takes to learn from")
-    p = _untempoed(Default.validate_params(base or {}))
+    p = Default.validate_params(base or {})
     checked = [(example, _checked_cuts(example, example.cuts))
                for example in map(_as_example, examples)]
     shortest = _shortest_segment(checked)
@@ -414,17 +326,17 @@ def _study(example: Example, cuts: np.ndarray, p: dict, options, studies) -> dic
         if stored is not None and _study_names(options) <= set(stored):
             return stored
     take = example.read()
-    analysis = Default.analyse(take, p)
+    analysis = default.analyse(take, p)
     if analysis is None:
         raise ExampleError(f"{example.name}: too short to learn from "
                            f"({example.n_frames} frames)")
-    study, placed, sides = _residuals(cuts, analysis, p)
-    study.update(_all_peaks("placed", analysis, p, placed, sides))
+    study, placed, found = _residuals(cuts, analysis, p)
+    study.update(_all_peaks("placed", analysis, found, p, placed))
     others = analysis.with_windows(*options[1:]) if len(options) > 1 else []
     for windows, other in zip(options[1:], others, strict=True):
         window_p = {**p, "scale_min_s": windows[0], "scale_max_s": windows[1]}
-        sides = unmatched_sides(other, Default.window_peaks(other, window_p)[0], window_p)
-        study.update(_all_peaks(_label(windows), other, window_p, {}, sides))
+        study.update(_all_peaks(_label(windows), other, default.peaks(other, window_p),
+                                window_p, {}))
     if keep:
         studies.save(example.key, key, study)
     return study
@@ -435,18 +347,7 @@ def _window_options(zero_windows: tuple[float, float],
     """The novelty windows to score, zero-shot first.
 
     Shorter windows are tried only when an example activity is shorter than the shortest
-    zero-shot window: otherwise they only add cuts inside activities (out of sample).
-    Tried before the detector's step 4c (unmatched poses), not kept: trying them when
-    one is shorter than the longest zero-shot window. On the three full-skeleton takes
-    with every inner activity cut down to 3 s (``benchdata.shortened``), each fitted on
-    the other two, mean F1@1 s 0.795 -> 0.830 but edits per true cut 0.61 -> 0.68; at 4
-    s and on the takes as they are no change. Also tried then, not kept: from three
-    examples on, the windows chosen by how well the count chosen on the other examples
-    fits each one left out (as the prior's strength is chosen). With one inner activity
-    cut down to 2.5 s (``bench_quality``'s real short-activity check) both boundaries
-    found in 5 of 12 cases instead of 3, false cuts 12 alike; 1.8 s, the synthetic check
-    (30/35) and the takes as they are unchanged: too little for a second nested
-    leave-one-out in every refit.
+    zero-shot window: otherwise they only add cuts inside activities.
     """
     if shortest is None or shortest >= zero_windows[0]:
         return [zero_windows]
@@ -494,25 +395,20 @@ def matched_count(candidates: np.ndarray, truth: np.ndarray, tolerance: int) -> 
     return matched
 
 
-def _all_peaks(label: str, analysis, p: dict, placed: dict,
-               sides: dict | None = None) -> dict[str, np.ndarray]:
+def _all_peaks(label: str, analysis, found: Peaks, p: dict,
+               placed: dict) -> dict[str, np.ndarray]:
     """Every novelty peak of one example, as study arrays ``<label>_frames``,
     ``_prominence`` and ``_raw`` (the peak's own frame), in frame order.
 
     A peak the zero-shot detector keeps is counted where it places it (``placed``: peak
     index -> take frame), since its placement can move it by more than the tolerance
     (the onset after a pause); any other peak at its own frame. A kept peak that the
-    detector replaces by the two sides of a short activity (``sides``: peak index -> its
-    sides' indices, ``segmenters.default`` step 4c) is counted as those two, each with
-    its prominence, wherever the detector places them.
+    detector replaces by the two sides of a short activity (``found.sides``, the
+    zero-shot peaks) is counted as those two, each with its prominence, wherever the
+    detector places them.
     """
-    peaks, prominence = Default.select_peaks(analysis.novelty, analysis.rate,
-                                             {**p, "prominence": 0.0})
-    sides = sides or {}
-    # As Default.window_peaks, whatever the prominence chosen; the short activities are
-    # those the zero-shot detector finds beside its kept peaks.
-    keep = supported_peaks(analysis, peaks, p, short=sides)
-    peaks, prominence = peaks[keep], prominence[keep]
+    peaks, prominence = default.candidates(analysis, found, p)
+    sides = found.sides
     index, of = [], []  # novelty sample counted, and the peak whose prominence it has
     for i, k in enumerate(peaks.tolist()):
         for counted in sides.get(k, (k,)):
@@ -605,7 +501,7 @@ def _prior_strength(fit: np.ndarray, away: np.ndarray) -> float:
     return best
 
 
-def _residuals(cuts: np.ndarray, analysis, p: dict) -> tuple[dict, dict[int, int], dict]:
+def _residuals(cuts: np.ndarray, analysis, p: dict) -> tuple[dict, dict[int, int], Peaks]:
     """Each placement step's signed (human - placed) offsets in seconds over the
     zero-shot cuts that match a human cut within 1 s, as study arrays
     ``residual_<step>``.
@@ -613,21 +509,17 @@ def _residuals(cuts: np.ndarray, analysis, p: dict) -> tuple[dict, dict[int, int
     Returns
     -------
     the arrays; novelty peak index -> take frame where the zero-shot detector places
-    that peak; and the peaks it replaces by the two sides of a short activity (peak
-    index -> the sides' indices, ``segmenters.default.unmatched_sides``).
+    that peak; and the zero-shot peaks.
     """
-    window, _ = Default.window_peaks(analysis, p)
-    sides = unmatched_sides(analysis, window, p)
-    peaks, _ = Default.choose_peaks(analysis, p)
-    stages, _ = place_stages(analysis.x, analysis.peak_frames(peaks), analysis.fps,
-                             analysis.gamma, p)
+    found = default.peaks(analysis, p)
+    placement = default.place(analysis, found, p)
     arrays = {}
-    for name, placed in stages.items():
+    for name, placed in placement.stages.items():
         placed = placed + analysis.first
         ci, ti = metrics.match(placed, cuts, tolerance=int(round(MATCH_S * analysis.fps)))
         arrays[f"residual_{name}"] = (cuts[ti] - placed[ci]) / analysis.fps
-    zero_shot = stages[shipped_stage(p)] + analysis.first
-    return arrays, dict(zip(peaks.tolist(), zero_shot.tolist(), strict=True)), sides
+    zero_shot = placement.cuts + analysis.first
+    return arrays, dict(zip(found.samples.tolist(), zero_shot.tolist(), strict=True)), found
 
 
 def _placement(residuals: dict, zero_shot: str) -> tuple[str, float]:
@@ -650,21 +542,11 @@ def _placement(residuals: dict, zero_shot: str) -> tuple[str, float]:
 
 
 def _segment(analysis, p: dict, placement: str, offset_s: float) -> Segmentation:
-    peaks, strength = Default.choose_peaks(analysis, p)
-    stages, speed = place_stages(analysis.x, analysis.peak_frames(peaks), analysis.fps,
-                                 analysis.gamma, p)
-    cuts = stages[placement] + int(round(offset_s * analysis.fps))
-    result = analysis.segmentation(cuts, confidence(strength, p), speed)
+    found = default.peaks(analysis, p)
+    placed = default.place(analysis, found, p)
+    cuts = placed.stages[placement] + int(round(offset_s * analysis.fps))
+    result = analysis.segmentation(cuts, found.confidence(p), placed.speed)
     return _checked(result, len(analysis.x) + analysis.first)
-
-
-def _untempoed(p: dict) -> dict:
-    """``p``, refused with the ``tempo`` setting: a model's windows and offsets are
-    learnt in seconds of the examples' own pace."""
-    if p["tempo"]:
-        raise ParamError("tempo: an adapted model learns its windows in seconds and "
-                         "cannot be combined with the tempo setting")
-    return p
 
 
 def detect(take, model: CutModel | None = None, **params) -> Segmentation:
@@ -681,79 +563,13 @@ def detect(take, model: CutModel | None = None, **params) -> Segmentation:
     """
     if model is None:
         return Default(**params).fit_predict(take)
-    p = _untempoed({**Default.validate_params(params), **model.params()})
+    p = {**Default.validate_params(params), **model.params()}
     start = time.perf_counter()
-    analysis = Default.analyse(take, p)
-    result = empty_segmentation(take) if analysis is None else \
-        _segment(analysis, p, model.placement, model.offset_s)
+    analysis = default.analyse(take, p)
+    if analysis is None:  # too short to compare anything: no cuts, as the detector says
+        result = Segmentation(np.zeros(0, np.int64), np.zeros(0),
+                              {"novelty": np.zeros(take.n_frames)})
+    else:
+        result = _segment(analysis, p, model.placement, model.offset_s)
     result.timings["total"] = time.perf_counter() - start
     return result
-
-
-# --- examples CSV -----------------------------------------------------------------------
-
-EXAMPLE_COLUMNS = ("file", "asf", "cuts")
-
-
-def read_examples(path) -> list[tuple[object, np.ndarray]]:
-    """Example takes and their human cuts from a CSV with the header ``file,asf,cuts``.
-
-    ``file`` is a BVH or AMC path (relative paths from the CSV's folder), ``asf`` the ASF of
-    an AMC (empty for BVH), ``cuts`` 0-based take frames separated by spaces.
-
-    Raises
-    ------
-    ExampleError naming the CSV, the line and the value for a malformed row, an unreadable
-    take or a cut outside its take.
-    """
-    import motionlib
-
-    path = Path(path)
-    try:
-        # utf-8-sig: a spreadsheet's "CSV UTF-8" starts with a byte-order mark.
-        with open(path, newline="", encoding="utf-8-sig") as fh:
-            rows = list(csv.reader(fh))
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ExampleError(f"{path}: cannot read examples: {exc}") from None
-    header = [c.strip() for c in rows[0]] if rows else []
-    if tuple(header) != EXAMPLE_COLUMNS:
-        raise ExampleError(f"{path}:1: expected the header {','.join(EXAMPLE_COLUMNS)}, "
-                           f"got {','.join(header) or 'nothing'!r}")
-    examples = []
-    for line, row in enumerate(rows[1:], start=2):
-        if not any(cell.strip() for cell in row):
-            continue
-        if len(row) != 3:
-            raise ExampleError(f"{path}:{line}: expected 3 fields (file,asf,cuts), "
-                               f"got {len(row)}: {','.join(row)!r}")
-        file, asf, text = (cell.strip() for cell in row)
-        cuts = _parse_cuts(path, line, text)
-        if not file:
-            raise ExampleError(f"{path}:{line}: file is empty")
-        take_path = path.parent / file
-        asf_path = path.parent / asf if asf else None
-        try:
-            take = motionlib.read(take_path, asf=asf_path)
-        except (ValueError, OSError) as exc:
-            first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-            raise ExampleError(f"{path}:{line}: cannot read {file}: {first}") from None
-        for cut in cuts:
-            if not 0 < cut < take.n_frames:
-                raise ExampleError(f"{path}:{line}: cut {cut} is outside {file} "
-                                   f"({take.n_frames} frames; 1 to {take.n_frames - 1} can "
-                                   f"start a segment)")
-        examples.append((take, np.asarray(cuts, dtype=np.int64)))
-    if not examples:
-        raise ExampleError(f"{path}: no example takes")
-    return examples
-
-
-def _parse_cuts(path: Path, line: int, text: str) -> list[int]:
-    cuts = []
-    for word in text.split():
-        try:
-            cuts.append(int(word))
-        except ValueError:
-            raise ExampleError(f"{path}:{line}: cut {word!r} is not a whole frame "
-                               f"number") from None
-    return cuts

@@ -1,19 +1,22 @@
-"""The default detector's optional tempo setting and the bench's slower/quicker takes."""
+"""The tempo option tried and not shipped (``tried.Tried``) and the bench's slower and
+quicker takes."""
 
 import numpy as np
 import pytest
 
 from benchmarks.quality import variants
-from motionlib import synth
-from motionlib.errors import InputError
-from motionlib.segmenters.default import (
+from benchmarks.quality.tried import (
     TEMPO_REFERENCE_S,
     TEMPO_SCALE,
-    Default,
+    PacedAnalysis,
+    Tried,
     movement_period,
+    paced,
     scaled_times,
-    take_features,
 )
+from motionlib import adapt, synth
+from motionlib.errors import InputError, ParamError
+from motionlib.segmenters.default import Default, take_features
 
 FPS = 60.0
 
@@ -65,24 +68,26 @@ def test_a_take_too_short_or_without_repetition_has_no_cycle_and_keeps_its_setti
     assert movement_period(x[: int(3 * FPS)], FPS) is None  # shorter than the longest lag
     still = np.repeat(x[:1], int(20 * FPS), axis=0)
     assert movement_period(still, FPS) is None  # nothing moves away and comes back
-    analysis = Default.analyse(take.slice(0, int(3 * FPS)),
-                               Default.validate_params({"tempo": True}))
+    analysis = Tried.analyse(take.slice(0, int(3 * FPS)),
+                             Tried.validate_params({"tempo": True}))
     assert analysis.tempo == 1.0
 
 
 def test_tempo_scales_the_time_settings_by_the_takes_cycle_within_bounds():
     take, _ = _take()
-    p = Default.validate_params({"tempo": True})
-    analysis = Default.analyse(take, p)
+    p = Tried.validate_params({"tempo": True})
+    analysis = Tried.analyse(take, p)
     x, _ = take_features(take)
     expected = np.clip(movement_period(x, FPS) / TEMPO_REFERENCE_S, *TEMPO_SCALE)
     assert analysis.tempo == pytest.approx(expected)
-    scaled = analysis.params(p)
+    scaled = paced(analysis, p)
     for key in ("scale_min_s", "scale_max_s", "min_segment_s", "refine_s"):
         assert scaled[key] == pytest.approx(p[key] * analysis.tempo)
     assert scaled["threshold"] == p["threshold"]
     # Off, nothing is scaled.
-    assert Default.analyse(take, Default.validate_params({})).tempo == 1.0
+    off = Tried.validate_params({})
+    assert not isinstance(Tried.analyse(take, off), PacedAnalysis)
+    assert paced(Tried.analyse(take, off), off) == off
 
 
 def test_scaled_settings_stay_within_their_bounds():
@@ -92,15 +97,20 @@ def test_scaled_settings_stay_within_their_bounds():
     assert out["scale_min_s"] <= out["scale_max_s"]
 
 
+def test_with_tempo_it_cuts_as_the_windows_scaled_by_the_cycle_would():
+    take, _ = _take()
+    p = Tried.validate_params({"tempo": True})
+    scale = Tried.analyse(take, p).tempo
+    assert scale != 1.0
+    with_tempo = Tried(tempo=True).fit_predict(take)
+    by_hand = Default(**{k: v for k, v in scaled_times(p, scale).items() if k in Default.params})
+    np.testing.assert_array_equal(with_tempo.cuts, by_hand.fit_predict(take).cuts)
 
-def test_an_adapted_model_refuses_the_tempo_setting():
-    from motionlib import adapt
-    from motionlib.errors import ParamError
 
+def test_the_shipped_detector_and_adaptation_refuse_the_tempo_setting_by_name():
     take, segments = _take()
     truth = np.asarray([start for start, _, _ in segments[1:]])
-    with pytest.raises(ParamError, match="tempo: an adapted model learns its windows"):
+    with pytest.raises(ParamError, match="tempo: unknown parameter for method 'default'"):
+        Default(tempo=True).fit_predict(take)
+    with pytest.raises(ParamError, match="tempo: unknown parameter for method 'default'"):
         adapt.fit_cut_model([(take, truth)], base={"tempo": True})
-    model = adapt.fit_cut_model([(take, truth)])
-    with pytest.raises(ParamError, match="tempo"):
-        adapt.detect(take, model, tempo=True)
