@@ -126,7 +126,7 @@ class IngestTestCase(BaseTestCase):
         capture_id = self.upload(BVH_13_29.read_bytes(), name="13_29.bvh").json()["id"]
         # A file where the derived-arrays folder should be: saving positions fails.
         (self.media_root / "derived").write_text("not a folder")
-        with self.assertLogs("segmentation.services.captures", "ERROR"):
+        with self.assertLogs("segmentation.services.jobs", "ERROR"):
             capture = self.ingest(capture_id)
         self.assertEqual(capture.status, "failed")
         self.assertIn("Ingest failed with an internal error", capture.error)
