@@ -2,7 +2,6 @@ from django.urls import path
 from drf_spectacular.views import SpectacularAPIView, SpectacularSwaggerSplitView
 from rest_framework.routers import SimpleRouter
 
-from cutroom.accounts import api as accounts_api
 from segmentation.api import assignments, invitations, library, reviews, team
 from segmentation.api.captures import CaptureViewSet
 from segmentation.api.projects import MethodsView, MeView, ProjectViewSet
@@ -13,7 +12,6 @@ router.register("captures", CaptureViewSet, basename="capture")
 
 review = "captures/<int:pk>/review/"
 urlpatterns = [
-    *accounts_api.urlpatterns,
     path("me/", MeView.as_view(), name="api-me"),
     path("methods/", MethodsView.as_view(), name="api-methods"),
     path("schema/", SpectacularAPIView.as_view(), name="api-schema"),
