@@ -117,7 +117,7 @@ def guard(kind, job, work=None):
     except (MotionlibError, CutroomError) as exc:
         job.fail(_bounded(model.input_error.format(error=exc)), permanent=True)
     except Exception:
-        reference = internal_error(f"{kind.what} of {model._meta.model_name} {job.pk}", log)
+        reference = internal_error(f"{kind.what} of {model._meta.verbose_name} {job.pk}", log)
         usable_connection()
         job.fail(model.crashed_error.format(what=kind.what, reference=reference))
     finally:

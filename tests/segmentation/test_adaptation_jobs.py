@@ -232,6 +232,7 @@ class TimeLimitTrainingTestCase(AdaptationTestCase):
         self.assertTrue(job.error.startswith(
             "Training stopped after its time limit of 600 s (CUTROOM_RETRAIN_TIME_LIMIT)"), job.error)
         self.assertIn("not retried", job.error)
+        self.assertTrue(job.error_permanent)  # the same examples would take as long again
         self.assertIsNotNone(job.finished_at)
         self.assertEqual(len(sends), 1)
         self.assertEqual(ProjectCutModel.objects.get(pk=self.waiting.pk).status, "queued")

@@ -55,6 +55,7 @@ class ClaimsTestCase(BaseTestCase):
         self.assertEqual(capture.status, "failed")
         self.assertIn("started 3 times and never finished", capture.error)
         self.assertIn("original upload is kept", capture.error)
+        self.assertFalse(capture.error_permanent)
         self.assertTrue(capture.original.storage.exists(capture.original.name))
 
 
