@@ -73,7 +73,7 @@ def run_query(user, query, repeat, pagination=None):
     from django.test.utils import CaptureQueriesContext
     from rest_framework.test import APIRequestFactory, force_authenticate
 
-    from segmentation.api.library import SegmentListView
+    from segmentation.api.segments import SegmentListView
 
     view = SegmentListView.as_view(**({"pagination_class": pagination} if pagination else {}))
     factory = APIRequestFactory()

@@ -102,7 +102,7 @@ CPU = []
 def call_view(user, pk):
     from rest_framework.test import APIRequestFactory, force_authenticate
 
-    from segmentation.api.library import SimilarView
+    from segmentation.api.similar import SimilarView
 
     request = APIRequestFactory().get(f"/api/segments/{pk}/similar/?k=10")
     force_authenticate(request, user=user)

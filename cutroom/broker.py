@@ -244,6 +244,12 @@ class Transport(virtual.Transport):
     def driver_version(self):
         return sqlite3.sqlite_version
 
+    @staticmethod
+    def release_all(path):
+        """See ``release_all``: reached through kombu's transport registry by those that
+        know the broker by its URL only (``manage.py sweep_claims --release-broker``)."""
+        return release_all(path)
+
 
 def statistics(path):
     """Per queue: messages sent, acknowledged, and still waiting (reserved or not)."""

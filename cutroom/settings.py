@@ -322,7 +322,7 @@ SPECTACULAR_SETTINGS = {
         "RoleEnum": "segmentation.models.ROLES",
         "ReviewStateEnum": "segmentation.api.serializers.REVIEW_STATES",
         "QueueStateEnum": "segmentation.api.assignments.QUEUE_STATES",
-        "CaptureStateEnum": "segmentation.api.library.CAPTURE_STATES",
+        "CaptureStateEnum": "segmentation.api.dashboard.CAPTURE_STATES",
     },
 }
 

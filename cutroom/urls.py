@@ -8,6 +8,7 @@ from segmentation import views
 urlpatterns = [
     path("admin/login/", throttled_sign_in(admin.site.login)),
     path("admin/", admin.site.urls),
+    path("api/", include("cutroom.accounts.api")),
     path("api/", include("segmentation.api.urls")),
     path("login/", throttled_sign_in(auth_views.LoginView.as_view()), name="login"),
     path("logout/", views.logout_view, name="logout"),

@@ -66,21 +66,21 @@ class CaptureAdmin(admin.ModelAdmin):
     list_display = ("name", "project", "format", "status", "n_frames", "fps", "created_at")
     list_filter = ("status", "format", "project")
     search_fields = ("name", "checksum")
-    readonly_fields = ("checksum", "claim_token", "claimed_at", "attempts")
+    readonly_fields = ("checksum", "error_permanent", "claim_token", "claimed_at", "attempts")
 
 
 @admin.register(ProjectCutModel)
 class ProjectCutModelAdmin(admin.ModelAdmin):
     list_display = ("id", "project", "version", "status", "n_takes", "n_cuts", "created_at", "finished_at")
     list_filter = ("status", "project")
-    readonly_fields = ("claim_token", "claimed_at", "attempts")
+    readonly_fields = ("error_permanent", "claim_token", "claimed_at", "attempts")
 
 
 @admin.register(DetectionRun)
 class DetectionRunAdmin(admin.ModelAdmin):
     list_display = ("id", "capture", "method", "status", "created_at", "finished_at")
     list_filter = ("status", "method")
-    readonly_fields = ("claim_token", "claimed_at", "attempts")
+    readonly_fields = ("error_permanent", "claim_token", "claimed_at", "attempts")
 
 
 class CutInline(admin.TabularInline):

@@ -56,8 +56,8 @@ from django.db import connections, transaction
 
 from motionlib import similarity
 from motionlib.vector_index import IvfIndex
+from segmentation import workers
 from segmentation.models import LibrarySegment
-from segmentation.services import jobs
 
 log = logging.getLogger(__name__)
 
@@ -257,7 +257,7 @@ def schedule_update(project_id):
     """Queue ``update`` for when the current transaction commits (a worker must see the
     rows). A broker that cannot be reached costs freshness of the file only: searches
     read newer segments from the database."""
-    transaction.on_commit(lambda: jobs.send(
+    transaction.on_commit(lambda: workers.send(
         "update_similar_index", project_id, then="searches read the newer segments from the database"))
 
 

@@ -31,11 +31,10 @@ from django.db.models import Count, F, Max, Q
 from django.utils import timezone
 
 from motionlib import similarity
-from segmentation import storage
+from segmentation import storage, workers
 from segmentation.descriptors import capture_joints, load_descriptors, profile_pool
 from segmentation.models import Capture, LabelSuggestion, LibrarySegment, Review, SuggestionRequest
 from segmentation.search import SHORTLIST, SIMILAR_POOL
-from segmentation.services import jobs
 
 log = logging.getLogger(__name__)
 
@@ -128,7 +127,7 @@ def ask(capture, annotator):
 
 
 def _send(capture_id, annotator_id):
-    jobs.send("suggest", capture_id, annotator_id,
+    workers.send("suggest", capture_id, annotator_id,
               then="the next look at the page asks again once the request counts as lost")
 
 

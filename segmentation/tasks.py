@@ -1,9 +1,13 @@
-"""Background jobs. Like views: they take ids, claim the row, and call the services.
+"""Background jobs. Like views: they take ids and hand the job to the job runner
+(``services.jobs``), which claims the row, guards the work and closes the row.
 
 A job message may arrive twice (two workers, a redelivery after a worker died); the
 conditional claim on the row makes the second delivery a no-op unless the first one was
 abandoned. Failures are stored on the row (``status="failed"``, ``error``), never only
 logged.
+
+This module is where the app meets Celery: importing it (the app does when it is ready)
+connects ``segmentation.workers`` to the broker.
 """
 
 import logging
@@ -11,79 +15,66 @@ import threading
 import time
 import uuid
 
-from celery import Task, shared_task
-from celery.exceptions import TimeLimitExceeded
+from celery import Task, current_app, shared_task
+from celery.exceptions import SoftTimeLimitExceeded, TimeLimitExceeded
 from celery.signals import worker_init, worker_process_init, worker_ready
 from django.conf import settings
 from django.db import connection
 
-from segmentation import services, similar_index, suggestions
-from segmentation.models import Capture, DetectionRun, ProjectCutModel
-from segmentation.services import adaptation, jobs
-from segmentation.services.convert import convert_capture
+from segmentation import similar_index, suggestions, workers
+from segmentation.services import adaptation, captures, jobs
+from segmentation.services.convert import CONVERT
 
 log = logging.getLogger(__name__)
 
 
+def send(task_name, args, options):
+    """Send task ``segmentation.tasks.<task_name>`` by name (the sender need not import it)."""
+    current_app.send_task(f"segmentation.tasks.{task_name}", args=args, **options)
+
+
+workers.connect(send, stopped=SoftTimeLimitExceeded)
+
+
 class JobTask(Task):
-    """A task that works on one job row, the first argument: ``job_model``, named
-    ``job_name`` in messages, under the time limit of setting ``limit_setting``.
+    """A task that runs one job of ``kind`` (``services.jobs.Kind``), the row whose id is
+    its first argument.
 
     Celery kills the process of a job still running at its hard time limit (it did not
     stop at the soft one). That is deterministic for the same input, so the job fails at
     once, naming the limit, instead of being retried until CUTROOM_MAX_ATTEMPTS.
     """
 
-    job_model, job_name, limit_setting = None, "", ""
+    kind = None
+
+    def run_job(self, pk):
+        jobs.run(self.kind, pk, self.request.id or uuid.uuid4().hex)
 
     def on_failure(self, exc, task_id, args, kwargs, einfo):
         # Called in the worker's main process (the pool process is gone).
-        if not isinstance(exc, TimeLimitExceeded) or self.job_model is None:
+        if not isinstance(exc, TimeLimitExceeded) or self.kind is None:
             return
         try:
-            self.fail_at_time_limit(args[0], task_id)
+            jobs.fail_at_time_limit(self.kind, args[0], task_id)
         except Exception:  # the claim goes stale and the sweep takes over, as before
             log.exception("could not fail %s %s after its time limit", self.name, args[0])
         finally:
             connection.close()
 
-    def fail_at_time_limit(self, pk, token):
-        """Fail job ``pk`` if the task's claim ``token`` still holds it."""
-        jobs.fail_at_time_limit(self.job_model, pk, token, self.job_name, self.limit_setting)
-
-
-class TrainingTask(JobTask):
-    """A cut-model training: killed at its hard time limit, it fails at once as other jobs
-    do, and the training that waited behind it is started, as when a training ends."""
-
-    job_model = ProjectCutModel
-
-    def fail_at_time_limit(self, pk, token):
-        adaptation.fail_at_time_limit(pk, token)
-
-
-def _claim(model, pk, task):
-    """The claimed row, or None if another worker has it or it is already done."""
-    return jobs.claim(model, pk, task.request.id or uuid.uuid4().hex)
-
 
 @shared_task(bind=True, acks_late=True, reject_on_worker_lost=True, base=JobTask,
-             job_model=Capture, job_name="Ingest", limit_setting="CUTROOM_INGEST_TIME_LIMIT")
+             kind=captures.INGEST)
 def ingest(self, capture_id):
     """Parse a capture, store its metadata and positions, then queue default detection."""
-    capture = _claim(Capture, capture_id, self)
-    if capture is not None:
-        services.ingest_capture(capture)
+    self.run_job(capture_id)
 
 
 @shared_task(bind=True, acks_late=True, reject_on_worker_lost=True,
-             time_limit=settings.CUTROOM_CONVERT_TIME_LIMIT, base=JobTask, job_model=Capture,
-             job_name="Conversion", limit_setting="CUTROOM_CONVERT_TIME_LIMIT")
+             time_limit=settings.CUTROOM_CONVERT_TIME_LIMIT, base=JobTask,
+             kind=CONVERT)
 def convert(self, capture_id):
     """Read an FBX capture with Blender (convert queue), then queue each animation's ingest."""
-    capture = _claim(Capture, capture_id, self)
-    if capture is not None:
-        convert_capture(capture)
+    self.run_job(capture_id)
 
 
 @worker_process_init.connect
@@ -108,23 +99,19 @@ def _warm_blender():
 
 
 @shared_task(bind=True, acks_late=True, reject_on_worker_lost=True, base=JobTask,
-             job_model=DetectionRun, job_name="Detection",
-             limit_setting="CUTROOM_DETECT_TIME_LIMIT")
+             kind=captures.DETECT)
 def detect(self, run_id):
     """Compute a run's candidate cuts."""
-    run = _claim(DetectionRun, run_id, self)
-    if run is not None:
-        services.detect_run(run)
+    self.run_job(run_id)
 
 
-@shared_task(bind=True, acks_late=True, reject_on_worker_lost=True, base=TrainingTask)
+@shared_task(bind=True, acks_late=True, reject_on_worker_lost=True, base=JobTask,
+             kind=adaptation.RETRAIN)
 def retrain(self, model_id):
     """Train a project's cut model from its reviewed takes (one at a time per project:
     the claim fails while another training of the project runs, which starts this one
     when it ends)."""
-    job = adaptation.claim_training(model_id, self.request.id or uuid.uuid4().hex)
-    if job is not None:
-        adaptation.train_project_model(job)
+    self.run_job(model_id)
 
 
 @shared_task(acks_late=True, reject_on_worker_lost=True)
@@ -143,7 +130,7 @@ def update_similar_index(project_id):
 @shared_task
 def sweep():
     """Requeue (or fail) jobs whose claim went stale because their worker vanished."""
-    return services.sweep_stale_claims() + adaptation.sweep_stale_trainings()
+    return jobs.sweep()
 
 
 @worker_init.connect
@@ -168,5 +155,4 @@ def apply_time_limits(**kwargs):
 @worker_ready.connect
 def sweep_on_start(**kwargs):
     # A restarted worker first picks up whatever a killed worker left behind.
-    services.sweep_stale_claims()
-    adaptation.sweep_stale_trainings()
+    jobs.sweep()

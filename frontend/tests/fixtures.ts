@@ -9,7 +9,6 @@ export function review(cuts: Cut[] = [cut(1, 200), cut(2, 500), cut(3, 800)]): R
   return {
     id: 7, capture: 3, annotator: { id: 1, username: "ann" }, run: 1, status: "in_progress", version: 4,
     return_comment: "",
-    adaptation: { model_version: null, n_takes: null, project_model: null, training: false, training_error: null },
     cuts,
     segments: [
       { index: 0, start: 0, stop: 200, label: "walk" },

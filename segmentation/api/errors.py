@@ -23,7 +23,7 @@ from rest_framework.response import Response
 from rest_framework.views import exception_handler as drf_exception_handler
 
 from motionlib.errors import MotionlibError, ParamError
-from segmentation.api.library import StaleGoldSerializer, gold_body
+from segmentation.api.adjudication import StaleGoldSerializer, gold_body
 from segmentation.api.serializers import ReviewSerializer
 from segmentation.errors import (
     CutroomError,

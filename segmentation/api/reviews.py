@@ -15,36 +15,45 @@ from segmentation.api.serializers import (
     EventSerializer,
     InsertCutSerializer,
     LabelSegmentSerializer,
+    ReviewPageSerializer,
     ReviewSerializer,
     SuggestionsSerializer,
     VersionSerializer,
 )
 from segmentation.services.adaptation import adaptation_summary
-from segmentation.services.reviews import reload
+from segmentation.services.reviews import catch_up, started_review
 
 
 class OwnReviewView(APIView):
     """Base: the caller's own review of capture ``pk`` (a write starts it on first use)."""
 
+    # An edit's answer is the review as the edit left it, without the adaptation summary
+    # of the review page (GET): no edit changes it, and it costs four queries.
+
     def review(self, pk):
-        return services.get_or_create_review(capture_for(self.request.user, pk), self.request.user)
+        review = started_review(self.request.user, pk)
+        if review is None:
+            return services.get_or_create_review(capture_for(self.request.user, pk), self.request.user)
+        catch_up(review)
+        return review
 
     def reply(self, review, status=200):
-        reload(review)
+        # The services keep ``review`` as the database has it after their write.
         return Response(ReviewSerializer(review).data, status=status)
 
 
 class ReviewView(OwnReviewView):
-    @extend_schema(responses=ReviewSerializer)
+    @extend_schema(responses=ReviewPageSerializer)
     def get(self, request, pk):
-        """The caller's review; before they start one, the review they would start
-        (``id`` null; its cuts have no ids yet), which is not stored: reading never writes.
-        A write based on it sends version 1, the version the review starts at."""
+        """The caller's review, with what the review page says about adaptation; before
+        they start one, the review they would start (``id`` null; its cuts have no ids
+        yet), which is not stored: reading never writes. A write based on it sends
+        version 1, the version the review starts at."""
         capture = capture_for(request.user, pk)
         review = services.own_review(capture, request.user)
         if review is None:
             return Response(unstarted_review(capture, request.user))
-        return Response(ReviewSerializer(review).data)
+        return Response(ReviewPageSerializer(review).data)
 
     @extend_schema(request=None, responses=ReviewSerializer)
     def post(self, request, pk):

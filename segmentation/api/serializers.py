@@ -14,6 +14,7 @@ from segmentation.models import (
     Review,
     ReviewEvent,
 )
+from segmentation.services.adaptation import adaptation_summary
 
 
 class UserRefSerializer(serializers.Serializer):
@@ -340,28 +341,20 @@ REVIEW_STATES = [*Review.STATUSES, ("not_started", "Not started")]
 
 
 class ReviewSerializer(serializers.ModelSerializer):
+    """A review as its edits answer it: its cuts and segments."""
+
     # null, and status not_started: the review the caller would start (GET …/review/).
     id = serializers.IntegerField(read_only=True, allow_null=True)
     status = serializers.ChoiceField(choices=REVIEW_STATES, read_only=True)
     annotator = serializers.SerializerMethodField()
     cuts = serializers.SerializerMethodField()
     segments = serializers.SerializerMethodField()
-    adaptation = serializers.SerializerMethodField()
 
     class Meta:
         model = Review
         fields = [
             "id", "capture", "annotator", "run", "status", "version", "return_comment", "cuts", "segments",
-            "adaptation",
         ]
-
-    @extend_schema_field(AdaptationSerializer)
-    def get_adaptation(self, review):
-        """Which project model the review's candidates came from (model_version null:
-        the zero-shot detector), the project's newest model and its last failed training."""
-        from segmentation.services.adaptation import adaptation_summary
-
-        return adaptation_summary(review.run, review.capture.project_id)
 
     @extend_schema_field(UserRefSerializer)
     def get_annotator(self, review):
@@ -369,17 +362,43 @@ class ReviewSerializer(serializers.ModelSerializer):
 
     @extend_schema_field(CutSerializer(many=True))
     def get_cuts(self, review):
+        return self._cuts(review)
+
+    def _cuts(self, review):
+        """The review's cuts in frame order, read once for its cuts and its segments."""
+        cached = getattr(self, "_cuts_of", None)
+        if cached is not None and cached[0] is review:
+            return cached[1]
         # Plain values, not a nested serializer per cut: a one-hour take has thousands.
         fields = list(CutSerializer().fields)
-        return [dict(zip(fields, row, strict=True))
+        cuts = [dict(zip(fields, row, strict=True))
                 for row in review.cuts.order_by("frame", "id").values_list(*fields)]
+        self._cuts_of = (review, cuts)
+        return cuts
 
     @extend_schema_field(ReviewSegmentSerializer(many=True))
     def get_segments(self, review):
         # Label suggestions are not part of a review: they are computed by a worker and
         # read from …/review/suggestions/ (segmentation.suggestions).
+        kept = [(cut["id"], cut["frame"]) for cut in self._cuts(review) if cut["fate"] != "deleted"]
         return [{"index": index, "start": start, "stop": stop, "label": label}
-                for index, start, stop, label in review.segments()]
+                for index, start, stop, label in review.segments(kept)]
+
+
+class ReviewPageSerializer(ReviewSerializer):
+    """A review as the review page opens it (GET): also where its candidates came from
+    and the state of the project's learnt model."""
+
+    adaptation = serializers.SerializerMethodField()
+
+    class Meta(ReviewSerializer.Meta):
+        fields = [*ReviewSerializer.Meta.fields, "adaptation"]
+
+    @extend_schema_field(AdaptationSerializer)
+    def get_adaptation(self, review):
+        """Which project model the review's candidates came from (model_version null:
+        the zero-shot detector), the project's newest model and its last failed training."""
+        return adaptation_summary(review.run, review.capture.project_id)
 
 
 class SuggestionSerializer(serializers.Serializer):

@@ -2,8 +2,17 @@ from django.urls import path
 from drf_spectacular.views import SpectacularAPIView, SpectacularSwaggerSplitView
 from rest_framework.routers import SimpleRouter
 
-from cutroom.accounts import api as accounts_api
-from segmentation.api import assignments, invitations, library, reviews, team
+from segmentation.api import (
+    adjudication,
+    agreement,
+    assignments,
+    dashboard,
+    invitations,
+    reviews,
+    segments,
+    similar,
+    team,
+)
 from segmentation.api.captures import CaptureViewSet
 from segmentation.api.projects import MethodsView, MeView, ProjectViewSet
 
@@ -13,7 +22,6 @@ router.register("captures", CaptureViewSet, basename="capture")
 
 review = "captures/<int:pk>/review/"
 urlpatterns = [
-    *accounts_api.urlpatterns,
     path("me/", MeView.as_view(), name="api-me"),
     path("methods/", MethodsView.as_view(), name="api-methods"),
     path("schema/", SpectacularAPIView.as_view(), name="api-schema"),
@@ -27,7 +35,11 @@ urlpatterns = [
     path(review + "events/", reviews.EventsView.as_view(), name="api-review-events"),
     path(review + "suggestions/", reviews.SuggestionsView.as_view(), name="api-review-suggestions"),
     path("captures/<int:pk>/reviews/", reviews.AllReviewsView.as_view(), name="api-reviews"),
-    *library.urlpatterns,
+    *segments.urlpatterns,
+    *similar.urlpatterns,
+    *agreement.urlpatterns,
+    *adjudication.urlpatterns,
+    *dashboard.urlpatterns,
     *invitations.urlpatterns,
     *assignments.urlpatterns,
     *team.urlpatterns,

@@ -138,6 +138,7 @@ class DetectionRun(Job):
     model_n_takes = models.PositiveIntegerField(null=True, blank=True)
 
     objects = ClaimQuerySet.as_manager()
+    task = "detect"
 
     class Meta:
         ordering = ["-created_at", "-id"]

@@ -72,27 +72,72 @@ class JSONArrayLength(models.Func):
 
 
 class Job(models.Model):
-    """State shared by the two kinds of background work (ingest, detect)."""
+    """State shared by every kind of background work (ingest, conversion, detection,
+    training): who holds the claim, how often it was claimed, and how it ended.
+
+    A failed job keeps its ``error`` and whether it is ``error_permanent``: the input's
+    fault (a bad file, a time limit the same input would reach again), so running it again
+    as it is fails the same way; a job that failed for another reason (an internal error,
+    workers lost) may succeed if it is retried.
+
+    The ``*_error`` templates are the texts a failed job of this model stores; the job
+    runner (``services.jobs``) fills them in.
+    """
 
     status = models.CharField(max_length=20, choices=JOB_STATUSES, default="queued")
     error = models.TextField(blank=True)
+    error_permanent = models.BooleanField(default=False)
     claim_token = models.CharField(max_length=64, blank=True)
     # Time of the last claim, or of the last requeue while queued.
     claimed_at = models.DateTimeField(null=True, blank=True)
     attempts = models.PositiveIntegerField(default=0)
 
+    # The task of ``segmentation.tasks`` that does this job (see ``first_job``).
+    task = ""
+    input_error = "{error}"
+    stopped_error = (
+        "{what} took too long and was stopped (time limits: ingest with its default "
+        "detection {settings.CUTROOM_INGEST_TIME_LIMIT} s, CUTROOM_INGEST_TIME_LIMIT; "
+        "detection {settings.CUTROOM_DETECT_TIME_LIMIT} s, CUTROOM_DETECT_TIME_LIMIT). "
+        "Try parameters that cost less, or ask the administrators to raise the limit."
+    )
+    killed_error = (
+        "{killed} The same input would run as long again, so it is not retried; try "
+        "parameters that cost less, or ask the administrators to raise the limit. The "
+        "original upload is kept."
+    )
+    crashed_error = (
+        "{what} failed with an internal error (reference {reference}). The original "
+        "upload is kept; report this reference to the service's administrators."
+    )
+    abandoned_error = (
+        "processing started {attempts} times and never finished (the worker was killed "
+        "or lost each time); giving up. The original upload is kept."
+    )
+
     class Meta:
         abstract = True
 
+    def first_job(self):
+        """The name of the task that starts (or restarts) this job."""
+        return self.task
+
+    def queued_behind(self):
+        """The queued job that cannot start before this one ends, or None."""
+        return None
+
     def finish(self, **fields):
         """Store the result, but only if this job's claim still holds."""
-        return self._close("ready", "", fields)
+        return self._close("ready", "", False, fields)
 
-    def fail(self, error, **fields):
-        return self._close("failed", error, fields)
+    def fail(self, error, permanent=False, **fields):
+        """Store why the job failed, but only if this job's claim still holds."""
+        return self._close("failed", error, permanent, fields)
 
-    def _close(self, status, error, fields):
-        fields.update(status=status, error=error)
+    def _close(self, status, error, permanent, fields):
+        fields.update(status=status, error=error, error_permanent=permanent)
+        if any(f.name == "finished_at" for f in self._meta.fields):
+            fields.setdefault("finished_at", timezone.now())
         updated = (
             type(self)
             .objects.filter(pk=self.pk, status="processing", claim_token=self.claim_token)

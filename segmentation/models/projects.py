@@ -192,6 +192,25 @@ class ProjectCutModel(Job):
     finished_at = models.DateTimeField(null=True, blank=True)
 
     objects = CutModelQuerySet.as_manager()
+    task = "retrain"
+    input_error = "training: {error}"
+    stopped_error = (
+        "Training took too long and was stopped (time limit "
+        "{settings.CUTROOM_RETRAIN_TIME_LIMIT} s, CUTROOM_RETRAIN_TIME_LIMIT); ask the "
+        "administrators to raise the limit."
+    )
+    killed_error = (
+        "{killed} The same examples would take as long again, so it is not retried; ask "
+        "the administrators to raise the limit."
+    )
+    crashed_error = (
+        "training failed with an internal error (reference {reference}); report this "
+        "reference to the service's administrators"
+    )
+    abandoned_error = (
+        "training started {attempts} times and never finished (the worker was killed or "
+        "lost); the project keeps its previous model"
+    )
 
     class Meta:
         ordering = ["-created_at", "-id"]
@@ -202,6 +221,15 @@ class ProjectCutModel(Job):
                 fields=["project"], condition=Q(status="queued"), name="one_queued_training"
             ),
         ]
+
+    def queued_behind(self):
+        """The project's queued training: one training at a time per project, so it
+        waits for this one to end."""
+        return (
+            ProjectCutModel.objects.filter(project_id=self.project_id, status="queued")
+            .exclude(pk=self.pk)
+            .first()
+        )
 
     def __str__(self):
         return f"cut model v{self.version} of {self.project}" if self.version else (

@@ -51,13 +51,14 @@ class Review(models.Model):
         one-hour take has thousands of cuts, and every edit asks."""
         return list(self.cuts.exclude(fate="deleted").order_by("frame", "id").values_list("id", "frame"))
 
-    def segments(self):
+    def segments(self, kept=None):
         """Intervals between kept cuts: list of (index, start, stop, label name or None).
 
         A segment's label is stored against the cut that starts it (no cut for the
-        first segment), so labels follow their cut when it is moved.
+        first segment), so labels follow their cut when it is moved. ``kept`` is
+        ``kept_frames()`` when the caller has read it already.
         """
-        kept = self.kept_frames()
+        kept = self.kept_frames() if kept is None else kept
         labels = dict(self.segment_labels.filter(label__isnull=False).values_list("cut_id", "label__name"))
         starts = [(None, 0)] + kept
         stops = [frame for _, frame in kept] + [self.capture.n_frames or 0]

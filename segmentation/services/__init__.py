@@ -1,7 +1,9 @@
 """Workflows of the service, one module per noun.
 
 ``do_*`` functions run under ``transaction.atomic`` and enqueue background work only
-once their transaction commits, so a worker never sees a row that is not there yet.
+once their transaction commits, so a worker never sees a row that is not there yet. Every
+kind of job (ingest, conversion, detection, training) runs through ``services.jobs``; all
+of them are registered once this package is imported.
 """
 
 from segmentation.services.captures import (
@@ -13,13 +15,13 @@ from segmentation.services.captures import (
     do_upload_capture,
     ingest_capture,
 )
+from segmentation.services.convert import convert_capture
 from segmentation.services.invitations import (
     do_accept_invitation,
     do_add_member,
     do_cancel_invitation,
     do_decline_invitation,
 )
-from segmentation.services.jobs import sweep_stale_claims
 from segmentation.services.projects import (
     do_add_label,
     do_create_project,
@@ -37,6 +39,7 @@ from segmentation.services.reviews import (
 
 __all__ = [
     "default_method",
+    "convert_capture",
     "detect_run",
     "do_accept_invitation",
     "do_add_label",
@@ -57,5 +60,4 @@ __all__ = [
     "get_or_create_review",
     "ingest_capture",
     "own_review",
-    "sweep_stale_claims",
 ]

@@ -20,7 +20,6 @@ import functools
 import logging
 import time
 
-from celery.exceptions import SoftTimeLimitExceeded
 from django.conf import settings
 from django.db import IntegrityError, transaction
 from django.db.models import Max
@@ -29,10 +28,10 @@ from django.utils import timezone
 from motionlib.errors import MotionlibError
 from motionlib.segmenters import get_segmenter
 from segmentation import takecache
-from segmentation.errors import CutroomError, Invalid, internal_error
+from segmentation.errors import CutroomError, Invalid
 from segmentation.models import Capture, ProjectCutModel, Review
 from segmentation.services import jobs
-from segmentation.services.jobs import heartbeat
+from segmentation.services.jobs import Kind, register
 from segmentation.storage import read_take
 
 log = logging.getLogger(__name__)
@@ -65,17 +64,11 @@ def request_training(project_id):
     try:
         with transaction.atomic():
             job = ProjectCutModel.objects.create(project_id=project_id)
-            transaction.on_commit(
-                lambda: _send_training(job.pk, countdown=settings.CUTROOM_RETRAIN_DELAY)
-            )
+            # The row stays queued if the broker is down; the sweep sends it again later.
+            jobs.enqueue("retrain", job.pk, countdown=settings.CUTROOM_RETRAIN_DELAY)
     except IntegrityError:
         return None  # a concurrent request queued it (one queued training per project)
     return job
-
-
-def _send_training(pk, countdown=0):
-    # The row stays queued if the broker is down; the sweep sends it again later.
-    jobs.send("retrain", pk, countdown=countdown)
 
 
 # ---- training ----------------------------------------------------------------------------
@@ -133,76 +126,10 @@ def example(capture, cuts):
     )
 
 
-def claim_training(pk, token):
-    """The claimed training row, or None when it is not its turn (another training of
-    the project runs), another worker has it, or it is done. A training that was
-    started too often without finishing (it keeps killing its worker) fails instead."""
-    if not ProjectCutModel.objects.claim(pk, token):
-        return None
-    job = ProjectCutModel.objects.get(pk=pk)
-    if job.attempts > settings.CUTROOM_MAX_ATTEMPTS:
-        _give_up(job)
-        return None
-    return job
-
-
-def _give_up(job):
-    failed = job.fail(
-        f"training started {job.attempts} times and never finished (the worker was killed or "
-        "lost); the project keeps its previous model",
-        finished_at=timezone.now(),
-    )
-    _start_waiting(job.project_id)
-    return failed
-
-
-def fail_at_time_limit(pk, token):
-    """Fail the training whose process was killed at its hard time limit (it did not stop
-    at the soft one), if it still holds the claim ``token``, then start the training that
-    waited behind it. Returns whether it was failed.
-
-    Unlike a training whose process died for another reason, it is not retried: the same
-    examples would take as long again. The project keeps its previous model.
-    """
-    job = ProjectCutModel.objects.filter(pk=pk, status="processing", claim_token=token).first()
-    if job is None:
-        return False
-    failed = job.fail(
-        f"{jobs.killed_at_time_limit('Training', 'CUTROOM_RETRAIN_TIME_LIMIT')} The same "
-        "examples would take as long again, so it is not retried; ask the administrators to "
-        "raise the limit.",
-        finished_at=timezone.now(),
-    )
-    _start_waiting(job.project_id)
-    return failed
-
-
 def train_project_model(job):
     """Train a claimed ProjectCutModel row from the project's current examples, store it
     as the next version (or the reason it failed), then start the training that waited."""
-    try:
-        with heartbeat(job):  # a training outlives the claim timeout; a dead one must not
-            _train(job)
-    except SoftTimeLimitExceeded:
-        jobs.usable_connection()
-        job.fail(
-            "Training took too long and was stopped (time limit "
-            f"{settings.CUTROOM_RETRAIN_TIME_LIMIT} s, CUTROOM_RETRAIN_TIME_LIMIT); ask the "
-            "administrators to raise the limit.",
-            finished_at=timezone.now(),
-        )
-    except (MotionlibError, CutroomError) as exc:
-        job.fail(f"training: {exc}", finished_at=timezone.now())
-    except Exception:
-        reference = internal_error(f"training of project {job.project_id}", log)
-        jobs.usable_connection()
-        job.fail(
-            f"training failed with an internal error (reference {reference}); "
-            "report this reference to the service's administrators",
-            finished_at=timezone.now(),
-        )
-    finally:
-        _start_waiting(job.project_id)
+    jobs.guard(RETRAIN, job)
 
 
 def _train(job):
@@ -228,42 +155,7 @@ def _train(job):
         )
 
 
-def _start_waiting(project_id):
-    """Send the project's queued training now: its own message may have found this one
-    running and been dropped (one training at a time per project)."""
-    waiting = ProjectCutModel.objects.filter(project_id=project_id, status="queued").first()
-    if waiting is not None:
-        transaction.on_commit(lambda: _send_training(waiting.pk))
-
-
-def sweep_stale_trainings():
-    """Requeue trainings whose worker vanished (or fail them when a newer one waits or
-    they were tried too often) and resend queued trainings whose message may be lost.
-
-    Returns the number of trainings requeued, failed or resent.
-    """
-    count = 0
-    for job in ProjectCutModel.objects.stale():
-        waiting = ProjectCutModel.objects.filter(project_id=job.project_id, status="queued")
-        if job.attempts >= settings.CUTROOM_MAX_ATTEMPTS or waiting.exists():
-            count += _give_up(job)
-            continue
-        try:
-            with transaction.atomic():
-                requeued = ProjectCutModel.objects.filter(
-                    pk=job.pk, status="processing", claim_token=job.claim_token
-                ).update(status="queued", claim_token="", claimed_at=timezone.now())
-                if requeued:
-                    transaction.on_commit(functools.partial(_send_training, job.pk))
-                count += requeued
-        except IntegrityError:
-            continue  # a request queued another training meanwhile; the next sweep fails this one
-    for job in ProjectCutModel.objects.waiting_too_long():
-        with transaction.atomic():
-            ProjectCutModel.objects.filter(pk=job.pk, status="queued").update(claimed_at=timezone.now())
-            transaction.on_commit(functools.partial(_send_training, job.pk))
-        count += 1
-    return count
+RETRAIN = register(Kind("retrain", ProjectCutModel, "Training", _train, "CUTROOM_RETRAIN_TIME_LIMIT"))
 
 
 # ---- detecting with the project's model --------------------------------------------------

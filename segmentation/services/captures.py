@@ -1,5 +1,5 @@
-"""Captures and detection runs: upload, ingest, detect (recovery of abandoned jobs is
-``services.jobs``)."""
+"""Captures and detection runs: upload, ingest, detect (the jobs' lifecycle, from claim to
+close, is ``services.jobs``)."""
 
 import hashlib
 import logging
@@ -8,26 +8,18 @@ import re
 import uuid
 
 import numpy as np
-from celery.exceptions import SoftTimeLimitExceeded
 from django.conf import settings
 from django.db import IntegrityError, transaction
 from django.utils import timezone
 
 import motionlib
-from motionlib.errors import MotionlibError, shorten
+from motionlib.errors import shorten
 from motionlib.segmenters import ParamError, get_segmenter, list_segmenters
 from segmentation import storage
-from segmentation.errors import (
-    CutroomError,
-    NotReady,
-    ReviewStarted,
-    UploadError,
-    UploadTooLarge,
-    internal_error,
-)
+from segmentation.errors import NotReady, ReviewStarted, UploadError, UploadTooLarge
 from segmentation.models import Capture, DetectionRun, Project
 from segmentation.services import adaptation, jobs, quotas
-from segmentation.services.jobs import enqueue
+from segmentation.services.jobs import Kind, enqueue, register
 from segmentation.services.reviews import do_take_in_candidates
 from segmentation.storage import read_take
 
@@ -169,49 +161,12 @@ def do_start_run(capture, user, method, params):
     return run
 
 
-def _guarded(job, what, work, **fail_fields):
-    """Run ``work()``; any error fails the job, so a job never stays "processing" because
-    of its input or a bug.
-
-    A domain error (motionlib's, naming file, line and value, or the service's own) is the
-    input's fault and its message is stored as it is; anything else is ours: it is logged
-    with its traceback and the job stores an internal error with a reference to quote.
-    """
-    try:
-        with jobs.heartbeat(job):
-            work()
-    except SoftTimeLimitExceeded:
-        jobs.usable_connection()
-        job.fail(
-            f"{what} took too long and was stopped (time limits: ingest with its default "
-            f"detection {settings.CUTROOM_INGEST_TIME_LIMIT} s, CUTROOM_INGEST_TIME_LIMIT; "
-            f"detection {settings.CUTROOM_DETECT_TIME_LIMIT} s, CUTROOM_DETECT_TIME_LIMIT). "
-            "Try parameters that cost less, or ask the administrators to raise the limit.",
-            **fail_fields,
-        )
-    except (MotionlibError, CutroomError) as exc:
-        job.fail(_bounded(str(exc), 2000), **fail_fields)
-    except Exception:
-        reference = internal_error(what, log)
-        jobs.usable_connection()
-        job.fail(
-            f"{what} failed with an internal error (reference {reference}). The original "
-            "upload is kept; report this reference to the service's administrators.",
-            **fail_fields,
-        )
-
-
-def _bounded(text, limit):
-    """An error text for a job's row, cut to about ``limit`` characters."""
-    return text if len(text) <= limit else text[:limit] + "..."
-
-
 def ingest_capture(capture):
     """Parse a claimed capture, store its metadata and positions, start default detection.
 
     A bad file marks the capture failed with motionlib's message (file, line, value).
     """
-    _guarded(capture, "Ingest", lambda: _ingest(capture))
+    jobs.guard(INGEST, capture)
 
 
 def _ingest(capture):
@@ -235,9 +190,7 @@ def _detect_here(run, take):
     reading the file again and a trip through the queue), unless a worker claimed the run
     first. The queued message stays as the fallback: if this process dies the claim goes
     stale and the sweep requeues the run; otherwise its delivery finds the run claimed."""
-    if DetectionRun.objects.claim(run.pk, uuid.uuid4().hex):
-        run.refresh_from_db()
-        _guarded(run, "Detection", lambda: _detect(run, take), finished_at=timezone.now())
+    jobs.run(DETECT, run.pk, uuid.uuid4().hex, work=lambda run: _detect(run, take))
 
 
 def _metadata(take, height):
@@ -277,7 +230,7 @@ def _start_default_run(capture):
 
 def detect_run(run):
     """Run a claimed detection and store candidates, signals and timings on the row."""
-    _guarded(run, "Detection", lambda: _detect(run), finished_at=timezone.now())
+    jobs.guard(DETECT, run)
 
 
 def _detect(run, take=None):
@@ -328,3 +281,7 @@ def do_redetect(capture, user):
         if capture.runs.filter(status__in=("queued", "processing")).exists():
             raise NotReady(f"capture {capture.pk} already has a detection queued or running")
         return do_start_run(capture, user, project.default_method, project.default_params)
+
+
+INGEST = register(Kind("ingest", Capture, "Ingest", _ingest, "CUTROOM_INGEST_TIME_LIMIT"))
+DETECT = register(Kind("detect", DetectionRun, "Detection", _detect, "CUTROOM_DETECT_TIME_LIMIT"))

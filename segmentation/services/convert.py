@@ -16,8 +16,8 @@ from motionlib.io.fbx import read_fbx_all
 from motionlib.io.npz import take_bytes
 from segmentation import storage
 from segmentation.models import Capture
-from segmentation.services.captures import _guarded
-from segmentation.services.jobs import enqueue
+from segmentation.services import jobs
+from segmentation.services.jobs import Kind, enqueue, register
 
 log = logging.getLogger(__name__)
 
@@ -28,7 +28,7 @@ def convert_capture(capture):
     A file Blender cannot read (no armature, no animation, damaged, Blender crashing or
     hanging on it) marks the capture failed with a reason a person can act on.
     """
-    _guarded(capture, "Conversion", lambda: _convert(capture))
+    jobs.guard(CONVERT, capture)
 
 
 def _convert(capture):
@@ -78,3 +78,8 @@ def add_animation(capture, take):
             enqueue("ingest", sibling.pk)
     except IntegrityError:
         log.info("animation %s of capture %s already added", take.animation, capture.pk)
+
+
+# FBX conversion runs Blender: its own queue, served by its own worker.
+CONVERT = register(Kind("convert", Capture, "Conversion", _convert, "CUTROOM_CONVERT_TIME_LIMIT",
+                        queue="CUTROOM_CONVERT_QUEUE"))

@@ -9,8 +9,7 @@ from django.utils import timezone
 
 from segmentation.models import Capture, DetectionRun
 from segmentation.models.jobs import claim_cutoff
-from segmentation.services.adaptation import sweep_stale_trainings
-from segmentation.services.jobs import sweep_stale_claims
+from segmentation.services import jobs
 
 JOBS = (Capture, DetectionRun)
 
@@ -22,7 +21,7 @@ def look(concurrency):
 
     Returns (jobs requeued, failed or resent; why the workers look stuck, or None).
     """
-    swept = sweep_stale_claims() + sweep_stale_trainings()
+    swept = jobs.sweep()
     return swept, stalled(concurrency)
 
 

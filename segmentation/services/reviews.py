@@ -11,7 +11,7 @@ from django.db.models import F
 from django.utils import timezone
 
 from segmentation.errors import Invalid, NotReady, ReviewClosed, StaleVersion
-from segmentation.models import Cut, Review, ReviewEvent, SegmentLabel
+from segmentation.models import Capture, Cut, Review, ReviewEvent, SegmentLabel
 from segmentation.services.adaptation import on_examples_changed
 from segmentation.services.assignments import check_may_start
 from segmentation.services.library import on_review_submitted
@@ -41,6 +41,19 @@ def reload(review):
     review.refresh_from_db(fields=["run", "status", "version", "updated_at", "submitted_at"])
 
 
+def started_review(user, capture_id):
+    """The user's review of a capture of one of their projects, read with its capture in
+    one query (every edit asks), or None if they have not started one."""
+    review = (
+        Review.objects.select_related("capture")
+        .filter(capture_id=capture_id, annotator=user, capture__in=Capture.objects.visible_to(user))
+        .first()
+    )
+    if review is not None:
+        review.annotator = user
+    return review
+
+
 def get_or_create_review(capture, user):
     """The user's review of a capture, started from the latest finished run if new.
 
@@ -48,7 +61,7 @@ def get_or_create_review(capture, user):
     """
     review = own_review(capture, user)
     if review:
-        _catch_up(review)
+        catch_up(review)
         return review
     try:
         with transaction.atomic():
@@ -77,7 +90,7 @@ def _add_candidates(review, candidates, taken=()):
     )
 
 
-def _catch_up(review):
+def catch_up(review):
     """A review started before detection finished, whose run has finished since but
     missed the hand-over (``do_take_in_candidates``; e.g. both committed at once), takes
     the candidates in before the write. Its version goes up, so the write itself is
@@ -122,9 +135,14 @@ def do_take_in_candidates(run):
 
 def _write(review, version):
     """Claim the next version of ``review`` or raise StaleVersion / ReviewClosed."""
+    now = timezone.now()
     updated = Review.objects.filter(pk=review.pk, version=version, status__in=Review.EDITABLE).update(
-        version=F("version") + 1, updated_at=timezone.now()
+        version=F("version") + 1, updated_at=now
     )
+    if updated and review.version == version:
+        # Every write moves the version on: the row is as this object read it, one on.
+        review.version, review.updated_at = version + 1, now
+        return
     reload(review)
     if updated:
         return

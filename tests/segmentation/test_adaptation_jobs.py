@@ -7,7 +7,7 @@ from django.utils import timezone
 
 from segmentation import tasks
 from segmentation.models import ProjectCutModel
-from segmentation.services import adaptation, gold
+from segmentation.services import adaptation, gold, jobs
 from tests.segmentation.base import BaseTestCase
 
 
@@ -196,14 +196,14 @@ class StaleTrainingTestCase(AdaptationTestCase):
 
     def test_the_sweep_requeues_a_training_whose_worker_vanished(self):
         with self.captureOnCommitCallbacks() as sends:
-            self.assertEqual(adaptation.sweep_stale_trainings(), 1)
+            self.assertEqual(jobs.sweep(), 1)
         self.assertEqual(ProjectCutModel.objects.get(pk=self.job.pk).status, "queued")
         self.assertEqual(len(sends), 1)
 
     def test_it_fails_it_instead_when_a_newer_training_waits(self):
         waiting = adaptation.request_training(self.project.pk)
         with self.captureOnCommitCallbacks() as sends:
-            adaptation.sweep_stale_trainings()
+            jobs.sweep()
         job = ProjectCutModel.objects.get(pk=self.job.pk)
         self.assertEqual(job.status, "failed")
         self.assertIn("keeps its previous model", job.error)
@@ -226,18 +226,19 @@ class TimeLimitTrainingTestCase(AdaptationTestCase):
 
     def test_it_fails_at_once_naming_the_limit_and_sends_the_one_that_waited(self):
         with self.captureOnCommitCallbacks() as sends:
-            self.assertTrue(adaptation.fail_at_time_limit(self.running.pk, "worker-1"))
+            self.assertTrue(jobs.fail_at_time_limit(adaptation.RETRAIN, self.running.pk, "worker-1"))
         job = ProjectCutModel.objects.get(pk=self.running.pk)
         self.assertEqual((job.status, job.version, job.attempts), ("failed", None, 1))
         self.assertTrue(job.error.startswith(
             "Training stopped after its time limit of 600 s (CUTROOM_RETRAIN_TIME_LIMIT)"), job.error)
         self.assertIn("not retried", job.error)
+        self.assertTrue(job.error_permanent)  # the same examples would take as long again
         self.assertIsNotNone(job.finished_at)
         self.assertEqual(len(sends), 1)
         self.assertEqual(ProjectCutModel.objects.get(pk=self.waiting.pk).status, "queued")
 
     def test_the_project_keeps_its_model_and_the_review_page_says_why(self):
-        adaptation.fail_at_time_limit(self.running.pk, "worker-1")
+        jobs.fail_at_time_limit(adaptation.RETRAIN, self.running.pk, "worker-1")
         self.assertEqual(ProjectCutModel.objects.newest(self.project.pk), self.v1)
         self.login(self.bob)
         adapted = self.client.get(f"/api/captures/{self.capture.pk}/review/").json()["adaptation"]
@@ -247,7 +248,7 @@ class TimeLimitTrainingTestCase(AdaptationTestCase):
     def test_it_leaves_alone_a_training_another_claim_holds(self):
         ProjectCutModel.objects.filter(pk=self.running.pk).update(claim_token="worker-2")
         with self.captureOnCommitCallbacks() as sends:
-            self.assertFalse(adaptation.fail_at_time_limit(self.running.pk, "worker-1"))
+            self.assertFalse(jobs.fail_at_time_limit(adaptation.RETRAIN, self.running.pk, "worker-1"))
         self.assertEqual(ProjectCutModel.objects.get(pk=self.running.pk).status, "processing")
         self.assertEqual(sends, [])
 

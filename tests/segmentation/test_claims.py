@@ -4,8 +4,9 @@ from django.core.management import call_command
 from django.test import override_settings
 from django.utils import timezone
 
-from segmentation import services, tasks
+from segmentation import tasks
 from segmentation.models import Capture, DetectionRun
+from segmentation.services import jobs
 from tests.segmentation.base import BaseTestCase
 
 
@@ -54,6 +55,7 @@ class ClaimsTestCase(BaseTestCase):
         self.assertEqual(capture.status, "failed")
         self.assertIn("started 3 times and never finished", capture.error)
         self.assertIn("original upload is kept", capture.error)
+        self.assertFalse(capture.error_permanent)
         self.assertTrue(capture.original.storage.exists(capture.original.name))
 
 
@@ -69,13 +71,13 @@ class SweepTestCase(BaseTestCase):
 
     def test_it_requeues_a_job_whose_worker_vanished(self):
         with self.captureOnCommitCallbacks() as callbacks:
-            self.assertEqual(services.sweep_stale_claims(), 1)
+            self.assertEqual(jobs.sweep(), 1)
         self.assertEqual(DetectionRun.objects.get(pk=self.run.pk).status, "queued")
         self.assertEqual(len(callbacks), 1)
 
     @override_settings(CUTROOM_MAX_ATTEMPTS=1)
     def test_it_fails_a_stale_job_that_used_up_its_attempts(self):
-        services.sweep_stale_claims()
+        jobs.sweep()
         run = DetectionRun.objects.get(pk=self.run.pk)
         self.assertEqual(run.status, "failed")
         self.assertIn("never finished", run.error)
@@ -83,7 +85,7 @@ class SweepTestCase(BaseTestCase):
 
     def test_it_leaves_a_fresh_claim_alone(self):
         DetectionRun.objects.filter(pk=self.run.pk).update(claimed_at=timezone.now())
-        self.assertEqual(services.sweep_stale_claims(), 0)
+        self.assertEqual(jobs.sweep(), 0)
         self.assertEqual(DetectionRun.objects.get(pk=self.run.pk).status, "processing")
 
 
@@ -106,9 +108,9 @@ class LostMessageTestCase(BaseTestCase):
 
     def test_the_sweep_sends_it_again_once(self):
         with self.captureOnCommitCallbacks() as first:
-            services.sweep_stale_claims()
+            jobs.sweep()
         with self.captureOnCommitCallbacks() as second:
-            services.sweep_stale_claims()
+            jobs.sweep()
         self.assertEqual((len(first), len(second)), (1, 0))
 
     def test_an_unreachable_broker_does_not_fail_the_upload(self):
@@ -126,7 +128,7 @@ class LostMessageTestCase(BaseTestCase):
         reset_connections()
         app.conf.update(unreachable)
         self.login(self.bob)
-        with self.assertLogs("segmentation.services.jobs", "ERROR") as logs:
+        with self.assertLogs("segmentation.workers", "ERROR") as logs:
             with self.captureOnCommitCallbacks(execute=True):
                 r = self.upload(b"HIERARCHY\n", name="offline.bvh")
         self.assertEqual(r.status_code, 201)

@@ -24,7 +24,7 @@ class JobGuardTestCase(BaseTestCase):
     def test_it_stores_a_bare_value_error_in_detection_as_an_internal_error_with_a_reference(self):
         numpy_bug = ValueError("operands could not be broadcast together with shapes (3,) (4,)")
         with mock.patch.object(adaptation, "detect", side_effect=numpy_bug), \
-                self.assertLogs("segmentation.services.captures", "ERROR") as logs:
+                self.assertLogs("segmentation.services.jobs", "ERROR") as logs:
             capture = self.ingest(self.upload(synthetic_bvh(), name="take.bvh").json()["id"])
         run = DetectionRun.objects.get(capture=capture)
         self.assertEqual(run.status, "failed")

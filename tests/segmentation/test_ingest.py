@@ -70,6 +70,10 @@ class IngestTestCase(BaseTestCase):
         self.assertEqual(capture.status, "failed")
         self.assertTrue(capture.error)
 
+    def test_a_file_at_fault_fails_it_with_a_permanent_error(self):
+        capture = self.ingest(self.upload(b"HIERARCHY\nROOT", name="broken.bvh").json()["id"])
+        self.assertEqual((capture.status, capture.error_permanent), ("failed", True))
+
     def test_a_failed_capture_leaves_earlier_captures_untouched(self):
         good = self.ingest(self.upload(BVH_13_29.read_bytes(), name="13_29.bvh").json()["id"])
         self.ingest(self.upload(b"HIERARCHY\nROOT", name="broken.bvh").json()["id"])
@@ -126,8 +130,9 @@ class IngestTestCase(BaseTestCase):
         capture_id = self.upload(BVH_13_29.read_bytes(), name="13_29.bvh").json()["id"]
         # A file where the derived-arrays folder should be: saving positions fails.
         (self.media_root / "derived").write_text("not a folder")
-        with self.assertLogs("segmentation.services.captures", "ERROR"):
+        with self.assertLogs("segmentation.services.jobs", "ERROR"):
             capture = self.ingest(capture_id)
         self.assertEqual(capture.status, "failed")
         self.assertIn("Ingest failed with an internal error", capture.error)
+        self.assertFalse(capture.error_permanent)  # retrying once storage works may succeed
         self.assertTrue(capture.original.storage.exists(capture.original.name))

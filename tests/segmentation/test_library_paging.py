@@ -3,7 +3,7 @@ capped count beyond it, and pages that still cover every segment once."""
 
 from unittest import mock
 
-from segmentation.api.library import SegmentPagination
+from segmentation.api.segments import SegmentPagination
 from tests.segmentation.test_library import LibraryTestCase
 
 

@@ -187,9 +187,10 @@ export interface paths {
             cookie?: never;
         };
         /**
-         * @description The caller's review; before they start one, the review they would start
-         *     (``id`` null; its cuts have no ids yet), which is not stored: reading never writes.
-         *     A write based on it sends version 1, the version the review starts at.
+         * @description The caller's review, with what the review page says about adaptation; before
+         *     they start one, the review they would start (``id`` null; its cuts have no ids
+         *     yet), which is not stored: reading never writes. A write based on it sends
+         *     version 1, the version the review starts at.
          */
         get: operations["captures_review_retrieve"];
         put?: never;
@@ -1445,7 +1446,24 @@ export interface components {
         ReturnRequestRequest: {
             comment: string;
         };
+        /** @description A review as its edits answer it: its cuts and segments. */
         Review: {
+            readonly id: number | null;
+            capture: number;
+            readonly annotator: components["schemas"]["UserRef"];
+            run: number | null;
+            readonly status: components["schemas"]["ReviewStateEnum"];
+            /** Format: int64 */
+            version: number;
+            return_comment: string;
+            readonly cuts: components["schemas"]["Cut"][];
+            readonly segments: components["schemas"]["ReviewSegment"][];
+        };
+        /**
+         * @description A review as the review page opens it (GET): also where its candidates came from
+         *     and the state of the project's learnt model.
+         */
+        ReviewPage: {
             readonly id: number | null;
             capture: number;
             readonly annotator: components["schemas"]["UserRef"];
@@ -2030,7 +2048,7 @@ export interface operations {
                     [name: string]: unknown;
                 };
                 content: {
-                    "application/json": components["schemas"]["Review"];
+                    "application/json": components["schemas"]["ReviewPage"];
                 };
             };
         };

@@ -52,6 +52,9 @@ export type Suggestions = Schemas["Suggestions"];
 /** A review as the server sends it; `id` null: the caller has not started one, and this is
  * the one the first write starts. */
 export type ApiReview = Schemas["Review"];
+/** `GET /api/captures/{id}/review/`: the review the page opens, and where its candidates
+ * came from (edits answer with the review alone). */
+export type OpenedReview = Schemas["ReviewPage"];
 /** A review as the pages hold it: every cut has an id (see `Cut`). */
 export type Review = Omit<ApiReview, "cuts" | "segments"> & { cuts: Cut[]; segments: Segment[] };
 /** Where a review's candidates came from, and the project's learnt model. */

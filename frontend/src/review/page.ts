@@ -4,7 +4,7 @@
 
 import { ApiError, get, post } from "../api/client";
 import { isReady } from "../api/types";
-import type { ApiReview, Capture, Cut, ReadyCapture, Label, Me, Project, Review, ReviewEvent, Segment, Signal, SignalResponse, Suggestions } from "../api/types";
+import type { Adaptation, Capture, Cut, ReadyCapture, Label, Me, OpenedReview, Project, Review, ReviewEvent, Segment, Signal, SignalResponse, Suggestions } from "../api/types";
 import { advance, frameOf, nextSpeed, seek, togglePlay, type Playback } from "../player/clock";
 import { MAX_JOINTS, SkeletonView, TooManyJoints } from "../player/skeletonView";
 import { clear, confirmDialog, dialog, h, toast } from "../ui/dom";
@@ -39,12 +39,14 @@ export async function renderReview(root: HTMLElement, captureId: number): Promis
   // Poses start streaming now, in parallel with the review and the signal.
   const frames = new FrameFeed(capture, maxJoints(me));
   try {
-    const [review, signal] = await Promise.all([
+    const [opened, signal] = await Promise.all([
       // Reading does not start a review: the first edit does (saver.ts).
-      get<ApiReview>(`/api/captures/${captureId}/review/`).then(withTempIds),
+      get<OpenedReview>(`/api/captures/${captureId}/review/`),
       get<SignalResponse>(`/api/captures/${captureId}/signal/?max_points=4000`).catch(() => null),
     ]);
-    const page = new ReviewPage(root, capture, me, project ?? null, review, signal?.signals ?? [], frames);
+    // Only the page's GET carries the adaptation summary: no edit changes it.
+    const { adaptation, ...review } = opened;
+    const page = new ReviewPage(root, capture, me, project ?? null, withTempIds(review), adaptation, signal?.signals ?? [], frames);
     return () => page.dispose();
   } catch (err) {
     frames.abort.abort();
@@ -142,6 +144,7 @@ class ReviewPage {
     private readonly me: Me,
     private readonly project: Project | null,
     review: Review,
+    private readonly adaptation: Adaptation,
     private signals: Signal[],
     frames: FrameFeed,
   ) {
@@ -280,7 +283,7 @@ class ReviewPage {
     renderLabels(this.el.labels, this.activeLabels(), segment?.label ?? null, this.locked() !== null, (name) => this.labelCurrent(name));
     renderSelection(this.el.selection, this.selectedCut(), segment, this.capture.fps);
     renderStats(this.el.stats, this.review);
-    renderAdaptation(this.el.adaptation, this.review.adaptation);
+    renderAdaptation(this.el.adaptation, this.adaptation);
   }
 
   private selectedCut(): Cut | undefined {

@@ -1,8 +1,8 @@
 from django.conf import settings
 from django.core.management.base import BaseCommand
+from kombu.transport import resolve_transport
 
-from segmentation.services import sweep_stale_claims
-from segmentation.services.adaptation import sweep_stale_trainings
+from segmentation.services import jobs
 
 
 class Command(BaseCommand):
@@ -19,11 +19,11 @@ class Command(BaseCommand):
         )
 
     def handle(self, *args, **options):
-        count = sweep_stale_claims() + sweep_stale_trainings()
+        count = jobs.sweep()
         released = ""
         if options["release_broker"] and settings.CELERY_BROKER_URL.startswith("sqlite"):
-            from cutroom import broker
-
+            # The transport the broker URL names (the project registers it with kombu).
+            transport = resolve_transport("sqlite")
             path = settings.CELERY_BROKER_TRANSPORT_OPTIONS["path"]
-            released = f"; {broker.release_all(path)} broker message(s) released"
+            released = f"; {transport.release_all(path)} broker message(s) released"
         self.stdout.write(f"{count} stale job(s) requeued or failed{released}")

@@ -17,7 +17,7 @@ from rest_framework.test import APIClient
 
 from segmentation import services
 from segmentation.models import Capture, DetectionRun, ProjectCutModel, Review
-from segmentation.services import adaptation
+from segmentation.services import adaptation, captures, jobs
 from tests.segmentation.base import synthetic_bvh
 from tests.segmentation.integration.conftest import Workers, new_queue, sending_to, wait_for
 
@@ -61,8 +61,7 @@ def project_of(user):
 def sweeping_until(predicate, timeout):
     """Run the sweep every second (as `make up`'s supervisor does) until ``predicate``."""
     def swept():
-        services.sweep_stale_claims()
-        adaptation.sweep_stale_trainings()
+        jobs.sweep()
         return predicate()
     return wait_for(swept, timeout=timeout, interval=1.0, what="the job to finish")
 
@@ -157,7 +156,7 @@ def test_it_fails_at_once_a_run_killed_at_its_hard_time_limit(production_workers
     assert run.finished_at is not None
     assert "Hard time limit" in worker.log.read_text()
     time.sleep(2)  # the message given back or acknowledged: either way nothing runs it again
-    services.sweep_stale_claims()
+    jobs.sweep()
     assert DetectionRun.objects.get(pk=run_id).attempts == 1
 
 
@@ -233,7 +232,7 @@ def test_it_fails_at_once_a_training_killed_at_its_hard_time_limit_and_trains_wh
     trained = ProjectCutModel.objects.get(pk=waiting.pk)
     assert (trained.status, trained.version, trained.n_takes) == ("ready", 1, 2), trained.error
     assert trained.claimed_at >= failed.finished_at
-    adaptation.sweep_stale_trainings()
+    jobs.sweep()
     assert ProjectCutModel.objects.get(pk=training.pk).attempts == 1
 
 
@@ -316,8 +315,7 @@ def test_a_detection_whose_soft_limit_lands_inside_a_query_still_fails_naming_th
     run = DetectionRun.objects.create(capture=capture, method="default", status="processing",
                                       claim_token="token")
     with table_locked(Capture), soft_limit_after(0.5):
-        services.captures._guarded(run, "Detection", lambda: list(Capture.objects.all()),
-                                   finished_at=None)
+        jobs.guard(captures.DETECT, run, work=lambda run: list(Capture.objects.all()))
 
     failed = DetectionRun.objects.get(pk=run.pk)
     assert failed.status == "failed"

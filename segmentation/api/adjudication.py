@@ -1,0 +1,132 @@
+"""``GET/PUT /api/captures/{id}/adjudication/``: every review of a capture side by side,
+and the gold version a reviewer or admin makes of them."""
+
+from django.urls import path
+from drf_spectacular.utils import extend_schema
+from rest_framework import serializers
+from rest_framework.response import Response
+from rest_framework.views import APIView
+
+from segmentation import agreement
+from segmentation.api.agreement import AgreementSerializer, staff_capture
+from segmentation.api.params import body
+from segmentation.api.serializers import DetailSerializer, NamedRefSerializer, UserRefSerializer
+from segmentation.errors import Invalid
+from segmentation.models import Adjudication, Review
+from segmentation.services.gold import do_save_gold
+
+
+class SpanSerializer(serializers.Serializer):
+    start = serializers.IntegerField()
+    stop = serializers.IntegerField()
+    label = serializers.CharField(allow_null=True)
+
+
+class GoldBodySerializer(serializers.Serializer):
+    """The capture's gold version as stored."""
+
+    version = serializers.IntegerField()
+    cuts = serializers.ListField(child=serializers.IntegerField())
+    labels = serializers.ListField(child=serializers.CharField(allow_null=True))
+    segments = SpanSerializer(many=True)
+    adjudicator = serializers.CharField(allow_null=True)
+    source_review = serializers.IntegerField(allow_null=True)
+    updated_at = serializers.DateTimeField()
+
+
+class AdjudicationCaptureSerializer(NamedRefSerializer):
+    fps = serializers.FloatField(allow_null=True)
+    n_frames = serializers.IntegerField(allow_null=True)
+    project = serializers.IntegerField()
+
+
+class AdjudicationLabelSerializer(serializers.Serializer):
+    name = serializers.CharField()
+    color = serializers.CharField()
+    hotkey = serializers.CharField(allow_null=True)
+
+
+class AdjudicationReviewSerializer(serializers.Serializer):
+    id = serializers.IntegerField()
+    annotator = UserRefSerializer()
+    status = serializers.ChoiceField(choices=Review.STATUSES)
+    cuts = serializers.ListField(child=serializers.IntegerField())
+    segments = SpanSerializer(many=True)
+
+
+class AdjudicationSerializer(serializers.Serializer):
+    capture = AdjudicationCaptureSerializer()
+    labels = AdjudicationLabelSerializer(many=True)
+    reviews = AdjudicationReviewSerializer(many=True)
+    gold = GoldBodySerializer(allow_null=True)
+    agreement = AgreementSerializer()
+
+
+class StaleGoldSerializer(DetailSerializer):
+    """409: the gold version changed since the one the edit was based on."""
+
+    gold = GoldBodySerializer(allow_null=True)
+
+
+class GoldSerializer(serializers.Serializer):
+    cuts = serializers.ListField(child=serializers.IntegerField())
+    labels = serializers.ListField(child=serializers.CharField(allow_null=True))
+    version = serializers.IntegerField(min_value=0)
+    source_review = serializers.IntegerField(required=False, allow_null=True)
+
+
+def gold_body(gold):
+    if gold is None:
+        return None
+    return {
+        "version": gold.version, "cuts": gold.cuts, "labels": gold.labels,
+        "segments": [{"start": a, "stop": b, "label": c} for a, b, c in gold.segments()],
+        "adjudicator": gold.adjudicator.username if gold.adjudicator else None,
+        "source_review": gold.source_review_id, "updated_at": gold.updated_at,
+    }
+
+
+def adjudication_body(capture):
+    reviews = Review.objects.filter(capture=capture).select_related("annotator", "capture")
+    reviews = reviews.prefetch_related("cuts", "segment_labels__label").order_by("id")
+    gold = Adjudication.objects.select_related("adjudicator").filter(capture=capture).first()
+    return {
+        "capture": {"id": capture.pk, "name": capture.name, "fps": capture.fps,
+                    "n_frames": capture.n_frames, "project": capture.project_id},
+        "labels": [{"name": x.name, "color": x.color, "hotkey": x.hotkey}
+                   for x in capture.project.labels.all()],
+        "reviews": [
+            {"id": r.pk, "annotator": {"id": r.annotator_id, "username": r.annotator.username},
+             "status": r.status, "cuts": agreement.review_cuts(r),
+             "segments": [{"start": a, "stop": b, "label": c}
+                          for a, b, c in agreement.review_segments(r)]}
+            for r in reviews
+        ],
+        "gold": gold_body(gold),
+        "agreement": agreement.capture_agreement(capture),
+    }
+
+
+class AdjudicationView(APIView):
+    @extend_schema(responses=AdjudicationSerializer)
+    def get(self, request, pk):
+        return Response(AdjudicationSerializer(adjudication_body(staff_capture(request.user, pk))).data)
+
+    @extend_schema(request=GoldSerializer, responses={200: AdjudicationSerializer, 409: StaleGoldSerializer})
+    def put(self, request, pk):
+        capture = staff_capture(request.user, pk)
+        data = body(request, GoldSerializer)
+        source = None
+        if data.get("source_review") is not None:
+            source = Review.objects.filter(pk=data["source_review"], capture=capture,
+                                           status="submitted").first()
+            if source is None:
+                raise Invalid(f"source_review: review {data['source_review']} is not a "
+                              "submitted review of this capture")
+        do_save_gold(capture, request.user, data["cuts"], data["labels"], data["version"], source)
+        return Response(AdjudicationSerializer(adjudication_body(capture)).data)
+
+
+urlpatterns = [
+    path("captures/<int:pk>/adjudication/", AdjudicationView.as_view(), name="api-adjudication"),
+]

@@ -1,0 +1,226 @@
+"""The clip library's segments: the filtered, paged list, one segment, and its exports.
+
+- ``GET /api/segments/?project=&label=&capture=&annotator=&min_duration=&max_duration=&min_agreement=&gold=&ordering=&page=``
+  (``count`` exact up to 10,000 matches, else 10,000 with ``count_capped``)
+- ``GET /api/segments/{id}/``, ``…/export.bvh``, ``…/export.fbx``, ``…/export.glb``
+- ``GET /api/segments/export.zip?<same filters>&file_format=bvh|fbx|glb`` (streamed)
+
+Annotators see their own segments and gold segments; reviewers and admins everybody's.
+"""
+
+from django.http import HttpResponse, StreamingHttpResponse
+from django.urls import path
+from drf_spectacular.utils import OpenApiParameter, extend_schema, extend_schema_field
+from rest_framework import serializers
+from rest_framework.exceptions import NotFound
+from rest_framework.pagination import PageNumberPagination
+from rest_framework.response import Response
+from rest_framework.utils.urls import remove_query_param, replace_query_param
+from rest_framework.views import APIView
+
+from segmentation import exports
+from segmentation.api.params import bool_param, float_param, int_param
+from segmentation.api.serializers import NamedRefSerializer, UserRefSerializer
+from segmentation.errors import Invalid
+from segmentation.models import LibrarySegment
+from segmentation.storage import read_take
+
+ORDERINGS = {
+    "recent": ("-id",), "duration": ("duration", "id"), "-duration": ("-duration", "-id"),
+    "agreement": ("agreement", "id"), "-agreement": ("-agreement", "-id"),
+    "label": ("label_name", "id"), "capture": ("capture_id", "start", "id"),
+}
+
+
+class SegmentPagination(PageNumberPagination):
+    """Page numbers as before, without counting a million rows for each page.
+
+    A page reads one id more than it shows, which says whether there is a next page.
+    The count is exact up to ``count_cap`` matches (a count of at most that many rows,
+    or none at all on the last page); beyond it ``count`` is the cap and ``count_capped``
+    is true, so a page of a huge library costs as much as a page of a small one.
+    """
+
+    page_size = 50
+    page_size_query_param = "page_size"
+    max_page_size = 500
+    count_cap = 10_000
+
+    def paginate_queryset(self, queryset, request, view=None):
+        self.request = request
+        size = self.get_page_size(request)
+        self.number = int_param(request, self.page_query_param, 1, 1, 1_000_000)
+        offset = (self.number - 1) * size
+        # The page's ids first (an index can answer that alone, however deep the page),
+        # then its rows by id.
+        ids = list(queryset.values_list("id", flat=True)[offset:offset + size + 1])
+        self.has_next = len(ids) > size
+        found = queryset.order_by().in_bulk(ids[:size])
+        rows = [found[pk] for pk in ids[:size] if pk in found]
+        if rows and not self.has_next:
+            self.count, self.capped = offset + len(rows), False
+        else:
+            cap = max(self.count_cap, offset + size + 1)
+            self.count = queryset.order_by()[:cap + 1].count()
+            self.capped = self.count > cap
+            self.count = min(self.count, cap)
+        if not rows and self.number > 1:
+            raise NotFound(f"page: there is no page {self.number}; the query matches "
+                           f"{self.count} segment(s)")
+        return rows
+
+    def get_next_link(self):
+        if not self.has_next:
+            return None
+        return replace_query_param(self.request.build_absolute_uri(), self.page_query_param,
+                                   self.number + 1)
+
+    def get_previous_link(self):
+        if self.number == 1:
+            return None
+        url = self.request.build_absolute_uri()
+        if self.number == 2:
+            return remove_query_param(url, self.page_query_param)
+        return replace_query_param(url, self.page_query_param, self.number - 1)
+
+    def get_paginated_response(self, data):
+        return Response({"count": self.count, "count_capped": self.capped,
+                         "next": self.get_next_link(), "previous": self.get_previous_link(),
+                         "results": data})
+
+    def get_paginated_response_schema(self, schema):
+        page = super().get_paginated_response_schema(schema)
+        page["properties"]["count_capped"] = {"type": "boolean"}
+        return page
+
+
+class SegmentSerializer(serializers.ModelSerializer):
+    capture = serializers.SerializerMethodField()
+    annotator = serializers.SerializerMethodField()
+    label = serializers.CharField(source="label_name")
+    color = serializers.SerializerMethodField()
+    gold = serializers.BooleanField(source="is_gold")
+    fps = serializers.FloatField(source="capture.fps")
+
+    class Meta:
+        model = LibrarySegment
+        fields = ["id", "project", "capture", "review", "annotator", "gold", "superseded",
+                  "label", "color", "start", "stop", "fps", "duration", "agreement"]
+
+    @extend_schema_field(NamedRefSerializer)
+    def get_capture(self, s):
+        return {"id": s.capture_id, "name": s.capture.name}
+
+    @extend_schema_field(UserRefSerializer(allow_null=True))
+    def get_annotator(self, s):
+        return {"id": s.annotator_id, "username": s.annotator.username} if s.annotator_id else None
+
+    def get_color(self, s) -> str:
+        return s.label.color if s.label_id else "#888888"
+
+
+def segment_query(request):
+    """The caller's visible segments filtered by the query string (shared by list and zip)."""
+    segments = LibrarySegment.objects.visible_to(request.user)
+    gold = bool_param(request, "gold")
+    if gold is None:
+        segments = segments.preferred()
+    else:
+        segments = segments.filter(is_gold=gold)
+    for name, field in (("project", "project_id"), ("capture", "capture_id"),
+                        ("annotator", "annotator_id")):
+        value = int_param(request, name, None, 1)
+        if value is not None:
+            segments = segments.filter(**{field: value})
+    if request.query_params.get("label"):
+        segments = segments.filter(label_name=request.query_params["label"])
+    for name, lookup, high in (("min_duration", "duration__gte", None),
+                               ("max_duration", "duration__lte", None),
+                               ("min_agreement", "agreement__gte", 1)):
+        value = float_param(request, name, 0, high)
+        if value is not None:
+            segments = segments.filter(**{lookup: value})
+    ordering = request.query_params.get("ordering") or "recent"
+    if ordering not in ORDERINGS:
+        raise Invalid(f"ordering: must be one of {', '.join(ORDERINGS)}, got {ordering!r}")
+    return segments.order_by(*ORDERINGS[ordering])
+
+
+def segment_for(user, pk):
+    segment = (LibrarySegment.objects.visible_to(user).select_related("capture", "annotator", "label")
+               .filter(pk=pk).first())
+    if segment is None:
+        raise NotFound("No such segment.")
+    return segment
+
+
+class SegmentListView(APIView):
+    pagination_class = SegmentPagination
+
+    @extend_schema(responses=SegmentSerializer(many=True))
+    def get(self, request):
+        segments = segment_query(request).select_related("capture", "annotator", "label").defer(
+            "descriptor", "profile", "capture__skeleton")
+        paginator = self.pagination_class()
+        page = paginator.paginate_queryset(segments, request, view=self)
+        return paginator.get_paginated_response(SegmentSerializer(page, many=True).data)
+
+
+class SegmentView(APIView):
+    @extend_schema(responses=SegmentSerializer)
+    def get(self, request, pk):
+        return Response(SegmentSerializer(segment_for(request.user, pk)).data)
+
+
+class SegmentBvhView(APIView):
+    @extend_schema(responses={(200, "text/plain"): str})
+    def get(self, request, pk):
+        segment = segment_for(request.user, pk)
+        text = exports.bvh_text(read_take(segment.capture), segment)
+        response = HttpResponse(text, content_type="application/octet-stream")
+        response["Content-Disposition"] = f'attachment; filename="{exports.file_name(segment)}"'
+        return response
+
+
+class SegmentClipView(APIView):
+    """``…/export.fbx`` and ``…/export.glb``: the segment as FBX or glTF binary."""
+
+    @extend_schema(responses={(200, "application/octet-stream"): bytes})
+    def get(self, request, pk, fmt):
+        fmt = exports.check_format(fmt)
+        segment = segment_for(request.user, pk)
+        capture = segment.capture
+        [(_, name, data)] = exports.clip_files(capture, read_take(capture), [segment], fmt)
+        response = HttpResponse(data, content_type=exports.CONTENT_TYPES[fmt])
+        response["Content-Disposition"] = f'attachment; filename="{name}"'
+        return response
+
+
+class SegmentZipView(APIView):
+    @extend_schema(responses={(200, "application/zip"): bytes},
+                   parameters=[OpenApiParameter("file_format", str,
+                                                enum=list(exports.EXPORT_FORMATS),
+                                                description="clip format (default bvh)")])
+    def get(self, request):
+        # Not "format": DRF reads that one to pick a renderer.
+        fmt = exports.check_format(request.query_params.get("file_format"))
+        segments = segment_query(request)
+        count = segments.count()
+        if count > exports.MAX_EXPORT_SEGMENTS:
+            raise Invalid(f"export: the query matches {count} segments; export at most "
+                          f"{exports.MAX_EXPORT_SEGMENTS} at a time (narrow the filters)")
+        rows = (segments.select_related("capture", "annotator").defer("descriptor", "profile")
+                .order_by("capture_id", "start", "id").iterator(chunk_size=200))
+        response = StreamingHttpResponse(exports.stream_zip(rows, fmt),
+                                         content_type="application/zip")
+        response["Content-Disposition"] = f'attachment; filename="segments-{fmt}.zip"'
+        return response
+
+
+urlpatterns = [
+    path("segments/", SegmentListView.as_view(), name="api-segments"),
+    path("segments/export.zip", SegmentZipView.as_view(), name="api-segments-zip"),
+    path("segments/<int:pk>/", SegmentView.as_view(), name="api-segment"),
+    path("segments/<int:pk>/export.bvh", SegmentBvhView.as_view(), name="api-segment-bvh"),
+    path("segments/<int:pk>/export.<str:fmt>", SegmentClipView.as_view(), name="api-segment-clip"),
+]

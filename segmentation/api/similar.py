@@ -1,0 +1,45 @@
+"""``GET /api/segments/{id}/similar/?k=10``: the library's clips nearest to a segment."""
+
+from django.urls import path
+from drf_spectacular.utils import OpenApiParameter, extend_schema
+from rest_framework import serializers
+from rest_framework.exceptions import NotFound
+from rest_framework.response import Response
+from rest_framework.views import APIView
+
+from segmentation import search
+from segmentation.api.params import int_param
+from segmentation.api.segments import SegmentSerializer
+from segmentation.models import LibrarySegment
+
+
+class SimilarSegmentSerializer(SegmentSerializer):
+    distance = serializers.FloatField(read_only=True, help_text="Descriptor distance to the segment")
+
+    class Meta(SegmentSerializer.Meta):
+        fields = [*SegmentSerializer.Meta.fields, "distance"]
+
+
+class SimilarSerializer(serializers.Serializer):
+    segment = serializers.IntegerField()
+    results = SimilarSegmentSerializer(many=True, help_text="Nearest first")
+
+
+class SimilarView(APIView):
+    @extend_schema(responses=SimilarSerializer, parameters=[OpenApiParameter("k", int)])
+    def get(self, request, pk):
+        k = int_param(request, "k", 10, 1, 100)
+        # One membership lookup for both the segment and the clips it may be compared with.
+        visible = LibrarySegment.objects.visible_to(request.user)
+        segment = visible.select_related("capture", "annotator", "label").filter(pk=pk).first()
+        if segment is None:
+            raise NotFound("No such segment.")
+        found = search.similar(segment, visible.preferred(), k=k)
+        for s, d in found:
+            s.distance = round(d, 4)
+        return Response(SimilarSerializer({"segment": segment.pk, "results": [s for s, _ in found]}).data)
+
+
+urlpatterns = [
+    path("segments/<int:pk>/similar/", SimilarView.as_view(), name="api-segment-similar"),
+]

@@ -1,0 +1,16 @@
+from django.db import migrations, models
+
+
+class Migration(migrations.Migration):
+    dependencies = [
+        ("segmentation", "0012_library_scale"),
+    ]
+
+    operations = [
+        migrations.AddField(
+            model_name=model,
+            name="error_permanent",
+            field=models.BooleanField(default=False),
+        )
+        for model in ("capture", "detectionrun", "projectcutmodel")
+    ]
