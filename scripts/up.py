@@ -43,6 +43,10 @@ WEB_WORKERS, WEB_THREADS = 2, 32
 # (benchmarks/review_long_take.py, twenty page loads of a one-hour take: nice 10 kept a
 # small capture's requests within 1.4-1.5x of alone at p95, nice 5 within 1.9-2.1x).
 BULK_NICE = 10
+# FBX files Blender converts at once, each in a pool process of the convert worker with a
+# Blender of its own: a file that hangs Blender holds one slot until MOTIONLIB_BLENDER_TIMEOUT
+# while the other slots keep serving the queue (CUTROOM_CONVERT_SLOTS).
+CONVERT_SLOTS = 2
 # What stops everything; SIGHUP too: the children are in the terminal's session, and
 # closing it must stop them.
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
@@ -173,12 +177,20 @@ def convert_worker(env, logs):
     argv = [
         "nice", "-n", str(WORKER_NICE),
         str(BIN / "celery"), "-A", "cutroom", "worker", "--loglevel", "INFO",
-        "--queues", env.get("CUTROOM_CONVERT_QUEUE") or "convert", "--concurrency", "1",
-        "--max-tasks-per-child", "50", "--hostname", "cutroom-convert@%h",
+        *convert_options(env), "--hostname", "cutroom-convert@%h",
         "--without-mingle", "--without-gossip",
     ]
     return Child("convert worker", argv, {**SINGLE_THREADED, **env, "CUTROOM_CONVERT_WORKER": "1"},
                  logs / "convert-worker.log")
+
+
+def convert_options(env):
+    """The convert worker's queue, slots (pool processes, one file each) and recycling."""
+    return [
+        "--queues", env.get("CUTROOM_CONVERT_QUEUE") or "convert",
+        "--concurrency", env.get("CUTROOM_CONVERT_SLOTS") or str(CONVERT_SLOTS),
+        "--max-tasks-per-child", "50",
+    ]
 
 
 def gunicorn(bind):

@@ -32,6 +32,9 @@ CONTENT_TYPES = {"bvh": "application/octet-stream", "fbx": "application/octet-st
                  "glb": "model/gltf-binary"}
 
 MAX_EXPORT_SEGMENTS = 5000
+# Every entry of an export archive carries this time stamp, not the time of the export: the
+# same library exports to the same bytes (a restored backup is checked that way).
+ZIP_ENTRY_TIME = (1980, 1, 1, 0, 0, 0)
 
 
 def check_format(fmt):
@@ -162,7 +165,7 @@ def stream_zip(segments, fmt="bvh"):
                 take = read_take(capture)
                 for segment, name, data in _clips(capture, take, group, fmt):
                     name = unique_name(name, segment, used)
-                    archive.writestr(name, data)
+                    archive.writestr(_entry(name), data)
                     manifest.append(manifest_row(segment, name, fmt))
                     yield sink.drain()
             except (MotionlibError, CutroomError) as exc:
@@ -172,11 +175,17 @@ def stream_zip(segments, fmt="bvh"):
                 reference = internal_error(f"export of capture {capture.pk}", log)
                 errors.append(f"capture {capture.pk} ({capture.name}): internal error "
                               f"(reference {reference})")
-        archive.writestr("manifest.json", json.dumps(manifest, indent=1))
-        archive.writestr("manifest.csv", _csv(manifest))
+        archive.writestr(_entry("manifest.json"), json.dumps(manifest, indent=1))
+        archive.writestr(_entry("manifest.csv"), _csv(manifest))
         if errors:
-            archive.writestr("errors.txt", "\n".join(errors) + "\n")
+            archive.writestr(_entry("errors.txt"), "\n".join(errors) + "\n")
     yield sink.drain()
+
+
+def _entry(name):
+    info = zipfile.ZipInfo(name, date_time=ZIP_ENTRY_TIME)
+    info.compress_type, info.external_attr = zipfile.ZIP_DEFLATED, 0o644 << 16
+    return info
 
 
 def _clips(capture, take, segments, fmt):

@@ -22,7 +22,7 @@ from django.conf import settings
 from django.db import connection
 
 from segmentation import similar_index, suggestions, workers
-from segmentation.services import adaptation, captures, jobs
+from segmentation.services import adaptation, captures, health, jobs
 from segmentation.services.convert import CONVERT
 
 log = logging.getLogger(__name__)
@@ -156,3 +156,11 @@ def apply_time_limits(**kwargs):
 def sweep_on_start(**kwargs):
     # A restarted worker first picks up whatever a killed worker left behind.
     jobs.sweep()
+
+
+@worker_ready.connect
+def start_heartbeat(sender, **kwargs):
+    # The health endpoint's sign that this worker is alive, and which queues it serves.
+    worker = sender.controller
+    health.beat(worker.hostname, sorted(sender.app.amqp.queues.consume_from),
+                worker.concurrency)

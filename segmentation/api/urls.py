@@ -7,6 +7,7 @@ from segmentation.api import (
     agreement,
     assignments,
     dashboard,
+    health,
     invitations,
     reviews,
     segments,
@@ -43,5 +44,6 @@ urlpatterns = [
     *invitations.urlpatterns,
     *assignments.urlpatterns,
     *team.urlpatterns,
+    *health.urlpatterns,
     *router.urls,
 ]

@@ -116,13 +116,15 @@ class Workers:
         }
         self.queue, self.logs, self.procs = queue, logs, []
 
-    def start(self, name=None):
+    def start(self, name=None, options=None):
+        """A worker of one pool process on this queue, or with ``options`` (its queue, its
+        concurrency) instead."""
         name = name or f"w{len(self.procs)}-{uuid.uuid4().hex[:6]}"
         log = self.logs / f"{name}.log"
+        options = options or ["-c", "1", "-Q", self.queue]
         proc = subprocess.Popen(
-            [str(CELERY), "-A", "cutroom", "worker", "--pool=prefork", "-c", "1",
-             "-Q", self.queue, "-n", f"{name}@%h", "--without-mingle", "--without-gossip",
-             "-l", "INFO"],
+            [str(CELERY), "-A", "cutroom", "worker", "--pool=prefork", *options,
+             "-n", f"{name}@%h", "--without-mingle", "--without-gossip", "-l", "INFO"],
             cwd=REPO, env=self.env, stdout=log.open("w"), stderr=subprocess.STDOUT,
             start_new_session=True,
         )

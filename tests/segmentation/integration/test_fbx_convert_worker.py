@@ -4,16 +4,19 @@ ingest and detection on another; Blender crashing or hanging costs one capture, 
 import os
 import signal
 import subprocess
+import threading
 
 import pytest
 from django.contrib.auth import get_user_model
 from django.core.files.uploadedfile import SimpleUploadedFile
+from django.db import transaction
 from rest_framework.test import APIClient
 
 from segmentation import services
 from segmentation.models import Capture, DetectionRun
 from tests.fbx.files import shared_fbx
 from tests.segmentation.integration.conftest import Workers, new_queue, wait_for
+from tests.segmentation.test_command_up import up_script
 
 pytestmark = pytest.mark.integration
 
@@ -28,17 +31,19 @@ def owner(transactional_db):
 @pytest.fixture
 def fbx_workers(workers, shared_media, tmp_path, settings):
     """An ingest worker on the test's queue and a convert worker on a convert queue of its own
-    (``start_convert(**env)`` starts one, with extra environment)."""
+    (``start_convert(**env)`` starts one, with extra environment, as ``make up`` starts it:
+    its slots, its recycling)."""
     convert_queue = new_queue() + "-convert"
     settings.CUTROOM_CONVERT_QUEUE = convert_queue
     workers.env["CUTROOM_CONVERT_QUEUE"] = convert_queue
     workers.start()
     converters = Workers(convert_queue, shared_media, tmp_path, claim_timeout=300)
-    converters.env["CUTROOM_CONVERT_WORKER"] = "1"
+    converters.env.update(CUTROOM_CONVERT_WORKER="1", CUTROOM_CONVERT_QUEUE=convert_queue)
 
     def start_convert(**env):
         converters.env.update(env)
-        return converters.start(f"convert-{len(converters.procs)}")
+        options = up_script().convert_options(converters.env)
+        return converters.start(f"convert-{len(converters.procs)}", options)
 
     yield start_convert, converters
     converters.stop_all()
@@ -67,6 +72,16 @@ def blender_pids(worker):
     return [int(p) for p in out.stdout.split() if _parent(int(p)) in pool]
 
 
+def blenders_ready(worker):
+    """Once every pool process (slot) of the convert worker has loaded its Blender, their pids."""
+    slots = len(Workers.children(None, worker))
+    wait_for(lambda: worker.log.read_text().count("Blender ready in") >= slots,
+             what="Blender to start in every slot")
+    blender = blender_pids(worker)
+    assert len(blender) == slots
+    return blender
+
+
 def _parent(pid):
     try:
         with open(f"/proc/{pid}/stat") as stat:
@@ -88,28 +103,27 @@ def test_it_converts_then_ingests_and_detects_an_fbx_upload(fbx_workers, owner):
 def test_it_makes_a_capture_per_animation(fbx_workers, owner, made_fbx):
     start_convert, _ = fbx_workers
     worker = start_convert()
-    wait_for(lambda: "Blender ready in" in worker.log.read_text(), what="Blender to start")
-    blender = blender_pids(worker)
+    blender = blenders_ready(worker)
     first = settled(upload(owner, made_fbx / "two_armatures.fbx"))
     assert first.status == "ready", first.error
     other = Capture.objects.get(source=first)
     assert settled(other.pk).status == "ready"
     assert sorted([first.name, other.name]) == ["two_armatures.fbx#Breakdance|Scene",
                                                 "two_armatures.fbx#Flair|Scene"]
-    # The Blender loaded as the worker started read the file: none started for it.
-    assert blender_pids(worker) == blender and len(blender) == 1
+    # A Blender loaded as the worker started read the file: none started for it.
+    assert blender_pids(worker) == blender
 
 
 def test_a_blender_crash_fails_that_capture_and_the_worker_converts_the_next(fbx_workers, owner):
     start_convert, _ = fbx_workers
     worker = start_convert()
-    wait_for(lambda: "Blender ready in" in worker.log.read_text(), what="Blender to start")
+    blenders_ready(worker)
     capture_id = upload(owner, shared_fbx("13_29_blender.fbx"))
     wait_for(lambda: Capture.objects.get(pk=capture_id).status == "processing", interval=0.01,
              what="conversion to start")
-    doomed = blender_pids(worker)
-    assert len(doomed) == 1
-    for pid in doomed:
+    # Every slot's Blender, the one reading the file among them (the others start afresh
+    # on their next file).
+    for pid in blender_pids(worker):
         os.kill(pid, signal.SIGKILL)
     crashed = settled(capture_id)
     assert crashed.status == "failed"
@@ -132,3 +146,52 @@ def test_a_blender_past_its_time_limit_fails_that_capture_only(fbx_workers, owne
     after = settled(upload(owner, shared_fbx("flair.fbx")))
     assert after.status == "ready" or "within 0.3 s and was stopped" in after.error
     assert worker.poll() is None
+
+
+@pytest.fixture
+def hanging_upload(owner):
+    """Upload an FBX whose stored original then hangs Blender: a named pipe that gives the
+    header check the file's first bytes, then leaves Blender's read waiting for a writer.
+    Yields the upload function; lets Blender go at the end."""
+    pipes = []
+
+    def upload_hanging(path):
+        head = path.read_bytes()[:64]
+        project = owner.memberships.get().project
+        with transaction.atomic():  # the job is sent on commit: after the swap
+            capture, _ = services.do_upload_capture(
+                project, owner, SimpleUploadedFile("hangs.fbx", path.read_bytes()))
+            stored = capture.original.path
+            os.remove(stored)
+            os.mkfifo(stored)
+        pipes.append(stored)
+        threading.Thread(target=_feed, args=(stored, head), daemon=True).start()
+        return capture.pk
+
+    yield upload_hanging
+    for pipe in pipes:
+        try:  # a writer that closes at once: Blender reads the end of the file
+            os.close(os.open(pipe, os.O_WRONLY | os.O_NONBLOCK))
+        except OSError:
+            pass  # nobody reading it any more
+
+
+def _feed(pipe, head):
+    with open(pipe, "wb") as writer:
+        writer.write(head)
+
+
+def test_a_file_that_hangs_blender_holds_its_own_slot_only(fbx_workers, owner, hanging_upload):
+    start_convert, _ = fbx_workers
+    worker = start_convert()
+    wait_for(lambda: "Blender ready in" in worker.log.read_text(), what="Blender to start")
+    hung = hanging_upload(shared_fbx("flair.fbx"))
+    wait_for(lambda: Capture.objects.get(pk=hung).status != "queued",
+             what="the hanging conversion to start")
+    assert Capture.objects.get(pk=hung).status == "processing", Capture.objects.get(pk=hung).error
+    bob = get_user_model().objects.create_user("bob", password="bob-password")
+    services.do_create_project(bob, "Studio B")
+    other = settled(upload(bob, shared_fbx("flair.fbx")))
+    assert other.status == "ready", other.error
+    # Served while the hanging file still held its slot (MOTIONLIB_BLENDER_TIMEOUT, 300 s).
+    assert Capture.objects.get(pk=hung).status == "processing"
