@@ -44,7 +44,7 @@ CAPTURE_STATES = dashboard.STATES
 ORDERINGS = {
     "recent": ("-id",), "duration": ("duration", "id"), "-duration": ("-duration", "-id"),
     "agreement": ("agreement", "id"), "-agreement": ("-agreement", "-id"),
-    "label": ("label_name", "id"), "capture": ("capture_id", "start", "id"),
+    "label": ("label__name", "id"), "capture": ("capture_id", "start", "id"),
 }
 
 
@@ -113,7 +113,7 @@ class SegmentPagination(PageNumberPagination):
 class SegmentSerializer(serializers.ModelSerializer):
     capture = serializers.SerializerMethodField()
     annotator = serializers.SerializerMethodField()
-    label = serializers.CharField(source="label_name")
+    label = serializers.CharField(source="label.name")
     color = serializers.SerializerMethodField()
     gold = serializers.BooleanField(source="is_gold")
     fps = serializers.FloatField(source="capture.fps")
@@ -219,9 +219,12 @@ class AdjudicationCaptureSerializer(NamedRefSerializer):
 
 
 class AdjudicationLabelSerializer(serializers.Serializer):
+    id = serializers.IntegerField()
     name = serializers.CharField()
     color = serializers.CharField()
     hotkey = serializers.CharField(allow_null=True)
+    retired = serializers.BooleanField(help_text="Kept on segments that carry it; not offered "
+                                                 "for new ones")
 
 
 class AdjudicationReviewSerializer(serializers.Serializer):
@@ -312,7 +315,7 @@ def segment_query(request):
         if value is not None:
             segments = segments.filter(**{field: value})
     if request.query_params.get("label"):
-        segments = segments.filter(label_name=request.query_params["label"])
+        segments = segments.filter(label__name=request.query_params["label"])
     for name, lookup, high in (("min_duration", "duration__gte", None),
                                ("max_duration", "duration__lte", None),
                                ("min_agreement", "agreement__gte", 1)):
@@ -388,7 +391,7 @@ class SegmentZipView(APIView):
         if count > exports.MAX_EXPORT_SEGMENTS:
             raise Invalid(f"export: the query matches {count} segments; export at most "
                           f"{exports.MAX_EXPORT_SEGMENTS} at a time (narrow the filters)")
-        rows = (segments.select_related("capture", "annotator").defer("descriptor", "profile")
+        rows = (segments.select_related("capture", "annotator", "label").defer("descriptor", "profile")
                 .order_by("capture_id", "start", "id").iterator(chunk_size=200))
         response = StreamingHttpResponse(exports.stream_zip(rows, fmt),
                                          content_type="application/zip")
@@ -441,9 +444,10 @@ class GoldSerializer(serializers.Serializer):
 def gold_body(gold):
     if gold is None:
         return None
+    segments = gold.segments()
     return {
-        "version": gold.version, "cuts": gold.cuts, "labels": gold.labels,
-        "segments": [{"start": a, "stop": b, "label": c} for a, b, c in gold.segments()],
+        "version": gold.version, "cuts": gold.cuts, "labels": [c for _, _, c in segments],
+        "segments": [{"start": a, "stop": b, "label": c} for a, b, c in segments],
         "adjudicator": gold.adjudicator.username if gold.adjudicator else None,
         "source_review": gold.source_review_id, "updated_at": gold.updated_at,
     }
@@ -456,8 +460,8 @@ def adjudication_body(capture):
     return {
         "capture": {"id": capture.pk, "name": capture.name, "fps": capture.fps,
                     "n_frames": capture.n_frames, "project": capture.project_id},
-        "labels": [{"name": x.name, "color": x.color, "hotkey": x.hotkey}
-                   for x in capture.project.labels.all()],
+        "labels": [{"id": x.pk, "name": x.name, "color": x.color, "hotkey": x.hotkey,
+                    "retired": x.retired} for x in capture.project.labels.all()],
         "reviews": [
             {"id": r.pk, "annotator": {"id": r.annotator_id, "username": r.annotator.username},
              "status": r.status, "cuts": agreement.review_cuts(r),

@@ -51,14 +51,15 @@ class Review(models.Model):
         one-hour take has thousands of cuts, and every edit asks."""
         return list(self.cuts.exclude(fate="deleted").order_by("frame", "id").values_list("id", "frame"))
 
-    def segments(self):
-        """Intervals between kept cuts: list of (index, start, stop, label name or None).
+    def segments(self, label="label__name"):
+        """Intervals between kept cuts: list of (index, start, stop, label name or None),
+        or the label's id with ``label="label_id"``.
 
         A segment's label is stored against the cut that starts it (no cut for the
         first segment), so labels follow their cut when it is moved.
         """
         kept = self.kept_frames()
-        labels = dict(self.segment_labels.filter(label__isnull=False).values_list("cut_id", "label__name"))
+        labels = dict(self.segment_labels.filter(label__isnull=False).values_list("cut_id", label))
         starts = [(None, 0)] + kept
         stops = [frame for _, frame in kept] + [self.capture.n_frames or 0]
         return [
