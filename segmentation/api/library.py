@@ -31,10 +31,12 @@ from segmentation.api.projects import project_for
 from segmentation.api.serializers import (
     DetailSerializer,
     NamedRefSerializer,
+    Text,
     UserRefSerializer,
 )
 from segmentation.errors import Invalid
-from segmentation.models import Adjudication, LibrarySegment, Review
+from segmentation.limits import text_limit
+from segmentation.models import Adjudication, Label, LibrarySegment, Review
 from segmentation.services.gold import do_save_gold
 from segmentation.storage import read_take
 
@@ -436,7 +438,7 @@ class AgreementView(APIView):
 
 class GoldSerializer(serializers.Serializer):
     cuts = serializers.ListField(child=serializers.IntegerField())
-    labels = serializers.ListField(child=serializers.CharField(allow_null=True))
+    labels = serializers.ListField(child=Text(text_limit(Label, "name"), allow_null=True))
     version = serializers.IntegerField(min_value=0)
     source_review = serializers.IntegerField(required=False, allow_null=True)
 

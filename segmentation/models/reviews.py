@@ -30,7 +30,9 @@ class Review(models.Model):
     created_at = models.DateTimeField(default=timezone.now)
     updated_at = models.DateTimeField(default=timezone.now)
     submitted_at = models.DateTimeField(null=True, blank=True)
-    return_comment = models.TextField(blank=True)
+    # Bounded like every free-text field (segmentation.limits): it is shown in the
+    # annotator's queue and review answers.
+    return_comment = models.TextField(blank=True, max_length=2000)
     returned_at = models.DateTimeField(null=True, blank=True)
 
     class Meta:
