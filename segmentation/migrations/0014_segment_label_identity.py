@@ -159,6 +159,9 @@ class Migration(migrations.Migration):
             model_name="librarysegment",
             index=models.Index(fields=["project", "label", "duration"], name="libseg_label_duration"),
         ),
+        # The bound of segmentation.limits (no change to the column).
+        migrations.AlterField(model_name="review", name="return_comment",
+                              field=models.TextField(blank=True, max_length=2000)),
         migrations.AddIndex(
             model_name="librarysegment",
             index=models.Index(fields=["project", "superseded", "-id"], include=("label", "duration", "agreement", "annotator", "is_gold", "capture"), name="libseg_list_recent"),
