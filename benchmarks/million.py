@@ -148,8 +148,8 @@ def populate(n, seed):
 
 
 COLUMNS = ("project_id", "capture_id", "annotator_id", "is_gold", "superseded", "label_id",
-           "label_name", "start", "stop", "duration", "agreement", "descriptor",
-           "descriptor_shape", "profile", "created_at")
+           "start", "stop", "duration", "agreement", "descriptor", "descriptor_shape", "profile",
+           "created_at")
 
 
 def _copy_rows(connection, rng, project_id, cap_ids, gold, label_ids, annotators, desc):
@@ -171,10 +171,10 @@ def _copy_rows(connection, rng, project_id, cap_ids, gold, label_ids, annotators
             for i in range(count):
                 cap = int(caps[i])
                 is_gold = cap in gold and gold_draw[i] < 0.25
-                label_id, label_name = label_ids[labs[i]]
+                label_id, _ = label_ids[labs[i]]
                 copy.write_row((
                     project_id, cap, None if is_gold else annotators[anns[i]].pk, is_gold,
-                    not is_gold and cap in gold, label_id, label_name, int(starts[i]),
+                    not is_gold and cap in gold, label_id, int(starts[i]),
                     int(starts[i] + lengths[i]), float(lengths[i]) / 120.0,
                     float(agree[i]) if has_agree[i] else None, desc[i].tobytes(), "[35, 35]",
                     desc[i, :3].tobytes(), now))

@@ -105,7 +105,8 @@ class Limits:
         The positions (12 bytes per joint per frame) may be at most this many times the
         size of the file, or :data:`EXPANSION_FLOOR_BYTES` when that is more.
     min_frames : int
-        Frames a take needs (0: an empty take can be read and written back).
+        Frames a take needs: at least one by default, since a file declaring ``Frames: 0``
+        holds a skeleton and no motion, which is not a take.
     min_frame_time, max_frame_time : float
         Seconds per frame (10 kHz to one frame every 10 s).
     max_length : float
@@ -119,7 +120,7 @@ class Limits:
     max_values: int = 60_000_000
     max_joint_frames: int = 20_000_000
     max_expansion: int = 16
-    min_frames: int = 0
+    min_frames: int = 1
     min_frame_time: float = 1e-4
     max_frame_time: float = 10.0
     max_length: float = 1e6

@@ -33,14 +33,16 @@ def review_cuts(review):
     return sorted(c.frame for c in review.kept_cuts())
 
 
-def review_segments(review):
-    return [(start, stop, label) for _, start, stop, label in review.segments()]
+def review_segments(review, label="label__name"):
+    """``[(start, stop, label name or None)]``, or label ids with ``label="label_id"``."""
+    return [(start, stop, x) for _, start, stop, x in review.segments(label)]
 
 
-def compute(capture, reviews, tolerance_s=DEFAULT_TOLERANCE_S):
-    """motionlib's take agreement over ``reviews`` (at least one)."""
+def compute(capture, reviews, tolerance_s=DEFAULT_TOLERANCE_S, label="label__name"):
+    """motionlib's take agreement over ``reviews`` (at least one), labels named by
+    ``label`` (see ``review_segments``)."""
     return take_agreement(
-        [review_segments(r) for r in reviews],
+        [review_segments(r, label) for r in reviews],
         [review_cuts(r) for r in reviews],
         n_frames=capture.n_frames,
         fps=capture.fps,
@@ -102,17 +104,18 @@ def _pair(pair, reviews):
 
 
 def refresh_capture_agreement(capture, reviews=None):
-    """Recompute and store the capture's summary row; returns it."""
+    """Recompute and store the capture's summary row (per label by label id, so that it
+    follows a rename); returns it."""
     reviews = submitted_reviews(capture) if reviews is None else reviews
     fields = {"n_reviews": len(reviews), "boundary_f1": None, "label_agreement": None,
               "per_label": {}}
     if len(reviews) >= 2:
-        result = compute(capture, reviews)
+        result = compute(capture, reviews, label="label_id")
         fields["boundary_f1"] = finite(result["mean_boundary_f1"])
         fields["label_agreement"] = finite(label_measure(result, len(reviews))[1])
         fields["per_label"] = {
-            name: {"overlap": finite(v["overlap"]), "frames": v["frames"]}
-            for name, v in result["per_label"].items()
+            str(label_id): {"overlap": finite(v["overlap"]), "frames": v["frames"]}
+            for label_id, v in result["per_label"].items()
         }
     row, _ = CaptureAgreement.objects.update_or_create(capture=capture, defaults=fields)
     return row

@@ -56,7 +56,7 @@ def dashboard(project):
         row["assigned"] = team[row["id"]]["assigned"]
         row["review_states"] = team[row["id"]]["reviews"]
     return {"project": project.pk, "states": counts, "captures": rows,
-            "annotators": annotator_throughput(project), "labels": label_agreement(summaries),
+            "annotators": annotator_throughput(project), "labels": label_agreement(summaries, dict(project.labels.values_list("id", "name"))),
             "library": library_counts(project)}
 
 
@@ -90,14 +90,15 @@ def annotator_throughput(project):
     return sorted(people.values(), key=lambda p: p["username"])
 
 
-def label_agreement(summaries):
-    """Per label over the project's captures: frame-weighted mean overlap."""
+def label_agreement(summaries, names):
+    """Per label over the project's captures: frame-weighted mean overlap, under the
+    labels' current ``names`` (by id)."""
     totals = {}
     for summary in summaries.values():
-        for name, v in summary.per_label.items():
-            if v["overlap"] is None:
+        for label_id, v in summary.per_label.items():
+            if v["overlap"] is None or int(label_id) not in names:
                 continue
-            entry = totals.setdefault(name, [0.0, 0, 0])
+            entry = totals.setdefault(names[int(label_id)], [0.0, 0, 0])
             entry[0] += v["overlap"] * v["frames"]
             entry[1] += v["frames"]
             entry[2] += 1

@@ -51,7 +51,7 @@ def file_stem(segment):
     if "#" in segment.capture.name:  # "take.fbx#walk": the animation after the file stem
         base, animation = segment.capture.name.split("#", 1)
         stem = f"{PurePath(base).stem}_{animation}"
-    return f"{slug(stem)}_{slug(segment.label_name)}_{segment.start}-{segment.stop}"
+    return f"{slug(stem)}_{slug(segment.label.name)}_{segment.start}-{segment.stop}"
 
 
 def clip_files(capture, take, segments, fmt):
@@ -88,7 +88,7 @@ def slug(text):
 def file_name(segment):
     """``capture_label_start-stop.bvh`` with safe characters only."""
     stem = PurePath(segment.capture.name).stem
-    return f"{slug(stem)}_{slug(segment.label_name)}_{segment.start}-{segment.stop}.bvh"
+    return f"{slug(stem)}_{slug(segment.label.name)}_{segment.start}-{segment.stop}.bvh"
 
 
 def bvh_text(take, segment):
@@ -122,7 +122,7 @@ def manifest_row(segment, name, fmt="bvh"):
     return {
         "file": name, "format": fmt, "segment": segment.pk, "capture": segment.capture.name,
         "capture_id": segment.capture_id, "start": segment.start, "stop": segment.stop,
-        "label": segment.label_name, "gold": segment.is_gold,
+        "label": segment.label.name, "gold": segment.is_gold,
         "annotator": segment.annotator.username if segment.annotator else None,
         "agreement": segment.agreement,
     }

@@ -91,7 +91,7 @@ def unlabelled_spans(capture, annotator):
 def stored(capture, key, spans):
     """{(start, stop): label name or None} of ``spans`` stored for the pool ``key``."""
     rows = LabelSuggestion.objects.filter(capture=capture, pool=key)
-    found = {(s, e): name or None for s, e, name in rows.values_list("start", "stop", "label_name")}
+    found = dict(((s, e), name) for s, e, name in rows.values_list("start", "stop", "label__name"))
     return {span: found[span] for span in spans if span in found}
 
 
@@ -159,7 +159,7 @@ def fill(capture, annotator):
         suggester = suggester or at_low_priority(Suggester, capture, annotator)
         labels = at_low_priority(suggester.labels, batch)
         LabelSuggestion.objects.bulk_create(
-            [LabelSuggestion(capture=capture, pool=key, start=s, stop=e, label_name=label or "")
+            [LabelSuggestion(capture=capture, pool=key, start=s, stop=e, label_id=label)
              for (s, e), label in zip(batch, labels, strict=True)],
             ignore_conflicts=True)
         computed += len(batch)
@@ -228,7 +228,7 @@ class Suggester:
         self.ids, self.profiles, self.names = [], None, {}
         if self.joints is not None:
             rows = list(pool(capture, annotator).order_by("-is_gold", "-id")
-                        .values_list("id", "profile", "label_name")[:SIMILAR_POOL])
+                        .values_list("id", "profile", "label_id")[:SIMILAR_POOL])
             self.names = {pk: name for pk, _, name in rows}
             self.rows = [(pk, blob) for pk, blob, _ in rows]
 
@@ -238,7 +238,7 @@ class Suggester:
                                              fps=self.capture.fps, scale=self.scale)
 
     def labels(self, spans):
-        """A label name or None for each ``(start, stop)``."""
+        """A label id or None for each ``(start, stop)``."""
         if self.joints is None or not self.names:
             return [None] * len(spans)
         queries = [self.descriptor(s, e) for s, e in spans]

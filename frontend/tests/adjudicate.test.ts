@@ -53,7 +53,7 @@ describe("undo history of gold drafts", () => {
 });
 
 describe("the label palette filter", () => {
-  const labels = ["walk", "crawl", "cartwheel", "kick"].map((name, id) => ({ id, name, color: "#000000", hotkey: null }));
+  const labels = ["walk", "crawl", "cartwheel", "kick"].map((name, id) => ({ id, name, color: "#000000", hotkey: null, retired: false }));
   it("lists names starting with the text first, then names containing it", () => {
     expect(filterLabels(labels, "c").map((l) => l.name)).toEqual(["crawl", "cartwheel", "kick"]);
     expect(filterLabels(labels, "WAL").map((l) => l.name)).toEqual(["walk"]);

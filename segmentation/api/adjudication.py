@@ -10,9 +10,15 @@ from rest_framework.views import APIView
 from segmentation import agreement
 from segmentation.api.agreement import AgreementSerializer, staff_capture
 from segmentation.api.params import body
-from segmentation.api.serializers import DetailSerializer, NamedRefSerializer, UserRefSerializer
+from segmentation.api.serializers import (
+    DetailSerializer,
+    NamedRefSerializer,
+    Text,
+    UserRefSerializer,
+)
 from segmentation.errors import Invalid
-from segmentation.models import Adjudication, Review
+from segmentation.limits import text_limit
+from segmentation.models import Adjudication, Label, Review
 from segmentation.services.gold import do_save_gold
 
 
@@ -41,9 +47,12 @@ class AdjudicationCaptureSerializer(NamedRefSerializer):
 
 
 class AdjudicationLabelSerializer(serializers.Serializer):
+    id = serializers.IntegerField()
     name = serializers.CharField()
     color = serializers.CharField()
     hotkey = serializers.CharField(allow_null=True)
+    retired = serializers.BooleanField(help_text="Kept on segments that carry it; not offered "
+                                                 "for new ones")
 
 
 class AdjudicationReviewSerializer(serializers.Serializer):
@@ -70,7 +79,7 @@ class StaleGoldSerializer(DetailSerializer):
 
 class GoldSerializer(serializers.Serializer):
     cuts = serializers.ListField(child=serializers.IntegerField())
-    labels = serializers.ListField(child=serializers.CharField(allow_null=True))
+    labels = serializers.ListField(child=Text(text_limit(Label, "name"), allow_null=True))
     version = serializers.IntegerField(min_value=0)
     source_review = serializers.IntegerField(required=False, allow_null=True)
 
@@ -78,9 +87,10 @@ class GoldSerializer(serializers.Serializer):
 def gold_body(gold):
     if gold is None:
         return None
+    segments = gold.segments()
     return {
-        "version": gold.version, "cuts": gold.cuts, "labels": gold.labels,
-        "segments": [{"start": a, "stop": b, "label": c} for a, b, c in gold.segments()],
+        "version": gold.version, "cuts": gold.cuts, "labels": [c for _, _, c in segments],
+        "segments": [{"start": a, "stop": b, "label": c} for a, b, c in segments],
         "adjudicator": gold.adjudicator.username if gold.adjudicator else None,
         "source_review": gold.source_review_id, "updated_at": gold.updated_at,
     }
@@ -93,8 +103,8 @@ def adjudication_body(capture):
     return {
         "capture": {"id": capture.pk, "name": capture.name, "fps": capture.fps,
                     "n_frames": capture.n_frames, "project": capture.project_id},
-        "labels": [{"name": x.name, "color": x.color, "hotkey": x.hotkey}
-                   for x in capture.project.labels.all()],
+        "labels": [{"id": x.pk, "name": x.name, "color": x.color, "hotkey": x.hotkey,
+                    "retired": x.retired} for x in capture.project.labels.all()],
         "reviews": [
             {"id": r.pk, "annotator": {"id": r.annotator_id, "username": r.annotator.username},
              "status": r.status, "cuts": agreement.review_cuts(r),

@@ -13,8 +13,9 @@ from rest_framework.views import APIView
 from segmentation.api.captures import capture_for
 from segmentation.api.params import body, int_param
 from segmentation.api.projects import project_for
-from segmentation.api.serializers import NamedRefSerializer, ReviewSerializer
-from segmentation.models import Assignment, Project
+from segmentation.api.serializers import NamedRefSerializer, ReviewSerializer, Text
+from segmentation.limits import USERNAME_LENGTH, text_limit
+from segmentation.models import Assignment, Project, Review
 from segmentation.services import assignments as service
 from segmentation.services import queue as queues
 from segmentation.services import returns
@@ -46,18 +47,18 @@ class AssignmentSerializer(serializers.ModelSerializer):
 
 class AssignRequest(serializers.Serializer):
     captures = serializers.ListField(child=serializers.IntegerField(), allow_empty=False)
-    annotators = serializers.ListField(child=serializers.CharField(), allow_empty=False)
+    annotators = serializers.ListField(child=Text(USERNAME_LENGTH), allow_empty=False)
     per_capture = serializers.IntegerField(required=False, allow_null=True, default=None,
                                            help_text="Each capture to this many of the annotators, "
                                                      "spread evenly; omitted: to all of them.")
 
 
 class ReassignRequest(serializers.Serializer):
-    annotator = serializers.CharField()
+    annotator = Text(USERNAME_LENGTH)
 
 
 class ReturnRequest(serializers.Serializer):
-    comment = serializers.CharField(allow_blank=True)
+    comment = Text(text_limit(Review, "return_comment"), allow_blank=True)
 
 
 class QueueCaptureSerializer(NamedRefSerializer):

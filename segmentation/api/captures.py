@@ -11,12 +11,13 @@ from rest_framework import mixins, viewsets
 from rest_framework.decorators import action
 from rest_framework.exceptions import NotFound, PermissionDenied
 from rest_framework.pagination import PageNumberPagination
-from rest_framework.parsers import FormParser, JSONParser, MultiPartParser
+from rest_framework.parsers import FormParser, MultiPartParser
 from rest_framework.response import Response
 
 from segmentation import services, storage
 from segmentation.api.heavy import immutable
 from segmentation.api.params import body, int_param
+from segmentation.api.parsers import BoundedJSONParser
 from segmentation.api.projects import project_for
 from segmentation.api.serializers import (
     CaptureListSerializer,
@@ -47,7 +48,7 @@ class CaptureViewSet(
 ):
     serializer_class = CaptureSerializer
     pagination_class = CapturePagination
-    parser_classes = [MultiPartParser, FormParser, JSONParser]
+    parser_classes = [MultiPartParser, FormParser, BoundedJSONParser]
 
     def get_serializer_class(self):
         return CaptureListSerializer if self.action == "list" else super().get_serializer_class()

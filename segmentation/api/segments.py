@@ -28,7 +28,7 @@ from segmentation.storage import read_take
 ORDERINGS = {
     "recent": ("-id",), "duration": ("duration", "id"), "-duration": ("-duration", "-id"),
     "agreement": ("agreement", "id"), "-agreement": ("-agreement", "-id"),
-    "label": ("label_name", "id"), "capture": ("capture_id", "start", "id"),
+    "label": ("label__name", "id"), "capture": ("capture_id", "start", "id"),
 }
 
 
@@ -97,7 +97,7 @@ class SegmentPagination(PageNumberPagination):
 class SegmentSerializer(serializers.ModelSerializer):
     capture = serializers.SerializerMethodField()
     annotator = serializers.SerializerMethodField()
-    label = serializers.CharField(source="label_name")
+    label = serializers.CharField(source="label.name")
     color = serializers.SerializerMethodField()
     gold = serializers.BooleanField(source="is_gold")
     fps = serializers.FloatField(source="capture.fps")
@@ -133,7 +133,7 @@ def segment_query(request):
         if value is not None:
             segments = segments.filter(**{field: value})
     if request.query_params.get("label"):
-        segments = segments.filter(label_name=request.query_params["label"])
+        segments = segments.filter(label__name=request.query_params["label"])
     for name, lookup, high in (("min_duration", "duration__gte", None),
                                ("max_duration", "duration__lte", None),
                                ("min_agreement", "agreement__gte", 1)):
@@ -209,7 +209,7 @@ class SegmentZipView(APIView):
         if count > exports.MAX_EXPORT_SEGMENTS:
             raise Invalid(f"export: the query matches {count} segments; export at most "
                           f"{exports.MAX_EXPORT_SEGMENTS} at a time (narrow the filters)")
-        rows = (segments.select_related("capture", "annotator").defer("descriptor", "profile")
+        rows = (segments.select_related("capture", "annotator", "label").defer("descriptor", "profile")
                 .order_by("capture_id", "start", "id").iterator(chunk_size=200))
         response = StreamingHttpResponse(exports.stream_zip(rows, fmt),
                                          content_type="application/zip")

@@ -4,17 +4,30 @@ check the request's shape, and the services check its meaning."""
 from drf_spectacular.utils import extend_schema_field
 from rest_framework import serializers
 
+from segmentation.limits import USERNAME_LENGTH, text_limit
 from segmentation.models import (
     ROLES,
     Capture,
     Cut,
     DetectionRun,
     Label,
+    Project,
     ProjectCutModel,
     Review,
     ReviewEvent,
 )
 from segmentation.services.adaptation import adaptation_summary
+
+
+class Text(serializers.CharField):
+    """A free-text request field with its bound (see ``segmentation.limits``): a longer
+    value is refused saying the bound and its length, as the services do."""
+
+    def __init__(self, max_length, **kwargs):
+        messages = kwargs.pop("error_messages", {})
+        messages.setdefault("max_length",
+                            "must be at most {max_length} characters, got %(show_value)d")
+        super().__init__(max_length=max_length, error_messages=messages, **kwargs)
 
 
 class UserRefSerializer(serializers.Serializer):
@@ -38,8 +51,9 @@ class DetailSerializer(serializers.Serializer):
 
 
 class LabelSerializer(serializers.ModelSerializer):
-    hotkey = serializers.CharField(allow_null=True, required=False, default=None)
-    color = serializers.CharField(required=False, default="#888888")
+    name = Text(text_limit(Label, "name"))
+    hotkey = Text(text_limit(Label, "hotkey"), allow_null=True, required=False, default=None)
+    color = Text(text_limit(Label, "color"), required=False, default="#888888")
 
     class Meta:
         model = Label
@@ -51,9 +65,10 @@ class LabelSerializer(serializers.ModelSerializer):
 
 class ProjectSerializer(serializers.Serializer):
     id = serializers.IntegerField(read_only=True)
-    name = serializers.CharField(max_length=200)
+    name = Text(text_limit(Project, "name"))
     role = serializers.SerializerMethodField()
-    default_method = serializers.CharField(required=False, allow_blank=True, default="")
+    default_method = Text(text_limit(Project, "default_method"), required=False, allow_blank=True,
+                          default="")
     default_params = serializers.DictField(required=False, default=dict)
     annotators_pick_unassigned = serializers.BooleanField(required=False, default=True)
     labels = LabelSerializer(many=True, read_only=True)
@@ -115,7 +130,8 @@ class ErrorField(serializers.CharField):
 
 class MemberSerializer(serializers.Serializer):
     id = serializers.IntegerField(source="user.id", read_only=True)
-    username = serializers.CharField(source="user.username")
+    username = Text(USERNAME_LENGTH, source="user.username", error_messages={
+        "max_length": "must be 1 to {max_length} characters, got %(show_value)d"})
     role = serializers.ChoiceField(choices=ROLES)
 
 
@@ -157,7 +173,7 @@ class CutModelSerializer(serializers.ModelSerializer):
 
 
 class RunRequestSerializer(serializers.Serializer):
-    method = serializers.CharField(required=False, allow_blank=True, default="")
+    method = Text(text_limit(DetectionRun, "method"), required=False, allow_blank=True, default="")
     params = serializers.DictField(required=False, default=dict)
 
 
@@ -431,7 +447,7 @@ class ChangeCutSerializer(VersionSerializer):
 
 
 class LabelSegmentSerializer(VersionSerializer):
-    label = serializers.CharField(allow_null=True)
+    label = Text(text_limit(Label, "name"), allow_null=True)
 
 
 class EventSerializer(serializers.ModelSerializer):

@@ -15,8 +15,9 @@ from rest_framework.views import APIView
 
 from segmentation.api.params import body
 from segmentation.api.projects import project_for
-from segmentation.api.serializers import LabelSerializer, MemberSerializer
-from segmentation.models import ROLES
+from segmentation.api.serializers import LabelSerializer, MemberSerializer, Text
+from segmentation.limits import USERNAME_LENGTH, text_limit
+from segmentation.models import ROLES, Label
 from segmentation.services import taxonomy, team
 
 
@@ -32,7 +33,7 @@ class RoleRequest(serializers.Serializer):
 
 
 class NewAccountRequest(serializers.Serializer):
-    username = serializers.CharField(max_length=150)
+    username = Text(USERNAME_LENGTH)
     role = serializers.ChoiceField(choices=ROLES)
 
 
@@ -41,9 +42,9 @@ class NewAccountResponse(MemberSerializer):
 
 
 class LabelChange(serializers.Serializer):
-    name = serializers.CharField(required=False)
-    color = serializers.CharField(required=False)
-    hotkey = serializers.CharField(required=False, allow_null=True, allow_blank=True)
+    name = Text(text_limit(Label, "name"), required=False)
+    color = Text(text_limit(Label, "color"), required=False)
+    hotkey = Text(text_limit(Label, "hotkey"), required=False, allow_null=True, allow_blank=True)
     retired = serializers.BooleanField(required=False)
 
 

@@ -54,8 +54,9 @@ class LibrarySegment(models.Model):
     is_gold = models.BooleanField(default=False)
     # An annotator's segment of a capture that has a gold version.
     superseded = models.BooleanField(default=False)
-    label = models.ForeignKey(Label, models.SET_NULL, null=True, blank=True, related_name="+")
-    label_name = models.CharField(max_length=100)
+    # By identity: a renamed label shows its new name on every segment at once, and a
+    # label that segments carry cannot be deleted from under them.
+    label = models.ForeignKey(Label, models.RESTRICT, related_name="+")
     start = models.PositiveIntegerField()
     stop = models.PositiveIntegerField()
     duration = models.FloatField()
@@ -76,7 +77,7 @@ class LibrarySegment(models.Model):
         ordering = ["-id"]
         indexes = [
             models.Index(fields=["project", "superseded", "-id"], name="libseg_project_recent"),
-            models.Index(fields=["project", "label_name", "duration"], name="libseg_label_duration"),
+            models.Index(fields=["project", "label", "duration"], name="libseg_label_duration"),
             models.Index(fields=["project", "annotator", "-id"], name="libseg_annotator"),
             models.Index(fields=["project", "is_gold", "-id"], name="libseg_gold"),
             models.Index(fields=["project", "agreement"], name="libseg_agreement"),
@@ -84,23 +85,23 @@ class LibrarySegment(models.Model):
             # The list's default view in its default order, with every filtered column, so
             # that a page's ids and a capped count come from the index alone.
             models.Index(fields=["project", "superseded", "-id"], name="libseg_list_recent",
-                         include=["label_name", "duration", "agreement", "annotator", "is_gold",
+                         include=["label", "duration", "agreement", "annotator", "is_gold",
                                   "capture"]),
             # The same across projects (every project a reviewer sees, an annotator's own
             # and gold segments).
             models.Index(fields=["superseded", "-id"], name="libseg_list_all",
-                         include=["project", "label_name", "duration", "agreement", "annotator",
+                         include=["project", "label", "duration", "agreement", "annotator",
                                   "is_gold", "capture"]),
             # The same for a label (its segments newest first, or every label in order) and
             # for an annotator.
-            models.Index(fields=["project", "superseded", "label_name", "id"], name="libseg_list_label",
+            models.Index(fields=["project", "superseded", "label", "id"], name="libseg_list_label",
                          include=["duration", "agreement", "annotator", "is_gold", "capture"]),
             models.Index(fields=["project", "superseded", "annotator", "-id"],
                          name="libseg_list_annotator",
-                         include=["label_name", "duration", "agreement", "is_gold", "capture"]),
+                         include=["label", "duration", "agreement", "is_gold", "capture"]),
             models.Index(fields=["project", "superseded", "-agreement", "-id"],
                          name="libseg_list_agreement",
-                         include=["label_name", "duration", "annotator", "is_gold", "capture"]),
+                         include=["label", "duration", "annotator", "is_gold", "capture"]),
             # The similar-clip index reads a project's described segments by id (all of
             # them, or those newer than the index file).
             models.Index(fields=["project", "id"], name="libseg_described",
@@ -108,7 +109,7 @@ class LibrarySegment(models.Model):
         ]
 
     def __str__(self):
-        return f"{self.label_name} {self.start}-{self.stop} of {self.capture_id}"
+        return f"label {self.label_id} {self.start}-{self.stop} of {self.capture_id}"
 
     def descriptor_array(self):
         if self.descriptor is None:
@@ -119,8 +120,10 @@ class LibrarySegment(models.Model):
 class Adjudication(models.Model):
     """The gold version of a capture: cut frames and one label per segment.
 
-    ``labels`` has ``len(cuts) + 1`` entries (label names or null), one per segment in
-    frame order. ``version`` guards against two reviewers overwriting each other.
+    ``labels`` has ``len(cuts) + 1`` entries, one per segment in frame order: the id of a
+    label of the capture's project, or null. Ids, not names, so that a rename or a retire
+    leaves the gold version as it was. ``version`` guards against two reviewers
+    overwriting each other.
     """
 
     capture = models.OneToOneField(Capture, models.CASCADE, related_name="adjudication")
@@ -139,10 +142,21 @@ class Adjudication(models.Model):
     def __str__(self):
         return f"gold version of {self.capture}"
 
-    def segments(self):
-        """``[(start, stop, label name or None)]`` in frame order."""
+    def label_segments(self):
+        """``[(start, stop, label id or None)]`` in frame order."""
         bounds = [0, *self.cuts, self.capture.n_frames]
         return list(zip(bounds[:-1], bounds[1:], self.labels, strict=True))
+
+    def label_names(self):
+        """The labels' current names, one per segment (None where unlabelled)."""
+        names = dict(Label.objects.filter(pk__in=[x for x in self.labels if x is not None])
+                     .values_list("id", "name"))
+        return [names[x] if x is not None else None for x in self.labels]
+
+    def segments(self):
+        """``[(start, stop, label name or None)]`` in frame order, with current names."""
+        bounds = [0, *self.cuts, self.capture.n_frames]
+        return list(zip(bounds[:-1], bounds[1:], self.label_names(), strict=True))
 
 
 class CaptureAgreement(models.Model):
@@ -153,7 +167,7 @@ class CaptureAgreement(models.Model):
     boundary_f1 = models.FloatField(null=True, blank=True)
     # Cohen's kappa for two reviews, Krippendorff's alpha for more.
     label_agreement = models.FloatField(null=True, blank=True)
-    # {label: {"overlap": IoU, "frames": n}}
+    # {label id (a string, as JSON keys are): {"overlap": IoU, "frames": n}}
     per_label = models.JSONField(default=dict)
     computed_at = models.DateTimeField(default=timezone.now)
 
@@ -187,8 +201,8 @@ class LabelSuggestion(models.Model):
     pool = models.CharField(max_length=100)
     start = models.PositiveIntegerField()
     stop = models.PositiveIntegerField()
-    # "" when nothing in the pool can name the span (no descriptor, empty pool).
-    label_name = models.CharField(max_length=100, blank=True)
+    # Null when nothing in the pool can name the span (no descriptor, empty pool).
+    label = models.ForeignKey(Label, models.CASCADE, null=True, blank=True, related_name="+")
 
     class Meta:
         constraints = [
@@ -197,7 +211,7 @@ class LabelSuggestion(models.Model):
         ]
 
     def __str__(self):
-        return f"{self.label_name or '-'} for {self.start}-{self.stop} of {self.capture_id}"
+        return f"label {self.label_id or '-'} for {self.start}-{self.stop} of {self.capture_id}"
 
 
 class SuggestionRequest(models.Model):

@@ -30,7 +30,9 @@ class Review(models.Model):
     created_at = models.DateTimeField(default=timezone.now)
     updated_at = models.DateTimeField(default=timezone.now)
     submitted_at = models.DateTimeField(null=True, blank=True)
-    return_comment = models.TextField(blank=True)
+    # Bounded like every free-text field (segmentation.limits): it is shown in the
+    # annotator's queue and review answers.
+    return_comment = models.TextField(blank=True, max_length=2000)
     returned_at = models.DateTimeField(null=True, blank=True)
 
     class Meta:
@@ -51,15 +53,16 @@ class Review(models.Model):
         one-hour take has thousands of cuts, and every edit asks."""
         return list(self.cuts.exclude(fate="deleted").order_by("frame", "id").values_list("id", "frame"))
 
-    def segments(self, kept=None):
-        """Intervals between kept cuts: list of (index, start, stop, label name or None).
+    def segments(self, kept=None, label="label__name"):
+        """Intervals between kept cuts: list of (index, start, stop, label name or None),
+        or the label's id with ``label="label_id"``.
 
         A segment's label is stored against the cut that starts it (no cut for the
         first segment), so labels follow their cut when it is moved. ``kept`` is
         ``kept_frames()`` when the caller has read it already.
         """
         kept = self.kept_frames() if kept is None else kept
-        labels = dict(self.segment_labels.filter(label__isnull=False).values_list("cut_id", "label__name"))
+        labels = dict(self.segment_labels.filter(label__isnull=False).values_list("cut_id", label))
         starts = [(None, 0)] + kept
         stops = [frame for _, frame in kept] + [self.capture.n_frames or 0]
         return [

@@ -18,31 +18,31 @@ from segmentation.models import Adjudication, LibrarySegment
 def refresh_capture_library(capture):
     """Rebuild a capture's library rows from its submitted reviews and gold version.
 
-    Only labelled segments enter the library. An annotator's segment carries the share of
-    the other annotators' frames that agree with its label; a gold segment the share of
-    all annotators' frames. Annotators' segments of a capture with gold are superseded.
+    Only labelled segments enter the library, each with its label's id (a rename shows on
+    it without a rebuild). An annotator's segment carries the share of the other
+    annotators' frames that agree with its label; a gold segment the share of all
+    annotators' frames. Annotators' segments of a capture with gold are superseded.
     """
     reviews = agreement.submitted_reviews(capture)
     gold = Adjudication.objects.filter(capture=capture).first()
-    lists = [agreement.review_segments(r) for r in reviews]
+    lists = [agreement.review_segments(r, label="label_id") for r in reviews]
     if gold:
-        lists.append(gold.segments())
+        lists.append(gold.label_segments())
     codes, _ = label_codes(lists, capture.n_frames)
-    labels = {label.name: label for label in capture.project.labels.all()}
     n = len(reviews)
     rows = []
     for row, segments in enumerate(lists):
         review = reviews[row] if row < n else None
-        for start, stop, name in segments:
-            if name is None or stop <= start:
+        for start, stop, label_id in segments:
+            if label_id is None or stop <= start:
                 continue
             support = (segment_support(codes[:n], row, start, stop) if review
                        else _gold_support(codes, n, start, stop))
             rows.append(LibrarySegment(
                 project_id=capture.project_id, capture=capture, review=review,
                 annotator_id=review.annotator_id if review else None, is_gold=review is None,
-                superseded=bool(gold) and review is not None, label=labels.get(name),
-                label_name=name, start=start, stop=stop, duration=(stop - start) / capture.fps,
+                superseded=bool(gold) and review is not None, label_id=label_id,
+                start=start, stop=stop, duration=(stop - start) / capture.fps,
                 agreement=agreement.finite(support)))
     for segment, descriptor in zip(rows, descriptors(capture, [(r.start, r.stop) for r in rows]),
                                    strict=True):

@@ -5,6 +5,7 @@ from django.db.models import F
 from django.utils import timezone
 
 from segmentation.errors import Invalid, ReviewClosed
+from segmentation.limits import check_text, text_limit
 from segmentation.models import Review, ReviewEvent
 from segmentation.services.library import on_review_submitted
 
@@ -18,6 +19,7 @@ def do_return_review(review, reviewer, comment):
     comment = (comment or "").strip()
     if not comment:
         raise Invalid("comment: say what the annotator should change")
+    check_text("comment", comment, text_limit(Review, "return_comment"))
     with transaction.atomic():
         now = timezone.now()
         updated = Review.objects.filter(pk=review.pk, status="submitted").update(

@@ -46,7 +46,7 @@ def test_it_makes_a_gold_version_from_two_annotators_reviews(live_server, new_pa
     page.screenshot(path=str(screenshots / "adjudication.png"))
 
     saved = Adjudication.objects.get(capture=ingested_capture)
-    assert (saved.cuts, saved.labels) == (cuts, ["walk", "punch", "walk", "kick"])
+    assert (saved.cuts, saved.label_names()) == (cuts, ["walk", "punch", "walk", "kick"])
     assert saved.version == 1 and saved.source_review_id == ann_review.pk
     assert saved.adjudicator.username == "rachel"
 
@@ -207,3 +207,28 @@ def test_tiers_feed_the_gold_tier_with_undo_snap_and_the_409_rule(live_server, n
     saved = Adjudication.objects.get(capture=ingested_capture)
     assert (saved.version, saved.cuts) == (2, [c2])
     assert page.errors == []
+
+
+def test_it_offers_a_retired_label_only_where_a_segment_already_carries_it(live_server, new_page, ingested_capture, studio):
+    from segmentation.models import Adjudication
+    from segmentation.services.taxonomy import do_change_label
+
+    _, cuts = two_reviews(ingested_capture, studio)
+    do_change_label(ingested_capture.project.labels.get(name="squat"), retired=True)
+    page = new_page("rachel")
+    page.goto(f"{live_server.url}/captures/{ingested_capture.pk}/adjudicate/")
+    page.get_by_test_id("use-ann").click()
+    gold = page.get_by_test_id("track-gold")
+    # ann labelled [c1, c2) squat before it was retired: the segment keeps it.
+    gold.get_by_test_id("track-gold-seg-2").click()
+    chosen = page.get_by_test_id("gold-label").locator("option:checked")
+    expect(chosen).to_have_text("squat (retired)")
+    # Another segment is not offered it.
+    gold.get_by_test_id("track-gold-seg-0").click()
+    expect(page.get_by_test_id("gold-segment")).to_contain_text(f"frames 0–{cuts[0]}")
+    options = page.get_by_test_id("gold-label").locator("option")
+    expect(options).to_have_text(["(unlabelled)", "walk (1)", "punch (2)", "kick (4)", "jumping_jack (5)"])
+    page.get_by_test_id("save-gold").click()
+    expect(page.get_by_test_id("gold-status")).to_have_text("Saved")
+    saved = Adjudication.objects.get(capture=ingested_capture)
+    assert saved.label_names() == ["walk", "punch", "squat", "kick"]

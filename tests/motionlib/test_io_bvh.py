@@ -7,7 +7,7 @@ import pytest
 from numpy.testing import assert_allclose, assert_array_equal
 
 import motionlib
-from motionlib import synth
+from motionlib import CaptureError, synth
 
 SMALL = """HIERARCHY
 ROOT Hips
@@ -77,10 +77,17 @@ def test_it_reads_crlf_and_tabs_and_blank_lines_alike(tmp_path):
     assert crlf.skeleton.names == plain.skeleton.names
 
 
-def test_it_reads_a_take_with_no_frames(tmp_path):
+def test_it_refuses_a_take_with_no_frames_naming_the_line(tmp_path):
     text = SMALL.split("Frames:")[0] + "Frames: 0\nFrame Time: 0.01\n"
-    take = motionlib.read(write(tmp_path, text))
-    assert take.channels.shape == (0, 11) and take.rest_pose_frame is None
+    line = text.count("\n") - 1
+    with pytest.raises(CaptureError, match=rf"\.bvh:{line}: the take has 0 frames; a capture "
+                                           r"needs at least 1$"):
+        motionlib.read(write(tmp_path, text))
+
+
+def test_it_reads_a_take_of_one_frame(tmp_path):
+    text = SMALL.split("Frames:")[0] + "Frames: 1\nFrame Time: 0.01\n" + " ".join(["0"] * 11) + "\n"
+    assert motionlib.read(write(tmp_path, text)).channels.shape == (1, 11)
 
 
 def test_it_parses_plain_decimals_exactly_like_float(tmp_path):

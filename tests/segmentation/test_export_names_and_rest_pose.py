@@ -38,7 +38,7 @@ class ExportRoughEdgesTest(CmuLibraryTestCase):
     def test_a_clip_from_frame_0_of_a_cgspeed_take_leaves_out_the_t_pose(self):
         assert self.take.rest_pose_frame == 0
         submit_review(self.capture, self.bob, [469], ["JumpJack", None])
-        segment = LibrarySegment.objects.get(label_name="JumpJack")
+        segment = LibrarySegment.objects.get(label__name="JumpJack")
         response = self.client.get(f"/api/segments/{segment.pk}/export.bvh")
         path = self.media_root / "clip.bvh"
         path.parent.mkdir(parents=True, exist_ok=True)

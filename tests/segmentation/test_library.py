@@ -57,7 +57,7 @@ class MaterialisationTest(LibraryTestCase):
         services.do_submit_review(review, self.bob, review.version)
         rows = list(LibrarySegment.objects.order_by("start"))
         # Only the labelled first segment [0, 100) enters the library.
-        assert [(s.start, s.stop, s.label_name, s.annotator_id) for s in rows] == [
+        assert [(s.start, s.stop, s.label.name, s.annotator_id) for s in rows] == [
             (0, 100, "walk", self.bob.pk)]
         assert rows[0].duration == 100 / 120
         assert rows[0].agreement is None  # nobody else reviewed it yet
@@ -155,7 +155,7 @@ class SegmentDetailTest(LibraryTestCase):
         self.two_reviews()
         danas = LibrarySegment.objects.filter(annotator=self.dana).first()
         self.login(self.dana)
-        assert self.client.get(f"/api/segments/{danas.pk}/").json()["label"] == danas.label_name
+        assert self.client.get(f"/api/segments/{danas.pk}/").json()["label"] == danas.label.name
         self.login(self.bob)
         assert self.client.get(f"/api/segments/{danas.pk}/").status_code == 404
         self.login(self.charlie)
@@ -235,4 +235,4 @@ class LostPositionsTest(LibraryTestCase):
         Path(capture.positions.path).unlink()
         submit_review(capture, self.bob, [100], ["walk", "punch"])
         rows = LibrarySegment.objects.order_by("start")
-        assert [(r.label_name, r.descriptor) for r in rows] == [("walk", None), ("punch", None)]
+        assert [(r.label.name, r.descriptor) for r in rows] == [("walk", None), ("punch", None)]

@@ -93,7 +93,7 @@ class ExportTest(CmuLibraryTestCase):
         self.login(self.rachel)
 
     def test_it_exports_a_segment_as_trimmed_bvh_with_the_original_hierarchy(self):
-        squat = LibrarySegment.objects.get(label_name="Squat")
+        squat = LibrarySegment.objects.get(label__name="Squat")
         response = self.client.get(f"/api/segments/{squat.pk}/export.bvh")
         assert response.status_code == 200
         assert response["Content-Disposition"] == 'attachment; filename="13_29_Squat_3805-4593.bvh"'
@@ -135,7 +135,7 @@ class ExportTest(CmuLibraryTestCase):
         assert "13_29_JumpJack_1-469.bvh" in names
 
     def test_it_hides_exports_of_segments_the_caller_may_not_see(self):
-        squat = LibrarySegment.objects.get(label_name="Squat")
+        squat = LibrarySegment.objects.get(label__name="Squat")
         for user in (self.dana, self.charlie):
             self.login(user)
             assert self.client.get(f"/api/segments/{squat.pk}/export.bvh").status_code == 404
@@ -150,7 +150,7 @@ class AmcExportTest(CmuLibraryTestCase):
         capture, take = self.real_capture(amc, asf)
         submit_review(capture, self.bob, [1417, 1933], [None, "Squat", "Jog"])
         self.login(self.bob)
-        squat = LibrarySegment.objects.get(label_name="Squat")
+        squat = LibrarySegment.objects.get(label__name="Squat")
         response = self.client.get(f"/api/segments/{squat.pk}/export.bvh")
         assert response["Content-Disposition"] == 'attachment; filename="13_30_Squat_1417-1933.bvh"'
         path = self.media_root / "squat.bvh"
@@ -173,7 +173,7 @@ class SimilarAndSuggestionsTest(CmuLibraryTestCase):
 
     def test_it_ranks_squats_nearest_to_a_squat(self):
         self.login(self.rachel)
-        squats = LibrarySegment.objects.filter(label_name="Squat").order_by("start")
+        squats = LibrarySegment.objects.filter(label__name="Squat").order_by("start")
         query = squats[1]
         body = self.client.get(f"/api/segments/{query.pk}/similar/?k=3").json()
         assert body["segment"] == query.pk
@@ -184,7 +184,7 @@ class SimilarAndSuggestionsTest(CmuLibraryTestCase):
 
     def test_it_ranks_twists_nearest_to_a_twist(self):
         self.login(self.rachel)
-        twist = LibrarySegment.objects.filter(label_name="Twist").order_by("start")[1]
+        twist = LibrarySegment.objects.filter(label__name="Twist").order_by("start")[1]
         body = self.client.get(f"/api/segments/{twist.pk}/similar/?k=3").json()
         assert [r["label"] for r in body["results"]] == ["Twist"] * 3
 

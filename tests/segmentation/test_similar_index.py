@@ -12,7 +12,7 @@ from django.test.utils import CaptureQueriesContext
 import motionlib
 from motionlib import similarity, synth, vector_index
 from motionlib.vector_index import IvfIndex
-from segmentation import descriptors, search, similar_index, tasks
+from segmentation import descriptors, search, services, similar_index, tasks
 from segmentation.models import LibrarySegment
 from tests.segmentation.base import BaseTestCase
 from tests.segmentation.test_library import submit_review
@@ -55,7 +55,7 @@ class SimilarIndexTestCase(BaseTestCase):
         rows = []
         for (start, stop), desc in zip(spans, descs, strict=True):
             row = LibrarySegment(project=self.project, capture=capture, annotator=annotator or self.bob,
-                                 label=self.walk, label_name="walk", start=start, stop=stop,
+                                 label=self.walk, start=start, stop=stop,
                                  duration=(stop - start) / 120)
             descriptors.store_descriptor(row, desc)
             rows.append(row)
@@ -129,7 +129,8 @@ class IncrementalTest(SimilarIndexTestCase):
         capture = self.ready_capture(name="theirs.bvh")
         capture.project = self.other_project
         capture.save()
-        theirs = LibrarySegment(project=self.other_project, capture=capture, label_name="x",
+        theirs_label = services.do_add_label(self.other_project, "x")
+        theirs = LibrarySegment(project=self.other_project, capture=capture, label=theirs_label,
                                 start=0, stop=10, duration=0.1)
         descriptors.store_descriptor(theirs, self.descs[0])
         theirs.save()

@@ -197,6 +197,11 @@ class AdjudicationPage {
     this.showPose(false);
   }
 
+  /** The labels offered for new gold segments: retired ones stay only where they are. */
+  private activeLabels(): LabelChoice[] {
+    return this.labels.filter((l) => !l.retired);
+  }
+
   private drawEditor(spans: Span[]): void {
     const index = segmentAt(this.draft, this.frame());
     const s = spans[index];
@@ -204,7 +209,10 @@ class AdjudicationPage {
       "select",
       { class: "select", "data-testid": "gold-label", "aria-label": "label of the gold segment under the playhead" },
       h("option", { value: "", selected: s.label === null }, "(unlabelled)"),
-      ...this.labels.map((l) => h("option", { value: l.name, selected: s.label === l.name }, l.hotkey ? `${l.name} (${l.hotkey})` : l.name)),
+      // A retired label is offered only on the segment that already carries it.
+      ...this.labels
+        .filter((l) => !l.retired || s.label === l.name)
+        .map((l) => h("option", { value: l.name, selected: s.label === l.name }, l.retired ? `${l.name} (retired)` : l.hotkey ? `${l.name} (${l.hotkey})` : l.name)),
     );
     select.addEventListener("change", () => {
       select.blur();
@@ -354,7 +362,7 @@ class AdjudicationPage {
         }
         return;
       case "label": {
-        const label = labelForHotkey(this.labels, c.hotkey);
+        const label = labelForHotkey(this.activeLabels(), c.hotkey);
         if (label) this.labelUnderPlayhead(label.name);
         else toast(`No label has hotkey ${c.hotkey}.`);
         return;
@@ -362,7 +370,7 @@ class AdjudicationPage {
       case "clearLabel":
         return this.labelUnderPlayhead(null);
       case "palette":
-        openPalette(this.labels, (name) => this.labelUnderPlayhead(name));
+        openPalette(this.activeLabels(), (name) => this.labelUnderPlayhead(name));
         return;
       case "help":
         this.toggleHelp();

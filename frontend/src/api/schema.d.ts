@@ -848,9 +848,12 @@ export interface components {
             project: number;
         };
         AdjudicationLabel: {
+            id: number;
             name: string;
             color: string;
             hotkey: string | null;
+            /** @description Kept on segments that carry it; not offered for new ones */
+            retired: boolean;
         };
         AdjudicationReview: {
             id: number;
