@@ -51,13 +51,13 @@ class TokenView(APIView):
 
     @extend_schema(request=AuthTokenSerializer, responses=IssuedTokenSerializer)
     def post(self, request):
-        wait = throttle.wait_seconds(request, throttle.username_of(request.data))
+        wait = throttle.admit(request, throttle.username_of(request.data))
         if wait:
             raise Throttled(wait, "Too many failed sign-ins for this account or from this address.")
         serializer = AuthTokenSerializer(data=request.data, context={"request": request})
         serializer.is_valid(raise_exception=True)
         user = serializer.validated_data["user"]
-        throttle.forget_failures(user.get_username())
+        throttle.succeeded(request, user.get_username())
         token, key = ApiToken.objects.issue(user)
         return Response(IssuedTokenSerializer({"token": key, "expires_at": token.expires_at}).data)
 
