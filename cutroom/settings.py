@@ -257,12 +257,14 @@ CUTROOM_DETECT_TIME_LIMIT = envint("CUTROOM_DETECT_TIME_LIMIT", 300)
 CUTROOM_RETRAIN_TIME_LIMIT = envint("CUTROOM_RETRAIN_TIME_LIMIT", 600)
 CUTROOM_SUGGEST_TIME_LIMIT = envint("CUTROOM_SUGGEST_TIME_LIMIT", 900)
 CUTROOM_TIME_LIMIT_GRACE = envint("CUTROOM_TIME_LIMIT_GRACE", 30)
-# Quotas (0 = no limit): uploads per user per hour, stored MB per project and per user,
-# detection runs queued or running at once per project.
+# Quotas (0 = no limit): uploads per user per hour (each animation of an FBX counts),
+# stored MB per project and per user, detection runs queued or running at once per project
+# and started by one person across projects.
 CUTROOM_UPLOADS_PER_HOUR = envint("CUTROOM_UPLOADS_PER_HOUR", 120)
 CUTROOM_PROJECT_STORAGE_MB = envint("CUTROOM_PROJECT_STORAGE_MB", 20 * 1024)
 CUTROOM_USER_STORAGE_MB = envint("CUTROOM_USER_STORAGE_MB", 10 * 1024)
 CUTROOM_PROJECT_ACTIVE_RUNS = envint("CUTROOM_PROJECT_ACTIVE_RUNS", 4)
+CUTROOM_USER_ACTIVE_RUNS = envint("CUTROOM_USER_ACTIVE_RUNS", 4)
 
 # Celery. No result backend: a job's state is its row (status, error, timings).
 # The embedded default's broker is one SQLite file (cutroom.broker): no server, and a

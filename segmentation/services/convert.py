@@ -16,6 +16,7 @@ from motionlib.io.fbx import read_fbx_all
 from motionlib.io.npz import take_bytes
 from segmentation import storage
 from segmentation.models import Capture
+from segmentation.services import quotas
 from segmentation.services.captures import _guarded
 from segmentation.services.jobs import enqueue
 
@@ -26,7 +27,9 @@ def convert_capture(capture):
     """Read a claimed FBX capture with Blender and queue the ingest of each animation.
 
     A file Blender cannot read (no armature, no animation, damaged, Blender crashing or
-    hanging on it) marks the capture failed with a reason a person can act on.
+    hanging on it) marks the capture failed with a reason a person can act on; so does a
+    file uploaded through the API with more animations than its uploader may still upload
+    this hour (each animation counts as an upload).
     """
     _guarded(capture, "Conversion", lambda: _convert(capture))
 
@@ -38,6 +41,10 @@ def _convert(capture):
     first, rest = takes[0], takes[1:]
     capture.converted.save("take.npz", ContentFile(take_bytes(first)), save=False)
     with transaction.atomic():
+        # Every animation is an upload: count them, and add them, under the uploader's lock.
+        if capture.rate_limited:
+            quotas.lock(user=capture.uploaded_by)
+            quotas.check_upload_rate(capture.uploaded_by, len(takes), fbx=capture)
         handed_over = Capture.objects.filter(
             pk=capture.pk, status="processing", claim_token=capture.claim_token
         ).update(
@@ -48,8 +55,8 @@ def _convert(capture):
         if not handed_over:
             return  # another worker took this capture over; it converts it itself
         enqueue("ingest", capture.pk)
-    for take in rest:
-        add_animation(capture, take)
+        for take in rest:
+            add_animation(capture, take)
 
 
 def animation_name(file_name, take):
