@@ -142,6 +142,10 @@ CUTROOM_TRUSTED_PROXIES = envint("CUTROOM_TRUSTED_PROXIES", 0)
 CUTROOM_TOKEN_DAYS = envint("CUTROOM_TOKEN_DAYS", 30)
 # An invitation to join a project can be accepted for this many days.
 CUTROOM_INVITATION_DAYS = envint("CUTROOM_INVITATION_DAYS", 14)
+# Invitations one person may send per hour, and one username may receive per day from
+# everyone (0 = no limit); past either, 429.
+CUTROOM_INVITATIONS_PER_HOUR = envint("CUTROOM_INVITATIONS_PER_HOUR", 20)
+CUTROOM_INVITATIONS_PER_INVITEE = envint("CUTROOM_INVITATIONS_PER_INVITEE", 5)
 
 # Scripts only from our own files; inline styles are allowed (label colours are style
 # attributes; so are parts of the admin and of Swagger UI), inline scripts are not.
