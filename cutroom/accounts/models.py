@@ -114,7 +114,7 @@ class ThrottleLock(models.Model):
     """
 
     key = models.CharField(max_length=64, unique=True)
-    used_at = models.DateTimeField(default=timezone.now)
+    used_at = models.DateTimeField(default=timezone.now, db_index=True)
 
     def __str__(self):
         return f"{self.key[:8]}… used {self.used_at:%Y-%m-%d %H:%M:%S}"

@@ -78,11 +78,6 @@ def _wait(keys, now):
     return math.ceil(longest.total_seconds()) if longest else 0
 
 
-def wait_seconds(request, username):
-    """Seconds before this username may try again from this address; 0 if it may now."""
-    return _wait(_keys(request, username), timezone.now())
-
-
 def admit(request, username):
     """Let this sign-in attempt check its password, or say how long it must wait.
 
@@ -93,12 +88,15 @@ def admit(request, username):
     """
     keys = _keys(request, username)
     now = timezone.now()
+    # Old rows go first, outside the locks: deleting rows of other keys while holding
+    # these would make attempts for different names wait on each other.
+    LoginFailure.objects.filter(at__lte=now - _window()).delete()
+    locks.forget_idle()
     with transaction.atomic():
         locks.hold(f"login:{key}" for key, _limit in keys)
         wait = _wait(keys, now)
         if wait:
             return wait
-        LoginFailure.objects.filter(at__lte=now - _window()).delete()
         rows = LoginFailure.objects.bulk_create(LoginFailure(key=key, at=now) for key, _ in keys)
     setattr(request, ATTEMPT, [row.pk for row in rows])
     return 0
