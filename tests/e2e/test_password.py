@@ -42,3 +42,32 @@ def test_a_person_changes_their_password_from_the_page(live_server, new_page, st
     studio["bob"].refresh_from_db()
     assert studio["bob"].check_password(NEW)
     assert page.errors == [] and elsewhere.errors == [], (page.errors, elsewhere.errors)
+
+
+def test_a_site_admin_resets_a_password_from_the_team_page(live_server, new_page, studio):
+    studio["alice"].is_superuser = True
+    studio["alice"].save()
+    bob = new_page("bob")
+    alice = new_page("alice")
+    alice.goto(f"{live_server.url}/projects/{studio['project'].pk}/team/")
+    expect(alice.get_by_test_id("reset-password-alice")).to_have_count(0)  # not one's own
+    alice.get_by_test_id("reset-password-bob").click()
+    alice.get_by_test_id("confirm-ok").click()
+    password = alice.get_by_test_id("one-time-password").inner_text()
+    alice.get_by_test_id("dialog-ok").click()
+    studio["bob"].refresh_from_db()
+    assert studio["bob"].check_password(password)
+    bob.reload()
+    bob.wait_for_url(f"{live_server.url}/login/?next=/")
+    bob.fill("#id_username", "bob")
+    bob.fill("#id_password", password)
+    bob.click("button[type=submit]")
+    bob.wait_for_url(f"{live_server.url}/")
+    assert alice.errors == [] and bob.errors == [], (alice.errors, bob.errors)
+
+
+def test_a_project_admin_is_not_offered_password_resets(live_server, new_page, studio):
+    alice = new_page("alice")
+    alice.goto(f"{live_server.url}/projects/{studio['project'].pk}/team/")
+    expect(alice.get_by_test_id("member-bob")).to_be_visible()
+    expect(alice.get_by_test_id("reset-password-bob")).to_have_count(0)
