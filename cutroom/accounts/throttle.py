@@ -23,6 +23,8 @@ from django.utils import timezone
 from cutroom.accounts import locks, usernames
 from cutroom.accounts.models import LoginFailure, digest
 
+# Longer typed usernames are counted by their first this many characters.
+MAX_TYPED = 20 * usernames.MAX_LENGTH
 # The request attribute holding the failure rows ``admit`` recorded in advance.
 ATTEMPT = "cutroom_sign_in_attempt"
 
@@ -130,6 +132,10 @@ def forget_failures(username):
 
 
 def username_of(data):
-    """The username field of a sign-in form or JSON body, as text ('' if absent or odd)."""
+    """The username field of a sign-in form or JSON body, as text ('' if absent or odd).
+
+    Cut to a length no username reaches even before NFKC (which can lengthen text up to
+    18 times), so a huge field costs no more than a long one.
+    """
     value = data.get("username", "") if hasattr(data, "get") else ""
-    return value if isinstance(value, str) else ""
+    return value[:MAX_TYPED] if isinstance(value, str) else ""

@@ -86,6 +86,8 @@ def find_user(name):
     """
     users = get_user_model()._default_manager
     stored = unicodedata.normalize("NFKC", name.strip())
+    if len(stored) > MAX_LENGTH:
+        return None
     user = users.filter(username=stored).first()
     if user is not None:
         return user

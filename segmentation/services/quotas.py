@@ -79,7 +79,7 @@ def _stored(**owner):
     return Capture.objects.filter(**owner).aggregate(total=Sum("stored_bytes"))["total"] or 0
 
 
-def check_active_runs(project, user):
+def check_active_runs(project, user=None):
     """TooManyRequests while ``project`` has CUTROOM_PROJECT_ACTIVE_RUNS detection runs
     queued or running, or ``user`` has started CUTROOM_USER_ACTIVE_RUNS of them in any
     of their projects (projects cost nothing to create, so a per-project limit alone

@@ -160,3 +160,8 @@ class UsernameSpellingThrottleTestCase(BaseTestCase):
         self.assertEqual(self.token("guess", "x").status_code, 400)
         self.assertEqual(self.token("bob", "bob-password").status_code, 200)
         self.assertEqual(LoginFailure.objects.count(), 2)  # guess's, by name and by address
+
+    def test_a_huge_username_is_refused_like_any_wrong_one_and_counted(self):
+        r = self.token("b" * 1_000_000)
+        self.assertEqual(r.status_code, 400)
+        self.assertEqual(LoginFailure.objects.count(), 2)
