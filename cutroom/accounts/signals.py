@@ -1,13 +1,14 @@
 """Failed and successful sign-ins, whichever view checked the password, feed the
 throttle: Django sends ``user_login_failed`` from ``authenticate`` (the login page, the
-admin's login page and the token endpoint all call it with the request). A new password revokes the account's API tokens."""
+admin's login page and the token endpoint all call it with the request). A new password revokes the account's API tokens, and a
+new account's username is checked however the account is made."""
 
 from django.conf import settings
 from django.contrib.auth.signals import user_logged_in, user_login_failed
-from django.db.models.signals import post_save
+from django.db.models.signals import post_save, pre_save
 from django.dispatch import receiver
 
-from cutroom.accounts import throttle
+from cutroom.accounts import throttle, usernames
 from cutroom.accounts.models import ApiToken
 
 
@@ -30,3 +31,14 @@ def revoke_tokens_on_new_password(sender, instance, created, **kwargs):
     # set_password() leaves the raw password on the instance until save() has run.
     if not created and getattr(instance, "_password", None) is not None:
         ApiToken.objects.filter(user=instance).delete()
+
+
+@receiver(pre_save, sender=settings.AUTH_USER_MODEL)
+def check_new_username(sender, instance, raw=False, **kwargs):
+    """Every new account's username goes through ``usernames`` (``createsuperuser`` and
+    scripts too; the forms and the API check first, to answer with the reason): a
+    UsernameError stops the account from being made."""
+    if raw or instance.pk is not None:
+        return
+    instance.username = usernames.clean(instance.username)
+    usernames.check_available(instance.username)

@@ -99,3 +99,16 @@ class CreationTestCase(BaseTestCase):
             "username": "eri\u200dn", "date_joined_0": "2026-01-01", "date_joined_1": "00:00:00",
         })
         self.assertContains(r, "U+200D")
+
+
+class AnyWayOfCreatingTestCase(BaseTestCase):
+    def test_an_account_made_by_a_command_or_script_is_checked_too(self):
+        users = get_user_model().objects
+        for name in ("bo\u200bb", "BOB", "p\u0430ypal"):
+            with self.assertRaises(usernames.UsernameError):
+                users.create_superuser(name, password="x")
+        self.assertEqual(users.create_user("  dora ").username, "dora")
+
+    def test_renaming_is_left_to_the_forms_and_saving_an_account_again_is_not_refused(self):
+        self.bob.first_name = "Bob"
+        self.bob.save()
