@@ -2,18 +2,18 @@
 rate, stored bytes, detection runs at once. All in settings (``CUTROOM_*``); a refusal
 names the limit, the setting and when to try again.
 
-Each check counts under row locks taken by ``lock`` (the project's row, then the user's,
-in that order everywhere so two transactions never wait on each other in a cycle), and
+Each check counts under row locks taken by ``lock`` (the project's row, then one for the
+user, in that order everywhere so two transactions never wait on each other in a cycle), and
 must run in the transaction that then inserts what it counted: requests at the same
 moment are counted one after the other, so none passes a limit another has just reached.
 On SQLite the service's IMMEDIATE transactions run one at a time anyway.
 """
 
 from django.conf import settings
-from django.contrib.auth import get_user_model
 from django.db.models import Sum
 from django.utils import timezone
 
+from cutroom.accounts import locks
 from segmentation.errors import QuotaExceeded, TooManyRequests
 from segmentation.models import Capture, DetectionRun, Project
 
@@ -22,11 +22,15 @@ ACTIVE = ("queued", "processing")
 
 
 def lock(project=None, user=None):
-    """Lock the project's row, then the user's, until the transaction ends."""
+    """Lock the project's row, then the user's lock row, until the transaction ends.
+
+    The user's is a ``ThrottleLock`` row rather than the account's own, so that counting
+    never holds up a sign-in (which writes ``last_login``) or an edit in the admin.
+    """
     if project is not None:
         Project.objects.select_for_update().filter(pk=project.pk).first()
     if user is not None and user.pk is not None:
-        get_user_model().objects.select_for_update().filter(pk=user.pk).first()
+        locks.hold([f"quotas:user:{user.pk}"])
 
 
 def check_upload_rate(user, uploads=1, fbx=None):
