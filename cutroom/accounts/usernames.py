@@ -8,8 +8,9 @@ round its lock and no new account can differ from an existing one by case or for
 
 A new name may also not hold characters that show as nothing or pass for others:
 format characters (zero-width spaces and joiners, direction marks), control and private
-characters, spaces other than the plain one, or letters of two scripts that share
-look-alike letters (Latin, Greek, Cyrillic...), as in a Cyrillic "а" in "pаypal".
+characters, spaces other than the plain one, letters of two scripts that share
+look-alike letters (Latin, Greek, Cyrillic...), as in a Cyrillic "а" in "pаypal", or only
+Cyrillic or Greek letters drawn like Latin ones (a Cyrillic "асе").
 """
 
 import unicodedata
@@ -20,6 +21,12 @@ MAX_LENGTH = 150  # Django's own limit on usernames
 
 # Scripts whose letters are mistaken for each other's; a name may use one of them.
 LOOKALIKE_SCRIPTS = ("LATIN", "GREEK", "CYRILLIC", "ARMENIAN", "CHEROKEE", "COPTIC")
+# Cyrillic and Greek letters drawn like Latin ones: a name made only of these (with
+# digits and punctuation) reads as a Latin name that it is not ("асе" in Cyrillic).
+LATIN_LOOKALIKES = set(
+    "аеорсухіјѕһԁԛԝӏԜАВЕКМНОРСТХІЈЅҮ"  # Cyrillic
+    "οαικνρτυχΑΒΕΖΗΙΚΜΝΟΡΤΥΧ"  # Greek
+)
 # Unicode categories never allowed: control, format, private use, surrogate, unassigned,
 # and line or paragraph separators. Space separators other than " " are refused too.
 REFUSED_CATEGORIES = {"Cc", "Cf", "Co", "Cs", "Cn", "Zl", "Zp"}
@@ -56,6 +63,12 @@ def clean(name):
         raise UsernameError(
             f"mixes letters of the {' and '.join(s.title() for s in scripts)} scripts, "
             "which look alike; use letters of one of them"
+        )
+    letters = [char for char in name if unicodedata.category(char).startswith("L")]
+    if scripts and scripts != ["LATIN"] and set(letters) <= LATIN_LOOKALIKES:
+        raise UsernameError(
+            f"is written in {scripts[0].title()} letters that all look like Latin ones, so it "
+            "reads as a Latin name it is not; use Latin letters, or others of your script"
         )
     return name
 

@@ -43,6 +43,13 @@ class CleanTestCase(SimpleTestCase):
         self.assertEqual(usernames.clean("\u0431\u043e\u0431"), "\u0431\u043e\u0431")
         self.assertEqual(usernames.clean("\u5c71\u7530-yamada"), "\u5c71\u7530-yamada")
 
+    def test_it_refuses_a_name_of_cyrillic_or_greek_letters_that_all_look_latin(self):
+        self.assertIn("Cyrillic letters that all look like Latin", self.refused("\u0430\u0441\u0435"))
+        self.refused("\u0421\u0410\u0420-1")  # "CAP-1"
+        self.refused("\u03bf\u03ba")  # Greek "ok"
+        self.assertEqual(usernames.clean("\u0421\u0435\u0440\u0433\u0435\u0439"),
+                         "\u0421\u0435\u0440\u0433\u0435\u0439")  # Сергей
+
     def test_it_refuses_empty_and_overlong_names(self):
         self.refused("   ")
         self.refused("x" * 151)
