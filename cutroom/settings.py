@@ -118,8 +118,13 @@ if DATABASES["default"]["ENGINE"] == "django.db.backends.sqlite3":
 DEFAULT_AUTO_FIELD = "django.db.models.BigAutoField"
 
 AUTH_PASSWORD_VALIDATORS = [
+    {"NAME": "django.contrib.auth.password_validation.UserAttributeSimilarityValidator"},
     {"NAME": "django.contrib.auth.password_validation.MinimumLengthValidator"},
+    {"NAME": "django.contrib.auth.password_validation.CommonPasswordValidator"},
+    {"NAME": "django.contrib.auth.password_validation.NumericPasswordValidator"},
 ]
+# Sign-in finds the account by any spelling of its username (cutroom.accounts.usernames).
+AUTHENTICATION_BACKENDS = ["cutroom.accounts.backends.UsernameBackend"]
 # Behind a TLS-terminating proxy: trust its X-Forwarded-Proto and send cookies over HTTPS only.
 if envbool("BEHIND_TLS_PROXY", False):
     SECURE_PROXY_SSL_HEADER = ("HTTP_X_FORWARDED_PROTO", "https")
@@ -138,6 +143,10 @@ CUTROOM_TRUSTED_PROXIES = envint("CUTROOM_TRUSTED_PROXIES", 0)
 CUTROOM_TOKEN_DAYS = envint("CUTROOM_TOKEN_DAYS", 30)
 # An invitation to join a project can be accepted for this many days.
 CUTROOM_INVITATION_DAYS = envint("CUTROOM_INVITATION_DAYS", 14)
+# Invitations one person may send per hour, and one username may receive per day from
+# everyone (0 = no limit); past either, 429.
+CUTROOM_INVITATIONS_PER_HOUR = envint("CUTROOM_INVITATIONS_PER_HOUR", 20)
+CUTROOM_INVITATIONS_PER_INVITEE = envint("CUTROOM_INVITATIONS_PER_INVITEE", 5)
 
 # Scripts only from our own files; inline styles are allowed (label colours are style
 # attributes; so are parts of the admin and of Swagger UI), inline scripts are not.
@@ -260,12 +269,14 @@ CUTROOM_DETECT_TIME_LIMIT = envint("CUTROOM_DETECT_TIME_LIMIT", 300)
 CUTROOM_RETRAIN_TIME_LIMIT = envint("CUTROOM_RETRAIN_TIME_LIMIT", 600)
 CUTROOM_SUGGEST_TIME_LIMIT = envint("CUTROOM_SUGGEST_TIME_LIMIT", 900)
 CUTROOM_TIME_LIMIT_GRACE = envint("CUTROOM_TIME_LIMIT_GRACE", 30)
-# Quotas (0 = no limit): uploads per user per hour, stored MB per project and per user,
-# detection runs queued or running at once per project.
+# Quotas (0 = no limit): uploads per user per hour (each animation of an FBX counts),
+# stored MB per project and per user, detection runs queued or running at once per project
+# and started by one person across projects.
 CUTROOM_UPLOADS_PER_HOUR = envint("CUTROOM_UPLOADS_PER_HOUR", 120)
 CUTROOM_PROJECT_STORAGE_MB = envint("CUTROOM_PROJECT_STORAGE_MB", 20 * 1024)
 CUTROOM_USER_STORAGE_MB = envint("CUTROOM_USER_STORAGE_MB", 10 * 1024)
 CUTROOM_PROJECT_ACTIVE_RUNS = envint("CUTROOM_PROJECT_ACTIVE_RUNS", 4)
+CUTROOM_USER_ACTIVE_RUNS = envint("CUTROOM_USER_ACTIVE_RUNS", 4)
 
 # Celery. No result backend: a job's state is its row (status, error, timings).
 # The embedded default's broker is one SQLite file (cutroom.broker): no server, and a

@@ -1,6 +1,42 @@
 from django.contrib import admin
+from django.contrib.auth import get_user_model
+from django.contrib.auth.admin import UserAdmin
+from django.contrib.auth.forms import AdminUserCreationForm, UserChangeForm
+from django.core.exceptions import ValidationError
 
+from cutroom.accounts import usernames
 from cutroom.accounts.models import ApiToken, LoginFailure
+
+
+class CheckedUsername:
+    """A user form's username goes through ``usernames``: stored stripped and in NFKC,
+    refused if it holds invisible or look-alike characters or is another account's name
+    in another case or form."""
+
+    def clean_username(self):
+        try:
+            name = usernames.clean(self.cleaned_data.get("username"))
+            usernames.check_available(name, exclude=self.instance)
+        except usernames.UsernameError as exc:
+            raise ValidationError(f"Username {exc}.", code="username") from None
+        return name
+
+
+class NewUserForm(CheckedUsername, AdminUserCreationForm):
+    pass
+
+
+class ChangeUserForm(CheckedUsername, UserChangeForm):
+    pass
+
+
+admin.site.unregister(get_user_model())
+
+
+@admin.register(get_user_model())
+class CheckedUserAdmin(UserAdmin):
+    add_form = NewUserForm
+    form = ChangeUserForm
 
 
 @admin.register(ApiToken)

@@ -1,16 +1,18 @@
-"""API tokens: obtain one (throttled like the login page), list and revoke your own."""
+"""API tokens: obtain one (throttled like the login page), list and revoke your own.
+Passwords: change your own, or (site admins) reset someone's."""
 
+from django.contrib.auth import get_user_model, update_session_auth_hash
 from django.urls import path
 from drf_spectacular.utils import extend_schema
 from rest_framework import serializers, status
 from rest_framework.authtoken.serializers import AuthTokenSerializer
-from rest_framework.exceptions import Throttled
+from rest_framework.exceptions import PermissionDenied, Throttled, ValidationError
 from rest_framework.generics import get_object_or_404
 from rest_framework.permissions import AllowAny
 from rest_framework.response import Response
 from rest_framework.views import APIView
 
-from cutroom.accounts import throttle
+from cutroom.accounts import passwords, throttle
 from cutroom.accounts.models import ApiToken
 
 
@@ -51,13 +53,13 @@ class TokenView(APIView):
 
     @extend_schema(request=AuthTokenSerializer, responses=IssuedTokenSerializer)
     def post(self, request):
-        wait = throttle.wait_seconds(request, throttle.username_of(request.data))
+        wait = throttle.admit(request, throttle.username_of(request.data))
         if wait:
             raise Throttled(wait, "Too many failed sign-ins for this account or from this address.")
         serializer = AuthTokenSerializer(data=request.data, context={"request": request})
         serializer.is_valid(raise_exception=True)
         user = serializer.validated_data["user"]
-        throttle.forget_failures(user.get_username())
+        throttle.succeeded(request, user.get_username())
         token, key = ApiToken.objects.issue(user)
         return Response(IssuedTokenSerializer({"token": key, "expires_at": token.expires_at}).data)
 
@@ -92,7 +94,72 @@ class OneTokenView(APIView):
         return Response(status=status.HTTP_204_NO_CONTENT)
 
 
+class PasswordChangeSerializer(serializers.Serializer):
+    current_password = serializers.CharField(trim_whitespace=False)
+    new_password = serializers.CharField(trim_whitespace=False)
+
+
+class PasswordChangedSerializer(serializers.Serializer):
+    detail = serializers.CharField()
+
+
+class PasswordResetSerializer(serializers.Serializer):
+    username = serializers.CharField()
+    password = serializers.CharField(help_text="The one-time password; shown only in this answer.")
+
+
+def refuse(exc):
+    """A PasswordError as a 400 whose detail names the field."""
+    return ValidationError({"detail": str(exc), exc.field: [str(exc).split(": ", 1)[1]]})
+
+
+class PasswordView(APIView):
+    """POST changes the caller's password: their other sessions and all their API tokens
+    (this request's too) stop working; a session making the change stays signed in."""
+
+    @extend_schema(request=PasswordChangeSerializer, responses=PasswordChangedSerializer)
+    def post(self, request):
+        serializer = PasswordChangeSerializer(data=request.data)
+        serializer.is_valid(raise_exception=True)
+        user = request.user
+        # Checking the current password is a sign-in attempt: same throttle, same count.
+        wait = throttle.admit(request, user.get_username())
+        if wait:
+            raise Throttled(wait, "Too many failed sign-ins for this account or from this address.")
+        data = serializer.validated_data
+        try:
+            passwords.change(user, data["current_password"], data["new_password"])
+        except passwords.PasswordError as exc:
+            if exc.field == "new_password":
+                throttle.succeeded(request, user.get_username())  # the current one was right
+            raise refuse(exc) from None
+        throttle.succeeded(request, user.get_username())
+        if not isinstance(request.auth, ApiToken):
+            update_session_auth_hash(request, user)
+        detail = "Password changed. Your other sessions and your API tokens are signed out."
+        return Response(PasswordChangedSerializer({"detail": detail}).data)
+
+
+class PasswordResetView(APIView):
+    """POST (site admins) gives an account a new one-time password, ending its sessions
+    and revoking its API tokens."""
+
+    @extend_schema(request=None, responses=PasswordResetSerializer)
+    def post(self, request, pk):
+        if not passwords.can_reset(request.user):
+            raise PermissionDenied("Only site admins reset other people's passwords.")
+        user = get_object_or_404(get_user_model().objects.all(), pk=pk)
+        password = passwords.reset(user)
+        if user == request.user and not isinstance(request.auth, ApiToken):
+            update_session_auth_hash(request, user)
+        return Response(PasswordResetSerializer({"username": user.get_username(),
+                                                 "password": password}).data)
+
+
 urlpatterns = [
+    path("auth/password/", PasswordView.as_view(), name="api-password"),
+    path("auth/users/<int:pk>/password-reset/", PasswordResetView.as_view(),
+         name="api-password-reset"),
     path("auth/token/", TokenView.as_view(), name="api-token"),
     path("auth/tokens/", TokensView.as_view(), name="api-tokens"),
     path("auth/tokens/<int:pk>/", OneTokenView.as_view(), name="api-token-revoke"),

@@ -1,11 +1,15 @@
 """Failed and successful sign-ins, whichever view checked the password, feed the
 throttle: Django sends ``user_login_failed`` from ``authenticate`` (the login page, the
-admin's login page and the token endpoint all call it with the request)."""
+admin's login page and the token endpoint all call it with the request). A new password revokes the account's API tokens, and a
+new account's username is checked however the account is made."""
 
+from django.conf import settings
 from django.contrib.auth.signals import user_logged_in, user_login_failed
+from django.db.models.signals import post_save, pre_save
 from django.dispatch import receiver
 
-from cutroom.accounts import throttle
+from cutroom.accounts import throttle, usernames
+from cutroom.accounts.models import ApiToken
 
 
 @receiver(user_login_failed)
@@ -16,4 +20,25 @@ def count_failure(sender, credentials, request=None, **kwargs):
 
 @receiver(user_logged_in)
 def clear_failures(sender, request, user, **kwargs):
-    throttle.forget_failures(user.get_username())
+    throttle.succeeded(request, user.get_username())
+
+
+@receiver(post_save, sender=settings.AUTH_USER_MODEL)
+def revoke_tokens_on_new_password(sender, instance, created, **kwargs):
+    """A new password revokes the account's API tokens, however it was set (the API, the
+    admin, ``manage.py changepassword``): whoever took the old password may hold one.
+    Sessions end on their own, since Django signs each with the password's hash."""
+    # set_password() leaves the raw password on the instance until save() has run.
+    if not created and getattr(instance, "_password", None) is not None:
+        ApiToken.objects.filter(user=instance).delete()
+
+
+@receiver(pre_save, sender=settings.AUTH_USER_MODEL)
+def check_new_username(sender, instance, raw=False, **kwargs):
+    """Every new account's username goes through ``usernames`` (``createsuperuser`` and
+    scripts too; the forms and the API check first, to answer with the reason): a
+    UsernameError stops the account from being made."""
+    if raw or instance.pk is not None:
+        return
+    instance.username = usernames.clean(instance.username)
+    usernames.check_available(instance.username)

@@ -6,6 +6,10 @@ process shares, on the embedded default as in production). A username with
 an address with ``CUTROOM_LOGIN_FAILURES_PER_ADDRESS``, is refused until the oldest of
 those failures leaves the window (a sliding window). A refused attempt does not check
 the password, so it costs no hashing, and it is not counted again.
+
+Usernames are counted by ``usernames.key`` (every spelling of a name is one count), and
+an attempt is counted before its password is checked (``admit``), under a row lock, so
+that simultaneous guesses cannot all pass a count taken before any of them failed.
 """
 
 import ipaddress
@@ -13,9 +17,16 @@ import math
 from datetime import timedelta
 
 from django.conf import settings
+from django.db import transaction
 from django.utils import timezone
 
+from cutroom.accounts import locks, usernames
 from cutroom.accounts.models import LoginFailure, digest
+
+# Longer typed usernames are counted by their first this many characters.
+MAX_TYPED = 20 * usernames.MAX_LENGTH
+# The request attribute holding the failure rows ``admit`` recorded in advance.
+ATTEMPT = "cutroom_sign_in_attempt"
 
 
 def client_address(request):
@@ -45,8 +56,8 @@ def client_address(request):
 def _keys(request, username):
     """(key, limit) pairs this attempt counts against."""
     keys = []
-    if username:
-        name = username.casefold()
+    if username and usernames.key(username):
+        name = usernames.key(username)
         keys.append((digest(f"user:{name}"), settings.CUTROOM_LOGIN_FAILURES_PER_USER))
     address = client_address(request)
     if address:
@@ -58,11 +69,9 @@ def _window():
     return timedelta(seconds=settings.CUTROOM_LOGIN_WINDOW)
 
 
-def wait_seconds(request, username):
-    """Seconds before this username may try again from this address; 0 if it may now."""
-    now = timezone.now()
+def _wait(keys, now):
     longest = timedelta(0)
-    for key, limit in _keys(request, username):
+    for key, limit in keys:
         recent = LoginFailure.objects.filter(key=key, at__gt=now - _window())
         times = list(recent.order_by("-at").values_list("at", flat=True)[:limit])
         if len(times) >= limit:
@@ -71,7 +80,34 @@ def wait_seconds(request, username):
     return math.ceil(longest.total_seconds()) if longest else 0
 
 
+def admit(request, username):
+    """Let this sign-in attempt check its password, or say how long it must wait.
+
+    Returns 0 and records the attempt as a failure in advance (a success takes it back,
+    ``succeeded``), or the seconds to wait, recording nothing. Counting and recording
+    happen under the keys' row locks, so of attempts arriving together no more are let
+    through than the limits allow.
+    """
+    keys = _keys(request, username)
+    now = timezone.now()
+    # Old rows go first, outside the locks: deleting rows of other keys while holding
+    # these would make attempts for different names wait on each other.
+    LoginFailure.objects.filter(at__lte=now - _window()).delete()
+    locks.forget_idle()
+    with transaction.atomic():
+        locks.hold(f"login:{key}" for key, _limit in keys)
+        wait = _wait(keys, now)
+        if wait:
+            return wait
+        rows = LoginFailure.objects.bulk_create(LoginFailure(key=key, at=now) for key, _ in keys)
+    setattr(request, ATTEMPT, [row.pk for row in rows])
+    return 0
+
+
 def record_failure(request, username):
+    """Count a failed sign-in (one ``admit`` counted already is not counted twice)."""
+    if getattr(request, ATTEMPT, None) is not None:
+        return
     now = timezone.now()
     LoginFailure.objects.filter(at__lte=now - _window()).delete()
     LoginFailure.objects.bulk_create(
@@ -79,13 +115,27 @@ def record_failure(request, username):
     )
 
 
+def succeeded(request, username):
+    """A successful sign-in clears the username's failures and takes back the address's
+    failure recorded in advance by ``admit`` (the address's earlier failures stay)."""
+    forget_failures(username)
+    attempt = getattr(request, ATTEMPT, None)
+    if attempt:
+        LoginFailure.objects.filter(pk__in=attempt).delete()
+        setattr(request, ATTEMPT, [])
+
+
 def forget_failures(username):
-    """A successful sign-in clears the username's failures (not the address's)."""
+    """Clear the username's failures (whatever its spelling), not the address's."""
     if username:
-        LoginFailure.objects.filter(key=digest(f"user:{username.casefold()}")).delete()
+        LoginFailure.objects.filter(key=digest(f"user:{usernames.key(username)}")).delete()
 
 
 def username_of(data):
-    """The username field of a sign-in form or JSON body, as text ('' if absent or odd)."""
+    """The username field of a sign-in form or JSON body, as text ('' if absent or odd).
+
+    Cut to a length no username reaches even before NFKC (which can lengthen text up to
+    18 times), so a huge field costs no more than a long one.
+    """
     value = data.get("username", "") if hasattr(data, "get") else ""
-    return value if isinstance(value, str) else ""
+    return value[:MAX_TYPED] if isinstance(value, str) else ""

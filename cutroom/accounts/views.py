@@ -11,13 +11,14 @@ from cutroom.accounts import throttle
 def throttled_sign_in(view):
     """Refuse a sign-in POST with 429 while its username or address is throttled.
 
-    The password is not checked then; failures are counted by ``signals.count_failure``.
+    The password is not checked then. An attempt let through is counted as a failure
+    until it succeeds (``throttle.admit``; ``signals.clear_failures`` takes it back).
     """
 
     @wraps(view)
     def wrapper(request, *args, **kwargs):
         if request.method == "POST":
-            wait = throttle.wait_seconds(request, throttle.username_of(request.POST))
+            wait = throttle.admit(request, throttle.username_of(request.POST))
             if wait:
                 return too_many_attempts(request, wait)
         return view(request, *args, **kwargs)

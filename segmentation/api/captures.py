@@ -90,9 +90,8 @@ class CaptureViewSet(
         data = upload.validated_data
         project = project_for(request.user, data["project"])
         # People uploading through the API are rate-limited; imports by command are not.
-        services.quotas.check_upload_rate(request.user)
         capture, created = services.do_upload_capture(
-            project, request.user, data["file"], data.get("asf")
+            project, request.user, data["file"], data.get("asf"), rate_limited=True
         )
         capture.duplicate = not created
         return Response(UploadedSerializer(capture).data, status=201 if created else 200)

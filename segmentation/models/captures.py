@@ -52,6 +52,9 @@ class Capture(Job):
     positions = models.FileField(upload_to=derived_path, max_length=500, blank=True)
     # Bytes of the original (and its ASF) as uploaded, for the storage quotas.
     stored_bytes = models.PositiveBigIntegerField(default=0)
+    # Uploaded through the API, where uploads per hour are limited: each further
+    # animation of its FBX file is counted against that limit too when it is converted.
+    rate_limited = models.BooleanField(default=False)
     created_at = models.DateTimeField(default=timezone.now)
     # FBX: the take Blender read (a saved .npz), written by the convert worker; ingest reads
     # it instead of the original. A file with several animations gives one capture each, all

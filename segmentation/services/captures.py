@@ -83,13 +83,18 @@ def checksum(upload, asf=None):
     return digest.hexdigest()
 
 
-def do_upload_capture(project, user, upload, asf=None):
+def do_upload_capture(project, user, upload, asf=None, rate_limited=False):
     """Store an upload unchanged and queue its ingest.
 
     Returns (capture, created); an identical upload to the same project returns the
-    existing capture with ``created=False``.
+    existing capture with ``created=False``. People uploading through the API are
+    ``rate_limited`` (CUTROOM_UPLOADS_PER_HOUR); imports by command are not. The quotas
+    are counted and the capture inserted under the project's and the user's row locks,
+    so simultaneous uploads cannot pass them together.
     """
     fmt = check_upload(upload, asf)
+    if rate_limited:
+        quotas.check_upload_rate(user)  # before the duplicate check, which may requeue
     digest = checksum(upload, asf)
     existing = Capture.objects.filter(project=project, checksum=digest).first()
     if existing:
@@ -99,20 +104,41 @@ def do_upload_capture(project, user, upload, asf=None):
             existing.refresh_from_db()
         return existing, False
     size = upload.size + (asf.size if asf is not None else 0)
+    # Before storing the file, without locks: most refusals need not write anything.
     quotas.check_storage(project, user, size)
-    capture = Capture(project=project, uploaded_by=user, name=upload.name, format=fmt)
+    capture = Capture(project=project, uploaded_by=user, name=upload.name, format=fmt,
+                      rate_limited=rate_limited)
     capture.checksum, capture.stored_bytes = digest, size
     capture.original.save(stored_name(upload.name), upload, save=False)
     if asf is not None:
         capture.asf.save(stored_name(asf.name), asf, save=False)
     try:
         with transaction.atomic():
+            quotas.lock(project, user)
+            _check_quotas(project, user, size, rate_limited)
             capture.save()
             enqueue(capture.first_job(), capture.pk)
     except IntegrityError:
         # The same file arrived twice at once; the other request stored it.
+        _delete_files(capture)
         return Capture.objects.get(project=project, checksum=digest), False
+    except CutroomError:
+        _delete_files(capture)
+        raise
     return capture, True
+
+
+def _check_quotas(project, user, size, rate_limited):
+    if rate_limited:
+        quotas.check_upload_rate(user)
+    quotas.check_storage(project, user, size)
+
+
+def _delete_files(capture):
+    """Remove the files of a capture that was not saved (refused, or a duplicate)."""
+    for field in (capture.original, capture.asf):
+        if field.name:
+            field.storage.delete(field.name)
 
 
 def stored_name(name):
@@ -153,7 +179,7 @@ def do_start_run(capture, user, method, params):
         raise NotReady(f"capture {capture.pk} is {capture.status}; detection needs a ready capture")
     method, params = validate_method(method, params)
     with transaction.atomic():
-        quotas.check_active_runs(capture.project)
+        quotas.check_active_runs(capture.project, user)
         run = DetectionRun.objects.create(
             capture=capture, method=method, params=params, created_by=user
         )

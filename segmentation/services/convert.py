@@ -16,7 +16,7 @@ from motionlib.io.fbx import read_fbx_all
 from motionlib.io.npz import take_bytes
 from segmentation import storage
 from segmentation.models import Capture
-from segmentation.services import jobs
+from segmentation.services import jobs, quotas
 from segmentation.services.jobs import Kind, enqueue, register
 
 log = logging.getLogger(__name__)
@@ -26,7 +26,9 @@ def convert_capture(capture):
     """Read a claimed FBX capture with Blender and queue the ingest of each animation.
 
     A file Blender cannot read (no armature, no animation, damaged, Blender crashing or
-    hanging on it) marks the capture failed with a reason a person can act on.
+    hanging on it) marks the capture failed with a reason a person can act on; so does a
+    file uploaded through the API with more animations than its uploader may still upload
+    this hour (each animation counts as an upload).
     """
     jobs.guard(CONVERT, capture)
 
@@ -36,8 +38,13 @@ def _convert(capture):
         takes = read_fbx_all(path)
     several = len(takes) > 1
     first, rest = takes[0], takes[1:]
+    _check_rate(capture, len(takes))  # before writing anything for a file that is refused
     capture.converted.save("take.npz", ContentFile(take_bytes(first)), save=False)
+    siblings = [s for s in (new_animation(capture, take) for take in rest) if s is not None]
     with transaction.atomic():
+        # Counted again, and added, under the uploader's lock: a short transaction (the
+        # files are written), since on SQLite it holds up every writer.
+        _check_rate(capture, len(takes), locked=True)
         handed_over = Capture.objects.filter(
             pk=capture.pk, status="processing", claim_token=capture.claim_token
         ).update(
@@ -45,11 +52,23 @@ def _convert(capture):
             converted=capture.converted.name, animation=first.animation or "",
             name=animation_name(capture.name, first) if several else capture.name,
         )
-        if not handed_over:
-            return  # another worker took this capture over; it converts it itself
-        enqueue("ingest", capture.pk)
-    for take in rest:
-        add_animation(capture, take)
+        if handed_over:
+            enqueue("ingest", capture.pk)
+            for sibling in siblings:
+                add_animation(sibling)
+    if not handed_over:
+        # Another worker took this capture over; it converts it itself.
+        for sibling in siblings:
+            sibling.converted.delete(save=False)
+
+
+def _check_rate(capture, animations, locked=False):
+    """Every animation of a file uploaded through the API counts as an upload."""
+    if not capture.rate_limited or capture.uploaded_by is None:
+        return
+    if locked:
+        quotas.lock(user=capture.uploaded_by)
+    quotas.check_upload_rate(capture.uploaded_by, animations, fbx=capture)
 
 
 def animation_name(file_name, take):
@@ -57,27 +76,30 @@ def animation_name(file_name, take):
     return f"{file_name.split('#', 1)[0]}#{take.animation}"
 
 
-def add_animation(capture, take):
-    """A capture for another animation of ``capture``'s file, sharing its stored original.
-
-    Idempotent: a conversion that runs again finds the captures it made the first time (their
-    checksum is the file's with the animation name).
-    """
+def new_animation(capture, take):
+    """An unsaved capture for another animation of ``capture``'s file, sharing its stored
+    original, with its converted take written; None if a conversion that ran before added
+    it already (its checksum is the file's with the animation name)."""
     digest = hashlib.sha256(f"{capture.checksum}#{take.animation}".encode()).hexdigest()
     if Capture.objects.filter(project=capture.project, checksum=digest).exists():
-        return
+        return None
     sibling = Capture(
         project=capture.project, uploaded_by=capture.uploaded_by, source=capture,
         name=animation_name(capture.name, take), format="fbx", checksum=digest,
         animation=take.animation or "", original=capture.original.name,
     )
     sibling.converted.save("take.npz", ContentFile(take_bytes(take)), save=False)
+    return sibling
+
+
+def add_animation(sibling):
+    """Save ``new_animation``'s capture and queue its ingest (idempotent)."""
     try:
         with transaction.atomic():
             sibling.save()
             enqueue("ingest", sibling.pk)
     except IntegrityError:
-        log.info("animation %s of capture %s already added", take.animation, capture.pk)
+        log.info("animation %s of capture %s already added", sibling.animation, sibling.source_id)
 
 
 # FBX conversion runs Blender: its own queue, served by its own worker.

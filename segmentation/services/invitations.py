@@ -5,8 +5,14 @@ create a project, so it would enumerate usernames) nor put someone into a strang
 project. So it changes the role of someone already a member (the admin sees the members
 anyway) and otherwise invites the username, whether or not an account has it; only a
 site admin (who may see accounts) is told that no account has that name.
+
+Invitations are limited per inviter (CUTROOM_INVITATIONS_PER_HOUR) and per invited
+username (CUTROOM_INVITATIONS_PER_INVITEE in a day, from everyone), so nobody can flood a
+person's list of invitations (each shows a project name of the inviter's choosing). Both
+are counted under row locks in the transaction that makes the invitation.
 """
 
+import unicodedata
 from datetime import timedelta
 
 from django.conf import settings
@@ -14,8 +20,10 @@ from django.contrib.auth import get_user_model
 from django.db import transaction
 from django.utils import timezone
 
-from segmentation.errors import Invalid
+from cutroom.accounts import locks
+from segmentation.errors import Invalid, TooManyRequests
 from segmentation.models import Invitation
+from segmentation.services import quotas
 from segmentation.services.projects import do_set_member
 
 USERNAME_MAX = 150  # Django's own limit on usernames
@@ -31,13 +39,16 @@ def do_add_member(project, actor, username, role):
 
     The invitation is made the same way whether or not an account named ``username``
     exists, so nothing the caller sees differs (unless ``can_see_accounts(actor)``).
-    Inviting a username again replaces its pending invitation.
+    Inviting a username again replaces its pending invitation. The username is taken
+    stripped and in NFKC, the form account names are stored in.
     """
+    username = unicodedata.normalize("NFKC", (username or "").strip())
     if not username or len(username) > USERNAME_MAX:
         raise Invalid(f"username: must be 1 to {USERNAME_MAX} characters, got {len(username)}")
     with transaction.atomic():
         if project.memberships.filter(user__username=username).exists():
             return do_set_member(project, username, role)
+        _check_invitation_rates(project, actor, username)
         users = get_user_model().objects
         if can_see_accounts(actor) and not users.filter(username=username).exists():
             raise Invalid(f"username: no user named {username!r}")
@@ -48,6 +59,37 @@ def do_add_member(project, actor, username, role):
                       "expires_at": now + timedelta(days=settings.CUTROOM_INVITATION_DAYS)},
         )
     return invitation
+
+
+def _check_invitation_rates(project, actor, username):
+    """TooManyRequests past the inviter's hourly or the invitee's daily limit. The
+    refusal reads the same whether or not an account has the username."""
+    quotas.lock(project, actor)
+    locks.hold([f"invitee:{username}"])
+    now = timezone.now()
+    hour, day = now - timedelta(hours=1), now - timedelta(days=1)
+    limit = settings.CUTROOM_INVITATIONS_PER_HOUR
+    made = Invitation.objects.filter(invited_by=actor, created_at__gte=hour)
+    if limit and made.count() >= limit:
+        raise TooManyRequests(
+            f"username: you sent {limit} invitations in the last hour; the limit is {limit} "
+            f"per hour (CUTROOM_INVITATIONS_PER_HOUR); try again in {_wait(made, hour)} s",
+            retry_after=_wait(made, hour),
+        )
+    limit = settings.CUTROOM_INVITATIONS_PER_INVITEE
+    received = Invitation.objects.filter(username=username, created_at__gte=day)
+    if limit and received.exclude(project=project, status="pending").count() >= limit:
+        raise TooManyRequests(
+            f"username: {username!r} was invited {limit} times in the last day, the limit "
+            f"(CUTROOM_INVITATIONS_PER_INVITEE); try again in {_wait(received, day)} s",
+            retry_after=_wait(received, day),
+        )
+
+
+def _wait(invitations, since):
+    """Seconds until the oldest of ``invitations`` made after ``since`` stops counting."""
+    oldest = invitations.order_by("created_at").values_list("created_at", flat=True).first()
+    return max(1, int((oldest - since).total_seconds()) + 1) if oldest else 60
 
 
 def do_accept_invitation(invitation, user):

@@ -10,6 +10,7 @@ import secrets
 from django.contrib.auth import get_user_model
 from django.db import IntegrityError, transaction
 
+from cutroom.accounts import usernames
 from segmentation.errors import Invalid, NotAllowed
 from segmentation.models import Membership, Project
 
@@ -67,14 +68,24 @@ def do_create_account(project, actor, username, role):
         raise NotAllowed("Only site admins create accounts; invite an existing user instead.")
     if role not in ROLES:
         raise Invalid(f"role: must be one of {', '.join(ROLES)}, got {role!r}")
-    username = (username or "").strip()
-    if not username or len(username) > 150:
-        raise Invalid("username: must be 1 to 150 characters")
+    try:
+        username = usernames.clean(username)
+    except usernames.UsernameError as exc:
+        raise Invalid(f"username: {exc}") from None
     password = secrets.token_urlsafe(12)
     try:
         with transaction.atomic():
+            _check_available(username)
             user = get_user_model().objects.create_user(username, password=password)
             membership = Membership.objects.create(project=project, user=user, role=role)
     except IntegrityError:
         raise Invalid(f"username: an account named {username!r} already exists; invite it") from None
     return membership, password
+
+
+def _check_available(username):
+    """Invalid if an account's name differs from ``username`` only in case or form."""
+    try:
+        usernames.check_available(username)
+    except usernames.UsernameError as exc:
+        raise Invalid(f"username: {exc}; invite it") from None

@@ -2,11 +2,13 @@
 in-process by calling the task functions; the integration tests run them in real workers."""
 
 import pytest
+from django.core.files.uploadedfile import SimpleUploadedFile
+from django.test import override_settings
 
-from segmentation import tasks
+from segmentation import services, tasks
 from segmentation.models import Capture, DetectionRun
 from tests.fbx.files import shared_fbx
-from tests.segmentation.base import BaseTestCase
+from tests.segmentation.base import BaseTestCase, synthetic_bvh
 
 
 @pytest.fixture(autouse=True)
@@ -14,7 +16,7 @@ def _files(request, made_fbx):
     request.cls.made = made_fbx
 
 
-class ConvertTestCase(BaseTestCase):
+class FbxUploadsTestCase(BaseTestCase):
     def setUp(self):
         super().setUp()
         self.login(self.bob)
@@ -33,6 +35,8 @@ class ConvertTestCase(BaseTestCase):
             tasks.detect(run.pk)
         return Capture.objects.get(pk=capture_id)
 
+
+class ConvertTestCase(FbxUploadsTestCase):
     def test_it_converts_a_mixamo_fbx_and_proposes_cuts(self):
         capture = self.convert_and_ingest(self.upload_file(shared_fbx("samba_dancing.fbx")))
         self.assertEqual(capture.status, "ready", capture.error)
@@ -84,3 +88,33 @@ class ConvertTestCase(BaseTestCase):
         capture = Capture.objects.get(pk=self.upload_file(shared_fbx("flair.fbx")))
         self.assertTrue(capture.needs_conversion)
         self.assertEqual(capture.first_job(), "convert")
+
+
+class AnimationsCountAsUploadsTestCase(FbxUploadsTestCase):
+    """Each animation of an FBX uploaded through the API counts against the uploader's
+    CUTROOM_UPLOADS_PER_HOUR, checked when the file's animations are known (conversion)."""
+
+    @override_settings(CUTROOM_UPLOADS_PER_HOUR=2)
+    def test_a_file_with_more_animations_than_the_user_may_still_upload_fails_saying_so(self):
+        self.assertEqual(self.upload(synthetic_bvh(seed=1, duration=2.0)).status_code, 201)
+        capture = self.convert_and_ingest(self.upload_file(self.made / "two_actions.fbx"))
+        self.assertEqual(capture.status, "failed")
+        self.assertIn("this file holds 2 animations, each counted as an upload", capture.error)
+        self.assertIn("(CUTROOM_UPLOADS_PER_HOUR)", capture.error)
+        self.assertEqual(Capture.objects.filter(uploaded_by=self.bob).count(), 2)
+
+    @override_settings(CUTROOM_UPLOADS_PER_HOUR=2)
+    def test_a_file_within_the_limit_gives_all_its_animations_even_converted_again(self):
+        capture_id = self.upload_file(self.made / "two_actions.fbx")
+        self.assertEqual(self.convert_and_ingest(capture_id).status, "ready")
+        Capture.objects.filter(pk=capture_id).update(status="queued", converted="", attempts=0)
+        capture = self.convert_and_ingest(capture_id)
+        self.assertEqual(capture.status, "ready", capture.error)
+        self.assertEqual(Capture.objects.filter(project=self.project).count(), 2)
+
+    @override_settings(CUTROOM_UPLOADS_PER_HOUR=1)
+    def test_an_import_by_command_is_not_rate_limited(self):
+        upload = SimpleUploadedFile("two_actions.fbx", (self.made / "two_actions.fbx").read_bytes())
+        capture, _ = services.do_upload_capture(self.project, self.bob, upload)
+        self.assertEqual(self.convert_and_ingest(capture.pk).status, "ready")
+        self.assertEqual(Capture.objects.filter(project=self.project).count(), 2)

@@ -4,8 +4,10 @@ exists (unless they are a site admin), and nobody joins a project they did not a
 from datetime import timedelta
 
 from django.contrib.auth import get_user_model
+from django.test import override_settings
 from django.utils import timezone
 
+from segmentation import services
 from segmentation.models import Invitation
 from tests.segmentation.base import BaseTestCase
 
@@ -160,3 +162,62 @@ class InvitationsTestCase(BaseTestCase):
         r = self.add("x" * 151)
         self.assertEqual(r.status_code, 400)
         self.assertIn("1 to 150 characters, got 151", r.json()["detail"])
+
+
+class InvitationRateTestCase(BaseTestCase):
+    """Nobody can flood a person's list of invitations: each inviter sends at most
+    CUTROOM_INVITATIONS_PER_HOUR, each username receives at most
+    CUTROOM_INVITATIONS_PER_INVITEE a day, from everyone together."""
+
+    def add(self, username, by, project):
+        self.login(by)
+        return self.client.post(f"/api/projects/{project.pk}/members/",
+                                {"username": username, "role": "annotator"}, format="json")
+
+    def projects_of(self, user, n):
+        return [services.do_create_project(user, f"{user.username} studio {i}") for i in range(n)]
+
+    @override_settings(CUTROOM_INVITATIONS_PER_HOUR=3, CUTROOM_INVITATIONS_PER_INVITEE=0)
+    def test_an_inviter_is_refused_past_the_hourly_limit(self):
+        codes = [self.add(f"person{i}", self.charlie, self.other_project).status_code for i in range(4)]
+        self.assertEqual(codes, [202, 202, 202, 429])
+        r = self.add("person9", self.charlie, self.other_project)
+        self.assertIn("the limit is 3 per hour (CUTROOM_INVITATIONS_PER_HOUR)", r.json()["detail"])
+        self.assertGreater(int(r["Retry-After"]), 3500)
+        self.assertEqual(self.add("person9", self.alice, self.project).status_code, 202)
+
+    @override_settings(CUTROOM_INVITATIONS_PER_HOUR=0, CUTROOM_INVITATIONS_PER_INVITEE=2)
+    def test_a_username_receives_at_most_its_daily_limit_from_everyone(self):
+        charlies = self.projects_of(self.charlie, 2)
+        codes = [self.add("bob", self.charlie, p).status_code for p in charlies]
+        codes.append(self.add("bob", self.charlie, self.other_project).status_code)
+        self.assertEqual(codes, [202, 202, 429])
+        self.assertIn("(CUTROOM_INVITATIONS_PER_INVITEE)",
+                      self.add("bob", self.charlie, self.other_project).json()["detail"])
+        self.login(self.bob)
+        self.assertEqual(len(self.client.get("/api/invitations/").json()), 2)
+
+    @override_settings(CUTROOM_INVITATIONS_PER_HOUR=0, CUTROOM_INVITATIONS_PER_INVITEE=2)
+    def test_the_invitee_limit_reads_the_same_for_a_name_without_account(self):
+        charlies = self.projects_of(self.charlie, 3)
+        for name in ("bob", "nobody-has-this"):
+            for p in charlies[:2]:
+                self.add(name, self.charlie, p)
+        one = self.add("bob", self.charlie, charlies[2])
+        other = self.add("nobody-has-this", self.charlie, charlies[2])
+        self.assertEqual((one.status_code, other.status_code), (429, 429))
+        self.assertEqual(one.json()["detail"].replace("'bob'", "<name>"),
+                         other.json()["detail"].replace("'nobody-has-this'", "<name>"))
+
+    @override_settings(CUTROOM_INVITATIONS_PER_HOUR=0, CUTROOM_INVITATIONS_PER_INVITEE=1)
+    def test_inviting_the_same_username_again_to_one_project_replaces_and_is_not_refused(self):
+        self.assertEqual(self.add("bob", self.charlie, self.other_project).status_code, 202)
+        self.assertEqual(self.add("bob", self.charlie, self.other_project).status_code, 202)
+
+    @override_settings(CUTROOM_INVITATIONS_PER_HOUR=0, CUTROOM_INVITATIONS_PER_INVITEE=1)
+    def test_spellings_of_a_name_count_as_that_name_and_reach_its_account(self):
+        charlies = self.projects_of(self.charlie, 2)
+        self.assertEqual(self.add(" \uff42ob ", self.charlie, charlies[0]).status_code, 202)
+        self.assertEqual(self.add("bob", self.charlie, charlies[1]).status_code, 429)
+        self.login(self.bob)
+        self.assertEqual(len(self.client.get("/api/invitations/").json()), 1)

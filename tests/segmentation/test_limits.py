@@ -4,6 +4,7 @@ refusal is a 4xx naming the limit and its setting."""
 from django.test import override_settings
 from django.utils import timezone
 
+from segmentation import services
 from segmentation.models import Capture, DetectionRun
 from tests.segmentation.base import BaseTestCase, synthetic_bvh
 
@@ -61,6 +62,35 @@ class ActiveRunsTestCase(BaseTestCase):
             DetectionRun.objects.create(capture=self.capture, method="bone_angle", status=status)
         r = self.client.post(self.url, {"method": "bone_angle"}, format="json")
         self.assertEqual(r.status_code, 202)
+
+
+@override_settings(CUTROOM_PROJECT_ACTIVE_RUNS=2, CUTROOM_USER_ACTIVE_RUNS=3)
+class UserActiveRunsTestCase(BaseTestCase):
+    """Projects cost nothing to create, so one person's runs are limited across them all."""
+
+    def start_in_new_project(self, n):
+        project = services.do_create_project(self.bob, f"Bob's studio {n}")
+        capture = self.ready_capture(name=f"take{n}.bvh")
+        Capture.objects.filter(pk=capture.pk).update(project=project)
+        return self.client.post(f"/api/captures/{capture.pk}/runs/", {"method": "bone_angle"},
+                                format="json")
+
+    def test_it_refuses_a_persons_runs_past_the_limit_whatever_the_project(self):
+        self.login(self.bob)
+        self.assertEqual([self.start_in_new_project(n).status_code for n in range(3)], [202] * 3)
+        r = self.start_in_new_project(3)
+        self.assertEqual(r.status_code, 429)
+        self.assertIn("you have 3 detection runs queued or running across your projects; the "
+                      "limit is 3 at once per person (CUTROOM_USER_ACTIVE_RUNS)", r.json()["detail"])
+
+    def test_finished_runs_and_other_peoples_runs_do_not_count(self):
+        self.login(self.bob)
+        for n in range(2):
+            self.assertEqual(self.start_in_new_project(n).status_code, 202)
+        DetectionRun.objects.update(status="ready")
+        capture = self.ready_capture(name="alices.bvh")
+        DetectionRun.objects.create(capture=capture, method="bone_angle", created_by=self.alice)
+        self.assertEqual([self.start_in_new_project(n).status_code for n in range(2, 5)], [202] * 3)
 
 
 class UploadQuotaTestCase(BaseTestCase):

@@ -131,3 +131,37 @@ class LoginPageThrottleTestCase(BaseTestCase):
         for _ in range(2):
             self.sign_in()
         self.assertEqual(self.sign_in(password="bob-password").status_code, 302)
+
+
+@override_settings(**LIMITS)
+class UsernameSpellingThrottleTestCase(BaseTestCase):
+    def token(self, username, password="wrong"):
+        return self.client.post("/api/auth/token/", {"username": username, "password": password},
+                                format="json", REMOTE_ADDR="192.0.2.1")
+
+    def test_a_locked_username_stays_locked_in_any_spelling(self):
+        for _ in range(3):
+            self.assertEqual(self.token("bob").status_code, 400)
+        for spelling in (" bob", "bob ", "\tBOB\n", "\uff42\uff4f\uff42", "\u24d1ob"):
+            self.assertEqual(self.token(spelling, "bob-password").status_code, 429, repr(spelling))
+
+    def test_failures_in_other_spellings_count_against_one_name(self):
+        for spelling in (" bob", "\uff42ob", "BOB"):
+            self.assertEqual(self.token(spelling).status_code, 400)
+        self.assertEqual(self.token("bob", "bob-password").status_code, 429)
+
+    def test_the_login_page_counts_spellings_as_one_name(self):
+        for spelling in ("bob ", "\uff42ob", "Bob"):
+            Client().post("/login/", {"username": spelling, "password": "wrong"})
+        r = Client().post("/login/", {"username": " bob", "password": "bob-password"})
+        self.assertEqual(r.status_code, 429)
+
+    def test_a_success_takes_back_only_its_own_advance_count_on_the_address(self):
+        self.assertEqual(self.token("guess", "x").status_code, 400)
+        self.assertEqual(self.token("bob", "bob-password").status_code, 200)
+        self.assertEqual(LoginFailure.objects.count(), 2)  # guess's, by name and by address
+
+    def test_a_huge_username_is_refused_like_any_wrong_one_and_counted(self):
+        r = self.token("b" * 1_000_000)
+        self.assertEqual(r.status_code, 400)
+        self.assertEqual(LoginFailure.objects.count(), 2)

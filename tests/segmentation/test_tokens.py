@@ -105,3 +105,16 @@ class TokensTestCase(BaseTestCase):
         key = self.obtain()["token"]
         get_user_model().objects.filter(pk=self.bob.pk).update(is_active=False)
         self.assertEqual(self.call(key).status_code, 401)
+
+    def test_a_new_password_revokes_the_accounts_tokens_and_nobody_elses(self):
+        key, theirs = self.obtain()["token"], self.obtain("rachel")["token"]
+        self.bob.set_password("a-new-long-password")
+        self.bob.save()
+        self.assertEqual(self.call(key).status_code, 401)
+        self.assertEqual(self.call(theirs).status_code, 200)
+
+    def test_saving_an_account_without_a_new_password_keeps_its_tokens(self):
+        key = self.obtain()["token"]
+        self.bob.first_name = "Bob"
+        self.bob.save()
+        self.assertEqual(self.call(key).status_code, 200)

@@ -50,8 +50,24 @@ export async function renderTeam(root: HTMLElement, projectId: number): Promise<
       h("td", {}, m.username, m.id === me.id ? h("span", { class: "muted" }, " (you)") : null),
       h("td", {}, role),
       h("td", {}, h("a", { class: "btn btn-small", href: `/queue/?project=${projectId}&user=${encodeURIComponent(m.username)}` }, "Queue")),
-      h("td", {}, isAdmin ? h("button", { class: "btn btn-small", "data-testid": `remove-${m.username}`, onclick: () => void remove(m) }, "Remove") : null),
+      h(
+        "td",
+        {},
+        isAdmin ? h("button", { class: "btn btn-small", "data-testid": `remove-${m.username}`, onclick: () => void remove(m) }, "Remove") : null,
+        me.can_create_accounts && m.id !== me.id ? h("button", { class: "btn btn-small", "data-testid": `reset-password-${m.username}`, onclick: () => void resetPassword(m) }, "Reset password") : null,
+      ),
     );
+  }
+
+  async function resetPassword(m: Member): Promise<void> {
+    const ok = await confirmDialog(`Reset the password of ${m.username}?`, [h("p", {}, "They are signed out everywhere and their API tokens stop working; you get a one-time password to give them.")], "Reset");
+    if (!ok) return;
+    try {
+      const made = await post<{ username: string; password: string }>(`/api/auth/users/${m.id}/password-reset/`);
+      await oneTimePassword(`New password for ${made.username}`, made.password);
+    } catch (err) {
+      toast(err instanceof ApiError ? err.message : String(err), "error");
+    }
   }
 
   async function changeRole(m: Member, select: HTMLSelectElement): Promise<void> {
@@ -119,10 +135,7 @@ export async function renderTeam(root: HTMLElement, projectId: number): Promise<
   const createAccount = async (username: string, role: Role) => {
     try {
       const made = await post<{ username: string; password: string }>(`/api/projects/${projectId}/members/new-account/`, { username, role });
-      await dialog(`Account ${made.username} created`, [
-        h("p", {}, "Give this one-time password to the person; it is shown only now. They should change it after signing in."),
-        h("pre", { class: "one-time-password", "data-testid": "one-time-password" }, made.password),
-      ], "I have noted it");
+      await oneTimePassword(`Account ${made.username} created`, made.password);
     } catch (err) {
       toast(err instanceof ApiError ? err.message : String(err), "error");
     }
@@ -157,6 +170,13 @@ export async function renderTeam(root: HTMLElement, projectId: number): Promise<
   await loadMembers();
   if (isAdmin) await loadInvitations();
   return () => {};
+}
+
+function oneTimePassword(title: string, password: string): Promise<void> {
+  return dialog(title, [
+    h("p", {}, "Give this one-time password to the person; it is shown only now. They should change it after signing in, with the Password button at the top of any page."),
+    h("pre", { class: "one-time-password", "data-testid": "one-time-password" }, password),
+  ], "I have noted it");
 }
 
 function append(el: HTMLElement, children: (HTMLElement | null)[]): void {

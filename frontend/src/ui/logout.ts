@@ -1,8 +1,10 @@
 // Signing out is a POST carrying the CSRF token: the server refuses GET, so that a link or
-// an image on another page cannot sign anyone out.
+// an image on another page cannot sign anyone out. Beside it, the button that opens the
+// change-password dialog (a plain button: it does not submit the form).
 
 import { readCookie } from "../api/client";
 import { h } from "./dom";
+import { passwordButton } from "./password";
 
 export function logoutButton(): HTMLFormElement {
   const token = h("input", { type: "hidden", name: "csrfmiddlewaretoken", value: "" });
@@ -14,6 +16,7 @@ export function logoutButton(): HTMLFormElement {
     "form",
     { class: "logout-form", method: "post", action: "/logout/", onsubmit: fill },
     token,
+    passwordButton(),
     h("button", { type: "submit", class: "btn btn-ghost", "data-testid": "logout" }, "Log out"),
   );
 }
