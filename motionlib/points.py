@@ -98,7 +98,11 @@ def world(coordinates: np.ndarray, up: str) -> np.ndarray:
     c = np.asarray(coordinates, dtype=np.float64)
     if up == "y":
         return c.copy()
-    return np.stack([c[..., 0], c[..., 2], -c[..., 1]], axis=-1)
+    out = np.empty(c.shape)
+    out[..., 0] = c[..., 0]
+    out[..., 1] = c[..., 2]
+    np.negative(c[..., 1], out=out[..., 2])
+    return out
 
 
 def make_point_take(*, name: str, format: str, fps: float, coordinates: np.ndarray,

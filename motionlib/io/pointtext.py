@@ -63,8 +63,12 @@ def parse_cells(data: bytes, offset: int, n_columns: int, delimiter: str, path,
         if len(cells) != n_columns:
             raise CaptureError(f"expected {n_columns} cells, found {len(cells)}", path=path,
                                line=line + 1)
-        for k, cell in enumerate(cells):
-            values[row, k] = _cell(cell, columns[k], k, path, line + 1)
+        try:
+            values[row] = [float(c) if c.strip() else math.nan for c in cells]
+        except ValueError:
+            values[row] = math.nan
+        if not np.isfinite(values[row]).all():  # a gap, or a bad cell to name
+            values[row] = [_cell(c, columns[k], k, path, line + 1) for k, c in enumerate(cells)]
     return values, [line + 1 for _, line in starts]
 
 
