@@ -165,11 +165,18 @@ def body_joints(take) -> tuple[np.ndarray, dict[str, int]]:
         raise CaptureError(f"the points ({', '.join(take.point_names[:12])}"
                            f"{', ...' if take.n_points > 12 else ''}) follow no known marker "
                            f"set ({KNOWN}), so no body parts are known", path=take.path)
-    table = PARTS[take.marker_set]
-    points = filled(take.positions)
+    return body_parts(take.point_names, take.positions, take.marker_set, path=take.path)
+
+
+def body_parts(names: list[str], positions: np.ndarray, convention: str,
+               path=None) -> tuple[np.ndarray, dict[str, int]]:
+    """:func:`body_joints` from point names, their positions ``(n_frames, n_points, 3)``
+    (NaN at gaps) and the convention they follow."""
+    table = PARTS[convention]
+    points = filled(positions)
     seen = ~np.isnan(points[0, :, 0])
     index = {}
-    for i, name in enumerate(take.point_names):
+    for i, name in enumerate(names):
         if seen[i]:
             index.setdefault(normalise(name), i)
     parts, joints = [], {}
@@ -180,7 +187,7 @@ def body_joints(take) -> tuple[np.ndarray, dict[str, int]]:
                 continue
             raise CaptureError(f"no point of the {part.replace('_', ' ')} "
                                f"({', '.join(m.upper() for m in table[part])}) is seen in "
-                               f"any frame", path=take.path)
+                               f"any frame", path=path)
         joints[part] = len(parts)
         parts.append(points[:, members].mean(axis=1))
     return np.stack(parts, axis=1), joints

@@ -1,5 +1,6 @@
-"""Library clips as files: BVH (written here), FBX and glTF binary (written by Blender), and
-bulk export as a zip archive with a manifest.
+"""Library clips as files: BVH (written here), FBX and glTF binary (written by Blender), C3D
+and joint-position CSV for point takes (same points, rate and gaps), and bulk export as a
+zip archive with a manifest.
 
 FBX and glTF run Blender in a child process of the calling process (``motionlib.io.blender``;
 nothing here imports it). A clip of a capture read from FBX is cut from its stored original, so
@@ -27,9 +28,11 @@ from segmentation.storage import read_take
 
 log = logging.getLogger(__name__)
 
-EXPORT_FORMATS = {"bvh": "BVH", "fbx": "FBX", "glb": "glTF binary"}
+EXPORT_FORMATS = {"bvh": "BVH", "fbx": "FBX", "glb": "glTF binary", "c3d": "C3D",
+                  "csv": "joint-position CSV"}
 CONTENT_TYPES = {"bvh": "application/octet-stream", "fbx": "application/octet-stream",
-                 "glb": "model/gltf-binary"}
+                 "glb": "model/gltf-binary", "c3d": "application/octet-stream",
+                 "csv": "text/csv"}
 
 MAX_EXPORT_SEGMENTS = 5000
 

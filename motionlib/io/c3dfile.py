@@ -225,6 +225,7 @@ def write_c3d(take: PointTake, out, *, start: int | None = None,
 
     The same points (labels), rate, unit and up axis (``POINT:Y_SCREEN``) as the take; the
     header's first frame is the file number of ``start``; gaps are written as C3D gaps.
+    Coordinates are float32, as C3D stores them (a take read from C3D is written exactly).
 
     Parameters
     ----------

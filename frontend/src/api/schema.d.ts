@@ -3090,7 +3090,7 @@ export interface operations {
         parameters: {
             query?: {
                 /** @description clip format (default bvh) */
-                file_format?: "bvh" | "fbx" | "glb";
+                file_format?: "bvh" | "c3d" | "csv" | "fbx" | "glb";
             };
             header?: never;
             path?: never;
