@@ -35,6 +35,13 @@ CONTENT_TYPES = {"bvh": "application/octet-stream", "fbx": "application/octet-st
                  "csv": "text/csv"}
 
 MAX_EXPORT_SEGMENTS = 5000
+POINT_CAPTURE_FORMATS = ("c3d", "tsv", "csv")
+
+
+def formats_for(capture):
+    """The export formats that apply to a capture's segments: points as C3D or CSV, joint
+    rotations as BVH, FBX or glTF (``motionlib.io.export.check_export_format``)."""
+    return ["c3d", "csv"] if capture.format in POINT_CAPTURE_FORMATS else ["bvh", "fbx", "glb"]
 
 
 def check_format(fmt):

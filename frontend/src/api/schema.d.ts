@@ -1550,6 +1550,7 @@ export interface components {
             duration: number;
             /** Format: double */
             agreement: number | null;
+            readonly export_formats: string[];
         };
         /** @description A feature signal, sampled: value i is at frame start + i * step. */
         Signal: {
@@ -1592,6 +1593,7 @@ export interface components {
             duration: number;
             /** Format: double */
             agreement: number | null;
+            readonly export_formats: string[];
             /**
              * Format: double
              * @description Descriptor distance to the segment
@@ -1605,6 +1607,9 @@ export interface components {
             /** Format: double */
             height: number;
             up: string;
+            /** @description points: markers or tracked joints; parents are then the links drawn between them */
+            kind: string;
+            marker_set: string | null;
         };
         Span: {
             start: number;
