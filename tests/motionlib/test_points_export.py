@@ -45,3 +45,19 @@ def test_a_take_of_rotations_is_not_written_as_c3d(tmp_path):
     with pytest.raises(motionlib.CaptureError, match=r"export format 'c3d': a take of joint "
                        r"rotations is written as bvh or fbx or glb"):
         write_clip(take, tmp_path / "clip.c3d", format="c3d")
+
+
+def test_info_says_which_marker_set_maps_a_point_take_to_body_parts(capsys):
+    from motionlib.cli import main
+
+    assert main(["info", str(points_file("utkinect", "s02_e01.csv"))]) == 0
+    out = capsys.readouterr().out
+    assert "format:          csv" in out
+    assert "body parts:      19 of 19 mapped (Kinect v1 points)" in out
+
+
+def test_info_says_when_points_follow_no_known_marker_set(capsys):
+    from motionlib.cli import main
+
+    assert main(["info", str(points_file("vmci", "subject1_run1.tsv"))]) == 0
+    assert "not mapped (points of no known marker set" in capsys.readouterr().out
