@@ -33,7 +33,7 @@ from motionlib.errors import CaptureError, shorten
 from motionlib.io.pointtext import frame_numbers, on_clock, parse_cells
 from motionlib.io.text import read_lines_bytes
 from motionlib.points import UP_AXES, PointTake, make_point_take
-from motionlib.take import DEFAULT_LIMITS, Limits, check_size, frame_range
+from motionlib.take import DEFAULT_LIMITS, Limits, check_size, frame_range, max_frames_for
 
 DEFAULTS = {"fps": "30", "unit": "m", "up": "y"}
 FRAME_COLUMNS = ("frame", "frame_id")
@@ -67,7 +67,8 @@ def read_points_csv(path: str | os.PathLike, *, limits: Limits = DEFAULT_LIMITS)
         fps = _fps(settings, path)
         numbers = frame_numbers(values, lines, columns[0], path)
         first_number = int(numbers[0]) if len(numbers) else 0
-    coordinates = on_clock(numbers, rows, limits.max_frames, path)
+    coordinates = on_clock(numbers, rows, max_frames_for(
+        len(names), 3 * len(names), len(data), limits), path)
     return make_point_take(name=Path(path).stem, format="csv", fps=fps,
                            coordinates=coordinates, names=names, unit=settings["unit"],
                            up=settings["up"], first_number=first_number, path=path)

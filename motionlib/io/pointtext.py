@@ -106,13 +106,15 @@ def frame_numbers(values: np.ndarray, lines: list[int], column: str, path) -> np
 
 def on_clock(numbers: np.ndarray, rows: np.ndarray, max_frames: int, path) -> np.ndarray:
     """Rows ``(n_rows, ...)`` placed at frames ``numbers - numbers[0]`` of a take of
-    ``numbers[-1] - numbers[0] + 1`` frames; frames without a row are NaN."""
+    ``numbers[-1] - numbers[0] + 1`` frames; frames without a row are NaN. A span of more
+    than ``max_frames`` (the limits for a file of this size) is refused before allocating."""
     if len(numbers) == 0:
         return rows[:0]
     n_frames = int(numbers[-1] - numbers[0] + 1)
     if n_frames > max_frames:
-        raise CaptureError(f"frames {numbers[0]} to {numbers[-1]} make {n_frames} frames, "
-                           f"more than the limit of {max_frames}", path=path)
+        raise CaptureError(f"frame numbers {numbers[0]} to {numbers[-1]} span {n_frames} "
+                           f"frames, more than the {max_frames} a file of this size may hold",
+                           path=path)
     keep = np.ones(len(numbers), dtype=bool)
     keep[1:] = np.diff(numbers) > 0
     if keep.all() and n_frames == len(numbers):

@@ -20,7 +20,7 @@ from motionlib.errors import CaptureError, shorten
 from motionlib.io.pointtext import frame_numbers, on_clock, parse_cells
 from motionlib.io.text import read_lines_bytes
 from motionlib.points import PointTake, make_point_take
-from motionlib.take import DEFAULT_LIMITS, Limits, check_size
+from motionlib.take import DEFAULT_LIMITS, Limits, check_size, max_frames_for
 
 MAX_HEADER_LINES = 100
 
@@ -53,7 +53,8 @@ def read_qualisys_tsv(path: str | os.PathLike, *,
                else np.arange(1, len(values) + 1))
     first = 2 if framed else 0
     coordinates = values[:, first:].reshape(len(values), len(names), 3)
-    coordinates = on_clock(numbers, coordinates, limits.max_frames, path)
+    coordinates = on_clock(numbers, coordinates, max_frames_for(
+        len(names), 3 * len(names), len(data), limits), path)
     return make_point_take(name=Path(path).stem, format="tsv", fps=fps,
                            coordinates=coordinates, names=names, unit="mm", up="z",
                            first_number=int(numbers[0]) if len(numbers) else 0, path=path)

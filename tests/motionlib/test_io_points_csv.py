@@ -134,3 +134,10 @@ def test_it_names_an_unknown_setting(tmp_path):
     path = write(tmp_path, "# rate=30\nframe,a_x,a_y,a_z\n1,1,2,3\n")
     with pytest.raises(motionlib.CaptureError, match=r"take\.csv:1: setting 'rate=30'"):
         motionlib.read(path)
+
+
+def test_it_refuses_frame_numbers_spanning_more_frames_than_the_file_may_hold(tmp_path):
+    path = write(tmp_path, "frame,a_x,a_y,a_z\n1,1,2,3\n90000000,1,2,3\n")
+    with pytest.raises(motionlib.CaptureError, match=r"take\.csv: frame numbers 1 to 90000000 "
+                       r"span 90000000 frames, more than the \d+ a file of this size may hold"):
+        motionlib.read(path)
