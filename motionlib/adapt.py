@@ -144,6 +144,7 @@ import numpy as np
 
 from motionlib import metrics
 from motionlib.errors import InputError, MotionlibError, ParamError
+from motionlib.points import segmenter_input
 from motionlib.segmenters.base import Segmentation, _checked
 from motionlib.segmenters.default import (
     PLACEMENTS,
@@ -413,7 +414,7 @@ def _study(example: Example, cuts: np.ndarray, p: dict, options, studies) -> dic
         stored = studies.load(example.key, key)
         if stored is not None and _study_names(options) <= set(stored):
             return stored
-    take = example.read()
+    take = segmenter_input(example.read(), Default.name)  # bare points: their coordinates
     analysis = Default.analyse(take, p)
     if analysis is None:
         raise ExampleError(f"{example.name}: too short to learn from "
@@ -683,6 +684,7 @@ def detect(take, model: CutModel | None = None, **params) -> Segmentation:
         return Default(**params).fit_predict(take)
     p = _untempoed({**Default.validate_params(params), **model.params()})
     start = time.perf_counter()
+    take = segmenter_input(take, Default.name)  # bare points: their coordinates
     analysis = Default.analyse(take, p)
     result = empty_segmentation(take) if analysis is None else \
         _segment(analysis, p, model.placement, model.offset_s)

@@ -131,3 +131,13 @@ def test_a_body_part_whose_markers_are_never_seen_is_named(hdm05):
 def test_point_links_must_not_form_a_cycle():
     with pytest.raises(ValueError, match="forest"):
         point_skeleton(["a", "b"], [1, 0])
+
+
+def test_the_default_detector_adapts_to_reviewed_takes_of_bare_points(vmci):
+    from motionlib import adapt
+
+    other = motionlib.read(points_file("vmci", "subject1_run2.tsv"))
+    model = adapt.fit_cut_model([(vmci, [44, 130, 281, 337, 404, 495, 599]),
+                                 (other, [60, 200, 330, 470, 600])])
+    result = adapt.detect(motionlib.read(points_file("vmci", "subject1_run3.tsv")), model)
+    assert len(result.cuts) > 0 and (result.cuts > 0).all()
