@@ -1,8 +1,10 @@
 """The review page of a point take in Chromium: the joints of a Kinect take are drawn with the
 links of its marker set, frames in which nothing was tracked (gaps) show nothing, and the
-view draws the points again on the next tracked frame; the library offers C3D and CSV."""
+view draws the points again on the next tracked frame; the library offers C3D and CSV, per
+segment and for the zip."""
 
 import io
+import re
 
 import numpy as np
 import pytest
@@ -92,3 +94,6 @@ def test_the_library_offers_c3d_and_csv_for_a_point_segment(live_server, new_pag
     with page.expect_download() as download:
         page.get_by_test_id(f"c3d-{segment.pk}").click()
     assert download.value.suggested_filename.endswith("_walk_0-600.c3d")
+    page.get_by_test_id("export-format").select_option("c3d")
+    expect(page.get_by_test_id("export-zip")).to_have_attribute(
+        "href", re.compile(r"file_format=c3d$"))

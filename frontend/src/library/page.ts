@@ -59,6 +59,8 @@ export async function renderLibrary(root: HTMLElement): Promise<() => void> {
     h("option", { value: "bvh" }, "BVH"),
     h("option", { value: "fbx" }, "FBX"),
     h("option", { value: "glb" }, "glTF"),
+    h("option", { value: "c3d", title: "segments of point takes (markers, tracked joints)" }, "C3D (points)"),
+    h("option", { value: "csv", title: "segments of point takes (markers, tracked joints)" }, "CSV (points)"),
   ) as HTMLSelectElement;
   const zipHref = () => `/api/segments/export.zip?${libraryQuery(filters, false)}&file_format=${zipFormat.value}`;
   zipFormat.addEventListener("change", () => exportZip.setAttribute("href", zipHref()));
