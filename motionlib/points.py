@@ -150,9 +150,10 @@ def filled(points: np.ndarray) -> np.ndarray:
     return out
 
 
-# Methods that need only a stream of per-frame feature vectors, not body parts, and so run
-# on points that follow no known marker set.
-BARE_POINT_METHODS = frozenset({"default"})
+# Methods that need only a stream of per-frame pose vectors, not body parts, and so run on
+# points that follow no known marker set: ``default`` through :class:`BarePoints`, ``ppca``
+# on :func:`bare_coordinates` itself.
+BARE_POINT_METHODS = frozenset({"default", "ppca"})
 
 
 @dataclass(eq=False)
@@ -180,8 +181,9 @@ class BarePoints:
 
 def segmenter_input(take, method: str):
     """What segmenter ``method`` is given for ``take``: the take itself, unless it is a
-    point take of an unknown marker set: then :class:`BarePoints` for the methods that can
-    do without body parts, and for the others a CaptureError saying why they cannot run."""
+    point take of an unknown marker set: then :class:`BarePoints` for ``default``, the take
+    for the other methods that can do without body parts, and for the rest a CaptureError
+    saying why they cannot run."""
     from motionlib import markersets
     from motionlib.errors import CaptureError
 
@@ -192,10 +194,17 @@ def segmenter_input(take, method: str):
             f"method {method!r} cannot run on this take: it needs body parts (limbs, hips, "
             f"chest), and the points ({', '.join(take.point_names[:8])}"
             f"{', ...' if take.n_points > 8 else ''}) follow no known marker set "
-            f"({markersets.KNOWN}); {', '.join(sorted(BARE_POINT_METHODS))} runs on bare "
+            f"({markersets.KNOWN}); {' and '.join(sorted(BARE_POINT_METHODS))} run on bare "
             "points", path=take.path)
+    if method != "default":
+        return take
+    return BarePoints(name=take.name, fps=take.fps, channels=np.degrees(bare_coordinates(take)),
+                      path=take.path)
+
+
+def bare_coordinates(take: PointTake) -> np.ndarray:
+    """(n_frames, 3 n_seen) Y-up coordinates of every point seen at least once, gaps closed
+    (:func:`filled`): the pose vector of points without known body parts."""
     points = filled(take.positions)
     seen = ~np.isnan(points[0, :, 0])
-    coords = points[:, seen].reshape(take.n_frames, -1)
-    return BarePoints(name=take.name, fps=take.fps, channels=np.degrees(coords),
-                      path=take.path)
+    return points[:, seen].reshape(take.n_frames, -1)
