@@ -227,7 +227,8 @@ COLUMNS = (("P", "{:.2f}"), ("R", "{:.2f}"), ("F1", "{:.2f}"), ("edits", "{:.2f}
 
 def print_set(point_set: PointSet, scores: dict[str, dict]) -> None:
     first = point_set.takes[0].read()
-    print(f"\n## {point_set.name}: {len(point_set.takes)} takes, {first.format.upper()}, "
+    n = len(point_set.takes)
+    print(f"\n## {point_set.name}: {n} take{'' if n == 1 else 's'}, {first.format.upper()}, "
           f"{first.fps:g} Hz, marker set {first.marker_set or 'none (bare points)'}, "
           f"tolerance {point_set.tolerance_s:g} s")
     header = f"{'method':<20}{'take':<22}" + "".join(f"{c:>8}" for c, _ in COLUMNS)
