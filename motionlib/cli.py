@@ -62,8 +62,19 @@ def _animations(take, takes) -> list[tuple[str, str]]:
 
 def _body_parts(take) -> str:
     """How many canonical body parts the joint names map to (segmenters need them)."""
+    from motionlib import markersets
+    from motionlib.points import is_point_take
     from motionlib.skeleton import CANONICAL_PARTS, match_parts
 
+    if is_point_take(take):
+        if take.marker_set is None:
+            return f"not mapped (points of no known marker set: {markersets.KNOWN})"
+        try:
+            _, joints = markersets.body_joints(take)
+        except ValueError as exc:
+            return f"not mapped ({exc})"
+        return (f"{len(joints)} of {len(CANONICAL_PARTS)} mapped "
+                f"({markersets.TITLES[take.marker_set]} points)")
     found, missing = match_parts(take)
     if missing:
         return f"not mapped (no joint found for {', '.join(missing)})"

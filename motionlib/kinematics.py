@@ -122,7 +122,8 @@ def forward_kinematics(take, channels: np.ndarray | None = None) -> np.ndarray:
     Parameters
     ----------
     take : Take
-        Its skeleton gives offsets, channel layout, rotation orders and (ASF) axes.
+        Its skeleton gives offsets, channel layout, rotation orders and (ASF) axes. A point
+        take (``motionlib.points``) has its points already: a copy of them, NaN at gaps.
     channels : ndarray, shape (n_frames, n_channels), optional
         Channel values to use instead of ``take.channels`` (rotations in degrees).
 
@@ -142,6 +143,8 @@ def forward_kinematics(take, channels: np.ndarray | None = None) -> np.ndarray:
     zero angles are skipped exactly, and leaves (whose rotation moves no joint) not rotated.
     """
     skeleton = take.skeleton
+    if skeleton.point_set:  # a point take (motionlib.points): its points, gaps NaN
+        return np.array(take.positions, dtype=np.float64)
     channels = _channels(skeleton, take.channels if channels is None else channels)
     out = np.empty((channels.shape[0], skeleton.n_joints, 3))
     _kinematics.positions(channels, channels.shape[0], skeleton.n_channels, *_layout(skeleton),
@@ -188,8 +191,9 @@ def skeleton_height(take_or_positions) -> float:
     Parameters
     ----------
     take_or_positions : Take or ndarray of shape (n_frames, n_joints, 3)
-        A take: the vertical (Y) extent of its rest pose, End Sites included. Positions: the
-        median over frames of each frame's vertical extent.
+        A take: the vertical (Y) extent of its rest pose, End Sites included (a point take:
+        the median over frames of the extent of the points seen). Positions: the median over
+        frames of each frame's vertical extent.
 
     Returns
     -------
@@ -197,6 +201,8 @@ def skeleton_height(take_or_positions) -> float:
         In the file's length unit.
     """
     if hasattr(take_or_positions, "skeleton"):
+        if take_or_positions.skeleton.point_set:
+            return _seen_height(take_or_positions.positions)
         y = rest_positions(take_or_positions)[:, 1]
         return float(y.max() - y.min())
     positions = np.asarray(take_or_positions, dtype=np.float64)
@@ -204,3 +210,14 @@ def skeleton_height(take_or_positions) -> float:
         raise InputError(f"positions must have shape (n_frames, n_joints, 3), got {positions.shape}")
     y = positions[..., 1]
     return float(np.median(y.max(axis=1) - y.min(axis=1)))
+
+
+def _seen_height(positions: np.ndarray) -> float:
+    """Median vertical extent of the points seen in each frame (frames with one seen at
+    least); 0 when no frame has any."""
+    y = np.asarray(positions, dtype=np.float64)[..., 1]
+    seen = ~np.isnan(y).all(axis=1)
+    if not seen.any():
+        return 0.0
+    y = y[seen]
+    return float(np.median(np.nanmax(y, axis=1) - np.nanmin(y, axis=1)))

@@ -50,6 +50,9 @@ class Skeleton:
         ASF ``axis`` frames ``C``: the joint's local rotation is ``C @ R @ C.T``. None for BVH.
     end_sites : dict of int to ndarray of shape (3,)
         End Site offsets keyed by the index of the joint that carries them.
+    point_set : bool
+        True for the points of a marker or joint-position take (``motionlib.points``): no
+        channels, and parents are the links drawn between points, a forest in any order.
     """
 
     names: list[str]
@@ -59,6 +62,7 @@ class Skeleton:
     rotation_orders: list[str]
     axes: np.ndarray | None = None
     end_sites: dict[int, np.ndarray] = field(default_factory=dict)
+    point_set: bool = False
 
     def __post_init__(self):
         self.parents = np.asarray(self.parents, dtype=np.intp)
@@ -68,7 +72,13 @@ class Skeleton:
                 == len(self.rotation_orders) == n):
             raise InputError("names, parents, offsets, channels and rotation_orders "
                              f"must all have one entry per joint ({n})")
-        if n and not _is_preorder(self.parents):
+        if self.point_set:
+            # A set of points (motionlib.points): parents are only the links drawn between
+            # them, a forest in any order.
+            if not _is_forest(self.parents):
+                raise InputError("point links must form a forest: each parent -1 or another "
+                                 "point, without cycles")
+        elif n and not _is_preorder(self.parents):
             raise InputError("joints must be in depth-first order (as BVH nests them): root "
                              "first, each joint right after its parent or a sibling's subtree")
 
@@ -103,6 +113,20 @@ class Skeleton:
             if p >= 0:
                 lists[p].append(j)
         return lists
+
+
+def _is_forest(parents: np.ndarray) -> bool:
+    """True if every parent is -1 or another joint and following parents always ends."""
+    n = len(parents)
+    if ((parents < -1) | (parents >= n) | (parents == np.arange(n))).any():
+        return False
+    for j in range(n):
+        k, steps = j, 0
+        while parents[k] >= 0 and steps <= n:
+            k, steps = parents[k], steps + 1
+        if steps > n:
+            return False
+    return True
 
 
 def _is_preorder(parents: np.ndarray) -> bool:

@@ -18,8 +18,8 @@ class Take:
     ----------
     name : str
         Usually the file stem (``"13_29"``).
-    format : {"bvh", "amc", "fbx"}
-        The format it was read from.
+    format : {"bvh", "amc", "fbx", "c3d", "tsv", "csv"}
+        The format it was read from (the last three: a point take, ``motionlib.points``).
     fps : float
         Frames per second (``1 / frame_time``, snapped to a whole number when within 0.1 %).
     frame_time : float

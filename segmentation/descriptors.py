@@ -7,7 +7,7 @@ from types import SimpleNamespace
 import numpy as np
 
 import motionlib
-from motionlib import similarity
+from motionlib import markersets, similarity
 from segmentation import storage
 from segmentation.errors import Invalid
 from segmentation.models import LibrarySegment
@@ -24,14 +24,43 @@ def capture_joints(capture):
         return None
 
 
+def point_marker_set(capture):
+    """The marker set of a point capture (``motionlib.markersets``), else None."""
+    skeleton = capture.skeleton or {}
+    return skeleton.get("marker_set") if skeleton.get("kind") == "points" else None
+
+
+def body_positions(capture):
+    """``(positions, joints)`` a capture's motion descriptors are computed from, or None
+    when it has no stored positions or no body parts are known.
+
+    A skeleton's stored joint positions as they are; a point capture's body parts from its
+    marker set (``markersets.body_parts``, gaps closed for this only); points of no known
+    set have none. Positions as stored (float32) for a skeleton. OSError / ValueError when
+    the stored positions cannot be read.
+    """
+    if not capture.positions:
+        return None
+    if (capture.skeleton or {}).get("kind") == "points":
+        marker_set = point_marker_set(capture)
+        if marker_set is None:
+            return None
+        positions = np.asarray(storage.load_npy(capture.positions), dtype=float)
+        return markersets.body_parts(capture.skeleton["joints"], positions, marker_set)
+    joints = capture_joints(capture)
+    if joints is None:
+        return None
+    return storage.load_npy(capture.positions), joints
+
+
 def descriptors(capture, spans):
     """The float32 descriptor of each ``(start, stop)`` span of a capture, or Nones when
-    its skeleton cannot be mapped to body parts."""
-    joints = capture_joints(capture) if capture.positions else None
-    if joints is None:
-        return [None] * len(spans)
+    its skeleton (or its points) cannot be mapped to body parts."""
     try:
-        positions = np.asarray(storage.load_npy(capture.positions), dtype=float)
+        body = body_positions(capture)
+        if body is None:
+            return [None] * len(spans)
+        positions, joints = np.asarray(body[0], dtype=float), body[1]
         scale = similarity.body_scale(positions, joints)
         return [
             similarity.segment_descriptor(positions, joints, start, stop, fps=capture.fps, scale=scale)

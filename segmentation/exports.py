@@ -1,5 +1,6 @@
-"""Library clips as files: BVH (written here), FBX and glTF binary (written by Blender), and
-bulk export as a zip archive with a manifest.
+"""Library clips as files: BVH (written here), FBX and glTF binary (written by Blender), C3D
+and joint-position CSV for point takes (same points, rate and gaps), and bulk export as a
+zip archive with a manifest.
 
 FBX and glTF run Blender in a child process of the calling process (``motionlib.io.blender``;
 nothing here imports it). A clip of a capture read from FBX is cut from its stored original, so
@@ -27,14 +28,23 @@ from segmentation.storage import read_take
 
 log = logging.getLogger(__name__)
 
-EXPORT_FORMATS = {"bvh": "BVH", "fbx": "FBX", "glb": "glTF binary"}
+EXPORT_FORMATS = {"bvh": "BVH", "fbx": "FBX", "glb": "glTF binary", "c3d": "C3D",
+                  "csv": "joint-position CSV"}
 CONTENT_TYPES = {"bvh": "application/octet-stream", "fbx": "application/octet-stream",
-                 "glb": "model/gltf-binary"}
+                 "glb": "model/gltf-binary", "c3d": "application/octet-stream",
+                 "csv": "text/csv"}
 
 MAX_EXPORT_SEGMENTS = 5000
 # Every entry of an export archive carries this time stamp, not the time of the export: the
 # same library exports to the same bytes (a restored backup is checked that way).
 ZIP_ENTRY_TIME = (1980, 1, 1, 0, 0, 0)
+POINT_CAPTURE_FORMATS = ("c3d", "tsv", "csv")
+
+
+def formats_for(capture):
+    """The export formats that apply to a capture's segments: points as C3D or CSV, joint
+    rotations as BVH, FBX or glTF (``motionlib.io.export.check_export_format``)."""
+    return ["c3d", "csv"] if capture.format in POINT_CAPTURE_FORMATS else ["bvh", "fbx", "glb"]
 
 
 def check_format(fmt):

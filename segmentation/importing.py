@@ -18,7 +18,7 @@ from motionlib.io.fbx import check_fbx_header
 from segmentation import services, storage
 from segmentation.errors import ImportProblem
 
-CAPTURE_SUFFIXES = (".bvh", ".amc", ".fbx")
+CAPTURE_SUFFIXES = (".bvh", ".amc", ".fbx", ".c3d", ".tsv", ".csv")
 
 
 @dataclass
@@ -64,7 +64,7 @@ def _not_a_capture(path):
     if not path.exists():
         return f"{path}: no such file or folder"
     return (f"{path}: extension {path.suffix or '(none)'!r} is not a capture; "
-            "expected .bvh, .fbx, or .amc with its .asf")
+            "expected .bvh, .fbx, .amc with its .asf, or points in .c3d, .tsv or .csv")
 
 
 def find_asf(amc, asf=None):
@@ -102,7 +102,8 @@ def check_readable(path, asf=None, full=False):
     frames are read by the worker, which fails the capture naming a bad frame's line.
     ``full`` reads every frame here too (the worker then reads the file again). An FBX is
     only checked to be binary FBX: Blender reads it on the convert queue. A CMU AMC
-    (small files) is read in full."""
+    (small files) and a point take (C3D, TSV, CSV: read at the speed of copying) are read
+    in full."""
     suffix = Path(path).suffix.lower()
     limits = storage.input_limits()
     if suffix == ".fbx":

@@ -31,8 +31,8 @@ from django.db.models import Count, F, Max, Q
 from django.utils import timezone
 
 from motionlib import similarity
-from segmentation import storage, workers
-from segmentation.descriptors import capture_joints, load_descriptors, profile_pool
+from segmentation import workers
+from segmentation.descriptors import body_positions, load_descriptors, profile_pool
 from segmentation.models import Capture, LabelSuggestion, LibrarySegment, Review, SuggestionRequest
 from segmentation.search import SHORTLIST, SIMILAR_POOL
 
@@ -216,15 +216,16 @@ class Suggester:
 
     def __init__(self, capture, annotator):
         self.capture = capture
-        self.joints = capture_joints(capture) if capture.positions else None
-        self.positions = self.scale = None
-        if self.joints is not None:
-            try:
-                self.positions = storage.load_npy(capture.positions)
-                self.scale = similarity.body_scale(np.asarray(self.positions, dtype=float), self.joints)
-            except (OSError, ValueError) as exc:
-                log.warning("no label suggestions for capture %s: %s", capture.pk, exc)
-                self.joints = None
+        self.joints = self.positions = self.scale = None
+        try:
+            body = body_positions(capture)
+            if body is not None:
+                self.positions, self.joints = body
+                self.scale = similarity.body_scale(np.asarray(self.positions, dtype=float),
+                                                   self.joints)
+        except (OSError, ValueError) as exc:
+            log.warning("no label suggestions for capture %s: %s", capture.pk, exc)
+            self.joints = None
         self.ids, self.profiles, self.names = [], None, {}
         if self.joints is not None:
             rows = list(pool(capture, annotator).order_by("-is_gold", "-id")

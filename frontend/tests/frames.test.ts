@@ -76,4 +76,11 @@ describe("floorLevel", () => {
     store.put(chunk(0, 8, 2, (f, k) => (k % 3 === 1 ? -3 - f / 4 : 50)));
     expect(store.floorLevel()).toBe(-3 - 4 / 4);
   });
+
+  it("test_it_skips_points_not_seen_in_a_frame", () => {
+    const store = new FrameStore(8, 2);
+    // Point 0 is a gap (NaN) in every frame; point 1 is seen at height -2.
+    store.put(chunk(0, 8, 2, (_f, k) => (k < 3 ? Number.NaN : k % 3 === 1 ? -2 : 50)));
+    expect(store.floorLevel()).toBe(-2);
+  });
 });

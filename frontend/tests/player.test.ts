@@ -1,6 +1,6 @@
 import { describe, expect, it } from "vitest";
 import { advance, frameOf, nextSpeed, seek, togglePlay, type Playback } from "../src/player/clock";
-import { sideOf } from "../src/player/skeletonView";
+import { seenPoint, sideOf } from "../src/player/skeletonView";
 
 const playing = (over: Partial<Playback> = {}): Playback => ({ position: 0, playing: true, speed: 1, fps: 120, nFrames: 1000, loop: null, ...over });
 
@@ -49,5 +49,24 @@ describe("sideOf", () => {
     for (const n of ["lfemur", "lhumerus", "lhipjoint", "LeftUpLeg", "LHipJoint", "mixamorig:LeftArm", "hand.L"]) expect(sideOf(n), n).toBe("left");
     for (const n of ["rfemur", "rtibia", "RightForeArm", "RHipJoint", "mixamorig:RightHand"]) expect(sideOf(n), n).toBe("right");
     for (const n of ["root", "lowerback", "LowerBack", "Root", "head", "thorax", "Hips", "lowerneck", "Spine"]) expect(sideOf(n), n).toBe("centre");
+  });
+});
+
+describe("seenPoint", () => {
+  it("test_it_follows_the_first_point_seen_when_the_root_is_a_gap", () => {
+    const pose = new Float32Array([Number.NaN, Number.NaN, Number.NaN, 1, 2, 3, 4, 5, 6]);
+    expect(seenPoint(pose)?.toArray()).toEqual([1, 2, 3]);
+  });
+
+  it("test_it_finds_nothing_in_a_frame_where_no_point_is_seen", () => {
+    expect(seenPoint(new Float32Array([Number.NaN, 0, 0, 0, Number.NaN, 0]))).toBeNull();
+  });
+});
+
+describe("sideOf for point takes", () => {
+  it("test_it_knows_the_side_of_kinect_joints_and_plug_in_gait_markers", () => {
+    expect(["elbow_left", "ElbowLeft", "Bastian:LELB"].map(sideOf)).toEqual(["left", "left", "left"]);
+    expect(["knee_right", "HandRight", "RKNE"].map(sideOf)).toEqual(["right", "right", "right"]);
+    expect(["hip_center", "spine", "C7"].map(sideOf)).toEqual(["centre", "centre", "centre"]);
   });
 });

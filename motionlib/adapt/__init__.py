@@ -56,6 +56,7 @@ import numpy as np
 from motionlib import metrics
 from motionlib.adapt._examples import EXAMPLE_COLUMNS, ExampleError, read_examples
 from motionlib.errors import InputError
+from motionlib.points import segmenter_input
 from motionlib.segmenters import default
 from motionlib.segmenters.base import Segmentation, _checked
 from motionlib.segmenters.default import PLACEMENTS, Default, Peaks, shipped_stage
@@ -325,7 +326,7 @@ def _study(example: Example, cuts: np.ndarray, p: dict, options, studies) -> dic
         stored = studies.load(example.key, key)
         if stored is not None and _study_names(options) <= set(stored):
             return stored
-    take = example.read()
+    take = segmenter_input(example.read(), Default.name)  # bare points: their coordinates
     analysis = default.analyse(take, p)
     if analysis is None:
         raise ExampleError(f"{example.name}: too short to learn from "
@@ -565,6 +566,7 @@ def detect(take, model: CutModel | None = None, **params) -> Segmentation:
         return Default(**params).fit_predict(take)
     p = {**Default.validate_params(params), **model.params()}
     start = time.perf_counter()
+    take = segmenter_input(take, Default.name)  # bare points: their coordinates
     analysis = default.analyse(take, p)
     if analysis is None:  # too short to compare anything: no cuts, as the detector says
         result = Segmentation(np.zeros(0, np.int64), np.zeros(0),

@@ -497,6 +497,9 @@ def write_bvh(take: Take, path_or_textfile, *, start: int | None = None,
     start, stop : int, optional
         Frame range; the whole take by default.
     """
+    if take.skeleton.point_set:
+        raise CaptureError("a take of points (markers or tracked joints) has no joint "
+                           "rotations to write as BVH; write it as C3D or CSV", path=take.path)
     start, stop = frame_range(take.n_frames, start, stop) if take.n_frames else (0, 0)
     skeleton, channels = bvh_layout(take)
     head = ["HIERARCHY", *_hierarchy_lines(skeleton), "MOTION",

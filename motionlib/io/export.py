@@ -1,4 +1,6 @@
-"""Writing clips of a take as BVH, FBX or glTF binary (``.glb``).
+"""Writing clips of a take as BVH, FBX or glTF binary (``.glb``), and clips of a point take
+as C3D or joint-position CSV (the same points, rate and gaps; :mod:`motionlib.io.c3dfile`,
+:mod:`motionlib.io.pointcsv`).
 
 BVH is written here (:func:`motionlib.io.bvh.write_bvh`); FBX and glTF by Blender's exporters,
 in the Blender process of :mod:`motionlib.io.blender`:
@@ -22,16 +24,20 @@ import numpy as np
 
 from motionlib.errors import CaptureError
 from motionlib.io.bvh import write_bvh
+from motionlib.io.c3dfile import write_c3d
 from motionlib.io.fbx import (
     CENTIMETRES_PER_METRE,
     Z_UP_TO_Y_UP,
     check_fbx_header,
     matrix_to_quaternion,
 )
+from motionlib.io.pointcsv import write_points_csv
 from motionlib.kinematics import euler_to_matrix
 from motionlib.take import Take, frame_range
 
-FORMATS = ("bvh", "fbx", "glb")
+FORMATS = ("bvh", "fbx", "glb", "c3d", "csv")
+POINT_FORMATS = ("c3d", "csv")
+ROTATION_FORMATS = ("bvh", "fbx", "glb")
 Y_UP_TO_Z_UP = Z_UP_TO_Y_UP.T
 
 
@@ -45,7 +51,8 @@ def write_clip(take: Take, out, *, format: str, start: int | None = None,
     take : Take
     out : str or PathLike
         The file to write.
-    format : {"bvh", "fbx", "glb"}
+    format : {"bvh", "fbx", "glb", "c3d", "csv"}
+        C3D and CSV for a point take, the others for a take of joint rotations.
     start, stop : int, optional
         0-based, stop exclusive (default: the whole take).
     original : str or PathLike, optional
@@ -69,11 +76,14 @@ def write_clips(take: Take, clips, *, format: str, original=None, blender=None,
 
     Like :func:`write_clip`, but an original FBX is imported once for all of them.
     """
-    if format not in FORMATS:
-        raise CaptureError(f"unknown export format {format!r}; expected one of "
-                           f"{', '.join(FORMATS)}")
+    check_export_format(take, format)
     clips = [(*frame_range(take.n_frames, start, stop), os.fspath(out))
              for start, stop, out in clips]
+    if format in POINT_FORMATS:
+        write = write_c3d if format == "c3d" else write_points_csv
+        for start, stop, out in clips:
+            write(take, out, start=start, stop=stop)
+        return
     if format == "bvh":
         for start, stop, out in clips:
             write_bvh(take, out, start=start, stop=stop)
@@ -92,6 +102,21 @@ def write_clips(take: Take, clips, *, format: str, original=None, blender=None,
         return
     for start, stop, out in clips:
         _write_new_armature(take.slice(start, stop), out, format, blender, timeout)
+
+
+def check_export_format(take, format: str) -> None:
+    """CaptureError unless ``format`` is one a take of this kind is written in: points
+    (markers, tracked joints) as C3D or CSV, joint rotations as BVH, FBX or glTF."""
+    if format not in FORMATS:
+        raise CaptureError(f"unknown export format {format!r}; expected one of "
+                           f"{', '.join(FORMATS)}")
+    points = getattr(take.skeleton, "point_set", False)
+    allowed = POINT_FORMATS if points else ROTATION_FORMATS
+    if format not in allowed:
+        kind = "a take of points (markers or tracked joints)" if points else \
+            "a take of joint rotations"
+        raise CaptureError(f"export format {format!r}: {kind} is written as "
+                           f"{' or '.join(allowed)}", path=take.path)
 
 
 def _write_new_armature(take, out, format, blender, timeout):

@@ -143,6 +143,9 @@ class Segmenter:
     def fit(self, take: Any) -> Segmenter:
         """Compute candidate cuts for ``take`` (a ``motionlib.read`` result)."""
         values = self.validate_params(self.param_values)
+        from motionlib.points import segmenter_input
+
+        take = segmenter_input(take, self.name)
         start = time.perf_counter()
         result = self._segment(take, **values)
         result.timings["total"] = time.perf_counter() - start
@@ -189,6 +192,8 @@ def take_positions(take: Any) -> tuple[np.ndarray, dict[str, int], int]:
     A cgspeed BVH starts with an added T-pose frame (``take.rest_pose_frame``); it is
     not part of the performance, so detection starts after it. ``take.positions`` are
     used when set (a service that has just computed them for storage), else computed.
+    A point take gives the body parts its marker set defines
+    (``markersets.body_joints``, gaps interpolated; CaptureError for an unknown set).
 
     Returns
     -------
@@ -197,7 +202,12 @@ def take_positions(take: Any) -> tuple[np.ndarray, dict[str, int], int]:
     first : take frame index of ``positions[0]``.
     """
     import motionlib
+    from motionlib import markersets
+    from motionlib.points import is_point_take
 
+    if is_point_take(take):  # body parts from the marker set, gaps closed (features only)
+        positions, joints = markersets.body_joints(take)
+        return positions, joints, 0
     first = first_frame(take)
     known = getattr(take, "positions", None)
     positions = (motionlib.forward_kinematics(take) if known is None else known)[first:]

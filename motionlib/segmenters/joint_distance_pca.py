@@ -27,6 +27,8 @@ Where the seed text is ambiguous this implementation takes the evident intent:
   are segment ends, not cuts, and are not moved. The window is clipped to the take and
   to the neighbouring cuts, so refined cuts stay in order.
 - The PCA input is centred but not scaled (all nine distances share one unit).
+- A point take has no channels: its pose is the coordinates of its body parts
+  (``markersets.body_joints``), so ``beta`` is then in the take's length unit.
 
 Frame parameters are in frames of the take, as in the patent (its figures are for
 120 fps CMU captures). The defaults (span 31, delta 0.3, gamma 200, alpha 40, beta 8)
@@ -89,6 +91,14 @@ def refine_cuts(
     return out
 
 
+def pose_rows(take, positions: np.ndarray, first: int) -> np.ndarray:
+    """The pose compared in the refinement: the channels of frames ``first ..``, or for a
+    point take (no channels) the coordinates of its body parts, gaps closed."""
+    if take.skeleton.point_set:
+        return positions.reshape(len(positions), -1)
+    return take.channels[first:]
+
+
 class JointDistancePCA(Segmenter):
     name = "joint_distance_pca"
     title = "Joint-distance PCA (patent CN102867300A)"
@@ -125,7 +135,7 @@ class JointDistancePCA(Segmenter):
         if initial[-1] != ends[-1]:
             initial = np.append(initial, ends[-1])
         t2 = time.perf_counter()
-        final = refine_cuts(take.channels[first:], initial, alpha=alpha, beta=beta)
+        final = refine_cuts(pose_rows(take, positions, first), initial, alpha=alpha, beta=beta)
         t3 = time.perf_counter()
         conf = dict(zip(idx.tolist(), strength.tolist(), strict=True))
         interior = slice(1, len(final) - 1)

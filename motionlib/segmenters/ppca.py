@@ -27,7 +27,8 @@ Deviations, stated:
   joint positions in the body frame (relative to the root, heading removed,
   ``features.body_frame_positions``) of the 18 canonical joints other than the root
   (54 numbers, close to the paper's 56), which are likewise smooth and do not change
-  when the performer walks or turns.
+  when the performer walks or turns. Points of no known marker set (no body parts) are
+  described by their coordinates, gaps closed.
 """
 
 from __future__ import annotations
@@ -37,6 +38,7 @@ import time
 import numpy as np
 
 from motionlib import features
+from motionlib.points import bare_coordinates, is_point_take
 from motionlib.segmenters.base import Param, Segmentation, Segmenter, full_length, take_positions
 
 
@@ -145,10 +147,8 @@ class PPCA(Segmenter):
 
     def _segment(self, take, *, window_s, step_s, r_std, tau) -> Segmentation:
         t0 = time.perf_counter()
-        positions, joints, first = take_positions(take)
+        x, first = pose_vectors(take)
         t1 = time.perf_counter()
-        named = [index for name, index in sorted(joints.items()) if name != "root"]
-        x = features.body_frame_positions(positions, joints, named).reshape(len(positions), -1)
         window = max(2, int(round(window_s * take.fps)))
         step = max(1, int(round(step_s * take.fps)))
         cuts, scores, curve = [], [], np.full(len(x), np.nan)
@@ -171,6 +171,17 @@ class PPCA(Segmenter):
             signals={"mahalanobis": full_length(signal, first)},
             timings={"kinematics": t1 - t0, "detect": t2 - t1},
         )
+
+
+def pose_vectors(take) -> tuple[np.ndarray, int]:
+    """Per-frame pose vectors (n_used, d) and the take frame of the first: the body-frame
+    positions of the canonical joints other than the root, or for points of no known marker
+    set their coordinates (``points.bare_coordinates``)."""
+    if is_point_take(take) and take.marker_set is None:
+        return bare_coordinates(take), 0
+    positions, joints, first = take_positions(take)
+    named = [index for name, index in sorted(joints.items()) if name != "root"]
+    return features.body_frame_positions(positions, joints, named).reshape(len(positions), -1), first
 
 
 def _fill_gaps(curve: np.ndarray) -> np.ndarray:

@@ -101,11 +101,13 @@ class SegmentSerializer(serializers.ModelSerializer):
     color = serializers.SerializerMethodField()
     gold = serializers.BooleanField(source="is_gold")
     fps = serializers.FloatField(source="capture.fps")
+    export_formats = serializers.SerializerMethodField()
 
     class Meta:
         model = LibrarySegment
         fields = ["id", "project", "capture", "review", "annotator", "gold", "superseded",
-                  "label", "color", "start", "stop", "fps", "duration", "agreement"]
+                  "label", "color", "start", "stop", "fps", "duration", "agreement",
+                  "export_formats"]
 
     @extend_schema_field(NamedRefSerializer)
     def get_capture(self, s):
@@ -114,6 +116,9 @@ class SegmentSerializer(serializers.ModelSerializer):
     @extend_schema_field(UserRefSerializer(allow_null=True))
     def get_annotator(self, s):
         return {"id": s.annotator_id, "username": s.annotator.username} if s.annotator_id else None
+
+    def get_export_formats(self, s) -> list[str]:
+        return exports.formats_for(s.capture)
 
     def get_color(self, s) -> str:
         return s.label.color if s.label_id else "#888888"

@@ -182,6 +182,9 @@ class SkeletonSerializer(serializers.Serializer):
     parents = serializers.ListField(child=serializers.IntegerField(), help_text="-1: the root")
     height = serializers.FloatField()
     up = serializers.CharField()
+    kind = serializers.CharField(required=False, help_text="points: markers or tracked joints; "
+                                 "parents are then the links drawn between them")
+    marker_set = serializers.CharField(required=False, allow_null=True)
 
 
 class CaptureSerializer(serializers.ModelSerializer):

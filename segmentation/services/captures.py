@@ -16,7 +16,7 @@ import motionlib
 from motionlib.errors import shorten
 from motionlib.segmenters import ParamError, get_segmenter, list_segmenters
 from segmentation import storage
-from segmentation.errors import NotReady, ReviewStarted, UploadError, UploadTooLarge
+from segmentation.errors import CutroomError, NotReady, ReviewStarted, UploadError, UploadTooLarge
 from segmentation.models import Capture, DetectionRun, Project
 from segmentation.services import adaptation, jobs, quotas
 from segmentation.services.jobs import Kind, enqueue, register
@@ -25,7 +25,8 @@ from segmentation.storage import read_take
 
 log = logging.getLogger(__name__)
 
-FORMATS = {".bvh": "bvh", ".amc": "amc", ".fbx": "fbx"}
+FORMATS = {".bvh": "bvh", ".amc": "amc", ".fbx": "fbx", ".c3d": "c3d", ".tsv": "tsv",
+           ".csv": "csv"}
 # Stored file names keep word characters only and stay well under the 255 bytes a file
 # system allows per name (the capture's name keeps what the user uploaded; Django has cut
 # it to 255 characters, which may be up to 1,020 bytes).
@@ -54,7 +55,8 @@ def check_upload(upload, asf=None):
     if extension not in FORMATS:
         raise UploadError(
             f"file: {shorten(upload.name)} has extension {shorten(extension or '(none)')}; "
-            "upload a .bvh or binary .fbx file, or an .amc file with its .asf skeleton"
+            "upload a .bvh or binary .fbx file, an .amc file with its .asf skeleton, or "
+            "points: .c3d markers, a Qualisys .tsv export or a joint-position .csv"
         )
     for field, item in (("file", upload), ("asf", asf)):
         if item is None:
@@ -220,18 +222,23 @@ def _detect_here(run, take):
 
 
 def _metadata(take, height):
+    skeleton = {
+        "joints": list(take.skeleton.names),
+        "parents": [int(p) for p in take.skeleton.parents],
+        "height": height,
+        "up": "y",
+    }
+    if take.skeleton.point_set:
+        # Points, not joints: parents are the links of a known marker set (-1: none).
+        skeleton.update(kind="points", marker_set=take.marker_set, unit=take.unit,
+                        first_number=int(take.first_number))
     return {
         "format": take.format,
         "fps": float(take.fps),
         "n_frames": int(take.n_frames),
         "n_joints": len(take.skeleton.names),
         "rest_pose_frame": take.rest_pose_frame,
-        "skeleton": {
-            "joints": list(take.skeleton.names),
-            "parents": [int(p) for p in take.skeleton.parents],
-            "height": height,
-            "up": "y",
-        },
+        "skeleton": skeleton,
     }
 
 

@@ -143,9 +143,9 @@ def test_it_rejects_a_zero_frame_time(tmp_path):
 
 
 def test_it_rejects_an_unknown_extension(tmp_path):
-    path = tmp_path / "take.c3d"
+    path = tmp_path / "take.trc"
     path.write_text("x")
-    with pytest.raises(CaptureError, match=r"take\.c3d: unknown capture format '\.c3d'"):
+    with pytest.raises(CaptureError, match=r"take\.trc: unknown capture format '\.trc'"):
         motionlib.read(path)
 
 

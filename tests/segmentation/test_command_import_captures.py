@@ -112,9 +112,9 @@ class ImportCapturesTestCase(BaseTestCase):
 
     def test_it_reports_a_named_file_that_is_not_a_capture(self):
         good = self.write("good.bvh", synthetic_bvh(seed=7, duration=10.0))
-        notes = self.write("notes.csv", b"a,b\n")
+        notes = self.write("notes.txt", b"a,b\n")
         out, _ = self.run_import(notes, good)
-        self.assertIn("extension '.csv' is not a capture", out)
+        self.assertIn("extension '.txt' is not a capture", out)
 
     def test_it_fails_when_nothing_could_be_imported(self):
         self.write("empty.bvh", b"")

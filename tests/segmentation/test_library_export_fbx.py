@@ -66,7 +66,7 @@ class ExportTestCase(BaseTestCase):
         response = self.client.get(f"/api/segments/{self.segments[0].pk}/export.obj")
         assert response.status_code == 400
         assert response.json()["detail"] == ("format: 'obj' is not an export format; choose one "
-                                             "of bvh, fbx, glb")
+                                             "of bvh, fbx, glb, c3d, csv")
 
     def test_it_zips_every_segment_as_fbx_with_one_manifest(self):
         response = self.client.get("/api/segments/export.zip?file_format=fbx")

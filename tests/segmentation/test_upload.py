@@ -36,9 +36,9 @@ class UploadTestCase(BaseTestCase):
         self.assertEqual(r.status_code, 201)
 
     def test_it_refuses_a_wrong_extension(self):
-        r = self.upload(b"x,y,z\n1,2,3\n", name="take.csv")
+        r = self.upload(b"x,y,z\n1,2,3\n", name="take.txt")
         self.assertEqual(r.status_code, 400)
-        self.assertIn("'take.csv' has extension '.csv'", r.json()["detail"])
+        self.assertIn("'take.txt' has extension '.txt'", r.json()["detail"])
         self.assertFalse(Capture.objects.exists())
 
     def test_it_refuses_an_empty_file(self):

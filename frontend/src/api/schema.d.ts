@@ -1623,6 +1623,7 @@ export interface components {
             duration: number;
             /** Format: double */
             agreement: number | null;
+            readonly export_formats: string[];
         };
         /** @description A feature signal, sampled: value i is at frame start + i * step. */
         Signal: {
@@ -1665,6 +1666,7 @@ export interface components {
             duration: number;
             /** Format: double */
             agreement: number | null;
+            readonly export_formats: string[];
             /**
              * Format: double
              * @description Descriptor distance to the segment
@@ -1678,6 +1680,9 @@ export interface components {
             /** Format: double */
             height: number;
             up: string;
+            /** @description points: markers or tracked joints; parents are then the links drawn between them */
+            kind: string;
+            marker_set: string | null;
         };
         Span: {
             start: number;
@@ -3209,7 +3214,7 @@ export interface operations {
         parameters: {
             query?: {
                 /** @description clip format (default bvh) */
-                file_format?: "bvh" | "fbx" | "glb";
+                file_format?: "bvh" | "c3d" | "csv" | "fbx" | "glb";
             };
             header?: never;
             path?: never;

@@ -59,6 +59,8 @@ export async function renderLibrary(root: HTMLElement): Promise<() => void> {
     h("option", { value: "bvh" }, "BVH"),
     h("option", { value: "fbx" }, "FBX"),
     h("option", { value: "glb" }, "glTF"),
+    h("option", { value: "c3d", title: "segments of point takes (markers, tracked joints)" }, "C3D (points)"),
+    h("option", { value: "csv", title: "segments of point takes (markers, tracked joints)" }, "CSV (points)"),
   ) as HTMLSelectElement;
   const zipHref = () => `/api/segments/export.zip?${libraryQuery(filters, false)}&file_format=${zipFormat.value}`;
   zipFormat.addEventListener("change", () => exportZip.setAttribute("href", zipHref()));
@@ -112,6 +114,23 @@ export async function renderLibrary(root: HTMLElement): Promise<() => void> {
     ),
   );
 
+  // A segment of a point take (markers, tracked joints) downloads as C3D or CSV; one of joint
+  // rotations as BVH, FBX or glTF.
+  function exportButtons(s: LibrarySegment): HTMLElement[] {
+    if (!s.export_formats.includes("bvh")) {
+      return [
+        h("a", { class: "btn", "data-testid": `c3d-${s.id}`, href: `/api/segments/${s.id}/export.c3d`, download: "", title: "C3D markers" }, "C3D"),
+        h("a", { class: "btn", "data-testid": `csv-${s.id}`, href: `/api/segments/${s.id}/export.csv`, download: "", title: "joint-position CSV" }, "CSV"),
+      ];
+    }
+    return [
+      h("a", { class: "btn", href: `/api/segments/${s.id}/export.bvh`, download: "" }, "BVH"),
+      h("a", { class: "btn", "data-testid": `fbx-${s.id}`, href: `/api/segments/${s.id}/export.fbx`, download: "" }, "FBX"),
+      h("a", { class: "btn", "data-testid": `glb-${s.id}`, href: `/api/segments/${s.id}/export.glb`, download: "", title: "glTF binary" }, "glTF"),
+      h("button", { class: "btn", "data-testid": `play-glb-${s.id}`, title: "Play the glTF export as three.js loads it", onclick: () => void playGlb(s) }, "▶ glTF"),
+    ];
+  }
+
   function row(s: LibrarySegment): HTMLElement {
     return h(
       "tr",
@@ -127,10 +146,7 @@ export async function renderLibrary(root: HTMLElement): Promise<() => void> {
         { class: "lib-actions" },
         h("button", { class: "btn", "data-testid": `play-${s.id}`, onclick: () => void play(s) }, "▶ Play"),
         h("button", { class: "btn", "data-testid": `similar-${s.id}`, onclick: () => void similar(s) }, "Similar"),
-        h("a", { class: "btn", href: `/api/segments/${s.id}/export.bvh`, download: "" }, "BVH"),
-        h("a", { class: "btn", "data-testid": `fbx-${s.id}`, href: `/api/segments/${s.id}/export.fbx`, download: "" }, "FBX"),
-        h("a", { class: "btn", "data-testid": `glb-${s.id}`, href: `/api/segments/${s.id}/export.glb`, download: "", title: "glTF binary" }, "glTF"),
-        h("button", { class: "btn", "data-testid": `play-glb-${s.id}`, title: "Play the glTF export as three.js loads it", onclick: () => void playGlb(s) }, "▶ glTF"),
+        ...exportButtons(s),
       ),
     );
   }

@@ -23,14 +23,16 @@ export const MAX_JOINTS = 1000;
 /** Above this many joints, spheres and cylinders get fewer faces. */
 const DETAILED_JOINTS = 64;
 
-/** Which side of the body a joint is on: CMU "lfemur", BVH "LeftUpLeg"/"LHipJoint", "mixamorig:RightArm". */
+/** Which side of the body a joint is on: CMU "lfemur", BVH "LeftUpLeg"/"LHipJoint", "mixamorig:RightArm",
+ * Kinect "elbow_left", Plug-in Gait "LELB". */
 export function sideOf(name: string): "left" | "right" | "centre" {
   const bare = name.replace(/^.*:/, "");
   // Case-sensitive for the single-letter prefix, so "Root" or "LowerBack" stay central.
   const letter = /^L[A-Z_]/.test(bare) ? "left" : /^R[A-Z_]/.test(bare) ? "right" : null;
   if (letter) return letter;
-  if (/^left/i.test(bare) || LEFT_LIMB.test(bare) || /[._]l$/i.test(bare)) return "left";
-  if (/^right/i.test(bare) || RIGHT_LIMB.test(bare) || /[._]r$/i.test(bare)) return "right";
+  // Kinect joints name the side last: "elbow_left", "ElbowLeft".
+  if (/^left/i.test(bare) || /left$/i.test(bare) || LEFT_LIMB.test(bare) || /[._]l$/i.test(bare)) return "left";
+  if (/^right/i.test(bare) || /right$/i.test(bare) || RIGHT_LIMB.test(bare) || /[._]r$/i.test(bare)) return "right";
   return "centre";
 }
 
@@ -102,19 +104,28 @@ export class SkeletonView {
     return mesh;
   }
 
-  /** Show one pose: `pose` is (n_joints, 3) flattened, in the capture's units, Y up. */
+  /** Show one pose: `pose` is (n_joints, 3) flattened, in the capture's units, Y up. A point
+   * not seen in this frame (a marker take's gap: NaN) is hidden, and so are its links. */
   setPose(pose: Float32Array): void {
     const { m, q, a, b, mid, scale } = SCRATCH;
     const r = this.radius;
     for (let j = 0; j < this.skeleton.joints.length; j++) {
       a.fromArray(pose, j * 3);
-      m.compose(a, q.identity(), b.set(r * 1.25, r * 1.25, r * 1.25));
+      if (Number.isNaN(a.x + a.y + a.z)) {
+        m.makeScale(0, 0, 0);
+      } else {
+        m.compose(a, q.identity(), b.set(r * 1.25, r * 1.25, r * 1.25));
+      }
       this.joints.setMatrixAt(j, m);
     }
     for (let i = 0; i < this.boneList.length; i++) {
       const [p, c] = this.boneList[i];
       a.fromArray(pose, p * 3);
       b.fromArray(pose, c * 3);
+      if (Number.isNaN(a.x + a.y + a.z + b.x + b.y + b.z)) {
+        this.bones.setMatrixAt(i, m.makeScale(0, 0, 0));
+        continue;
+      }
       const length = a.distanceTo(b);
       mid.copy(a).add(b).multiplyScalar(0.5);
       q.setFromUnitVectors(UP, length > 1e-9 ? b.sub(a).divideScalar(length) : UP);
@@ -123,7 +134,8 @@ export class SkeletonView {
     }
     this.joints.instanceMatrix.needsUpdate = true;
     this.bones.instanceMatrix.needsUpdate = true;
-    this.followRoot(new THREE.Vector3().fromArray(pose, 0));
+    const root = seenPoint(pose);
+    if (root) this.followRoot(root);
     this.requestRender();
   }
 
@@ -184,6 +196,15 @@ export class SkeletonView {
     this.renderer.dispose();
     this.canvas.remove();
   }
+}
+
+/** The root (joint 0), or for a pose whose first point is a gap the first point seen; null
+ * when nothing is seen in this frame. */
+export function seenPoint(pose: Float32Array): THREE.Vector3 | null {
+  for (let j = 0; j + 2 < pose.length; j += 3) {
+    if (!Number.isNaN(pose[j] + pose[j + 1] + pose[j + 2])) return new THREE.Vector3().fromArray(pose, j);
+  }
+  return null;
 }
 
 /** A skeleton the player will not draw: more joints than the service admits. */

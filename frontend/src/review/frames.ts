@@ -83,7 +83,8 @@ export class FrameStore {
     // Every 4th frame is plenty for a floor and keeps this cheap on long takes.
     for (let f = 0; f < this.nFrames; f += 4) {
       if (!this.loaded[f]) continue;
-      for (let j = 1; j < size; j += 3) low = Math.min(low, this.positions[f * size + j]);
+      // A point not seen (NaN) is skipped: NaN < low is false.
+      for (let j = 1; j < size; j += 3) if (this.positions[f * size + j] < low) low = this.positions[f * size + j];
     }
     return Number.isFinite(low) ? low : null;
   }
