@@ -9,7 +9,8 @@ With no environment set, everything lives under ``var/`` (SQLite, the SQLite bro
 file, uploaded originals, logs). The worker and gunicorn run as child processes with
 their logs in ``var/log/``; a worker that dies is reported (with the end of its log),
 its jobs are requeued and it is restarted; Ctrl-C (or SIGTERM) stops both and waits for
-them. Running it again is safe: migrations and demo data are only added when missing.
+them. Running it again is safe: migrations are applied when missing and demo data is added
+once (``manage.py demo`` leaves an existing demo project as its admins keep it).
 """
 
 import argparse

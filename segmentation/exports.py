@@ -4,7 +4,11 @@ zip archive with a manifest.
 
 FBX and glTF run Blender in a child process of the calling process (``motionlib.io.blender``;
 nothing here imports it). A clip of a capture read from FBX is cut from its stored original, so
-it keeps the original's armature and bone names; any other becomes a new armature.
+it keeps the original's armature and bone names; any other becomes a new armature. FBX and glTF
+clips are in metres by :func:`motionlib.io.units.length_unit`; BVH clips keep the take's numbers.
+
+Every clip holds exactly the frames :func:`clip_range` names, in every format, and the manifest
+says which (``start``, ``stop``, ``frames``) and in what length unit (``unit``).
 """
 
 import contextlib
@@ -22,6 +26,7 @@ from pathlib import PurePath
 import motionlib
 from motionlib.errors import MotionlibError
 from motionlib.io.export import write_clips
+from motionlib.io.units import length_unit
 from segmentation import storage
 from segmentation.errors import CutroomError, ExportFormatError, internal_error
 from segmentation.storage import read_take
@@ -73,7 +78,7 @@ def clip_files(capture, take, segments, fmt):
     with tempfile.TemporaryDirectory(prefix="cutroom-export-") as folder, \
             _original(capture, take) as original:
         names = [f"{file_stem(s)}.{fmt}" for s in segments]
-        clips = [(s.start, s.stop, os.path.join(folder, f"{i}.{fmt}"))
+        clips = [(*clip_range(take, s), os.path.join(folder, f"{i}.{fmt}"))
                  for i, s in enumerate(segments)]
         write_clips(take, clips, format=fmt, original=original)
         for segment, name, (_, _, path) in zip(segments, names, clips, strict=True):
@@ -101,8 +106,8 @@ def file_name(segment):
     return f"{slug(stem)}_{slug(segment.label.name)}_{segment.start}-{segment.stop}.bvh"
 
 
-def bvh_text(take, segment):
-    """The segment's frames as BVH with the take's own hierarchy and frame time.
+def clip_range(take, segment):
+    """The capture frames ``(start, stop)`` the segment's clip holds, in every format.
 
     A cgspeed BVH's added T-pose frame (``take.rest_pose_frame``) is not part of the
     performance, so a clip that starts on or before it starts just after it.
@@ -110,9 +115,23 @@ def bvh_text(take, segment):
     start = segment.start
     if take.rest_pose_frame is not None and start <= take.rest_pose_frame < segment.stop - 1:
         start = take.rest_pose_frame + 1
+    return start, segment.stop
+
+
+def bvh_text(take, segment):
+    """The segment's frames (:func:`clip_range`) as BVH with the take's own hierarchy and
+    frame time."""
+    start, stop = clip_range(take, segment)
     out = io.StringIO()
-    motionlib.write_bvh(take, out, start=start, stop=segment.stop)
+    motionlib.write_bvh(take, out, start=start, stop=stop)
     return out.getvalue()
+
+
+def unit_text(take, fmt):
+    """The length unit of a clip in ``fmt``, for the manifest."""
+    if fmt == "bvh":
+        return "the capture's own (BVH numbers as in the original)"
+    return f"metre; the capture's unit taken as {length_unit(take).describe()}"
 
 
 def unique_name(name, segment, used):
@@ -128,11 +147,14 @@ def unique_name(name, segment, used):
     return name
 
 
-def manifest_row(segment, name, fmt="bvh"):
+def manifest_row(segment, name, fmt, take, unit):
+    """One clip of the archive: ``start``/``stop`` are the capture frames the file holds
+    (:func:`clip_range`), ``frames`` how many; ``unit`` its length unit (:func:`unit_text`)."""
+    start, stop = clip_range(take, segment)
     return {
         "file": name, "format": fmt, "segment": segment.pk, "capture": segment.capture.name,
-        "capture_id": segment.capture_id, "start": segment.start, "stop": segment.stop,
-        "label": segment.label.name, "gold": segment.is_gold,
+        "capture_id": segment.capture_id, "start": start, "stop": stop, "frames": stop - start,
+        "unit": unit, "label": segment.label.name, "gold": segment.is_gold,
         "annotator": segment.annotator.username if segment.annotator else None,
         "agreement": segment.agreement,
     }
@@ -173,10 +195,11 @@ def stream_zip(segments, fmt="bvh"):
             capture = group[0].capture
             try:
                 take = read_take(capture)
+                unit = unit_text(take, fmt)
                 for segment, name, data in _clips(capture, take, group, fmt):
                     name = unique_name(name, segment, used)
                     archive.writestr(_entry(name), data)
-                    manifest.append(manifest_row(segment, name, fmt))
+                    manifest.append(manifest_row(segment, name, fmt, take, unit))
                     yield sink.drain()
             except (MotionlibError, CutroomError) as exc:
                 errors.append(f"capture {capture.pk} ({capture.name}): {exc}")
@@ -206,8 +229,8 @@ def _clips(capture, take, segments, fmt):
 
 def _csv(rows):
     out = io.StringIO()
-    fields = ["file", "format", "segment", "capture", "capture_id", "start", "stop", "label", "gold",
-              "annotator", "agreement"]
+    fields = ["file", "format", "segment", "capture", "capture_id", "start", "stop", "frames",
+              "unit", "label", "gold", "annotator", "agreement"]
     writer = csv.DictWriter(out, fieldnames=fields)
     writer.writeheader()
     writer.writerows(rows)

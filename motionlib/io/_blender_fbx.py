@@ -17,9 +17,12 @@ Requests:
     Build an armature from rest heads and per-frame bone rotations/positions, key it, and export
     it as binary FBX or glTF binary.
 ``{"op": "trim", "path": FBX, "animation": NAME|null, "fps": F, "format": "fbx"|"glb",
-"clips": [{"start": I, "stop": J, "out": PATH}, ...]}``
+"scale": S, "clips": [{"start": I, "stop": J, "out": PATH}, ...]}``
     Import the original FBX and export frames [start, stop) of one of its animations, with
-    the same armature (bones, rest orientations, meshes).
+    the same armature (bones, rest orientations, meshes), scaled by S.
+
+Every clip written has one key per frame of the clip, the first at time 0: Blender's FBX
+importer puts a file's time 0 on its frame 1, and the glTF exporter slides the clip to 0 s.
 ``{"op": "evaluate", "path": FBX, "frames": [...]}``
     Blender's own pose evaluation of the first armature's assigned action: each bone's head in
     world coordinates on the given scene frames (an oracle for motionlib's pose arithmetic).
@@ -278,7 +281,7 @@ def op_write(request):
     armature = _build_armature(meta["name"], meta["bones"], meta["parents"], heads)
     _key_pose(armature, meta["bones"], quats, locations, meta["moving"])
     n = quats.shape[0]
-    bpy.context.scene.frame_start, bpy.context.scene.frame_end = 1, n
+    bpy.context.scene.frame_start, bpy.context.scene.frame_end = 0, n - 1
     _export(request["out"], request["format"], {"ARMATURE"})
     return {"frames": int(n)}
 
@@ -286,11 +289,13 @@ def op_write(request):
 def op_trim(request):
     """The original FBX again, cut to frames [start, stop) of one animation, once per clip.
 
-    The animation's armature (and the meshes it deforms) are kept as they are, every other
-    armature removed; the file is imported once for all clips. A baked animation keeps its keys,
-    renumbered 1, 2, … (its key times may drift from whole frames by float rounding, as Blender's
-    BVH round trip leaves them); any other is sampled by the exporter on the scene frames of
-    the range.
+    The animation's armature (and the meshes it deforms) are kept, scaled by ``scale`` (its
+    declared unit is not always the one its maker meant), every other armature removed; the
+    file is imported once for all clips. A baked animation keeps its keys, renumbered 0, 1, …
+    (its key times may drift from whole frames by float rounding, as Blender's BVH round trip
+    leaves them); any other is shifted so that the clip's first frame is at 0 and sampled by
+    the exporter on the scene frames of the range. The FBX exporter writes key times as they
+    are, so starting at 0 is what makes the clip start at time 0.
     """
     import bpy
 
@@ -306,27 +311,29 @@ def op_trim(request):
     for other in [o for o in armatures if o is not armature]:
         for child in list(other.children_recursive) + [other]:
             bpy.data.objects.remove(child)
+    scale = float(request.get("scale", 1.0))
+    _rescale(armature, scale)
     _set_fps(request["fps"])
     curves = _curves(action, armature)
     counts = {len(c.keyframe_points) for c in curves}
     frames, _, _ = _sample(curves, None)
     for clip in request["clips"]:
         start, stop = int(clip["start"]), int(clip["stop"])
+        cut = action.copy()
+        _bind(armature, cut)
         if len(counts) == 1 and stop <= next(iter(counts)):  # baked: one key per frame
-            cut = action.copy()
-            _bind(armature, cut)
             for c in _curves(cut, armature):
                 _renumber(c, start, stop)
-            scene.frame_start, scene.frame_end = 1, stop - start
+            scene.frame_start, scene.frame_end = 0, stop - start - 1
         else:
-            cut = None
-            _bind(armature, action)
-            scene.frame_start = int(round(frames[start]))
-            scene.frame_end = int(round(frames[stop - 1]))
+            first = int(round(frames[start]))
+            for c in _curves(cut, armature):
+                _shift(c, -first)
+            scene.frame_start, scene.frame_end = 0, int(round(frames[stop - 1])) - first
+        _rescale_keys(_curves(cut, armature), scale)
         _export(clip["out"], request["format"], {"ARMATURE", "MESH"})
-        if cut is not None:
-            _bind(armature, action)
-            bpy.data.actions.remove(cut)
+        _bind(armature, action)
+        bpy.data.actions.remove(cut)
     return {"clips": len(request["clips"])}
 
 
@@ -341,8 +348,43 @@ def _renumber(fcurve, start, stop):
     fcurve.keyframe_points.foreach_get("co", co)
     values = co[1::2][start:stop].copy()
     fcurve.keyframe_points.clear()
-    frames = np.arange(1, len(values) + 1, dtype=np.float64)
+    frames = np.arange(len(values), dtype=np.float64)
     _set_keys(fcurve, frames, values)
+
+
+def _shift(fcurve, frames):
+    """Move every key of ``fcurve`` (and its handles) by ``frames``."""
+    points = fcurve.keyframe_points
+    for prop in ("co", "handle_left", "handle_right"):
+        xy = np.empty(2 * len(points))
+        points.foreach_get(prop, xy)
+        xy[0::2] += frames
+        points.foreach_set(prop, xy)
+    fcurve.update()
+
+
+def _rescale(armature, scale):
+    """Scale the armature, and with it the meshes it deforms, about the world's origin."""
+    if scale != 1.0:
+        armature.scale = armature.scale * scale
+        armature.location = armature.location * scale
+
+
+def _rescale_keys(curves, scale):
+    """Scale the keyed location and scale of the armature object itself (FBX importers key
+    them with the bones), which would otherwise undo :func:`_rescale` on every frame."""
+    if scale == 1.0:
+        return
+    for fcurve in curves:
+        if fcurve.data_path not in ("location", "scale"):
+            continue
+        points = fcurve.keyframe_points
+        for prop in ("co", "handle_left", "handle_right"):
+            xy = np.empty(2 * len(points))
+            points.foreach_get(prop, xy)
+            xy[1::2] *= scale
+            points.foreach_set(prop, xy)
+        fcurve.update()
 
 
 def _set_fps(fps):
@@ -405,10 +447,10 @@ def _build_armature(name, bones, parents, heads):
 
 def _key_pose(armature, bones, quats, locations, moving):
     """Key every bone's rotation (quaternion, w x y z) and the location of the bones that move
-    (the root; any bone whose distance to its parent changes) on frames 1…F."""
+    (the root; any bone whose distance to its parent changes) on frames 0…F-1."""
     import bpy
 
-    frames = np.arange(1, quats.shape[0] + 1, dtype=np.float64)
+    frames = np.arange(quats.shape[0], dtype=np.float64)
     armature.animation_data_create()
     action = bpy.data.actions.new(armature.name)
     armature.animation_data.action = action

@@ -10,9 +10,11 @@ in the Blender process of :mod:`motionlib.io.blender`:
 - any other take becomes a new armature with the take's joint names, hierarchy and rest offsets,
   each bone's rest orientation the world's (BVH-shaped), keyed on every frame.
 
-Either way one frame of the clip is one key, at the take's frame rate, Y up; lengths are the
-take's unit divided by 100 in Blender's metres, so an FBX take (centimetres) keeps its size and an
-FBX written here reads back (:mod:`motionlib.io.fbx`) in the unit it was written from.
+Either way a clip of ``stop - start`` frames is ``stop - start`` keys, one per frame at the take's
+frame rate, the first at time 0 (so Blender's FBX importer puts it on its first frame, 1, and a
+glTF animation starts at 0 s), Y up. Lengths are in metres as :func:`motionlib.io.units.length_unit`
+decides the take's unit (an FBX take keeps its declared size when it is human-sized); an FBX
+written here declares centimetres, in which :mod:`motionlib.io.fbx` reads it back.
 """
 
 from __future__ import annotations
@@ -32,6 +34,7 @@ from motionlib.io.fbx import (
     matrix_to_quaternion,
 )
 from motionlib.io.pointcsv import write_points_csv
+from motionlib.io.units import length_unit
 from motionlib.kinematics import euler_to_matrix
 from motionlib.take import Take, frame_range
 
@@ -94,14 +97,18 @@ def write_clips(take: Take, clips, *, format: str, original=None, blender=None,
     what = f"writing {format.upper()} clips"
     if original is not None and take.format == "fbx":
         check_fbx_header(original)
+        unit = length_unit(take)
         blender.request({
             "op": "trim", "path": os.path.abspath(os.fspath(original)),
             "animation": take.animation, "fps": take.fps, "format": format,
+            # The armature as the file has it, rescaled when its declared unit is not the one.
+            "scale": unit.metres * CENTIMETRES_PER_METRE,
             "clips": [{"start": a, "stop": b, "out": os.path.abspath(o)} for a, b, o in clips],
         }, path=original, what=what, timeout=timeout)
         return
+    metres = length_unit(take).metres
     for start, stop, out in clips:
-        _write_new_armature(take.slice(start, stop), out, format, blender, timeout)
+        _write_new_armature(take.slice(start, stop), out, format, blender, timeout, metres)
 
 
 def check_export_format(take, format: str) -> None:
@@ -119,8 +126,8 @@ def check_export_format(take, format: str) -> None:
                            f"{' or '.join(allowed)}", path=take.path)
 
 
-def _write_new_armature(take, out, format, blender, timeout):
-    meta, arrays = armature_pose(take)
+def _write_new_armature(take, out, format, blender, timeout, metres):
+    meta, arrays = armature_pose(take, metres=metres)
     with tempfile.TemporaryDirectory(prefix="motionlib-export-") as folder:
         pose = os.path.join(folder, "pose.npz")
         np.savez(pose, **arrays)
@@ -129,9 +136,11 @@ def _write_new_armature(take, out, format, blender, timeout):
                         what=f"writing the {format.upper()} clip", timeout=timeout)
 
 
-def armature_pose(take: Take) -> tuple[dict, dict[str, np.ndarray]]:
+def armature_pose(take: Take, *, metres: float | None = None) -> tuple[dict, dict[str, np.ndarray]]:
     """The take as Blender bones: rest heads, and per frame each bone's local rotation and
     location offset, in Blender's Z-up metres.
+
+    ``metres`` per unit of the take's lengths (default: :func:`~motionlib.io.units.length_unit`).
 
     Returns
     -------
@@ -142,7 +151,7 @@ def armature_pose(take: Take) -> tuple[dict, dict[str, np.ndarray]]:
         continuous over time; ``locations`` (n_frames, n_bones, 3).
     """
     sk = take.skeleton
-    scale = 1.0 / CENTIMETRES_PER_METRE
+    scale = length_unit(take).metres if metres is None else metres
     rest = np.zeros((sk.n_joints, 3))
     for j in range(sk.n_joints):
         p = sk.parents[j]

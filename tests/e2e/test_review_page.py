@@ -277,7 +277,7 @@ def test_it_lists_the_shortcuts_and_locks_the_review_once_submitted(live_server,
 
     # Submitting asks first, saying what is still open; cancelling changes nothing.
     page.get_by_test_id("submit").click()
-    expect(page.get_by_role("dialog")).to_contain_text("pending candidates")
+    expect(page.get_by_role("dialog")).to_contain_text("pending candidates will be kept as cuts")
     page.get_by_test_id("confirm-cancel").click()
     # Nothing was edited yet, so not even the review is started.
     assert screen.review()["status"] == "not_started"

@@ -13,6 +13,7 @@ from motionlib.errors import CaptureError
 from motionlib.io.blender import blender_python
 from motionlib.io.export import write_clip, write_clips
 from motionlib.io.fbx import read_fbx_all, read_fbx_raw
+from motionlib.io.units import length_unit
 from tests.fbx.files import shared_bvh_13_29, shared_fbx
 
 GLTF_HEADS = Path(__file__).resolve().parents[1] / "fbx" / "gltf_heads.py"
@@ -20,6 +21,11 @@ GLTF_HEADS = Path(__file__).resolve().parents[1] / "fbx" / "gltf_heads.py"
 
 def positions(take):
     return motionlib.forward_kinematics(take)
+
+
+def exported_positions(take):
+    """The take's joint positions in the centimetres an exported clip reads back in."""
+    return positions(take) * length_unit(take).metres * 100.0
 
 
 def glb_json(path):
@@ -41,8 +47,8 @@ def test_it_cuts_an_fbx_clip_that_reads_back_as_the_trimmed_frames(tmp_path):
     [clip] = read_fbx_all(tmp_path / "clip.fbx")
     assert (clip.n_frames, clip.fps) == (1200, take.fps)
     assert clip.skeleton.names == take.skeleton.names
-    error = np.abs(positions(clip) - positions(take)[600:1800]).max()
-    assert error < 1e-4 * motionlib.skeleton_height(take)
+    error = np.abs(positions(clip) - exported_positions(take)[600:1800]).max()
+    assert error < 1e-4 * motionlib.skeleton_height(clip)
 
 
 def test_it_keeps_the_original_armature_of_an_fbx(tmp_path):
@@ -64,8 +70,8 @@ def test_it_writes_a_bvh_take_as_an_fbx_with_its_joints_and_motion(tmp_path):
     clip = motionlib.read(tmp_path / "clip.fbx")
     assert (clip.n_frames, clip.fps) == (360, 120.0)
     columns = [clip.skeleton.names.index(name) for name in take.skeleton.names]
-    error = np.abs(positions(clip)[:, columns] - positions(take)[120:480]).max()
-    assert error < 1e-4 * motionlib.skeleton_height(take)
+    error = np.abs(positions(clip)[:, columns] - exported_positions(take)[120:480]).max()
+    assert error < 1e-4 * motionlib.skeleton_height(clip)
 
 
 def test_it_writes_several_clips_of_an_fbx_in_one_go(tmp_path):
@@ -116,8 +122,9 @@ def test_it_writes_a_glb_that_poses_the_clip_as_the_take(tmp_path, source):
     frames = [0, 101, 237, 299]
     names, heads = gltf_positions(tmp_path / "clip.glb", take.fps, frames)
     columns = [take.skeleton.names.index(name) for name in names]
-    expected = positions(take)[[50 + f for f in frames]][:, columns]
-    assert np.abs(heads - expected).max() < 1e-4 * motionlib.skeleton_height(take)
+    expected = exported_positions(take)[[50 + f for f in frames]][:, columns]
+    height = motionlib.skeleton_height(take) * length_unit(take).metres * 100.0
+    assert np.abs(heads - expected).max() < 1e-4 * height
 
 
 def test_it_refuses_an_unknown_format(tmp_path):

@@ -13,6 +13,7 @@ from django.test import TestCase, override_settings
 from segmentation import services
 from segmentation.management.commands import demo
 from segmentation.models import Capture, Label, Project
+from segmentation.services.taxonomy import do_change_label
 from tests.segmentation.base import SHARED_DATA, BaseTestCase
 
 
@@ -90,13 +91,24 @@ class DemoTestCase(TestCase):
         run_demo("--no-shared-data")
         self.assertIsNotNone(authenticate(username="annotator", password="my-own-password"))
 
-    def test_a_second_run_adds_labels_that_were_deleted_without_taking_reused_hotkeys(self):
+    def test_a_second_run_keeps_a_label_the_admin_renamed(self):
+        do_change_label(self.project.labels.get(name="turn"), name="spin")
+        output = run_demo("--no-shared-data")
+        names = list(self.project.labels.values_list("name", flat=True))
+        self.assertIn("spin", names)
+        self.assertNotIn("turn", names)
+        self.assertIn("members and labels as its admins left them", output)
+
+    def test_a_second_run_keeps_a_label_the_admin_removed(self):
         self.project.labels.filter(name="walk").delete()
-        services.do_add_label(self.project, "stumble", "#000000", "1")
         run_demo("--no-shared-data")
-        walk = self.project.labels.get(name="walk")
-        self.assertIsNone(walk.hotkey)
-        self.assertEqual(self.project.labels.get(hotkey="1").name, "stumble")
+        self.assertFalse(self.project.labels.filter(name="walk").exists())
+
+    def test_a_second_run_keeps_a_role_the_admin_changed(self):
+        services.do_set_member(self.project, "reviewer", "annotator")
+        run_demo("--no-shared-data")
+        reviewer = get_user_model().objects.get(username="reviewer")
+        self.assertEqual(self.project.role_of(reviewer), "annotator")
 
     def test_it_says_when_the_shared_data_folder_is_missing(self):
         output = run_demo("--shared-data", "/nonexistent/shared/data")

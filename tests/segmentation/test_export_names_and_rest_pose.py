@@ -48,3 +48,43 @@ class ExportRoughEdgesTest(CmuLibraryTestCase):
         exported = motionlib.read(path)
         assert exported.n_frames == 469 - 1
         assert_allclose(exported.channels, self.take.channels[1:469], atol=1e-6)
+
+
+class ExportFramesAgreeWithManifestTest(CmuLibraryTestCase):
+    """Every format holds the frames the manifest names: a cgspeed clip from frame 0 leaves
+    out the T-pose in BVH, FBX and glTF alike, and its manifest row says so."""
+
+    def setUp(self):
+        super().setUp()
+        self.capture, self.take = self.real_capture(data_file("cmu", "bvh", "13_29.bvh"))
+        self.login(self.rachel)
+        submit_review(self.capture, self.bob, [469], ["JumpJack", None])
+
+    def archive(self, fmt):
+        url = f"/api/segments/export.zip?capture={self.capture.pk}&label=JumpJack&file_format={fmt}"
+        body = b"".join(self.client.get(url).streaming_content)
+        return zipfile.ZipFile(io.BytesIO(body))
+
+    def frames_in(self, archive, name):
+        import motionlib
+
+        path = self.media_root / name
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_bytes(archive.read(name))
+        return motionlib.read(path).n_frames
+
+    def test_it_lists_the_frames_each_bvh_clip_holds(self):
+        archive = self.archive("bvh")
+        [row] = json.loads(archive.read("manifest.json"))
+        assert (row["start"], row["stop"], row["frames"]) == (1, 469, 468)
+        assert self.frames_in(archive, row["file"]) == row["frames"]
+        assert "BVH" in row["unit"]
+
+    def test_it_lists_the_frames_and_unit_of_each_fbx_clip(self):
+        archive = self.archive("fbx")
+        [row] = json.loads(archive.read("manifest.json"))
+        assert (row["start"], row["stop"], row["frames"]) == (1, 469, 468)
+        assert self.frames_in(archive, row["file"]) == 468
+        assert row["unit"] == ("metre; the capture's unit taken as CMU Acclaim unit (inch / "
+                               "0.45) (chosen by the figure's height)")
+        assert "frames,unit" in archive.read("manifest.csv").decode().splitlines()[0]

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 import motionlib
+from motionlib.io.units import length_unit
 from segmentation import storage, tasks
 from segmentation.models import Capture, DetectionRun, LibrarySegment
 from tests.fbx.files import shared_fbx
@@ -102,6 +103,9 @@ class BvhCaptureExportTestCase(BaseTestCase):
         assert clip.n_frames == capture.n_frames - 240
         joints = capture.skeleton["joints"]
         columns = [clip.skeleton.names.index(name) for name in joints]
-        stored = storage.load_npy(capture.positions)[240:]
+        # The clip reads back in centimetres of the metres its unit makes of the capture's.
+        centimetres = length_unit(storage.read_take(capture)).metres * 100.0
+        stored = storage.load_npy(capture.positions)[240:] * centimetres
         moved = motionlib.forward_kinematics(clip)[:, columns]
-        np.testing.assert_allclose(moved, stored, atol=1e-4 * capture.skeleton["height"])
+        np.testing.assert_allclose(moved, stored,
+                                   atol=1e-4 * capture.skeleton["height"] * centimetres)

@@ -1,6 +1,10 @@
 // A segment's glTF export played in place: the .glb the service writes, loaded with three.js's
 // GLTFLoader as Unreal, Unity or a web viewer would, its first animation run by an
 // AnimationMixer on the file's own skeleton. Shows what a studio gets before it downloads.
+//
+// The skeleton is drawn from the nodes the animation moves, not from a skin: a clip of a BVH or
+// AMC capture is an armature without a mesh, whose joints three.js loads as plain nodes, and
+// the camera frames those joints (a bounding box of meshes alone would be empty).
 
 import * as THREE from "three";
 import { type GLTF, GLTFLoader } from "three/examples/jsm/loaders/GLTFLoader.js";
@@ -11,15 +15,92 @@ export interface GlbSummary {
   animations: { name: string; duration: number; tracks: number }[];
 }
 
+/** The names of the nodes the first animation moves: a track is named "<node>.<property>". */
+function animatedNames(gltf: GLTF): Set<string> {
+  const first = gltf.animations[0];
+  return new Set(first ? first.tracks.map((track) => track.name.slice(0, track.name.lastIndexOf("."))) : []);
+}
+
 /** What a loaded glTF holds: how many joints its first animation moves, its animations. */
 export function summarise(gltf: GLTF): GlbSummary {
-  const first = gltf.animations[0];
-  // A track is named "<node>.<property>"; the node names are the joints it moves.
-  const joints = new Set(first ? first.tracks.map((track) => track.name.slice(0, track.name.lastIndexOf("."))) : []);
   return {
-    joints: joints.size,
+    joints: animatedNames(gltf).size,
     animations: gltf.animations.map((clip) => ({ name: clip.name, duration: clip.duration, tracks: clip.tracks.length })),
   };
+}
+
+/** The skeleton's joints: the nodes the animation moves, and the bones of any skin. */
+export function jointNodes(gltf: GLTF): THREE.Object3D[] {
+  const names = animatedNames(gltf);
+  const nodes: THREE.Object3D[] = [];
+  gltf.scene.traverse((node) => {
+    if (names.has(node.name) || (node as THREE.Bone).isBone) nodes.push(node);
+  });
+  return nodes;
+}
+
+/** Lines from each joint to its parent joint and a dot on each, posed from the nodes' world
+ * matrices on every `update()`; drawn over any mesh so the skeleton always shows. */
+export class JointLines {
+  readonly object = new THREE.Group();
+  private readonly pairs: [THREE.Object3D, THREE.Object3D][];
+  private readonly lines: THREE.BufferAttribute;
+  private readonly dots: THREE.BufferAttribute;
+  private readonly point = new THREE.Vector3();
+
+  constructor(private readonly joints: THREE.Object3D[]) {
+    const set = new Set(joints);
+    this.pairs = joints.flatMap((j) => (j.parent && set.has(j.parent) ? [[j.parent, j] as [THREE.Object3D, THREE.Object3D]] : []));
+    this.lines = new THREE.BufferAttribute(new Float32Array(this.pairs.length * 6), 3);
+    this.dots = new THREE.BufferAttribute(new Float32Array(joints.length * 3), 3);
+    const lineGeometry = new THREE.BufferGeometry().setAttribute("position", this.lines);
+    const dotGeometry = new THREE.BufferGeometry().setAttribute("position", this.dots);
+    const lineMaterial = new THREE.LineBasicMaterial({ color: "#7ee2a8", depthTest: false, transparent: true });
+    const dotMaterial = new THREE.PointsMaterial({ color: "#ffd666", size: 5, sizeAttenuation: false, depthTest: false, transparent: true });
+    this.object.add(new THREE.LineSegments(lineGeometry, lineMaterial), new THREE.Points(dotGeometry, dotMaterial));
+    this.object.renderOrder = 1;
+    for (const child of this.object.children) child.frustumCulled = false;
+  }
+
+  update(): void {
+    this.pairs.forEach(([a, b], i) => {
+      this.lines.setXYZ(2 * i, ...this.world(a));
+      this.lines.setXYZ(2 * i + 1, ...this.world(b));
+    });
+    this.joints.forEach((j, i) => this.dots.setXYZ(i, ...this.world(j)));
+    this.lines.needsUpdate = true;
+    this.dots.needsUpdate = true;
+  }
+
+  /** The joints' current world positions, in a box (empty without joints). */
+  box(): THREE.Box3 {
+    const box = new THREE.Box3();
+    for (const j of this.joints) box.expandByPoint(j.getWorldPosition(this.point));
+    return box;
+  }
+
+  private world(node: THREE.Object3D): [number, number, number] {
+    node.getWorldPosition(this.point);
+    return [this.point.x, this.point.y, this.point.z];
+  }
+
+  dispose(): void {
+    for (const child of this.object.children) {
+      const drawn = child as THREE.LineSegments | THREE.Points;
+      drawn.geometry.dispose();
+      (drawn.material as THREE.Material).dispose();
+    }
+  }
+}
+
+/** What the camera frames: the posed joints and any mesh (a mesh's box alone is empty for an
+ * armature without one). */
+export function frameBox(gltf: GLTF, skeleton: JointLines): THREE.Box3 {
+  gltf.scene.updateMatrixWorld(true);
+  const box = skeleton.box();
+  const meshes = new THREE.Box3().setFromObject(gltf.scene);
+  if (!meshes.isEmpty()) box.union(meshes);
+  return box;
 }
 
 export class GlbPreview {
@@ -53,15 +134,19 @@ export class GlbPreview {
     stage.append(renderer.domElement);
     const scene = new THREE.Scene();
     scene.background = new THREE.Color("#161a21");
-    scene.add(new THREE.HemisphereLight("#ffffff", "#2a3140", 2.5), gltf.scene, new THREE.SkeletonHelper(gltf.scene));
-    const box = new THREE.Box3().setFromObject(gltf.scene);
-    const size = Math.max(box.getSize(new THREE.Vector3()).length(), 0.1);
-    const centre = box.getCenter(new THREE.Vector3());
+    const skeleton = new JointLines(jointNodes(gltf));
+    scene.add(new THREE.HemisphereLight("#ffffff", "#2a3140", 2.5), gltf.scene, skeleton.object);
+    const mixer = new THREE.AnimationMixer(gltf.scene);
+    if (gltf.animations[0]) mixer.clipAction(gltf.animations[0]).play();
+    mixer.update(0); // the first frame's pose, to frame
+    const box = frameBox(gltf, skeleton);
+    const extent = box.isEmpty() ? new THREE.Vector3(1, 1, 1) : box.getSize(new THREE.Vector3());
+    this.box.setAttribute("data-gltf-height", extent.y.toFixed(3));
+    const size = Math.max(extent.length(), 0.1);
+    const centre = box.isEmpty() ? new THREE.Vector3() : box.getCenter(new THREE.Vector3());
     const camera = new THREE.PerspectiveCamera(40, 1, size * 0.01, size * 100);
     camera.position.set(centre.x + size * 0.8, centre.y + size * 0.3, centre.z + size * 1.2);
     camera.lookAt(centre);
-    const mixer = new THREE.AnimationMixer(gltf.scene);
-    if (gltf.animations[0]) mixer.clipAction(gltf.animations[0]).play();
     const clock = new THREE.Clock();
     let raf = 0;
     const tick = () => {
@@ -71,6 +156,8 @@ export class GlbPreview {
       camera.aspect = width / height;
       camera.updateProjectionMatrix();
       mixer.update(clock.getDelta());
+      gltf.scene.updateMatrixWorld(true);
+      skeleton.update();
       renderer.render(scene, camera);
       raf = requestAnimationFrame(tick);
     };
@@ -78,6 +165,7 @@ export class GlbPreview {
     return () => {
       cancelAnimationFrame(raf);
       mixer.stopAllAction();
+      skeleton.dispose();
       renderer.dispose();
     };
   }

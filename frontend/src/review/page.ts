@@ -375,10 +375,15 @@ class ReviewPage {
     if (this.locked() || this.saver.pending) return;
     const pending = this.review.cuts.filter((c) => c.fate === "pending").length;
     const unlabelled = this.review.segments.filter((s) => !s.label).length;
+    // Submitting keeps every cut not deleted, pending candidates included: say so, with the count.
+    const candidates = `${pending} pending candidate${pending === 1 ? "" : "s"}`;
     const ok = await confirmDialog(next ? "Submit and open the next capture?" : "Submit this review?", [
       h("p", {}, "A submitted review counts towards agreement and the library, and can no longer be edited."),
-      pending || unlabelled ? h("p", { class: "muted" }, `Still open: ${pending} pending candidate${pending === 1 ? "" : "s"}, ${unlabelled} unlabelled segment${unlabelled === 1 ? "" : "s"}.`) : null,
-    ], "Submit");
+      pending
+        ? h("p", { "data-testid": "submit-pending" }, h("strong", {}, `${candidates} will be kept as cuts.`), ` Accept or delete ${pending === 1 ? "it" : "them"} first to decide each one.`)
+        : null,
+      unlabelled ? h("p", { class: "muted", "data-testid": "submit-unlabelled" }, `${unlabelled} unlabelled segment${unlabelled === 1 ? "" : "s"} will be left out of the library.`) : null,
+    ], pending ? `Submit, keeping ${pending}` : "Submit");
     if (!ok) return;
     try {
       this.review = await post<Review>(`/api/captures/${this.capture.id}/review/submit/`, { version: this.saver.server.version });

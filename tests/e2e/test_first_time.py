@@ -1,0 +1,86 @@
+"""What a first-time studio user trips over, checked where they would see it: the review page
+at laptop sizes, the submit dialog, the library's filters and export progress, the capture
+list's upload and assignment."""
+
+import pytest
+from playwright.sync_api import expect
+
+from tests.e2e.test_review_page import ReviewScreen
+
+# Where an element sits against the viewport, and whether the page scrolls sideways.
+FITS = """(selector) => {
+  const el = document.querySelector(selector);
+  const r = el.getBoundingClientRect();
+  return { left: r.left, right: r.right, top: r.top, bottom: r.bottom, width: innerWidth, height: innerHeight,
+           scrollWidth: document.documentElement.scrollWidth };
+}"""
+
+
+# The oldest entry of the edit history: is it what a person sees at its centre (not clipped
+# away by a panel that does not scroll)?
+LAST_EVENT = """() => {
+  const li = document.querySelector("[data-testid=events] li:last-child");
+  const r = li.getBoundingClientRect();
+  const seen = document.elementFromPoint(r.left + r.width / 2, r.top + r.height / 2);
+  return { top: r.top, bottom: r.bottom, height: r.height, seen: !!seen && li.contains(seen) };
+}"""
+# The demo project's taxonomy has 15 labels; a studio's is rarely smaller.
+MORE_LABELS = ["run", "jump", "arm circles", "idle", "knee raise", "twist", "side reach",
+               "side bend", "toe touch", "turn"]
+
+
+@pytest.mark.parametrize(("width", "height"), [(1280, 720), (1440, 900)])
+def test_the_review_page_fits_a_laptop_screen_with_its_history_in_reach(
+        live_server, new_page, ingested_capture, studio, screenshots, width, height):
+    from segmentation import services
+
+    for name in MORE_LABELS:
+        services.do_add_label(studio["project"], name, "#64748b")
+    page = new_page("ann", width=width, height=height)
+    screen = ReviewScreen(page, live_server.url, ingested_capture)
+    screen.open()
+    for _ in range(12):  # a history longer than the panel
+        page.keyboard.press("ArrowRight")
+        page.keyboard.press("i")
+    screen.saved()
+    expect(page.get_by_test_id("events").locator("li")).to_have_count(13)
+    if (width, height) == (1280, 720):  # the README's
+        page.screenshot(path=str(screenshots / "review-1280x720.png"))
+    side = page.evaluate(FITS, ".side")
+    assert side["scrollWidth"] <= width, side
+    assert side["right"] <= width and side["bottom"] <= height, side
+    # Scrolled to with the mouse wheel over the side panel, as a person would, the oldest
+    # entry of the history is on the screen.
+    page.mouse.move(side["right"] - 40, side["bottom"] - 40)
+    for _ in range(6):
+        page.mouse.wheel(0, 600)
+        page.wait_for_timeout(100)
+    last = page.evaluate(LAST_EVENT)
+    assert last["seen"] and last["height"] > 0, last
+    assert 0 <= last["top"] and last["bottom"] <= height, last
+    # The top bar's buttons keep to one line.
+    assert page.get_by_test_id("submit").bounding_box()["height"] < 40
+    assert page.errors == []
+
+
+def test_the_submit_dialog_says_the_pending_candidates_will_be_kept(live_server, new_page,
+                                                                   ingested_capture, studio):
+    from segmentation.models import LibrarySegment
+
+    page = new_page("ann")
+    screen = ReviewScreen(page, live_server.url, ingested_capture)
+    screen.open()
+    pending = len(ingested_capture.latest_finished_run().candidates)
+    page.get_by_test_id("submit").click()
+    dialog = page.get_by_role("dialog")
+    expect(dialog.get_by_test_id("submit-pending")).to_contain_text(
+        f"{pending} pending candidates will be kept as cuts")
+    expect(dialog.get_by_test_id("submit-unlabelled")).to_contain_text(
+        f"{pending + 1} unlabelled segments will be left out of the library")
+    expect(page.get_by_test_id("confirm-ok")).to_have_text(f"Submit, keeping {pending}")
+    page.get_by_test_id("confirm-ok").click()
+    expect(page.get_by_test_id("readonly-banner")).to_contain_text("You submitted this review")
+    kept = [c for c in screen.review()["cuts"] if c["fate"] != "deleted"]
+    assert len(kept) == pending  # as the dialog said
+    assert not LibrarySegment.objects.filter(capture=ingested_capture).exists()
+    assert page.errors == []
