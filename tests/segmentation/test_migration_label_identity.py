@@ -1,4 +1,4 @@
-"""Migration 0014 converts segments that stored a label by name into segments that refer
+"""Migration 0016 converts segments that stored a label by name into segments that refer
 to the label by id, losing none (issue 33, item 1).
 
 The rows are made in the 0012 schema as the service used to leave them after renaming
@@ -11,7 +11,7 @@ from django.db.migrations.executor import MigrationExecutor
 from django.test import TransactionTestCase
 
 BEFORE = [("segmentation", "0012_library_scale")]
-AFTER = [("segmentation", "0014_segment_label_identity")]
+AFTER = [("segmentation", "0016_segment_label_identity")]
 
 
 class LabelIdentityMigrationTest(TransactionTestCase):

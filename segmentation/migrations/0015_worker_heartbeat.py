@@ -7,7 +7,7 @@ from django.db import migrations, models
 class Migration(migrations.Migration):
 
     dependencies = [
-        ('segmentation', '0012_library_scale'),
+        ("segmentation", "0014_job_error_permanent"),
     ]
 
     operations = [

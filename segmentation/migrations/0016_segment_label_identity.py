@@ -130,7 +130,7 @@ def to_label_names(apps, schema_editor):
 class Migration(migrations.Migration):
 
     dependencies = [
-        ("segmentation", "0012_library_scale"),
+        ("segmentation", "0015_worker_heartbeat"),
     ]
 
     operations = [
