@@ -1,4 +1,10 @@
-"""``manage.py demo``: a demo project with users, labels and takes, safe to run again."""
+"""``manage.py demo``: a demo project with users, labels and takes, safe to run again.
+
+Demo data is added once: the project's members and labels are set when the project is created,
+and a later run leaves them as the project's admins keep them (a renamed or removed label, a
+changed role stay so). Takes not yet uploaded are added on every run (one placed under
+``../shared/data`` later, say); uploads are recognised by checksum, so none comes twice.
+"""
 
 import io
 from pathlib import Path
@@ -55,9 +61,10 @@ class Command(BaseCommand):
     def handle(self, *args, **options):
         with transaction.atomic():
             users = {name: demo_user(name, superuser) for name, (_, superuser) in USERS.items()}
-            project = demo_project(users)
+            project, created = demo_project(users)
         self.stdout.write(f"Project {project.name!r} (id {project.pk}), "
-                          f"{project.labels.count()} labels")
+                          f"{project.labels.count()} labels"
+                          + ("" if created else "; members and labels as its admins left them"))
         outcomes = [self.add_synth(project, users["annotator"], seed, seconds)
                     for seed, seconds in SYNTH_TAKES]
         if not options["no_shared_data"]:
@@ -109,17 +116,15 @@ def demo_user(username, superuser):
 
 
 def demo_project(users):
-    """The demo project with its members and label taxonomy (missing parts added)."""
+    """``(project, created)``: the demo project, made with its members and label taxonomy the
+    first time only; an existing one is left as it is."""
     project = Project.objects.filter(name=PROJECT).order_by("id").first()
-    if project is None:
-        project = services.do_create_project(users["admin"], PROJECT)
+    if project is not None:
+        return project, False
+    project = services.do_create_project(users["admin"], PROJECT)
     for name, (role, _) in USERS.items():
-        if project.role_of(users[name]) != role and name != "admin":
+        if name != "admin":
             services.do_set_member(project, name, role)
-    taken = set(project.labels.values_list("hotkey", flat=True))
     for name, color, hotkey in LABELS:
-        if not project.labels.filter(name=name).exists():
-            # Someone may have given this hotkey to another label since; keep theirs.
-            services.do_add_label(project, name, color, None if hotkey in taken else hotkey)
-            taken.add(hotkey)
-    return project
+        services.do_add_label(project, name, color, hotkey)
+    return project, True
