@@ -21,7 +21,7 @@ install: $(STAMP)
 $(STAMP): pyproject.toml setup.py motionlib/io/_parse.c motionlib/_kinematics.c
 	test -x $(PY) || python3 -m venv .venv
 	$(PIP) install -q --upgrade pip
-	$(PIP) install -q -e ".[dev,bench]"
+	$(PIP) install -q -e ".[dev,bench,plot]"
 	touch $(STAMP)
 
 # Blender as a module (FBX) in a virtualenv of its own: bpy pins numpy<2 (see the file).
@@ -63,13 +63,18 @@ pytest: install
 	$(PY) -m pytest -m "not integration"
 	$(INTEGRATION_ENV) $(PY) -m pytest -m integration
 
+# Each benchmark's output goes to benchmarks/results/<name>.md (generated, committed: every
+# figure quoted has one source, and a change shows as a diff), headed by date, commit and load.
+RECORD := $(PY) benchmarks/record.py
+RESULTS := benchmarks/results
+
 bench: install
-	$(PY) -m motionlib bench-speed io
-	$(PY) -m motionlib bench-quality
-	$(PY) benchmarks/upload_to_candidates.py
+	$(RECORD) $(RESULTS)/speed-io.md -- $(PY) -m benchmarks.quality speed io
+	$(RECORD) $(RESULTS)/quality.md -- $(PY) -m benchmarks.quality --loo
+	$(RECORD) $(RESULTS)/upload-to-candidates.md -- $(PY) benchmarks/upload_to_candidates.py
 	@command -v wrk >/dev/null || { apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq wrk; } \
 		|| echo "wrk not installed: the capture list benchmark uses its Python client"
-	$(PY) benchmarks/capture_list_load.py
+	$(RECORD) $(RESULTS)/capture-list-load.md -- $(PY) benchmarks/capture_list_load.py
 
 # The README's screenshots, taken by the browser tests.
 screenshots: install frontend browser

@@ -34,6 +34,10 @@ def run_segment(args) -> int:
 
     cls = get_segmenter(args.method)
     params = cls.validate_params(parse_param_args(args.param))  # before the slow read
+    if args.plot:  # before the slow read too
+        from motionlib.segmenters.plot import require_matplotlib
+
+        require_matplotlib()
     if args.examples and cls.name != "default":
         raise ParamError(f"--examples: only the default method adapts, not {cls.name!r}")
     model = None

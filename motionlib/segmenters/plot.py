@@ -1,4 +1,8 @@
-"""Draw a segmentation: the method's signal(s) over time with the cuts as dashed lines."""
+"""Draw a segmentation: the method's signal(s) over time with the cuts as dashed lines.
+
+matplotlib is an optional extra (``pip install "cutroom[plot]"``): only drawing needs it,
+so it is imported here, when a plot is asked for, and its absence is a clear error.
+"""
 
 from __future__ import annotations
 
@@ -6,7 +10,20 @@ from pathlib import Path
 
 import numpy as np
 
+from motionlib.errors import InputError
 from motionlib.segmenters.base import Segmentation
+
+MISSING = ('--plot: drawing needs matplotlib, which is not installed '
+           '(pip install "cutroom[plot]")')
+
+
+def require_matplotlib():
+    """The ``matplotlib`` module; InputError saying how to install it when it is missing."""
+    try:
+        import matplotlib
+    except ImportError:
+        raise InputError(MISSING) from None
+    return matplotlib
 
 
 def plot_segmentation(
@@ -17,8 +34,7 @@ def plot_segmentation(
     Each signal is scaled to [0, 1] so several fit one axis; a cut's line is darker the
     higher its confidence.
     """
-    import matplotlib
-
+    matplotlib = require_matplotlib()
     matplotlib.use("Agg")
     from matplotlib import pyplot as plt
 
