@@ -49,9 +49,11 @@ LOW_PRIORITY = 10
 
 
 def pool(capture, annotator):
-    """The library segments suggestions for ``annotator``'s review of ``capture`` draw on."""
+    """The library segments suggestions for ``annotator``'s review of ``capture`` draw on:
+    none of a retired label, which could not be applied (retiring or restoring one changes
+    the pool's state, so stored suggestions follow)."""
     return (LibrarySegment.objects.visible_to(annotator).preferred()
-            .filter(project_id=capture.project_id, profile__isnull=False)
+            .filter(project_id=capture.project_id, profile__isnull=False, label__retired=False)
             .exclude(capture_id=capture.pk))
 
 

@@ -18,6 +18,7 @@ from motionlib import synth
 from segmentation import services, storage, suggestions, tasks
 from segmentation.models import Capture, LabelSuggestion
 from segmentation.services import gold
+from segmentation.services.taxonomy import do_change_label
 from tests.segmentation.test_library import LibraryTestCase, submit_review
 
 
@@ -87,6 +88,16 @@ class SuggestionPoolTest(SuggestionsTestCase):
         submit_review(take_c, self.bob, [start for start, _, _ in truth_c[1:]], ["idle"] * len(truth_c))
         self.review_take_b(self.bob)
         assert set(self.suggested(self.bob).values()) == {"idle"}
+
+    def test_it_never_suggests_a_retired_label(self):
+        take_c, truth_c = self.synth_capture(7, 20.0)
+        submit_review(take_c, self.bob, [start for start, _, _ in truth_c[1:]], ["idle"] * len(truth_c))
+        self.submit_take_a(self.bob)
+        self.review_take_b(self.bob)
+        assert "idle" in set(self.suggested(self.bob).values())
+        do_change_label(self.project.labels.get(name="idle"), retired=True)
+        found = self.suggested(self.bob)
+        assert found and "idle" not in set(found.values())
 
     def test_it_suggests_nothing_when_the_annotator_may_see_no_segment(self):
         self.submit_take_a(self.dana)
