@@ -49,6 +49,7 @@ browser:
 
 lint: install
 	.venv/bin/ruff check .
+	$(PY) manage.py makemigrations --check --dry-run
 
 vitest: $(FRONT_STAMP)
 	cd frontend && npm test

@@ -12,6 +12,7 @@ the first take, a trained cut model and the project's similar-clip index.
 """
 
 import io
+import json
 
 from django.contrib.auth import get_user_model
 from django.core.files.uploadedfile import SimpleUploadedFile
@@ -49,7 +50,8 @@ def populate():
     first = captures[0]
     bobs = first.reviews.get(annotator=bob)
     cuts = sorted(c.frame for c in bobs.cuts.exclude(fate="deleted"))
-    do_save_gold(first, alice, cuts, ["walk"] * (len(cuts) + 1), 0, source_review=bobs)
+    gold_labels = [("walk", "punch")[i % 2] for i in range(len(cuts) + 1)]
+    do_save_gold(first, alice, cuts, gold_labels, 0, source_review=bobs)
     _train(project)
     similar_index.build(project.pk)
     return project
@@ -115,6 +117,64 @@ def library_exports(client):
     return files
 
 
+def holdings(client):
+    """What the installation's people see of their work, through the API as alice: per
+    project its label names and cut models; per capture, every review's cuts and segment
+    labels (by name) and the gold version; the library's segments. Fields other releases may add are left out, so an upgrade that
+    keeps the work keeps this unchanged."""
+    captures = {}
+    page = "/api/captures/"
+    while page:
+        listing = client.get(page).json()
+        for capture in listing["results"]:
+            captures[capture["name"]] = _capture_work(client, capture)
+        page = listing.get("next")
+    segments, page = [], "/api/segments/"
+    while page:
+        listing = client.get(page).json()
+        segments += [_segment(s) for s in listing["results"]]
+        page = listing.get("next")
+    projects = {project["name"]: {
+        "labels": sorted(_name(label) for label in project["labels"]),
+        "cut_models": [
+            {k: m[k] for k in ("version", "status", "n_takes", "n_cuts")}
+            for m in client.get(f"/api/projects/{project['id']}/cut-models/").json()],
+    } for project in client.get("/api/projects/").json()}
+    return {"projects": projects, "captures": captures,
+            "library": sorted(segments, key=json.dumps)}
+
+
+def _capture_work(client, capture):
+    reviews = client.get(f"/api/captures/{capture['id']}/reviews/").json()
+    gold = client.get(f"/api/captures/{capture['id']}/adjudication/").json()["gold"]
+    return {
+        "status": capture["status"], "n_frames": capture["n_frames"], "fps": capture["fps"],
+        "reviews": {r["annotator"]["username"]: {
+            "status": r["status"],
+            "cuts": [{k: c[k] for k in ("origin", "fate", "candidate_frame", "frame")}
+                     for c in r["cuts"]],
+            "segments": [(s["start"], s["stop"], _name(s["label"])) for s in r["segments"]],
+        } for r in reviews},
+        "gold": gold and {
+            "version": gold["version"], "cuts": gold["cuts"],
+            "segments": [(s["start"], s["stop"], _name(s["label"])) for s in gold["segments"]],
+        },
+    }
+
+
+def _segment(segment):
+    return {"capture": segment["capture"]["name"], "start": segment["start"],
+            "stop": segment["stop"], "label": _name(segment["label"]),
+            "gold": segment["gold"], "superseded": segment["superseded"],
+            "annotator": (segment["annotator"] or {}).get("username"),
+            "agreement": segment["agreement"]}
+
+
+def _name(label):
+    """A label's name, whether the API gives the name or the label ({"name": …})."""
+    return label["name"] if isinstance(label, dict) else label
+
+
 def _body(response):
     assert response.status_code == 200, response.content
     if response.streaming:
@@ -122,9 +182,10 @@ def _body(response):
     return response.content
 
 
-def main(out):
-    """Write alice's downloads of the installation this process is configured for (its
-    environment) into the folder ``out``."""
+def main(what, out):
+    """For the installation this process's environment configures: write alice's downloads
+    into the folder ``out`` (``exports``), or its :func:`holdings` as JSON to the file
+    ``out`` (``holdings``)."""
     import django
 
     django.setup()
@@ -134,6 +195,9 @@ def main(out):
 
     client = APIClient()
     client.force_authenticate(get_user_model().objects.get(username="alice"))
+    if what == "holdings":
+        Path(out).write_text(json.dumps(holdings(client), indent=1, sort_keys=True) + "\n")
+        return
     for name, data in library_exports(client).items():
         (Path(out) / name).write_bytes(data)
 
@@ -141,4 +205,4 @@ def main(out):
 if __name__ == "__main__":
     import sys
 
-    main(sys.argv[1])
+    main(*sys.argv[1:])

@@ -48,12 +48,18 @@ def manage(env, *args):
                           capture_output=True, text=True, timeout=600)
 
 
+def run_installation(env, what, out):
+    """``tests/segmentation/installation.py``'s ``main`` in the installation of ``env``."""
+    done = subprocess.run([sys.executable, "-m", "tests.segmentation.installation", what,
+                           str(out)], cwd=REPO, env=env, capture_output=True, text=True,
+                          timeout=600)
+    assert done.returncode == 0, done.stderr
+
+
 def exports_of(env, folder):
     """alice's downloads from the installation of ``env``, by file name."""
     folder.mkdir()
-    done = subprocess.run([sys.executable, "-m", "tests.segmentation.installation", str(folder)],
-                          cwd=REPO, env=env, capture_output=True, text=True, timeout=600)
-    assert done.returncode == 0, done.stderr
+    run_installation(env, "exports", folder)
     return {path.name: path.read_bytes() for path in folder.iterdir()}
 
 
