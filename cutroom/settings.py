@@ -202,6 +202,13 @@ CUTROOM_SWEEP_SECONDS = envint("CUTROOM_SWEEP_SECONDS", 15)
 CUTROOM_RESEND_AFTER = envint("CUTROOM_RESEND_AFTER", 15 * 60)
 # Workers are restarted when a job waited this long while a worker process sat idle.
 CUTROOM_STALL_SECONDS = envint("CUTROOM_STALL_SECONDS", 60)
+# Every worker's main process records a heartbeat this often; the health endpoint takes a
+# worker not heard of for CUTROOM_HEARTBEAT_STALE seconds to be gone.
+CUTROOM_HEARTBEAT_SECONDS = envint("CUTROOM_HEARTBEAT_SECONDS", 15)
+CUTROOM_HEARTBEAT_STALE = envint("CUTROOM_HEARTBEAT_STALE", 60)
+# The health endpoint calls a similar-clip index stale when a library segment has waited
+# this long to be indexed (searches still find it: they read newer segments from the rows).
+CUTROOM_INDEX_STALE_SECONDS = envint("CUTROOM_INDEX_STALE_SECONDS", 900)
 # After this many claims a job that keeps killing its worker is marked failed.
 CUTROOM_MAX_ATTEMPTS = envint("CUTROOM_MAX_ATTEMPTS", 3)
 # FBX uploads are read by Blender on this queue, served by its own worker (`make up`, compose).

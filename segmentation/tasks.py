@@ -19,7 +19,7 @@ from django.db import connection
 
 from segmentation import services, similar_index, suggestions
 from segmentation.models import Capture, DetectionRun, ProjectCutModel
-from segmentation.services import adaptation, jobs
+from segmentation.services import adaptation, health, jobs
 from segmentation.services.convert import convert_capture
 
 log = logging.getLogger(__name__)
@@ -170,3 +170,11 @@ def sweep_on_start(**kwargs):
     # A restarted worker first picks up whatever a killed worker left behind.
     services.sweep_stale_claims()
     adaptation.sweep_stale_trainings()
+
+
+@worker_ready.connect
+def start_heartbeat(sender, **kwargs):
+    # The health endpoint's sign that this worker is alive, and which queues it serves.
+    worker = sender.controller
+    health.beat(worker.hostname, sorted(sender.app.amqp.queues.consume_from),
+                worker.concurrency)

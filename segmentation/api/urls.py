@@ -3,7 +3,7 @@ from drf_spectacular.views import SpectacularAPIView, SpectacularSwaggerSplitVie
 from rest_framework.routers import SimpleRouter
 
 from cutroom.accounts import api as accounts_api
-from segmentation.api import assignments, invitations, library, reviews, team
+from segmentation.api import assignments, health, invitations, library, reviews, team
 from segmentation.api.captures import CaptureViewSet
 from segmentation.api.projects import MethodsView, MeView, ProjectViewSet
 
@@ -31,5 +31,6 @@ urlpatterns = [
     *invitations.urlpatterns,
     *assignments.urlpatterns,
     *team.urlpatterns,
+    *health.urlpatterns,
     *router.urls,
 ]

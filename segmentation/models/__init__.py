@@ -4,7 +4,8 @@
 - ``projects``: projects, members, labels, invitations, the project's cut model;
 - ``captures``: captures, detection runs, assignments;
 - ``reviews``: reviews, cuts, segment labels, the review audit log;
-- ``library``: library segments, gold versions, agreement, label suggestions.
+- ``library``: library segments, gold versions, agreement, label suggestions;
+- ``workers``: the Celery workers' heartbeats.
 
 Rules about one record live on the models; lookups live on the managers
 (``Capture.objects.visible_to(user)``). Workflows that touch several records are the
@@ -38,6 +39,7 @@ from segmentation.models.projects import (
     ProjectCutModel,
 )
 from segmentation.models.reviews import Cut, Review, ReviewEvent, SegmentLabel
+from segmentation.models.workers import WorkerHeartbeat
 
 __all__ = [
     "AGREED_BOUNDARY_F1",
@@ -67,4 +69,5 @@ __all__ = [
     "SuggestionRequest",
     "derived_path",
     "original_path",
+    "WorkerHeartbeat",
 ]

@@ -41,8 +41,9 @@ from segmentation.models import Capture, Project
 
 FORMAT = 1
 # Rows every installation makes for itself as it migrates (content types and permissions,
-# referred to by natural key), and sign-in sessions, which a restore does not carry over.
-NOT_BACKED_UP = {"contenttypes", "auth.permission", "sessions"}
+# referred to by natural key), and what belongs to the running processes, not the work:
+# sign-in sessions and the workers' heartbeats.
+NOT_BACKED_UP = {"contenttypes", "auth.permission", "sessions", "segmentation.workerheartbeat"}
 
 
 class BackupError(CutroomError):

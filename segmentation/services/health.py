@@ -1,16 +1,28 @@
-"""Is background work making progress? Asked by a watcher outside the workers (``make
-up``'s supervisor, ``manage.py watch_jobs`` in compose's watchdog), so a worker that hangs
-cannot hide it, and the jobs of a dead or hung worker are requeued without it."""
+"""Is the service working? Asked from outside the workers: by a watcher (``make up``'s
+supervisor, ``manage.py watch_jobs`` in compose's watchdog) every few seconds, so a worker
+that hangs cannot hide it and the jobs of a dead or hung worker are requeued without it;
+and by monitoring, through ``GET /api/health/`` (:func:`report`).
 
+Workers say they are alive by a heartbeat row their main process writes (:func:`beat`)."""
+
+import logging
+import threading
+import time
+
+from celery import current_app
 from django.conf import settings
+from django.db import connection
 from django.db.models import Max, Min, Q
 from django.db.models.functions import Coalesce
 from django.utils import timezone
 
-from segmentation.models import Capture, DetectionRun
+from segmentation import similar_index
+from segmentation.models import Capture, DetectionRun, LibrarySegment, WorkerHeartbeat
 from segmentation.models.jobs import claim_cutoff
 from segmentation.services.adaptation import sweep_stale_trainings
 from segmentation.services.jobs import sweep_stale_claims
+
+log = logging.getLogger(__name__)
 
 JOBS = (Capture, DetectionRun)
 
@@ -68,3 +80,109 @@ def _latest(querysets):
     times = [qs.aggregate(t=Max("claimed_at", filter=Q(claimed_at__isnull=False)))["t"]
              for qs in querysets]
     return max((t for t in times if t is not None), default=None)
+
+
+def beat(hostname, queues, processes):
+    """Record a worker's heartbeat now, and then every CUTROOM_HEARTBEAT_SECONDS from a
+    thread of its main process (which a busy pool process never holds up)."""
+
+    def record():
+        now = timezone.now()
+        try:
+            heartbeat, made = WorkerHeartbeat.objects.get_or_create(
+                hostname=hostname, defaults={"queues": queues, "processes": processes,
+                                             "started_at": now, "seen_at": now})
+            if not made:
+                WorkerHeartbeat.objects.filter(pk=heartbeat.pk).update(
+                    queues=queues, processes=processes, seen_at=now)
+        except Exception:  # the database away for a moment: the next beat tries again
+            log.exception("could not record the heartbeat of worker %s", hostname)
+        finally:
+            connection.close()
+
+    def forever():
+        while True:
+            record()
+            time.sleep(settings.CUTROOM_HEARTBEAT_SECONDS)
+
+    threading.Thread(target=forever, name=f"heartbeat {hostname}", daemon=True).start()
+
+
+def report():
+    """The service's health for monitoring: (ok, checks), each check a dict with ``ok``
+    and what it found. Checks: the database, the broker, the workers of the default queue
+    (heard of lately, and not stuck), the convert worker, the similar-clip indexes."""
+    checks = {}
+    for name, check in (("database", _database), ("broker", _broker),
+                        ("workers", _workers), ("convert_worker", _convert_worker),
+                        ("similar_index", _similar_index)):
+        try:
+            checks[name] = check()
+        except Exception as exc:
+            checks[name] = {"ok": False, "error": f"{type(exc).__name__}: {exc}"}
+    return all(c["ok"] for c in checks.values()), checks
+
+
+def _database():
+    with connection.cursor() as cursor:
+        cursor.execute("SELECT 1")
+    return {"ok": True, "vendor": connection.vendor}
+
+
+def _broker():
+    with current_app.connection_for_write() as conn:
+        conn.ensure_connection(max_retries=1, timeout=5)
+    return {"ok": True, "transport": conn.transport_cls}
+
+
+def _alive(queue):
+    since = timezone.now() - timezone.timedelta(seconds=settings.CUTROOM_HEARTBEAT_STALE)
+    return [h for h in WorkerHeartbeat.objects.filter(seen_at__gte=since) if queue in h.queues]
+
+
+def _workers():
+    queue = settings.CELERY_TASK_DEFAULT_QUEUE
+    alive = _alive(queue)
+    processes = sum(h.processes for h in alive)
+    found = {"workers": len(alive), "processes": processes}
+    if not alive:
+        return {"ok": False, **found, "error": f"no worker of the queue {queue!r} was heard of "
+                f"in the last {settings.CUTROOM_HEARTBEAT_STALE} s (CUTROOM_HEARTBEAT_STALE)"}
+    stuck = stalled(processes)
+    return {"ok": stuck is None, **found, **({"error": stuck} if stuck else {})}
+
+
+def _convert_worker():
+    queue = settings.CUTROOM_CONVERT_QUEUE
+    alive = _alive(queue)
+    converting = Capture.objects.filter(status="processing", format="fbx", converted="").count()
+    found = {"workers": len(alive), "slots": sum(h.processes for h in alive),
+             "converting": converting}
+    if not alive:
+        return {"ok": False, **found, "error": f"no worker of the convert queue {queue!r} was "
+                f"heard of in the last {settings.CUTROOM_HEARTBEAT_STALE} s: FBX uploads wait"}
+    return {"ok": True, **found}
+
+
+def _similar_index():
+    """Stale: a project's library segment waited more than CUTROOM_INDEX_STALE_SECONDS to
+    enter its index (no index, an unusable one, or one that stopped being updated)."""
+    limit = timezone.now() - timezone.timedelta(seconds=settings.CUTROOM_INDEX_STALE_SECONDS)
+    projects = (LibrarySegment.objects.filter(profile__isnull=False)
+                .order_by("project_id").values_list("project_id", flat=True).distinct())
+    stale = []
+    for project_id in projects:
+        try:
+            indexed_up_to = similar_index.read_manifest(project_id)["max_id"]
+        except similar_index.IndexUnusable:
+            indexed_up_to = 0
+        waiting = (similar_index.described(project_id).filter(id__gt=indexed_up_to)
+                   .aggregate(t=Min("created_at"))["t"])
+        if waiting is not None and waiting < limit:
+            stale.append(project_id)
+    found = {"projects": len(projects), "stale": stale}
+    if stale:
+        return {"ok": False, **found, "error": f"the similar-clip index of project(s) "
+                f"{', '.join(map(str, stale))} lacks segments older than "
+                f"{settings.CUTROOM_INDEX_STALE_SECONDS} s (CUTROOM_INDEX_STALE_SECONDS)"}
+    return {"ok": True, **found}

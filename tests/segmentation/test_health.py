@@ -1,12 +1,18 @@
-"""The watchdog's question: are the workers stuck, or just busy?"""
+"""The watchdog's question (are the workers stuck, or just busy?) and the monitor's
+(``GET /api/health/``: database, broker, workers, convert worker, similar-clip indexes)."""
 
 import io
 
+import numpy as np
+from django.conf import settings
 from django.core.management import CommandError, call_command
 from django.test import override_settings
 from django.utils import timezone
 
-from segmentation.models import Capture, DetectionRun
+from cutroom.celery import app
+from motionlib import similarity
+from segmentation import similar_index
+from segmentation.models import Capture, DetectionRun, LibrarySegment, WorkerHeartbeat
 from segmentation.services import health
 from tests.segmentation.base import BaseTestCase
 
@@ -85,3 +91,85 @@ class WatchJobsTestCase(BaseTestCase):
         )
         with self.assertRaisesRegex(CommandError, "the workers are stuck: a job has waited 90 s"):
             self.watch_once()
+
+
+@override_settings(CUTROOM_STALL_SECONDS=60, CUTROOM_CLAIM_TIMEOUT=30, CUTROOM_HEARTBEAT_STALE=60,
+                   CUTROOM_INDEX_STALE_SECONDS=900)
+class HealthEndpointTestCase(BaseTestCase):
+    """``GET /api/health/``: what a monitor asks, without signing in."""
+
+    def beating(self, hostname, queues, processes=2, seconds_ago=5):
+        return WorkerHeartbeat.objects.create(hostname=hostname, queues=queues,
+                                              processes=processes, seen_at=ago(seconds_ago))
+
+    def workers_beating(self):
+        self.beating("worker@host", [settings.CELERY_TASK_DEFAULT_QUEUE])
+        self.beating("convert@host", [settings.CUTROOM_CONVERT_QUEUE])
+
+    def health(self, expected_status):
+        response = self.client.get("/api/health/")
+        self.assertEqual(response.status_code, expected_status, response.content)
+        return response.json()
+
+    def test_it_answers_ok_while_everything_works(self):
+        self.workers_beating()
+        body = self.health(200)
+        self.assertEqual((body["status"], body["failing"]), ("ok", []))
+        self.assertEqual(body["checks"]["database"], {"ok": True, "vendor": "sqlite"})
+        self.assertTrue(body["checks"]["broker"]["ok"])
+        self.assertEqual(body["checks"]["workers"], {"ok": True, "workers": 1, "processes": 2})
+        self.assertEqual(body["checks"]["convert_worker"]["slots"], 2)
+
+    def test_it_names_workers_never_heard_of(self):
+        body = self.health(503)
+        self.assertEqual(body["failing"], ["workers", "convert_worker"])
+        self.assertIn(f"no worker of the queue '{settings.CELERY_TASK_DEFAULT_QUEUE}' was heard "
+                      "of in the last 60 s", body["checks"]["workers"]["error"])
+        self.assertIn("FBX uploads wait", body["checks"]["convert_worker"]["error"])
+
+    def test_a_worker_not_heard_of_lately_is_gone(self):
+        self.workers_beating()
+        WorkerHeartbeat.objects.filter(hostname="convert@host").update(seen_at=ago(120))
+        self.assertEqual(self.health(503)["failing"], ["convert_worker"])
+
+    def test_it_names_workers_that_beat_but_take_no_job(self):
+        self.workers_beating()
+        capture = self.ready_capture()
+        Capture.objects.filter(pk=capture.pk).update(claimed_at=ago(600))
+        DetectionRun.objects.filter(capture=capture).update(
+            status="queued", claimed_at=None, created_at=ago(90))
+        body = self.health(503)
+        self.assertEqual(body["failing"], ["workers"])
+        self.assertIn("a job has waited 90 s in the queue", body["checks"]["workers"]["error"])
+
+    def test_it_names_a_broker_it_cannot_reach(self):
+        self.workers_beating()
+        app.conf.broker_url, previous = "redis://127.0.0.1:9//", app.conf.broker_url
+        try:
+            body = self.health(503)
+        finally:
+            app.conf.broker_url = previous
+        self.assertEqual(body["failing"], ["broker"])
+        self.assertIn("Connection refused", body["checks"]["broker"]["error"])
+
+    def test_it_names_a_similar_index_that_lags_behind_the_library(self):
+        self.workers_beating()
+        capture = self.ready_capture()
+        profile = np.arange(similarity.PROFILE_ROWS * 4, dtype="<f4")
+        for start in (0, 100, 200):
+            LibrarySegment.objects.create(
+                project=self.project, capture=capture, label_name="walk", start=start,
+                stop=start + 100, duration=100 / 120, profile=(profile + start).tobytes(),
+                created_at=ago(1000))
+        body = self.health(503)
+        self.assertEqual(body["failing"], ["similar_index"])
+        self.assertIn(f"the similar-clip index of project(s) {self.project.pk} lacks segments "
+                      "older than 900 s", body["checks"]["similar_index"]["error"])
+        similar_index.build(self.project.pk)
+        self.assertEqual(self.health(200)["checks"]["similar_index"],
+                         {"ok": True, "projects": 1, "stale": []})
+
+    def test_it_tells_a_monitor_without_signing_in_and_without_names(self):
+        self.workers_beating()
+        body = self.health(200)
+        self.assertNotIn("worker@host", str(body))
