@@ -30,6 +30,7 @@ from django.conf import settings
 from django.contrib.auth import get_user_model
 from django.core import serializers
 from django.core.management import call_command
+from django.core.serializers.base import DeserializationError
 from django.core.serializers.json import Serializer as JSONSerializer
 from django.db import DEFAULT_DB_ALIAS, connection, connections, transaction
 from django.db.migrations.loader import MigrationLoader
@@ -142,8 +143,11 @@ def do_restore(path):
             target = Path(folder) / "db.json"
             with archive.extractfile(rows) as src, open(target, "wb") as dst:
                 dst.write(src.read())
-            with transaction.atomic():
-                call_command("loaddata", str(target), verbosity=0)
+            try:
+                with transaction.atomic():
+                    call_command("loaddata", str(target), verbosity=0)
+            except DeserializationError as exc:
+                raise BackupError(f"{path}: db.json cannot be loaded ({exc})") from None
         for name, folder_path in _folders().items():
             members = [m for m in archive.getmembers() if m.name.startswith(f"{name}/")]
             for member in members:

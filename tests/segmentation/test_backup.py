@@ -142,3 +142,26 @@ def test_it_names_a_file_that_is_not_a_backup(tmp_path, db, content, problem):
         path.write_bytes(content)
     with pytest.raises(CommandError, match=re.escape(f"backup.tar: {problem}")):
         call_command("restore", str(path), stdout=io.StringIO())
+
+
+def test_it_names_a_backup_file_it_cannot_write(tmp_path, db):
+    (tmp_path / "file").write_text("")
+    with pytest.raises(CommandError, match="file/cutroom.tar: cannot write the backup"):
+        call_command("backup", str(tmp_path / "file" / "cutroom.tar"), stdout=io.StringIO())
+
+
+def test_it_names_rows_it_cannot_load(tmp_path, db, settings):
+    backup = tmp_path / "cutroom.tar"
+    call_command("backup", str(backup), stdout=io.StringIO())
+    damaged = tmp_path / "damaged.tar"
+    with tarfile.open(backup) as src, tarfile.open(damaged, "w") as dst:
+        for member in src.getmembers():
+            data = src.extractfile(member).read() if member.isfile() else None
+            if member.name == "db.json":
+                data = data[: len(data) // 2]
+                member.size = len(data)
+            dst.addfile(member, io.BytesIO(data) if data is not None else None)
+    done = manage(fresh_installation(tmp_path / "new"), "restore", str(damaged))
+    assert done.returncode != 0
+    assert "damaged.tar: db.json cannot be loaded" in done.stderr
+    assert "Traceback" not in done.stderr

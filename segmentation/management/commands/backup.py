@@ -1,7 +1,7 @@
 from pathlib import Path
 
 from django.conf import settings
-from django.core.management.base import BaseCommand
+from django.core.management.base import BaseCommand, CommandError
 from django.utils import timezone
 
 from segmentation.services.backup import do_backup
@@ -19,6 +19,9 @@ class Command(BaseCommand):
     def handle(self, *args, **options):
         path = options["path"] or (Path(settings.VAR_DIR) / "backups" /
                                    f"cutroom-{timezone.now():%Y%m%d-%H%M%S}.tar")
-        manifest = do_backup(path)
+        try:
+            manifest = do_backup(path)
+        except OSError as exc:
+            raise CommandError(f"{path}: cannot write the backup ({exc.strerror or exc})") from None
         self.stdout.write(f"backup written to {path} ({len(manifest['migrations'])} "
                           f"migrations, {manifest['database']})")
