@@ -23,6 +23,8 @@ from segmentation.services import jobs
 
 log = logging.getLogger(__name__)
 
+log = logging.getLogger(__name__)
+
 JOBS = (Capture, DetectionRun)
 
 

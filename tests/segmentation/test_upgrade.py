@@ -1,4 +1,4 @@
-"""Upgrading keeps the work: the previous release's database (``upgrade/v0.2.0.sqlite3``, made
+"""Upgrading keeps the work: the previous release's database (``upgrade/v0.2.0.sqlite``, made
 by ``upgrade/make_fixture.py`` from the tag v0.2.0) migrated by this release holds every
 review's cuts and labels, the gold versions, the library segments and the cut models as that
 release's people saw them (``upgrade/v0.2.0.holdings.json``)."""
@@ -16,7 +16,7 @@ RELEASE = "v0.2.0"
 
 def test_migrating_the_previous_release_keeps_every_review_gold_and_library_segment(tmp_path):
     database = tmp_path / "cutroom.sqlite3"
-    shutil.copyfile(FIXTURES / f"{RELEASE}.sqlite3", database)
+    shutil.copyfile(FIXTURES / f"{RELEASE}.sqlite", database)
     with sqlite3.connect(database) as conn:
         applied = {row[0] for row in conn.execute(
             "SELECT name FROM django_migrations WHERE app = 'segmentation'")}

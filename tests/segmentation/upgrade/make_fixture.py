@@ -8,7 +8,7 @@ Exports the tagged commit (``git archive``) into a temporary folder, builds its 
 there, and runs, with that release's code on a new SQLite database: its migrations, then
 ``tests/segmentation/installation.py``'s ``populate`` (takes ingested and detected, reviews,
 gold, library segments, a cut model), then its ``holdings`` through that release's API. Writes
-``<tag>.sqlite3`` (the database) and ``<tag>.holdings.json`` beside this script; the stored
+``<tag>.sqlite`` (the database; git ignores ``.sqlite3``) and ``<tag>.holdings.json`` beside this script; the stored
 files are not kept (the upgrade test reads rows only). ``tests/segmentation/test_upgrade.py``
 migrates a copy of the database with the current code and expects the same holdings.
 """
@@ -48,8 +48,8 @@ def main(tag):
             conn.execute("PRAGMA journal_mode=DELETE")
         with sqlite3.connect(database) as conn:
             conn.execute("VACUUM")
-        shutil.copyfile(database, HERE / f"{tag}.sqlite3")
-    print(f"wrote {HERE / f'{tag}.sqlite3'} and {HERE / f'{tag}.holdings.json'}")
+        shutil.copyfile(database, HERE / f"{tag}.sqlite")
+    print(f"wrote {HERE / f'{tag}.sqlite'} and {HERE / f'{tag}.holdings.json'}")
 
 
 def inside(holdings_path):
