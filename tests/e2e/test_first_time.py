@@ -84,3 +84,53 @@ def test_the_submit_dialog_says_the_pending_candidates_will_be_kept(live_server,
     assert len(kept) == pending  # as the dialog said
     assert not LibrarySegment.objects.filter(capture=ingested_capture).exists()
     assert page.errors == []
+
+
+# Every table on the page, and the page itself, against the viewport's width.
+WIDTHS = """() => ({
+  page: document.documentElement.scrollWidth,
+  tables: [...document.querySelectorAll("table")].map((t) => Math.ceil(t.getBoundingClientRect().right)),
+  viewport: innerWidth,
+})"""
+
+
+@pytest.mark.parametrize("width", [1280, 1440])
+def test_no_page_is_wider_than_a_laptop_screen(live_server, new_page, ingested_capture, studio,
+                                               width):
+    from tests.segmentation.test_library import submit_review
+
+    submit_review(ingested_capture, studio["ann"], [1200, 2400], ["walk", "jumping_jack", None])
+    page = new_page("alice", width=width, height=800)
+    project = studio["project"].pk
+    for path, ready in [("/", "capture-row"), ("/library/", "segment-rows"),
+                        (f"/projects/{project}/team/", None),
+                        (f"/projects/{project}/dashboard/", None),
+                        (f"/captures/{ingested_capture.pk}/adjudicate/", None)]:
+        page.goto(f"{live_server.url}{path}")
+        page.wait_for_load_state("networkidle")
+        if ready:
+            page.locator(f"[data-testid^={ready}]").first.wait_for()
+        widths = page.evaluate(WIDTHS)
+        assert widths["page"] <= width and all(r <= width for r in widths["tables"]), (path, widths)
+    assert page.errors == []
+
+
+# The top bar's links, in order, by test id.
+NAV = """() => [...document.querySelectorAll("header.topbar [data-testid^=nav-], header.topbar [data-testid=logout]")]
+  .map((el) => el.dataset.testid)"""
+
+
+def test_every_page_has_the_same_navigation(live_server, new_page, ingested_capture, studio):
+    from tests.segmentation.test_library import submit_review
+
+    submit_review(ingested_capture, studio["ann"], [1200, 2400], ["walk", "jumping_jack", None])
+    project = studio["project"].pk
+    page = new_page("alice")
+    expected = ["nav-queue", "nav-library", "nav-dashboard", "nav-team", "nav-user", "logout"]
+    for path in ["/", "/queue/", "/library/", f"/captures/{ingested_capture.pk}/",
+                 f"/captures/{ingested_capture.pk}/adjudicate/", f"/projects/{project}/dashboard/",
+                 f"/projects/{project}/team/"]:
+        page.goto(f"{live_server.url}{path}")
+        expect(page.get_by_test_id("nav-user")).to_have_text("alice")
+        assert page.evaluate(NAV) == expected, path
+    assert page.errors == []

@@ -5,8 +5,7 @@ import "../queue/queue.css";
 import { get, post } from "../api/client";
 import type { CaptureSummary, Me, Page, Project, Role } from "../api/types";
 import { clear, formatDuration, h, toast } from "../ui/dom";
-import { logoutButton } from "../ui/logout";
-import { appLinks } from "../ui/appnav";
+import { accountLinks, appLinks } from "../ui/appnav";
 import { assignmentBar, teamCell } from "./assign";
 import { invitationsBox } from "./invitations";
 import { navigate } from "../router";
@@ -113,7 +112,7 @@ export async function renderCaptureList(root: HTMLElement): Promise<() => void> 
   const page = h(
     "div",
     { class: "list-page" },
-    h("header", { class: "topbar" }, h("a", { class: "brand", href: "/" }, "Cutroom"), h("nav", { class: "crumbs" }, h("strong", {}, "Captures")), h("span", { class: "spacer" }), nav, h("span", { class: "user" }, me.username), logoutButton()),
+    h("header", { class: "topbar" }, h("a", { class: "brand", href: "/" }, "Cutroom"), h("nav", { class: "crumbs" }, h("strong", {}, "Captures")), h("span", { class: "spacer" }), nav, ...accountLinks(me.username)),
     h(
       "main",
       { class: "list-main" },

@@ -43,6 +43,13 @@ export function segmentCount(count: number, capped: boolean): string {
   return `${count.toLocaleString("en-US")}${capped ? "+" : ""} segment${count === 1 && !capped ? "" : "s"}`;
 }
 
+/** The top bar, its dashboard and team links for the project filtered on, else the first
+ * project the user reviews or administers. */
+function navFor(projects: Project[], filtered: number): HTMLElement {
+  const project = projects.find((p) => p.id === filtered) ?? projects.find((p) => p.role !== "annotator");
+  return topbar([["Captures", "/"], ["Library", null]], project && project.role !== "annotator" ? project.id : undefined, project?.role);
+}
+
 const pct = (v: number | null) => (v === null ? "—" : `${Math.round(v * 100)} %`);
 
 export async function renderLibrary(root: HTMLElement): Promise<() => void> {
@@ -97,7 +104,7 @@ export async function renderLibrary(root: HTMLElement): Promise<() => void> {
     h(
       "div",
       { class: "list-page" },
-      topbar([["Captures", "/"], ["Library", null]], Number(filters.project) || projects.find((p) => p.role !== "annotator")?.id),
+      navFor(projects, Number(filters.project)),
       h(
         "main",
         { class: "list-main lib-main" },
