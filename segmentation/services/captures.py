@@ -169,13 +169,18 @@ def do_start_run(capture, user, method, params):
     return run
 
 
-def _guarded(job, what, work, **fail_fields):
+# What a capture's failure stores when the file is at fault: retrying it cannot help.
+FILE_AT_FAULT = {"error_permanent": True}
+
+
+def _guarded(job, what, work, input_fault=None, **fail_fields):
     """Run ``work()``; any error fails the job, so a job never stays "processing" because
     of its input or a bug.
 
     A domain error (motionlib's, naming file, line and value, or the service's own) is the
-    input's fault and its message is stored as it is; anything else is ours: it is logged
-    with its traceback and the job stores an internal error with a reference to quote.
+    input's fault and its message is stored as it is, with the fields ``input_fault``
+    (a capture's ``error_permanent``); anything else is ours: it is logged with its
+    traceback and the job stores an internal error with a reference to quote.
     """
     try:
         with jobs.heartbeat(job):
@@ -190,7 +195,7 @@ def _guarded(job, what, work, **fail_fields):
             **fail_fields,
         )
     except (MotionlibError, CutroomError) as exc:
-        job.fail(_bounded(str(exc), 2000), **fail_fields)
+        job.fail(_bounded(str(exc), 2000), **fail_fields, **(input_fault or {}))
     except Exception:
         reference = internal_error(what, log)
         jobs.usable_connection()
@@ -211,7 +216,7 @@ def ingest_capture(capture):
 
     A bad file marks the capture failed with motionlib's message (file, line, value).
     """
-    _guarded(capture, "Ingest", lambda: _ingest(capture))
+    _guarded(capture, "Ingest", lambda: _ingest(capture), input_fault=FILE_AT_FAULT)
 
 
 def _ingest(capture):

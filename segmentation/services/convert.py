@@ -16,7 +16,7 @@ from motionlib.io.fbx import read_fbx_all
 from motionlib.io.npz import take_bytes
 from segmentation import storage
 from segmentation.models import Capture
-from segmentation.services.captures import _guarded
+from segmentation.services.captures import FILE_AT_FAULT, _guarded
 from segmentation.services.jobs import enqueue
 
 log = logging.getLogger(__name__)
@@ -28,7 +28,7 @@ def convert_capture(capture):
     A file Blender cannot read (no armature, no animation, damaged, Blender crashing or
     hanging on it) marks the capture failed with a reason a person can act on.
     """
-    _guarded(capture, "Conversion", lambda: _convert(capture))
+    _guarded(capture, "Conversion", lambda: _convert(capture), input_fault=FILE_AT_FAULT)
 
 
 def _convert(capture):

@@ -134,3 +134,30 @@ def test_every_page_has_the_same_navigation(live_server, new_page, ingested_capt
         expect(page.get_by_test_id("nav-user")).to_have_text("alice")
         assert page.evaluate(NAV) == expected, path
     assert page.errors == []
+
+
+def test_the_capture_list_speaks_to_a_first_upload(live_server, new_page, ingested_capture,
+                                                  studio):
+    """The drop zone names every format taken; a file that can never parse offers no Retry;
+    with one project, assigning does not ask for it."""
+    from django.core.files.uploadedfile import SimpleUploadedFile
+
+    from segmentation import services, tasks
+    from tests.e2e.conftest import synthetic_bvh
+
+    content = synthetic_bvh(seed=8, duration=10.0)
+    upload = SimpleUploadedFile("cut_short.bvh", content[: len(content) // 2 - 7])
+    broken, _ = services.do_upload_capture(studio["project"], studio["alice"], upload)
+    tasks.ingest(broken.pk)
+    page = new_page("rachel")
+    expect(page.get_by_test_id("dropzone")).to_contain_text(".fbx")
+    row = page.get_by_test_id(f"capture-{broken.pk}")
+    expect(row).to_contain_text("failed")
+    expect(row.get_by_test_id(f"fix-file-{broken.pk}")).to_contain_text("upload it")
+    expect(row.get_by_test_id(f"retry-{broken.pk}")).to_have_count(0)
+    # rachel reviews one project only: ticking a capture offers its annotators at once.
+    page.get_by_test_id(f"select-{ingested_capture.pk}").check()
+    page.get_by_test_id("assign-to-ann").check()
+    page.get_by_test_id("assign-go").click()
+    expect(page.get_by_test_id(f"team-{ingested_capture.pk}")).to_have_text("ann assigned")
+    assert page.errors == []

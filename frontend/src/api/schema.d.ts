@@ -938,6 +938,8 @@ export interface components {
             format: string;
             status: components["schemas"]["JobStatusEnum"];
             readonly error: string | null;
+            /** @description Failed, and not for a fault of the file: reading the stored original again may succeed (POST …/retry/). */
+            readonly retryable: boolean;
             /** Format: double */
             fps: number | null;
             /** Format: int64 */
@@ -968,6 +970,8 @@ export interface components {
             format: string;
             status: components["schemas"]["JobStatusEnum"];
             readonly error: string | null;
+            /** @description Failed, and not for a fault of the file: reading the stored original again may succeed (POST …/retry/). */
+            readonly retryable: boolean;
             /** Format: double */
             fps: number | null;
             /** Format: int64 */
@@ -1650,6 +1654,8 @@ export interface components {
             format: string;
             status: components["schemas"]["JobStatusEnum"];
             readonly error: string | null;
+            /** @description Failed, and not for a fault of the file: reading the stored original again may succeed (POST …/retry/). */
+            readonly retryable: boolean;
             /** Format: double */
             fps: number | null;
             /** Format: int64 */
