@@ -1,6 +1,6 @@
 """The clip library, agreement, adjudication and the project dashboard.
 
-- ``GET /api/segments/?project=&label=&capture=&annotator=&min_duration=&max_duration=&min_agreement=&gold=&ordering=&page=``
+- ``GET /api/segments/?project=&label=&capture=&annotator=<username or id>&min_duration=&max_duration=&min_agreement=&gold=&ordering=&page=``
   (``count`` exact up to 10,000 matches, else 10,000 with ``count_capped``)
 - ``GET /api/segments/{id}/``, ``…/export.bvh``, ``…/export.fbx``, ``…/export.glb``,
   ``…/similar/?k=10``
@@ -14,6 +14,7 @@ adjudication and the dashboard compare everybody's reviews, so for annotators th
 exist (404, like any object the caller may not see).
 """
 
+from django.contrib.auth import get_user_model
 from django.http import HttpResponse, StreamingHttpResponse
 from django.urls import path
 from drf_spectacular.utils import OpenApiParameter, extend_schema, extend_schema_field
@@ -306,11 +307,18 @@ def segment_query(request):
         segments = segments.preferred()
     else:
         segments = segments.filter(is_gold=gold)
-    for name, field in (("project", "project_id"), ("capture", "capture_id"),
-                        ("annotator", "annotator_id")):
+    for name, field in (("project", "project_id"), ("capture", "capture_id")):
         value = int_param(request, name, None, 1)
         if value is not None:
             segments = segments.filter(**{field: value})
+    annotator = (request.query_params.get("annotator") or "").strip()
+    if annotator:
+        # A username (what the page and a person write) or a user id (what the API said).
+        field = "annotator_id" if annotator.isdigit() else "annotator__username"
+        if field == "annotator__username" and not get_user_model().objects.filter(
+                username=annotator).exists():
+            raise Invalid(f"annotator: no user named {annotator!r}")
+        segments = segments.filter(**{field: annotator})
     if request.query_params.get("label"):
         segments = segments.filter(label_name=request.query_params["label"])
     for name, lookup, high in (("min_duration", "duration__gte", None),

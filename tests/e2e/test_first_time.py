@@ -161,3 +161,33 @@ def test_the_capture_list_speaks_to_a_first_upload(live_server, new_page, ingest
     page.get_by_test_id("assign-go").click()
     expect(page.get_by_test_id(f"team-{ingested_capture.pk}")).to_have_text("ann assigned")
     assert page.errors == []
+
+
+def test_the_library_filters_by_annotator_and_shows_export_progress(live_server, new_page,
+                                                                   ingested_capture, studio):
+    from tests.segmentation.test_library import submit_review
+
+    submit_review(ingested_capture, studio["ann"], [1200, 2400], ["walk", "squat", "kick"])
+    submit_review(ingested_capture, studio["bob"], [2400], ["punch", "walk"])
+    page = new_page("rachel")
+    page.goto(f"{live_server.url}/library/?gold=false")
+    annotator = page.get_by_test_id("lib-annotator")
+    expect(annotator.locator("option")).to_have_text(
+        ["Any annotator", "alice", "ann", "bob", "rachel"])
+    annotator.select_option("bob")
+    expect(page.get_by_test_id("segment-count")).to_have_text("2 segments")
+    assert "annotator=bob" in page.url
+    page.goto(f"{live_server.url}/library/?gold=false&annotator=ann")  # a link to the filter
+    expect(page.get_by_test_id("segment-count")).to_have_text("3 segments")
+    expect(page.get_by_test_id("lib-annotator")).to_have_value("ann")
+
+    # Three glTF clips take Blender more than a second: the page says what is going on.
+    page.get_by_test_id("export-format").select_option("glb")
+    with page.expect_download(timeout=120_000) as download:
+        page.get_by_test_id("export-zip").click()
+        progress = page.get_by_test_id("export-progress")
+        expect(progress).to_contain_text("Exporting 3 clips as glTF", timeout=10_000)
+        expect(progress).to_contain_text("received")
+    assert download.value.suggested_filename == "segments-glb.zip"
+    expect(progress).to_have_count(0)
+    assert page.errors == []
