@@ -377,9 +377,12 @@ class SegmentClipView(APIView):
         fmt = exports.check_format(fmt)
         segment = segment_for(request.user, pk)
         capture = segment.capture
-        [(_, name, data)] = exports.clip_files(capture, read_take(capture), [segment], fmt)
+        take = read_take(capture)
+        [(_, name, data)] = exports.clip_files(capture, take, [segment], fmt)
         response = HttpResponse(data, content_type=exports.CONTENT_TYPES[fmt])
         response["Content-Disposition"] = f'attachment; filename="{name}"'
+        # What the manifest's "unit" says for a clip in a zip (docs/exports.md).
+        response["X-Length-Unit"] = exports.unit_text(take, fmt)
         return response
 
 
