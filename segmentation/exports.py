@@ -131,6 +131,9 @@ def unit_text(take, fmt):
     """The length unit of a clip in ``fmt``, for the manifest."""
     if fmt == "bvh":
         return "the capture's own (BVH numbers as in the original)"
+    if fmt in ("c3d", "csv"):
+        unit = getattr(take, "unit", "") or "as in the original"
+        return f"the capture's own ({unit})"
     return f"metre; the capture's unit taken as {length_unit(take).describe()}"
 
 

@@ -1,6 +1,6 @@
 """The clip library's segments: the filtered, paged list, one segment, and its exports.
 
-- ``GET /api/segments/?project=&label=&capture=&annotator=&min_duration=&max_duration=&min_agreement=&gold=&ordering=&page=``
+- ``GET /api/segments/?project=&label=&capture=&annotator=<username or id>&min_duration=&max_duration=&min_agreement=&gold=&ordering=&page=``
   (``count`` exact up to 10,000 matches, else 10,000 with ``count_capped``)
 - ``GET /api/segments/{id}/``, ``…/export.bvh``, ``…/export.fbx``, ``…/export.glb``
 - ``GET /api/segments/export.zip?<same filters>&file_format=bvh|fbx|glb`` (streamed)
@@ -8,6 +8,7 @@
 Annotators see their own segments and gold segments; reviewers and admins everybody's.
 """
 
+from django.contrib.auth import get_user_model
 from django.http import HttpResponse, StreamingHttpResponse
 from django.urls import path
 from drf_spectacular.utils import OpenApiParameter, extend_schema, extend_schema_field
@@ -132,11 +133,17 @@ def segment_query(request):
         segments = segments.preferred()
     else:
         segments = segments.filter(is_gold=gold)
-    for name, field in (("project", "project_id"), ("capture", "capture_id"),
-                        ("annotator", "annotator_id")):
+    for name, field in (("project", "project_id"), ("capture", "capture_id")):
         value = int_param(request, name, None, 1)
         if value is not None:
             segments = segments.filter(**{field: value})
+    annotator = (request.query_params.get("annotator") or "").strip()
+    if annotator.isdigit():  # a user id (what the API said)
+        segments = segments.filter(annotator_id=int_param(request, "annotator", None, 1))
+    elif annotator:  # a username (what the page and a person write)
+        if not get_user_model().objects.filter(username=annotator).exists():
+            raise Invalid(f"annotator: no user named {annotator[:150]!r}")
+        segments = segments.filter(annotator__username=annotator)
     if request.query_params.get("label"):
         segments = segments.filter(label__name=request.query_params["label"])
     for name, lookup, high in (("min_duration", "duration__gte", None),
@@ -195,9 +202,12 @@ class SegmentClipView(APIView):
         fmt = exports.check_format(fmt)
         segment = segment_for(request.user, pk)
         capture = segment.capture
-        [(_, name, data)] = exports.clip_files(capture, read_take(capture), [segment], fmt)
+        take = read_take(capture)
+        [(_, name, data)] = exports.clip_files(capture, take, [segment], fmt)
         response = HttpResponse(data, content_type=exports.CONTENT_TYPES[fmt])
         response["Content-Disposition"] = f'attachment; filename="{name}"'
+        # What the manifest's "unit" says for a clip in a zip (docs/exports.md).
+        response["X-Length-Unit"] = exports.unit_text(take, fmt)
         return response
 
 

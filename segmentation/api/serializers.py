@@ -194,11 +194,14 @@ class CaptureSerializer(serializers.ModelSerializer):
     # the model for every capture and was most of the capture list's time.
     latest_run = RunSerializer(read_only=True, allow_null=True)
     skeleton = serializers.SerializerMethodField()
+    retryable = serializers.BooleanField(
+        read_only=True, help_text="Failed, and not for a fault of the file: reading the stored "
+        "original again may succeed (POST …/retry/).")
 
     class Meta:
         model = Capture
         fields = [
-            "id", "project", "name", "format", "status", "error", "fps", "n_frames",
+            "id", "project", "name", "format", "status", "error", "retryable", "fps", "n_frames",
             "duration", "n_joints", "checksum", "rest_pose_frame", "created_at",
             "latest_run", "skeleton", "animation", "source",
         ]

@@ -17,6 +17,11 @@ class CaptureQuerySet(ClaimQuerySet):
         """Captures of the projects the user is a member of."""
         return self.filter(project__in=Project.objects.for_user(user))
 
+    def requeue_failed(self, pk):
+        """As for any job; the next try's failure decides afresh whether it is the file's."""
+        self.filter(pk=pk, status="failed").update(error_permanent=False)
+        return super().requeue_failed(pk)
+
 
 def original_path(capture, filename):
     return f"captures/{capture.project_id}/{uuid.uuid4().hex}/{filename}"
@@ -64,7 +69,6 @@ class Capture(Job):
     source = models.ForeignKey(
         "self", models.SET_NULL, null=True, blank=True, related_name="animations"
     )
-
     objects = CaptureQuerySet.as_manager()
 
     class Meta:
@@ -78,6 +82,11 @@ class Capture(Job):
 
     def __str__(self):
         return self.name
+
+    @property
+    def retryable(self):
+        """Whether reading the stored original again may succeed: a failure not the file's."""
+        return self.status == "failed" and not self.error_permanent
 
     @property
     def duration(self):

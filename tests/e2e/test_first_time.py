@@ -84,3 +84,110 @@ def test_the_submit_dialog_says_the_pending_candidates_will_be_kept(live_server,
     assert len(kept) == pending  # as the dialog said
     assert not LibrarySegment.objects.filter(capture=ingested_capture).exists()
     assert page.errors == []
+
+
+# Every table on the page, and the page itself, against the viewport's width.
+WIDTHS = """() => ({
+  page: document.documentElement.scrollWidth,
+  tables: [...document.querySelectorAll("table")].map((t) => Math.ceil(t.getBoundingClientRect().right)),
+  viewport: innerWidth,
+})"""
+
+
+@pytest.mark.parametrize("width", [1280, 1440])
+def test_no_page_is_wider_than_a_laptop_screen(live_server, new_page, ingested_capture, studio,
+                                               width):
+    from tests.segmentation.test_library import submit_review
+
+    submit_review(ingested_capture, studio["ann"], [1200, 2400], ["walk", "jumping_jack", None])
+    page = new_page("alice", width=width, height=800)
+    project = studio["project"].pk
+    for path, ready in [("/", "capture-row"), ("/library/", "segment-rows"),
+                        (f"/projects/{project}/team/", None),
+                        (f"/projects/{project}/dashboard/", None),
+                        (f"/captures/{ingested_capture.pk}/adjudicate/", None)]:
+        page.goto(f"{live_server.url}{path}")
+        page.wait_for_load_state("networkidle")
+        if ready:
+            page.locator(f"[data-testid^={ready}]").first.wait_for()
+        widths = page.evaluate(WIDTHS)
+        assert widths["page"] <= width and all(r <= width for r in widths["tables"]), (path, widths)
+    assert page.errors == []
+
+
+# The top bar's links, in order, by test id.
+NAV = """() => [...document.querySelectorAll("header.topbar [data-testid^=nav-], header.topbar [data-testid=logout]")]
+  .map((el) => el.dataset.testid)"""
+
+
+def test_every_page_has_the_same_navigation(live_server, new_page, ingested_capture, studio):
+    from tests.segmentation.test_library import submit_review
+
+    submit_review(ingested_capture, studio["ann"], [1200, 2400], ["walk", "jumping_jack", None])
+    project = studio["project"].pk
+    page = new_page("alice")
+    expected = ["nav-queue", "nav-library", "nav-dashboard", "nav-team", "nav-user", "logout"]
+    for path in ["/", "/queue/", "/library/", f"/captures/{ingested_capture.pk}/",
+                 f"/captures/{ingested_capture.pk}/adjudicate/", f"/projects/{project}/dashboard/",
+                 f"/projects/{project}/team/"]:
+        page.goto(f"{live_server.url}{path}")
+        expect(page.get_by_test_id("nav-user")).to_have_text("alice")
+        assert page.evaluate(NAV) == expected, path
+    assert page.errors == []
+
+
+def test_the_capture_list_speaks_to_a_first_upload(live_server, new_page, ingested_capture,
+                                                  studio):
+    """The drop zone names every format taken; a file that can never parse offers no Retry;
+    with one project, assigning does not ask for it."""
+    from django.core.files.uploadedfile import SimpleUploadedFile
+
+    from segmentation import services, tasks
+    from tests.e2e.conftest import synthetic_bvh
+
+    content = synthetic_bvh(seed=8, duration=10.0)
+    upload = SimpleUploadedFile("cut_short.bvh", content[: len(content) // 2 - 7])
+    broken, _ = services.do_upload_capture(studio["project"], studio["alice"], upload)
+    tasks.ingest(broken.pk)
+    page = new_page("rachel")
+    expect(page.get_by_test_id("dropzone")).to_contain_text(".fbx")
+    row = page.get_by_test_id(f"capture-{broken.pk}")
+    expect(row).to_contain_text("failed")
+    expect(row.get_by_test_id(f"fix-file-{broken.pk}")).to_contain_text("upload it")
+    expect(row.get_by_test_id(f"retry-{broken.pk}")).to_have_count(0)
+    # rachel reviews one project only: ticking a capture offers its annotators at once.
+    page.get_by_test_id(f"select-{ingested_capture.pk}").check()
+    page.get_by_test_id("assign-to-ann").check()
+    page.get_by_test_id("assign-go").click()
+    expect(page.get_by_test_id(f"team-{ingested_capture.pk}")).to_have_text("ann assigned")
+    assert page.errors == []
+
+
+def test_the_library_filters_by_annotator_and_shows_export_progress(live_server, new_page,
+                                                                   ingested_capture, studio):
+    from tests.segmentation.test_library import submit_review
+
+    submit_review(ingested_capture, studio["ann"], [1200, 2400], ["walk", "squat", "kick"])
+    submit_review(ingested_capture, studio["bob"], [2400], ["punch", "walk"])
+    page = new_page("rachel")
+    page.goto(f"{live_server.url}/library/?gold=false")
+    annotator = page.get_by_test_id("lib-annotator")
+    expect(annotator.locator("option")).to_have_text(
+        ["Any annotator", "alice", "ann", "bob", "rachel"])
+    annotator.select_option("bob")
+    expect(page.get_by_test_id("segment-count")).to_have_text("2 segments")
+    assert "annotator=bob" in page.url
+    page.goto(f"{live_server.url}/library/?gold=false&annotator=ann")  # a link to the filter
+    expect(page.get_by_test_id("segment-count")).to_have_text("3 segments")
+    expect(page.get_by_test_id("lib-annotator")).to_have_value("ann")
+
+    # Three glTF clips take Blender more than a second: the page says what is going on.
+    page.get_by_test_id("export-format").select_option("glb")
+    with page.expect_download(timeout=120_000) as download:
+        page.get_by_test_id("export-zip").click()
+        progress = page.get_by_test_id("export-progress")
+        expect(progress).to_contain_text("Exporting 3 clips as glTF", timeout=10_000)
+        expect(progress).to_contain_text("received")
+    assert download.value.suggested_filename == "segments-glb.zip"
+    expect(progress).to_have_count(0)
+    assert page.errors == []

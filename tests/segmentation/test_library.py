@@ -109,6 +109,14 @@ class SegmentListTest(LibraryTestCase):
         assert self.get("?min_agreement=0.95")["count"] == 2
         assert self.get(f"?capture={self.capture.pk}&label=punch&annotator={self.bob.pk}")["count"] == 2
 
+    def test_it_filters_by_annotator_username(self):
+        self.login(self.rachel)
+        assert self.get("?annotator=dana")["count"] == 3
+        assert self.get("?annotator=dana")["count"] == self.get(f"?annotator={self.dana.pk}")["count"]
+        response = self.client.get("/api/segments/?annotator=nobody")
+        assert response.status_code == 400
+        assert response.json()["detail"] == "annotator: no user named 'nobody'"
+
     def test_it_sorts_by_duration_and_agreement(self):
         self.login(self.rachel)
         durations = [r["duration"] for r in self.get("?ordering=-duration")["results"]]

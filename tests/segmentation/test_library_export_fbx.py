@@ -101,6 +101,8 @@ class BvhCaptureExportTestCase(BaseTestCase):
         assert response.status_code == 200, response.content[:300]
         clip = read_clip(self.tmp, "clip.fbx", response.content)
         assert clip.n_frames == capture.n_frames - 240
+        assert response["X-Length-Unit"] == ("metre; the capture's unit taken as CMU Acclaim "
+                                             "unit (inch / 0.45) (chosen by the figure's height)")
         joints = capture.skeleton["joints"]
         columns = [clip.skeleton.names.index(name) for name in joints]
         # The clip reads back in centimetres of the metres its unit makes of the capture's.

@@ -49,3 +49,37 @@ class RetryTestCase(BaseTestCase):
         response = self.client.post(f"/api/captures/{self.capture_id}/retry/")
         self.assertEqual(response.status_code, 404)
         self.assertEqual(Capture.objects.get(pk=self.capture_id).status, "failed")
+
+
+class RetryOfferTestCase(BaseTestCase):
+    """Retry is offered (``retryable``) only when reading the original again may help."""
+
+    def setUp(self):
+        super().setUp()
+        self.login(self.bob)
+
+    def failed(self, content, name):
+        capture_id = self.upload(content, name=name).json()["id"]
+        tasks.ingest(capture_id)
+        return self.client.get(f"/api/captures/{capture_id}/").json()
+
+    def test_it_does_not_offer_to_retry_a_truncated_file(self):
+        content = synthetic_bvh(seed=3, duration=20.0)
+        body = self.failed(content[: len(content) // 2 - 7], "cut.bvh")
+        assert body["status"] == "failed" and body["error"]
+        assert body["retryable"] is False
+        row = self.client.get("/api/captures/").json()["results"][0]
+        assert (row["id"], row["retryable"]) == (body["id"], False)
+
+    def test_it_offers_to_retry_a_failure_that_was_not_the_files(self):
+        capture_id = self.upload(synthetic_bvh(seed=4, duration=20.0), name="take.bvh").json()["id"]
+        Capture.objects.filter(pk=capture_id).update(
+            status="failed", error="the worker was lost 3 times", attempts=3)
+        assert self.client.get(f"/api/captures/{capture_id}/").json()["retryable"] is True
+
+    def test_a_retried_file_failure_is_judged_afresh(self):
+        content = synthetic_bvh(seed=5, duration=20.0)
+        body = self.failed(content[: len(content) // 2 - 7], "cut.bvh")
+        response = self.client.post(f"/api/captures/{body['id']}/retry/")
+        assert response.status_code == 202
+        assert Capture.objects.get(pk=body["id"]).error_permanent is False

@@ -151,7 +151,8 @@ class AdjudicationPage {
     return h(
       "div",
       { class: "list-page adj-page" },
-      topbar([["Captures", "/"], [this.data.capture.name, `/captures/${this.capture.id}/`], ["Adjudication", null]], this.data.capture.project),
+      // Only reviewers and admins adjudicate: their links include the team.
+      topbar([["Captures", "/"], [this.data.capture.name, `/captures/${this.capture.id}/`], ["Adjudication", null]], this.data.capture.project, "reviewer"),
       h(
         "main",
         { class: "list-main adj-main" },

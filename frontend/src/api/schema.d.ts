@@ -982,6 +982,8 @@ export interface components {
             format: string;
             status: components["schemas"]["JobStatusEnum"];
             readonly error: string | null;
+            /** @description Failed, and not for a fault of the file: reading the stored original again may succeed (POST …/retry/). */
+            readonly retryable: boolean;
             /** Format: double */
             fps: number | null;
             /** Format: int64 */
@@ -1012,6 +1014,8 @@ export interface components {
             format: string;
             status: components["schemas"]["JobStatusEnum"];
             readonly error: string | null;
+            /** @description Failed, and not for a fault of the file: reading the stored original again may succeed (POST …/retry/). */
+            readonly retryable: boolean;
             /** Format: double */
             fps: number | null;
             /** Format: int64 */
@@ -1728,6 +1732,8 @@ export interface components {
             format: string;
             status: components["schemas"]["JobStatusEnum"];
             readonly error: string | null;
+            /** @description Failed, and not for a fault of the file: reading the stored original again may succeed (POST …/retry/). */
+            readonly retryable: boolean;
             /** Format: double */
             fps: number | null;
             /** Format: int64 */

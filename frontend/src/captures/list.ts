@@ -5,8 +5,7 @@ import "../queue/queue.css";
 import { get, post } from "../api/client";
 import type { CaptureSummary, Me, Page, Project, Role } from "../api/types";
 import { clear, formatDuration, h, toast } from "../ui/dom";
-import { logoutButton } from "../ui/logout";
-import { appLinks } from "../ui/appnav";
+import { accountLinks, appLinks } from "../ui/appnav";
 import { assignmentBar, teamCell } from "./assign";
 import { invitationsBox } from "./invitations";
 import { navigate } from "../router";
@@ -107,13 +106,15 @@ export async function renderCaptureList(root: HTMLElement): Promise<() => void> 
     clear(nav, ...appLinks(project?.id ?? (projects.length === 1 ? projects[0].id : null), project?.role ?? (projects.length === 1 ? projects[0].role : null)));
   };
   const selection = new Set<number>();
-  const assignBar = assignmentBar(projects, () => Number(filters.project) || null, selection, () => void load());
+  // With one project there is nothing to pick: its captures are the ones ticked.
+  const assignProject = () => Number(filters.project) || (projects.length === 1 ? projects[0].id : null);
+  const assignBar = assignmentBar(projects, assignProject, selection, () => void load());
   drawNav();
-  const dropzone = h("div", { class: "dropzone", "data-testid": "dropzone" }, h("b", {}, "Drop .bvh, or .amc with its .asf, here"), h("span", {}, " or "), h("button", { class: "btn btn-primary", onclick: () => fileInput.click() }, "Choose files"));
+  const dropzone = h("div", { class: "dropzone", "data-testid": "dropzone" }, h("b", {}, "Drop .bvh, .fbx, or .amc with its .asf, here"), h("span", {}, " or "), h("button", { class: "btn btn-primary", onclick: () => fileInput.click() }, "Choose files"));
   const page = h(
     "div",
     { class: "list-page" },
-    h("header", { class: "topbar" }, h("a", { class: "brand", href: "/" }, "Cutroom"), h("nav", { class: "crumbs" }, h("strong", {}, "Captures")), h("span", { class: "spacer" }), nav, h("span", { class: "user" }, me.username), logoutButton()),
+    h("header", { class: "topbar" }, h("a", { class: "brand", href: "/" }, "Cutroom"), h("nav", { class: "crumbs" }, h("strong", {}, "Captures")), h("span", { class: "spacer" }), nav, ...accountLinks(me.username)),
     h(
       "main",
       { class: "list-main" },
@@ -195,6 +196,12 @@ export async function renderCaptureList(root: HTMLElement): Promise<() => void> 
   };
 }
 
+/** What a failed capture offers: Retry when reading the original again may help, else what to do. */
+function failedAction(c: CaptureSummary, reload: () => Promise<void>): HTMLElement {
+  if (c.retryable) return retryButton(c, reload);
+  return h("div", { class: "muted small", "data-testid": `fix-file-${c.id}` }, "The file itself cannot be read: fix or export it again, then upload it.");
+}
+
 /** Queue a failed capture's ingest again from its stored original, then refresh. */
 function retryButton(c: CaptureSummary, reload: () => Promise<void>): HTMLElement {
   const retry = (e: Event) => {
@@ -245,7 +252,7 @@ function row(c: CaptureSummary, project: string, role: Role | undefined, reload:
     "tr",
     { class: "capture-row", "data-testid": `capture-${c.id}`, tabindex: 0, onclick: open, onkeydown: (e: Event) => (e as KeyboardEvent).key === "Enter" && open() },
     h("td", { onclick: (e: Event) => e.stopPropagation() }, check),
-    h("td", {}, h("a", { href: `/captures/${c.id}/`, onclick: (e: Event) => e.preventDefault() }, c.name), c.status === "failed" && c.error ? h("div", { class: "error-text small" }, c.error) : null, c.status === "failed" ? retryButton(c, reload) : null),
+    h("td", {}, h("a", { href: `/captures/${c.id}/`, onclick: (e: Event) => e.preventDefault() }, c.name), c.status === "failed" && c.error ? h("div", { class: "error-text small" }, c.error) : null, c.status === "failed" ? failedAction(c, reload) : null),
     h("td", {}, project),
     h("td", {}, status),
     h("td", { class: "num" }, c.n_frames?.toLocaleString() ?? "—"),

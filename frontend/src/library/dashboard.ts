@@ -50,7 +50,8 @@ export async function renderDashboard(root: HTMLElement, projectId: number): Pro
     h(
       "div",
       { class: "list-page" },
-      topbar([["Captures", "/"], ["Dashboard", null]], projectId),
+      // Only reviewers and admins reach a dashboard: their links include the team.
+      topbar([["Captures", "/"], ["Dashboard", null]], projectId, "reviewer"),
       h(
         "main",
         { class: "list-main" },

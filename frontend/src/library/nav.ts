@@ -1,11 +1,10 @@
 import "./library.css";
-// The top bar of the library pages: breadcrumbs plus links to the library and, for a
-// project, its dashboard.
+// The top bar of the library pages: breadcrumbs plus the links every page carries.
 
+import { accountLinks, appLinks } from "../ui/appnav";
 import { h } from "../ui/dom";
-import { logoutButton } from "../ui/logout";
 
-export function topbar(crumbs: [string, string | null][], project?: number): HTMLElement {
+export function topbar(crumbs: [string, string | null][], project?: number, role?: string | null): HTMLElement {
   return h(
     "header",
     { class: "topbar" },
@@ -16,8 +15,7 @@ export function topbar(crumbs: [string, string | null][], project?: number): HTM
       ...crumbs.flatMap(([text, href], i) => [i ? h("span", {}, "/") : null, href ? h("a", { href }, text) : h("strong", {}, text)]),
     ),
     h("span", { class: "spacer" }),
-    h("a", { class: "btn btn-ghost", href: "/library/", "data-testid": "nav-library" }, "Library"),
-    project ? h("a", { class: "btn btn-ghost", href: `/projects/${project}/dashboard/`, "data-testid": "nav-dashboard" }, "Dashboard") : null,
-    logoutButton(),
+    ...appLinks(project, role),
+    ...accountLinks(),
   );
 }

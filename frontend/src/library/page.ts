@@ -2,8 +2,10 @@
 // that move like it, open it in its capture, export one BVH or the whole query as a zip.
 
 import { get } from "../api/client";
-import type { Page, Project } from "../api/types";
+import type { Me, Page, Project } from "../api/types";
+import type { Member } from "../queue/api";
 import { clear, formatDuration, h, toast } from "../ui/dom";
+import { downloadWithProgress } from "./download";
 import { topbar } from "./nav";
 import { GlbPreview } from "./gltfPreview";
 import { ClipPreview } from "./preview";
@@ -43,16 +45,52 @@ export function segmentCount(count: number, capped: boolean): string {
   return `${count.toLocaleString("en-US")}${capped ? "+" : ""} segment${count === 1 && !capped ? "" : "s"}`;
 }
 
+/** The top bar, its dashboard and team links for the project filtered on, else the first
+ * project the user reviews or administers. */
+function navFor(projects: Project[], filtered: number): HTMLElement {
+  const project = projects.find((p) => p.id === filtered) ?? projects.find((p) => p.role !== "annotator");
+  return topbar([["Captures", "/"], ["Library", null]], project && project.role !== "annotator" ? project.id : undefined, project?.role);
+}
+
+/** The annotators the filter offers: the members of the projects the user reviews or
+ * administers; an annotator, who sees only their own segments (and gold), is offered
+ * themself. */
+async function annotatorsOf(projects: Project[], me: string): Promise<string[]> {
+  const managed = projects.filter((p) => p.role !== "annotator");
+  const lists = await Promise.all(managed.map((p) => get<Member[]>(`/api/projects/${p.id}/members/`).catch(() => [] as Member[])));
+  const names = new Set([me, ...lists.flat().map((m) => m.username)]);
+  return [...names].sort();
+}
+
+/** A segment's export in one format: a link (save it with the browser as well), downloaded
+ * with progress when clicked, since Blender writes FBX and glTF on request. */
+function exportLink(s: LibrarySegment, fmt: string, text: string, testId: string): HTMLElement {
+  const href = `/api/segments/${s.id}/export.${fmt}`;
+  const link = h("a", { class: "btn", "data-testid": testId, href, download: "", title: fmt === "glb" ? "glTF binary" : `${text} file` }, text);
+  link.addEventListener("click", (e) => {
+    e.preventDefault();
+    void downloadWithProgress(href, `${s.label} ${s.start}–${s.stop} as ${text}`, `segment-${s.id}.${fmt}`);
+  });
+  return link;
+}
+
 const pct = (v: number | null) => (v === null ? "—" : `${Math.round(v * 100)} %`);
 
 export async function renderLibrary(root: HTMLElement): Promise<() => void> {
-  const projectsRaw = await get<Project[] | Page<Project>>("/api/projects/");
+  const [projectsRaw, me] = await Promise.all([get<Project[] | Page<Project>>("/api/projects/"), get<Me>("/api/me/")]);
   const projects = Array.isArray(projectsRaw) ? projectsRaw : projectsRaw.results;
   const labelNames = [...new Set(projects.flatMap((p) => p.labels.map((l) => l.name)))].sort();
+  const annotatorNames = await annotatorsOf(projects, me.username);
   let filters = libraryFiltersFrom(location.search);
   const rows = h("tbody", { "data-testid": "segment-rows" });
   const pager = h("div", { class: "pager" });
+  let matching = 0;
   const exportZip = h("a", { class: "btn", "data-testid": "export-zip", download: "" }, "Export these as zip");
+  exportZip.addEventListener("click", (e) => {
+    e.preventDefault();
+    const what = `${matching} clip${matching === 1 ? "" : "s"} as ${zipFormat.selectedOptions[0]?.text ?? zipFormat.value}`;
+    void downloadWithProgress(zipHref(), what, `segments-${zipFormat.value}.zip`);
+  });
   const zipFormat = h(
     "select",
     { class: "select", "data-testid": "export-format", "aria-label": "export format", title: "Clip format in the zip" },
@@ -83,6 +121,7 @@ export async function renderLibrary(root: HTMLElement): Promise<() => void> {
     { class: "filters lib-filters" },
     field("project", h("select", { class: "select" }, ...options([["", "All projects"], ...projects.map((p) => [String(p.id), p.name] as [string, string])]))),
     field("label", h("select", { class: "select" }, ...options([["", "Any label"], ...labelNames.map((l) => [l, l] as [string, string])]))),
+    field("annotator", h("select", { class: "select" }, ...options([["", "Any annotator"], ...annotatorNames.map((n) => [n, n] as [string, string])]))),
     field("min_duration", h("input", { class: "input num-input", type: "number", step: "0.1", min: "0", placeholder: "min s" })),
     field("max_duration", h("input", { class: "input num-input", type: "number", step: "0.1", min: "0", placeholder: "max s" })),
     field("min_agreement", h("input", { class: "input num-input", type: "number", step: "0.05", min: "0", max: "1", placeholder: "min agreement" })),
@@ -99,7 +138,7 @@ export async function renderLibrary(root: HTMLElement): Promise<() => void> {
     h(
       "div",
       { class: "list-page" },
-      topbar([["Captures", "/"], ["Library", null]], Number(filters.project) || projects.find((p) => p.role !== "annotator")?.id),
+      navFor(projects, Number(filters.project)),
       h(
         "main",
         { class: "list-main lib-main" },
@@ -118,15 +157,12 @@ export async function renderLibrary(root: HTMLElement): Promise<() => void> {
   // rotations as BVH, FBX or glTF.
   function exportButtons(s: LibrarySegment): HTMLElement[] {
     if (!s.export_formats.includes("bvh")) {
-      return [
-        h("a", { class: "btn", "data-testid": `c3d-${s.id}`, href: `/api/segments/${s.id}/export.c3d`, download: "", title: "C3D markers" }, "C3D"),
-        h("a", { class: "btn", "data-testid": `csv-${s.id}`, href: `/api/segments/${s.id}/export.csv`, download: "", title: "joint-position CSV" }, "CSV"),
-      ];
+      return [exportLink(s, "c3d", "C3D", `c3d-${s.id}`), exportLink(s, "csv", "CSV", `csv-${s.id}`)];
     }
     return [
-      h("a", { class: "btn", href: `/api/segments/${s.id}/export.bvh`, download: "" }, "BVH"),
-      h("a", { class: "btn", "data-testid": `fbx-${s.id}`, href: `/api/segments/${s.id}/export.fbx`, download: "" }, "FBX"),
-      h("a", { class: "btn", "data-testid": `glb-${s.id}`, href: `/api/segments/${s.id}/export.glb`, download: "", title: "glTF binary" }, "glTF"),
+      exportLink(s, "bvh", "BVH", `bvh-${s.id}`),
+      exportLink(s, "fbx", "FBX", `fbx-${s.id}`),
+      exportLink(s, "glb", "glTF", `glb-${s.id}`),
       h("button", { class: "btn", "data-testid": `play-glb-${s.id}`, title: "Play the glTF export as three.js loads it", onclick: () => void playGlb(s) }, "▶ glTF"),
     ];
   }
@@ -160,6 +196,7 @@ export async function renderLibrary(root: HTMLElement): Promise<() => void> {
     });
     if (!data) return;
     metricHead.textContent = "Agreement";
+    matching = data.count;
     clear(rows, ...data.results.map(row));
     if (!data.results.length) rows.append(h("tr", {}, h("td", { colspan: 7, class: "muted empty" }, "No segments match. Segments appear here when reviews are submitted.")));
     clear(

@@ -5,9 +5,8 @@
 
 import { api, get, patch } from "../api/client";
 import type { Me } from "../api/types";
-import { appLinks } from "../ui/appnav";
+import { accountLinks, appLinks } from "../ui/appnav";
 import { clear, formatDuration, h, toast } from "../ui/dom";
-import { logoutButton } from "../ui/logout";
 import { loadQueue, STATE_TEXT, type Assignment, type Member, type QueueItem, type QueueState } from "./api";
 import "./queue.css";
 
@@ -42,7 +41,7 @@ export async function renderQueue(root: HTMLElement): Promise<() => void> {
     h(
       "div",
       { class: "list-page queue-page" },
-      h("header", { class: "topbar" }, h("a", { class: "brand", href: "/" }, "Cutroom"), h("nav", { class: "crumbs" }, h("a", { href: "/" }, "Captures"), h("span", {}, "/"), h("strong", {}, "My queue")), h("span", { class: "spacer" }), nav, h("span", { class: "user" }, me.username), logoutButton()),
+      h("header", { class: "topbar" }, h("a", { class: "brand", href: "/" }, "Cutroom"), h("nav", { class: "crumbs" }, h("a", { href: "/" }, "Captures"), h("span", {}, "/"), h("strong", {}, "My queue")), h("span", { class: "spacer" }), nav, ...accountLinks(me.username)),
       h(
         "main",
         { class: "list-main" },
@@ -74,7 +73,9 @@ export async function renderQueue(root: HTMLElement): Promise<() => void> {
     if (user) query.set("user", user);
     if (state) query.set("state", state);
     history.replaceState(null, "", `/queue/${query.toString() ? `?${query}` : ""}`);
-    clear(nav, ...appLinks(project, role()));
+    // As on the capture list: the project filtered on, else the only one there is.
+    const navProject = project ?? (me.projects.length === 1 ? me.projects[0] : null)?.id ?? null;
+    clear(nav, ...appLinks(navProject, me.projects.find((p) => p.id === navProject)?.role ?? null));
     await whoSelect();
     const [items, assignments] = await Promise.all([
       loadQueue(project, user),

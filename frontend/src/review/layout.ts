@@ -4,7 +4,7 @@
 import type { Me, ReadyCapture } from "../api/types";
 import { SPEEDS } from "../player/clock";
 import { formatDuration, h } from "../ui/dom";
-import { appLinks } from "../ui/appnav";
+import { accountLinks, appLinks } from "../ui/appnav";
 import { icon } from "../ui/icons";
 import type { Command } from "./keymap";
 
@@ -66,9 +66,9 @@ function topbar(c: ReadyCapture, me: Me, el: Elements, button: ButtonMaker, acti
     (el.saveState = h("span", { class: "save-state", "data-testid": "save-state" }, "Saved")),
     button("submit", "Submit review", "Mark this review finished; it can no longer be edited", actions.submit, "btn-primary"),
     button("submit-next", "Submit & next", "Submit, then open the oldest open capture of your queue", actions.submitNext),
-    ...appLinks(c.project, null),
+    ...appLinks(c.project, me.projects.find((p) => p.id === c.project)?.role ?? null),
     button("help-button", "?", "Keyboard shortcuts (?)", actions.help, "btn-ghost"),
-    h("span", { class: "user" }, me.username),
+    ...accountLinks(me.username),
   );
 }
 

@@ -5,9 +5,8 @@
 import { api, ApiError, get, patch, post } from "../api/client";
 import type { Invitation, Label, Me, Project, Role } from "../api/types";
 import type { Member } from "../queue/api";
-import { appLinks } from "../ui/appnav";
+import { accountLinks, appLinks } from "../ui/appnav";
 import { clear, confirmDialog, dialog, h, toast } from "../ui/dom";
-import { logoutButton } from "../ui/logout";
 import { taxonomyEditor } from "./taxonomy";
 import "./team.css";
 
@@ -22,7 +21,7 @@ export async function renderTeam(root: HTMLElement, projectId: number): Promise<
     h(
       "div",
       { class: "list-page team-page" },
-      h("header", { class: "topbar" }, h("a", { class: "brand", href: "/" }, "Cutroom"), h("nav", { class: "crumbs" }, h("a", { href: "/" }, "Captures"), h("span", {}, "/"), h("span", {}, project.name), h("span", {}, "/"), h("strong", {}, "Team")), h("span", { class: "spacer" }), ...appLinks(project.id, project.role), h("span", { class: "user" }, me.username), logoutButton()),
+      h("header", { class: "topbar" }, h("a", { class: "brand", href: "/" }, "Cutroom"), h("nav", { class: "crumbs" }, h("a", { href: "/" }, "Captures"), h("span", {}, "/"), h("span", {}, project.name), h("span", {}, "/"), h("strong", {}, "Team")), h("span", { class: "spacer" }), ...appLinks(project.id, project.role), ...accountLinks(me.username)),
       main,
     ),
   );

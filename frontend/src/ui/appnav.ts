@@ -1,7 +1,23 @@
-// Links every page's top bar carries: the queue, the library and, for a project, its
-// dashboard and team.
+// Links every page's top bar carries, in the same order on every page: the queue, the
+// library and, for a project, its dashboard and team; then who is signed in and "Log out".
 
+import { get } from "../api/client";
+import type { Me } from "../api/types";
 import { h } from "./dom";
+import { logoutButton } from "./logout";
+
+let me: Promise<Me> | null = null;
+
+/** The signed-in user's name (filled in once /api/me/ answers, asked once per page load) and
+ * the sign-out button. */
+export function accountLinks(username?: string): HTMLElement[] {
+  const user = h("span", { class: "user", "data-testid": "nav-user" }, username ?? "");
+  if (username === undefined) {
+    me ??= get<Me>("/api/me/");
+    me.then((m) => (user.textContent = m.username)).catch(() => undefined);
+  }
+  return [user, logoutButton()];
+}
 
 export function appLinks(project?: number | null, role?: string | null): HTMLElement[] {
   const links = [
