@@ -145,3 +145,31 @@ def test_it_names_a_parameter_section_that_points_past_the_file(original, tmp_pa
     with pytest.raises(motionlib.CaptureError, match=r"header block 1, byte 1: the parameter "
                        r"section starts at block 240, the file has 7 blocks"):
         motionlib.read(path)
+
+
+def test_an_int16_c3d_reads_as_an_independent_reader_reads_it_with_its_gaps(tmp_path):
+    """Scaled 16-bit integer points (POINT:SCALE > 0), as many Vicon files store them."""
+    import c3d
+
+    rng = np.random.default_rng(0)
+    writer = c3d.Writer(point_rate=100.0, point_scale=0.1)
+    writer.set_point_labels(["A", "B"])
+    frames = []
+    for i in range(20):
+        points = np.zeros((2, 5), np.float32)
+        points[:, :3] = rng.uniform(-500, 500, (2, 3))
+        points[:, 3] = -1.0 if i == 5 else 1.0
+        frames.append((points, np.zeros((0, 0))))
+    writer.add_frames(frames)
+    path = tmp_path / "int16.c3d"
+    with warnings.catch_warnings(), open(path, "wb") as handle:
+        warnings.simplefilter("ignore")
+        writer.write(handle)
+    take = read_c3d(path)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        other = ezc3d.c3d(str(path))["data"]["points"][:3]
+    xyz = np.moveaxis(other, [0, 1, 2], [2, 1, 0]).reshape(20, 6)
+    assert (take.n_frames, take.fps, take.point_names) == (20, 100.0, ["A", "B"])
+    np.testing.assert_array_equal(take.channels, xyz)
+    assert np.isnan(take.channels[5]).all()
