@@ -69,7 +69,7 @@ def do_backup(path):
             archive.add(rows, "db.json")
             for name, folder_path in _folders().items():
                 if folder_path.is_dir():
-                    archive.add(folder_path, name)
+                    archive.add(folder_path, name, filter=_files_only)
         os.replace(partial, path)
     return manifest
 
@@ -114,6 +114,12 @@ def _rows():
         model._base_manager.order_by("pk").iterator(chunk_size=500) for model in ordered)
 
 
+def _files_only(member):
+    """Files and folders; not what only a running process makes or uses (named pipes,
+    sockets, device files), which no restore could put back."""
+    return member if member.isreg() or member.isdir() else None
+
+
 def _add_bytes(archive, name, data):
     info = tarfile.TarInfo(name)
     info.size, info.mtime = len(data), int(timezone.now().timestamp())
@@ -153,7 +159,11 @@ def do_restore(path):
             for member in members:
                 member.name = member.name[len(name) + 1:]
             folder_path.mkdir(parents=True, exist_ok=True)
-            archive.extractall(folder_path, members=members, filter="data")
+            try:
+                archive.extractall(folder_path, members=members, filter="data")
+            except tarfile.FilterError as exc:
+                raise BackupError(f"{path}: refused to restore {name}/{exc.tarinfo.name} "
+                                  f"({exc})") from None
     return manifest
 
 

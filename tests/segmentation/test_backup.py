@@ -83,6 +83,19 @@ def test_a_restored_backup_exports_the_same_library_byte_for_byte(installation, 
     assert tree(tmp_path / "restored" / "similar") == tree(settings.SIMILAR_INDEX_DIR)
 
 
+def test_it_leaves_out_what_only_a_running_process_uses(installation, tmp_path):
+    os.mkfifo(Path(settings.MEDIA_ROOT) / "pipe")
+    backup = tmp_path / "cutroom.tar"
+    call_command("backup", str(backup), stdout=io.StringIO())
+    with tarfile.open(backup) as archive:
+        names = archive.getnames()
+    assert "media/pipe" not in names and "db.json" in names
+    restored = fresh_installation(tmp_path / "restored")
+    done = manage(restored, "restore", str(backup))
+    assert done.returncode == 0, done.stderr
+    assert tree(tmp_path / "restored" / "media") == tree(settings.MEDIA_ROOT)
+
+
 def test_the_same_library_exports_to_the_same_bytes(installation):
     first = library_exports(installation)["segments.zip"]
     time.sleep(2.1)  # zip entries are stamped to the 2 s: a later export, a later stamp
