@@ -25,7 +25,7 @@ from __future__ import annotations
 import numpy as np
 
 from motionlib.errors import CaptureError
-from motionlib.points import filled
+from motionlib.gaps import filled
 from motionlib.skeleton import CANONICAL_PARTS, OPTIONAL_PARTS
 
 
@@ -149,7 +149,7 @@ def body_joints(take) -> tuple[np.ndarray, dict[str, int]]:
     """Canonical body parts of a point take, for the segmenters' features.
 
     Each part is the mean of its points (``PARTS``) over the points seen at least once, after
-    the gaps of each point are closed (``points.filled``; features only).
+    the gaps of each point are closed (``gaps.filled``; features only).
 
     Returns
     -------

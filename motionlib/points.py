@@ -18,6 +18,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from motionlib.errors import InputError
+from motionlib.gaps import filled
 from motionlib.skeleton import Skeleton
 from motionlib.take import Take, frame_range
 
@@ -122,32 +123,6 @@ def make_point_take(*, name: str, format: str, fps: float, coordinates: np.ndarr
                      channels=coordinates.reshape(n_frames, -1), skeleton=skeleton,
                      path=None if path is None else str(path), positions=positions,
                      unit=unit, up=up, first_number=int(first_number), marker_set=marker_set)
-
-
-def filled(points: np.ndarray) -> np.ndarray:
-    """Gaps closed for computing features: each coordinate linearly interpolated in time
-    between the frames where it was seen, held at its first / last seen value beyond them.
-
-    Features (distances, angles, kernels) need a value in every frame; a straight line
-    across a gap is the least a feature can assume there. Never used on stored data.
-
-    Parameters
-    ----------
-    points : (n_frames, n_points, 3), NaN at gaps.
-
-    Returns
-    -------
-    (n_frames, n_points, 3) float64; a point never seen stays NaN.
-    """
-    out = np.array(points, dtype=np.float64)
-    flat = out.reshape(len(out), -1)
-    missing = np.isnan(flat)
-    frames = np.arange(len(out))
-    for column in np.flatnonzero(missing.any(axis=0)):
-        seen = ~missing[:, column]
-        if seen.any():
-            flat[:, column] = np.interp(frames, frames[seen], flat[seen, column])
-    return out
 
 
 # Methods that need only a stream of per-frame pose vectors, not body parts, and so run on
