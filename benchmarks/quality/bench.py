@@ -29,6 +29,7 @@ capture to choose on gets NaN in the /loo rows.
 
 from __future__ import annotations
 
+import contextlib
 import os
 import sys
 import time
@@ -287,6 +288,16 @@ def _ruptures_loo(cache) -> list[dict]:
     return out
 
 
+def _point_sets(folder: Path, out) -> None:
+    """The point sets (markers and tracked joints) beside the rotation sets, each at its
+    own tolerance, with ruptures in the same run (``benchmarks.points_quality``)."""
+    from benchmarks import points_quality
+
+    print("\n# Point takes: every set per take and mean, at its tolerance", file=out)
+    with contextlib.redirect_stdout(out):
+        points_quality.main(["--data", str(folder)])
+
+
 def main(root: Path | None = None, only: list[str] | None = None, out=None, *,
          loo: bool = False, pool: list | None = None) -> int:
     """Print a table per take and the mean tables; 0 on success, 2 without data.
@@ -339,6 +350,8 @@ def main(root: Path | None = None, only: list[str] | None = None, out=None, *,
         print("\n" + long_take_check(folder), file=out)
     if (not only or "joint_distance_pca" in only) and "13_30" in takes:
         print("\n" + patent_comparison(folder), file=out)
+    if not only and (folder / "points").is_dir():
+        _point_sets(folder, out)
     print(f"\nwhole benchmark: {time.perf_counter() - started:.0f} s, load average "
           f"{' '.join(f'{x:.2f}' for x in os.getloadavg())}", file=out)
     return 0

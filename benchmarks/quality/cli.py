@@ -17,7 +17,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="python -m benchmarks.quality",
         description="Every segmenter (default parameters) and two change-point peers on "
-                    "every labelled take: a table per take and the mean. `speed` measures "
+                    "every labelled take (rotation sets, then the point sets): a table per take and the mean. `speed` measures "
                     "how fast motionlib reads and detects instead.")
     parser.add_argument("--data", help="benchmark data folder (default: $CUTROOM_BENCH_DATA "
                                        "or ../shared/data)")
