@@ -35,7 +35,7 @@ def review_cuts(review):
 
 def review_segments(review, label="label__name"):
     """``[(start, stop, label name or None)]``, or label ids with ``label="label_id"``."""
-    return [(start, stop, x) for _, start, stop, x in review.segments(label)]
+    return [(start, stop, x) for _, start, stop, x in review.segments(label=label)]
 
 
 def compute(capture, reviews, tolerance_s=DEFAULT_TOLERANCE_S, label="label__name"):

@@ -404,7 +404,7 @@ class ReviewSerializer(serializers.ModelSerializer):
         # read from …/review/suggestions/ (segmentation.suggestions).
         kept = [(cut["id"], cut["frame"]) for cut in self._cuts(review) if cut["fate"] != "deleted"]
         return [{"index": index, "start": start, "stop": stop, "label": label}
-                for index, start, stop, label in review.segments(kept)]
+                for index, start, stop, label in review.segments(kept=kept)]
 
 
 class ReviewPageSerializer(ReviewSerializer):
