@@ -123,7 +123,7 @@ AUTH_PASSWORD_VALIDATORS = [
     {"NAME": "django.contrib.auth.password_validation.CommonPasswordValidator"},
     {"NAME": "django.contrib.auth.password_validation.NumericPasswordValidator"},
 ]
-# Sign-in finds the account by any spelling of its username (cutroom.accounts.usernames).
+# Sign-in finds the account by any spelling of its username (segmentation.usernames).
 AUTHENTICATION_BACKENDS = ["cutroom.accounts.backends.UsernameBackend"]
 # Behind a TLS-terminating proxy: trust its X-Forwarded-Proto and send cookies over HTTPS only.
 if envbool("BEHIND_TLS_PROXY", False):

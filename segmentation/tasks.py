@@ -33,7 +33,14 @@ def send(task_name, args, options):
     current_app.send_task(f"segmentation.tasks.{task_name}", args=args, **options)
 
 
-workers.connect(send, stopped=SoftTimeLimitExceeded)
+def ping():
+    """Connect to the broker once; the transport's name (the health check's broker line)."""
+    with current_app.connection_for_write() as conn:
+        conn.ensure_connection(max_retries=1, timeout=5)
+        return conn.transport_cls
+
+
+workers.connect(send, stopped=SoftTimeLimitExceeded, ping=ping)
 
 
 class JobTask(Task):

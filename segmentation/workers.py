@@ -12,13 +12,22 @@ log = logging.getLogger(__name__)
 
 _send = None
 _stopped = ()
+_ping = None
 
 
-def connect(send, stopped):
+def connect(send, stopped, ping=None):
     """``send(task_name, args, options)`` sends task ``segmentation.tasks.<task_name>``;
-    ``stopped`` is the exception class a worker raises inside a job at its soft limit."""
-    global _send, _stopped
-    _send, _stopped = send, (stopped,)
+    ``stopped`` is the exception class a worker raises inside a job at its soft limit;
+    ``ping()`` connects to the broker once and returns its transport's name."""
+    global _send, _stopped, _ping
+    _send, _stopped, _ping = send, (stopped,), ping
+
+
+def ping_broker():
+    """Connect to the broker once (the health check); raises what connecting raises."""
+    if _ping is None:
+        raise RuntimeError("no broker connected (importing segmentation.tasks connects it)")
+    return _ping()
 
 
 def stopped():

@@ -8,8 +8,9 @@ from django.contrib.auth.signals import user_logged_in, user_login_failed
 from django.db.models.signals import post_save, pre_save
 from django.dispatch import receiver
 
-from cutroom.accounts import throttle, usernames
+from cutroom.accounts import throttle
 from cutroom.accounts.models import ApiToken
+from segmentation import usernames
 
 
 @receiver(user_login_failed)

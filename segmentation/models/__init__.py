@@ -5,7 +5,8 @@
 - ``captures``: captures, detection runs, assignments;
 - ``reviews``: reviews, cuts, segment labels, the review audit log;
 - ``library``: library segments, gold versions, agreement, label suggestions;
-- ``workers``: the Celery workers' heartbeats.
+- ``workers``: the Celery workers' heartbeats;
+- ``locks``: named row locks for counting against a limit atomically.
 
 Rules about one record live on the models; lookups live on the managers
 (``Capture.objects.visible_to(user)``). Workflows that touch several records are the
@@ -30,6 +31,7 @@ from segmentation.models.library import (
     LibrarySegment,
     SuggestionRequest,
 )
+from segmentation.models.locks import ThrottleLock
 from segmentation.models.projects import (
     ROLES,
     Invitation,
@@ -69,5 +71,6 @@ __all__ = [
     "SuggestionRequest",
     "derived_path",
     "original_path",
+    "ThrottleLock",
     "WorkerHeartbeat",
 ]

@@ -9,14 +9,13 @@ import logging
 import threading
 import time
 
-from celery import current_app
 from django.conf import settings
 from django.db import connection
 from django.db.models import Max, Min, Q
 from django.db.models.functions import Coalesce
 from django.utils import timezone
 
-from segmentation import similar_index
+from segmentation import similar_index, workers
 from segmentation.models import Capture, DetectionRun, LibrarySegment, WorkerHeartbeat
 from segmentation.models.jobs import claim_cutoff
 from segmentation.services import jobs
@@ -131,9 +130,7 @@ def _database():
 
 
 def _broker():
-    with current_app.connection_for_write() as conn:
-        conn.ensure_connection(max_retries=1, timeout=5)
-    return {"ok": True, "transport": conn.transport_cls}
+    return {"ok": True, "transport": workers.ping_broker()}
 
 
 def _alive(queue):

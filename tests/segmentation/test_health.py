@@ -156,9 +156,10 @@ class HealthEndpointTestCase(BaseTestCase):
         self.workers_beating()
         capture = self.ready_capture()
         profile = np.arange(similarity.PROFILE_ROWS * 4, dtype="<f4")
+        walk, _ = self.project.labels.get_or_create(name="walk", defaults={"color": "#2a9d8f"})
         for start in (0, 100, 200):
             LibrarySegment.objects.create(
-                project=self.project, capture=capture, label_name="walk", start=start,
+                project=self.project, capture=capture, label=walk, start=start,
                 stop=start + 100, duration=100 / 120, profile=(profile + start).tobytes(),
                 created_at=ago(1000))
         body = self.health(503)

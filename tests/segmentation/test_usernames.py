@@ -4,7 +4,7 @@ one account, and names with invisible or look-alike characters cannot be created
 from django.contrib.auth import get_user_model
 from django.test import Client, SimpleTestCase
 
-from cutroom.accounts import usernames
+from segmentation import usernames
 from tests.segmentation.base import BaseTestCase
 
 

@@ -7,15 +7,20 @@ cycle. On SQLite the service's IMMEDIATE transactions already run one at a time;
 rows make the same code hold on PostgreSQL, where transactions run side by side.
 """
 
+import hashlib
 from datetime import timedelta
 
 from django.db import transaction
 from django.utils import timezone
 
-from cutroom.accounts.models import ThrottleLock, digest
+from segmentation.models import ThrottleLock
 
 # A lock row unused this long is deleted (the next use makes it again).
 IDLE = timedelta(days=1)
+
+
+def digest(text):
+    return hashlib.sha256(text.encode("utf-8", "surrogatepass")).hexdigest()
 
 
 def hold(names):
