@@ -94,9 +94,13 @@ class OneTokenView(APIView):
         return Response(status=status.HTTP_204_NO_CONTENT)
 
 
+# A password longer than this is refused before it is hashed (hashing costs time per byte).
+PASSWORD_MAX = 4096
+
+
 class PasswordChangeSerializer(serializers.Serializer):
-    current_password = serializers.CharField(trim_whitespace=False)
-    new_password = serializers.CharField(trim_whitespace=False)
+    current_password = serializers.CharField(trim_whitespace=False, max_length=PASSWORD_MAX)
+    new_password = serializers.CharField(trim_whitespace=False, max_length=PASSWORD_MAX)
 
 
 class PasswordChangedSerializer(serializers.Serializer):
