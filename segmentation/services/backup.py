@@ -116,7 +116,10 @@ def _rows():
 
 def _files_only(member):
     """Files and folders; not what only a running process makes or uses (named pipes,
-    sockets, device files), which no restore could put back."""
+    sockets, device files), which no restore could put back, nor the similar indexes'
+    empty ``.lock`` files, which a writer makes on this machine when it needs one."""
+    if member.isreg() and member.name.endswith(".lock") and member.size == 0:
+        return None
     return member if member.isreg() or member.isdir() else None
 
 
