@@ -64,14 +64,33 @@ class FrameFeed {
   readonly abort = new AbortController();
   readonly started = performance.now();
   readonly done: Promise<void>;
+  /** Settles when the first chunk has landed (the first pose can be drawn), or loading ended. */
+  readonly first: Promise<void>;
   onChunk: () => void = () => {};
 
   constructor(capture: ReadyCapture, maxJoints: number) {
     // Poses the player will not draw are not fetched (nor memory set aside for them).
     const drawable = jointCount(capture) <= maxJoints;
     this.store = new FrameStore(capture.n_frames, drawable ? jointCount(capture) : 0);
-    this.done = drawable ? loadFrames(capture.id, this.store, frameFromUrl(capture.n_frames), () => this.onChunk(), this.abort.signal) : Promise.resolve();
+    let landed = () => {};
+    this.first = new Promise<void>((resolve) => (landed = resolve));
+    const onChunk = () => {
+      landed();
+      this.onChunk();
+    };
+    this.done = drawable ? loadFrames(capture.id, this.store, frameFromUrl(capture.n_frames), onChunk, this.abort.signal) : Promise.resolve();
+    void this.done.finally(landed);
   }
+}
+
+/**
+ * When the full-resolution signals are asked for: once the first pose is on screen, while
+ * the other poses stream in (an hour-long take's poses take seconds, its signals a fraction
+ * of one). `?signals=after-poses` keeps the previous order, after every pose has loaded,
+ * so benchmarks/review_long_take.py can time both in the same run.
+ */
+function signalsWait(frames: FrameFeed, search = location.search): Promise<void> {
+  return new URLSearchParams(search).get("signals") === "after-poses" ? frames.done : frames.first;
 }
 
 function jointCount(capture: ReadyCapture): number {
@@ -185,7 +204,7 @@ class ReviewPage {
     this.abort = frames.abort;
     frames.onChunk = () => this.onFramesLoaded(frames.started);
     if (this.store.loadedFrames) this.onFramesLoaded(frames.started);
-    void frames.done.then(() => this.loadFullSignals());
+    void signalsWait(frames).then(() => this.loadFullSignals());
     document.addEventListener("keydown", this.onKey);
     this.refresh();
     void this.loadEvents();
@@ -309,8 +328,9 @@ class ReviewPage {
   }
 
   /**
-   * The first paint uses signals decimated to a few thousand points; once the poses are
-   * in, fetch them at full frame resolution so zooming in shows every frame.
+   * The first paint uses signals decimated to a few thousand points; once the first pose
+   * is on screen (signalsWait), fetch them at full frame resolution so zooming in shows
+   * every frame.
    */
   private async loadFullSignals(): Promise<void> {
     if (this.abort.signal.aborted || !this.signals.some((sig) => sig.step > 1)) return;
@@ -320,6 +340,9 @@ class ReviewPage {
     this.signals = full.signals.map(({ data, ...sig }) => ({ ...sig, values: Array.from(decodeFloat32(data)) }));
     this.el.timeline.dataset.signalStep = String(Math.max(1, ...this.signals.map((sig) => sig.step)));
     this.refresh();
+    // The timeline draws on the next animation frame, before this callback (queued after
+    // its own): milliseconds from navigation to every lane drawn at full resolution.
+    requestAnimationFrame(() => (this.el.timeline.dataset.lanesMs = String(Math.round(performance.now()))));
   }
 
   // ---- editing -------------------------------------------------------------------------
