@@ -149,3 +149,24 @@ def test_the_previous_order_asks_for_the_full_signals_after_every_pose(live_serv
     last_frames = max(i for i, url in enumerate(seen) if "/frames/" in url)
     assert seen.index(next(url for url in seen if f"max_points={N_FRAMES}" in url)) > last_frames
     assert page.errors == []
+
+
+def test_the_rest_of_the_poses_wait_until_the_lanes_are_drawn(live_server, new_page, long_capture):
+    page = new_page("ann")
+    held, seen = [], []
+    page.on("request", lambda request: seen.append(request.url))
+    page.route(f"**/signal/?max_points={N_FRAMES}&*", lambda route: held.append(route))
+    page.goto(f"{live_server.url}/captures/{long_capture.pk}/")
+    expect(page.get_by_test_id("viewport")).to_have_attribute("data-first-pose-ms", re.compile(r"^\d+$"))
+    assert held
+    # Both chunks asked for at once have landed (5,000 of 72,000 frames); a request for the
+    # next would be sent as each landed, were the poses not held back. No more were sent.
+    expect(page.locator(".hud-loading-bar")).to_have_attribute("style", re.compile(r"width: 6\.9%"))
+    page.wait_for_timeout(500)  # time for a request the page sent to reach this process
+    assert page.get_by_test_id("frames-loading").get_attribute("data-done") is None
+    assert len([url for url in seen if "/frames/" in url]) == 2
+
+    held.pop().continue_()
+    expect(page.get_by_test_id("timeline")).to_have_attribute("data-lanes-ms", re.compile(r"^\d+$"))
+    expect(page.get_by_test_id("frames-loading")).to_have_attribute("data-done", re.compile(r"^\d+$"), timeout=30_000)
+    assert page.errors == []

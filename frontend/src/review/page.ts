@@ -37,7 +37,7 @@ export async function renderReview(root: HTMLElement, captureId: number): Promis
   const project = listOf(projects).find((p) => p.id === capture.project);
   if (!isReady(capture)) return renderNotReady(root, capture);
   // Poses start streaming now, in parallel with the review and the signal.
-  const frames = new FrameFeed(capture, maxJoints(me));
+  const frames = new FrameFeed(capture, maxJoints(me), !signalsAfterPoses());
   try {
     const [review, signal] = await Promise.all([
       // Reading does not start a review: the first edit does (saver.ts).
@@ -66,9 +66,11 @@ class FrameFeed {
   readonly done: Promise<void>;
   /** Settles when the first chunk has landed (the first pose can be drawn), or loading ended. */
   readonly first: Promise<void>;
+  /** Lets the poses after the first chunk load (see signalsWait); aborting does too. */
+  resume: () => void = () => {};
   onChunk: () => void = () => {};
 
-  constructor(capture: ReadyCapture, maxJoints: number) {
+  constructor(capture: ReadyCapture, maxJoints: number, holdAfterFirst: boolean) {
     // Poses the player will not draw are not fetched (nor memory set aside for them).
     const drawable = jointCount(capture) <= maxJoints;
     this.store = new FrameStore(capture.n_frames, drawable ? jointCount(capture) : 0);
@@ -78,19 +80,31 @@ class FrameFeed {
       landed();
       this.onChunk();
     };
-    this.done = drawable ? loadFrames(capture.id, this.store, frameFromUrl(capture.n_frames), onChunk, this.abort.signal) : Promise.resolve();
+    const gate = new Promise<void>((resolve) => (this.resume = resolve));
+    if (!holdAfterFirst) this.resume();
+    this.abort.signal.addEventListener("abort", () => this.resume());
+    this.done = drawable ? loadFrames(capture.id, this.store, frameFromUrl(capture.n_frames), onChunk, this.abort.signal, gate) : Promise.resolve();
     void this.done.finally(landed);
   }
 }
 
 /**
- * When the full-resolution signals are asked for: once the first pose is on screen, while
- * the other poses stream in (an hour-long take's poses take seconds, its signals a fraction
- * of one). `?signals=after-poses` keeps the previous order, after every pose has loaded,
- * so benchmarks/review_long_take.py can time both in the same run.
+ * The previous request order, `?signals=after-poses`: the full-resolution signals asked for
+ * once every pose has loaded. Kept so benchmarks/review_long_take.py can time both orders
+ * in the same run.
  */
-function signalsWait(frames: FrameFeed, search = location.search): Promise<void> {
-  return new URLSearchParams(search).get("signals") === "after-poses" ? frames.done : frames.first;
+function signalsAfterPoses(search = location.search): boolean {
+  return new URLSearchParams(search).get("signals") === "after-poses";
+}
+
+/**
+ * When the full-resolution signals are asked for: once the first pose is on screen. The
+ * other poses wait until the lanes are drawn (FrameFeed.resume): an hour-long take's poses
+ * take seconds to load, its signals a fraction of one, and on a small server the signals'
+ * request would otherwise queue behind pose chunks.
+ */
+function signalsWait(frames: FrameFeed): Promise<void> {
+  return signalsAfterPoses() ? frames.done : frames.first;
 }
 
 function jointCount(capture: ReadyCapture): number {
@@ -204,7 +218,7 @@ class ReviewPage {
     this.abort = frames.abort;
     frames.onChunk = () => this.onFramesLoaded(frames.started);
     if (this.store.loadedFrames) this.onFramesLoaded(frames.started);
-    void signalsWait(frames).then(() => this.loadFullSignals());
+    void signalsWait(frames).then(() => this.loadFullSignals()).finally(frames.resume);
     document.addEventListener("keydown", this.onKey);
     this.refresh();
     void this.loadEvents();
