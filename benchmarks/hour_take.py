@@ -4,8 +4,7 @@ whole signal, and the worker's peak memory.
 Runs as ``make up`` does (a temporary SQLite database, the SQLite broker, one Celery
 worker subprocess with concurrency 1). The take is a seeded ``motionlib.synth`` take of
 ``--minutes`` (default 60) at 120 fps written as BVH, cached in ``benchmarks/out/``. It is
-uploaded through the HTTP API (Django's test client; the upload limit is raised to 2 GB
-for this run), the clock stops when the default detection run is ready. Then, as the
+uploaded through the HTTP API (Django's test client) with the shipped limits, the clock stops when the default detection run is ready. Then, as the
 review page does: the capture, the first 600 poses (``frames/?start=0&stop=600``), the
 overview signal (4,000 points) and the whole signal (one value per frame).
 
@@ -112,7 +111,6 @@ def main():
     prepared = time.perf_counter() - started
     var = Path(tempfile.mkdtemp(prefix="cutroom-hour-"))
     worker = watch = None
-    os.environ["CUTROOM_MAX_UPLOAD_MB"] = "2048"
     try:
         embedded_environment(var)
         client, project = client_and_project()

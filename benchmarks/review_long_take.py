@@ -34,8 +34,19 @@ Measured, over HTTP with a token (wall-clock ms on the client):
     .venv/bin/python benchmarks/review_long_take.py [--minutes 60] [--library-minutes 60]
         [--repeats 40] [--pages 20] [--waves 3] [--old-serving]
 
+``--browser`` measures instead what a person sees opening the long take in headless Chromium
+(``/usr/bin/chromium``, the built ``frontend/dist``), served as ``make up`` serves it: the
+first pose on screen and every lane drawn at full resolution (the page's
+``data-first-pose-ms`` and ``data-lanes-ms``, milliseconds from navigation), and all poses
+loaded, ``--browser-repeats`` page loads of each path alternating in the same run. The old
+path is the previous request order (``?signals=after-poses``: the full signals asked for
+once every pose has loaded); the new one asks for them once the first pose is on screen.
+No library is built for it.
+
+    .venv/bin/python benchmarks/review_long_take.py --browser [--minutes 60] [--browser-repeats 5]
+
 Targets: review GET and edit p95 <= 100 ms; the small capture's p50 and p95 under the
-load <= 2x alone.
+load <= 2x alone; in Chromium, first pose <= 1 s and every lane drawn <= 2 s.
 """
 
 import argparse
@@ -43,6 +54,7 @@ import http.client
 import json
 import multiprocessing
 import os
+import re
 import shutil
 import socket
 import statistics
@@ -58,6 +70,9 @@ import numpy as np
 from harness import REPO, start_django, stop, up_script
 
 TARGET_MS = 100.0
+TARGET_FIRST_POSE_MS = 1000.0
+TARGET_LANES_MS = 2000.0
+CHROMIUM = "/usr/bin/chromium"
 TARGET_SLOWDOWN = 2.0
 LIBRARY_TAKE_MINUTES = 10.0
 
@@ -74,6 +89,9 @@ def parse_args():
                         help="leave stored suggestions in place: the worker stays idle during the loads")
     parser.add_argument("--old-serving", action="store_true",
                         help="gunicorn 2x4, worker not niced, no answer cache, no heavy-request bound")
+    parser.add_argument("--browser", action="store_true",
+                        help="only the page in Chromium: first pose and every lane drawn, old and new order")
+    parser.add_argument("--browser-repeats", type=int, default=5, help="page loads of each order")
     return parser.parse_args()
 
 
@@ -444,6 +462,110 @@ def serving(old, var, port):
         f"worker {niced}, CUTROOM_HEAVY_REQUESTS={heavy}, CUTROOM_ANSWER_CACHE_MB={cache_mb}, {lane}")
 
 
+# ---- the page in Chromium -------------------------------------------------------------------
+
+BROWSER_PATHS = {"OLD (signals after every pose)": "?signals=after-poses",
+                 "NEW (signals after the first pose)": ""}
+
+
+def open_in_chromium(browser, port, capture, query, password):
+    """(first pose, every lane drawn, all poses loaded) in ms from navigation, one page load
+    by a fresh context (no cached answers of the last load)."""
+    from playwright.sync_api import expect
+
+    context = browser.new_context(viewport={"width": 1440, "height": 900})
+    try:
+        page = context.new_page()
+        base = f"http://127.0.0.1:{port}"
+        page.goto(f"{base}/login/?next=/")
+        page.fill("#id_username", "ann")
+        page.fill("#id_password", password)
+        page.click("button[type=submit]")
+        page.wait_for_url(f"{base}/")
+        page.goto(f"{base}/captures/{capture.pk}/{query}")
+        timeline, loading = page.get_by_test_id("timeline"), page.get_by_test_id("frames-loading")
+        expect(page.get_by_test_id("viewport")).to_have_attribute("data-first-pose-ms", re.compile(r"^\d+$"), timeout=120_000)
+        expect(timeline).to_have_attribute("data-lanes-ms", re.compile(r"^\d+$"), timeout=120_000)
+        expect(loading).to_have_attribute("data-done", re.compile(r"^\d+$"), timeout=120_000)
+        # data-done counts from when the poses were first asked for; as the others, from navigation.
+        done = page.evaluate("""() => Number(document.querySelector('[data-testid=frames-loading]').dataset.done)
+            + performance.getEntriesByType('resource').find((e) => e.name.includes('/frames/')).startTime""")
+        return (int(page.get_by_test_id("viewport").get_attribute("data-first-pose-ms")),
+                int(timeline.get_attribute("data-lanes-ms")), done)
+    finally:
+        context.close()
+
+
+def time_in_chromium(port, capture, repeats, password):
+    """{path: {"first pose": [ms], "every lane drawn": [ms], "all poses loaded": [ms]}}."""
+    from playwright.sync_api import sync_playwright
+
+    sys.path.insert(0, str(REPO))
+    from tests.e2e.conftest import CHROMIUM_ARGS
+
+    times = {name: {"first pose": [], "every lane drawn": [], "all poses loaded": []} for name in BROWSER_PATHS}
+    with sync_playwright() as p:
+        browser = p.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS, headless=True)
+        try:
+            open_in_chromium(browser, port, capture, "", password)  # warm the answer caches
+            for _ in range(repeats):
+                for name, query in BROWSER_PATHS.items():
+                    for kind, ms in zip(times[name], open_in_chromium(browser, port, capture, query, password),
+                                        strict=True):
+                        times[name][kind].append(ms)
+        finally:
+            browser.close()
+    return times
+
+
+def browser_main(args, var):
+    """The long take opened in Chromium, old and new request order in the same run."""
+    from django.contrib.auth import get_user_model
+
+    from segmentation import services
+
+    password = "benchmark-password"
+    admin = get_user_model().objects.create_user("admin")
+    project = services.do_create_project(admin, "Benchmark studio")
+    get_user_model().objects.create_user("ann", password=password)
+    services.do_set_member(project, "ann", "annotator")
+    started = time.perf_counter()
+    long_take, _ = synth_capture(project, admin, 11, args.minutes, detect=True)
+    services.get_or_create_review(long_take, get_user_model().objects.get(username="ann"))
+    lanes = len(storage_signals(long_take))
+    print(f"long take: {long_take.n_frames:,} frames at 120 fps, {long_take.n_joints} joints, {lanes} "
+          f"signal lanes ({time.perf_counter() - started:.0f} s to build)")
+    port = free_port()
+    worker_argv, web_argv, bulk, described = serving(False, var, port)
+    print(described)
+    procs = []
+    try:
+        if bulk:
+            sock = Path(os.environ["CUTROOM_BULK_SOCKET"])
+            procs.append(start(bulk.argv, var / "web-bulk.log", sock.exists, env=bulk.env))
+        procs.append(start(web_argv, var / "web.log", lambda: answers(port)))
+        print(f"before: {load()}")
+        times = time_in_chromium(port, long_take, args.browser_repeats, password)
+        print(f"\nheadless Chromium, {args.browser_repeats} page loads of each order, alternating "
+              f"(ms from navigation; a fresh browser context each):")
+        print(f"{'page load':<52} {'n':>5} {'p50':>9} {'p95':>9} {'max':>9}")
+        for name, kinds in times.items():
+            for kind, values in kinds.items():
+                target = {"first pose": TARGET_FIRST_POSE_MS, "every lane drawn": TARGET_LANES_MS}.get(kind)
+                row(f"{name}: {kind}", values, target, width=52)
+        print(f"\nafter: {load()}")
+    finally:
+        for proc in reversed(procs):
+            stop(proc)
+
+
+def storage_signals(capture):
+    from segmentation import storage
+
+    run = capture.latest_finished_run()
+    return storage.load_npz(run.signals) if run and run.signals else {}
+
+
 # ---- report -------------------------------------------------------------------------------
 
 
@@ -451,10 +573,10 @@ def pct(values, q):
     return float(np.percentile(values, q)) if values else float("nan")
 
 
-def row(name, values, target=None):
+def row(name, values, target=None, width=34):
     p95 = pct(values, 95)
     verdict = "" if target is None else ("ok" if p95 <= target else "MISSED")
-    print(f"{name:<34} {len(values):>5} {statistics.median(values):>9.1f} {p95:>9.1f} {max(values):>9.1f}  {verdict}")
+    print(f"{name:<{width}} {len(values):>5} {statistics.median(values):>9.1f} {p95:>9.1f} {max(values):>9.1f}  {verdict}")
 
 
 def main():
@@ -465,6 +587,8 @@ def main():
         start_django(unset=("DATABASE_URL", "CELERY_BROKER_URL", "CUTROOM_MEDIA_ROOT", "CELERY_BROKER_DIR"),
                      CUTROOM_VAR_DIR=str(var))
         print(f"embedded default (SQLite, SQLite broker) in {var}; {load()}")
+        if args.browser:
+            return browser_main(args, var)
         data = populate(args)
         old = time_old_path(data, args.old_repeats)
 

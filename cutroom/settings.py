@@ -197,9 +197,13 @@ STORAGES = {
     "staticfiles": {"BACKEND": "django.contrib.staticfiles.storage.StaticFilesStorage"},
 }
 
-CUTROOM_MAX_UPLOAD_MB = envint("CUTROOM_MAX_UPLOAD_MB", 200)
-# Django refuses request bodies above this; keep it just over the upload limit so the
-# API can answer with its own clear 413 instead of a generic error.
+# Sized for real takes: a studio's hour at 120 fps is a ~285 MB BVH, and the reader's
+# frame limits (CUTROOM_MAX_FRAME_VALUES) refuse at ingest what a bigger file would hold
+# (docs/operations.md, "Limits and quotas").
+CUTROOM_MAX_UPLOAD_MB = envint("CUTROOM_MAX_UPLOAD_MB", 1024)
+# The form fields besides the files (Django refuses more with a generic 400). Uploaded files
+# above FILE_UPLOAD_MAX_MEMORY_SIZE are streamed to a temporary file as they arrive, never
+# held in memory; storage then moves that file into place.
 DATA_UPLOAD_MAX_MEMORY_SIZE = 10 * 1024 * 1024
 FILE_UPLOAD_MAX_MEMORY_SIZE = 10 * 1024 * 1024
 # A running job renews its claim every CUTROOM_CLAIM_TIMEOUT / 6 seconds; a claim not

@@ -91,3 +91,82 @@ def test_it_opens_a_ten_minute_take_in_under_two_seconds_and_plays_it(live_serve
     assert after > shown
     assert median < 500
     assert page.errors == []
+
+
+def _held_frames(page):
+    """Hold every frames request but the first pose's until ``release()``: the page's pose
+    download stays in flight for as long as a check needs. Returns (held routes, requests
+    seen in order, release)."""
+    held, seen, state = [], [], {"holding": True}
+    page.on("request", lambda request: seen.append(request.url))
+
+    def frames(route):
+        if state["holding"] and "start=0&" not in route.request.url:
+            held.append(route)
+        else:
+            route.continue_()
+
+    def release():
+        state["holding"] = False
+        while held:
+            held.pop(0).continue_()
+
+    page.route("**/api/captures/*/frames/*", frames)
+    return held, seen, release
+
+
+def test_it_draws_every_lane_at_full_resolution_while_the_poses_still_load(live_server, new_page, long_capture):
+    page = new_page("ann")
+    held, seen, release = _held_frames(page)
+    page.goto(f"{live_server.url}/captures/{long_capture.pk}/")
+    expect(page.get_by_test_id("viewport")).to_have_attribute("data-first-pose-ms", re.compile(r"^\d+$"))
+    timeline = page.get_by_test_id("timeline")
+    expect(timeline).to_have_attribute("data-signal-step", "1")
+    expect(timeline).to_have_attribute("data-lanes-ms", re.compile(r"^\d+$"))
+    # Drawn while the pose download is still in flight.
+    assert held
+    assert page.get_by_test_id("frames-loading").get_attribute("data-done") is None
+
+    release()
+    expect(page.get_by_test_id("frames-loading")).to_have_attribute("data-done", re.compile(r"^\d+$"), timeout=30_000)
+    # In request order: the first pose, the full signals, then the rest of the poses.
+    full = [i for i, url in enumerate(seen) if f"max_points={N_FRAMES}" in url]
+    frames = [i for i, url in enumerate(seen) if "/frames/" in url]
+    assert len(full) == 1 and frames[0] < full[0] < frames[-1]
+    assert page.errors == []
+
+
+def test_the_previous_order_asks_for_the_full_signals_after_every_pose(live_server, new_page, long_capture):
+    page = new_page("ann")
+    held, seen, release = _held_frames(page)
+    page.goto(f"{live_server.url}/captures/{long_capture.pk}/?signals=after-poses")
+    expect(page.get_by_test_id("viewport")).to_have_attribute("data-first-pose-ms", re.compile(r"^\d+$"))
+    expect(page.get_by_test_id("timeline")).not_to_have_attribute("data-signal-step", "1", timeout=1_000)
+    assert not any(f"max_points={N_FRAMES}" in url for url in seen)
+
+    release()
+    expect(page.get_by_test_id("timeline")).to_have_attribute("data-signal-step", "1", timeout=30_000)
+    last_frames = max(i for i, url in enumerate(seen) if "/frames/" in url)
+    assert seen.index(next(url for url in seen if f"max_points={N_FRAMES}" in url)) > last_frames
+    assert page.errors == []
+
+
+def test_the_rest_of_the_poses_wait_until_the_lanes_are_drawn(live_server, new_page, long_capture):
+    page = new_page("ann")
+    held, seen = [], []
+    page.on("request", lambda request: seen.append(request.url))
+    page.route(f"**/signal/?max_points={N_FRAMES}&*", lambda route: held.append(route))
+    page.goto(f"{live_server.url}/captures/{long_capture.pk}/")
+    expect(page.get_by_test_id("viewport")).to_have_attribute("data-first-pose-ms", re.compile(r"^\d+$"))
+    assert held
+    # Both chunks asked for at once have landed (5,000 of 72,000 frames); a request for the
+    # next would be sent as each landed, were the poses not held back. No more were sent.
+    expect(page.locator(".hud-loading-bar")).to_have_attribute("style", re.compile(r"width: 6\.9%"))
+    page.wait_for_timeout(500)  # time for a request the page sent to reach this process
+    assert page.get_by_test_id("frames-loading").get_attribute("data-done") is None
+    assert len([url for url in seen if "/frames/" in url]) == 2
+
+    held.pop().continue_()
+    expect(page.get_by_test_id("timeline")).to_have_attribute("data-lanes-ms", re.compile(r"^\d+$"))
+    expect(page.get_by_test_id("frames-loading")).to_have_attribute("data-done", re.compile(r"^\d+$"), timeout=30_000)
+    assert page.errors == []

@@ -110,9 +110,11 @@ export class FrameStore {
 
 /**
  * Fill `store` chunk by chunk, two requests in flight (the server is small), calling
- * `onChunk` after each so the player and progress bar can update.
+ * `onChunk` after each so the player and progress bar can update. After each chunk a
+ * request waits for `gate`: the page holds the rest of the poses back while it fetches
+ * what it draws next, so that request does not queue behind pose chunks.
  */
-export async function loadFrames(captureId: number, store: FrameStore, firstFrame: number, onChunk: () => void, signal?: AbortSignal): Promise<void> {
+export async function loadFrames(captureId: number, store: FrameStore, firstFrame: number, onChunk: () => void, signal?: AbortSignal, gate: Promise<void> = Promise.resolve()): Promise<void> {
   const queue = planChunks(store.nFrames, firstFrame, CHUNK, HEAD);
   const worker = async () => {
     for (let range = queue.shift(); range && !signal?.aborted; range = queue.shift()) {
@@ -122,6 +124,7 @@ export async function loadFrames(captureId: number, store: FrameStore, firstFram
       // The server sends fewer frames per answer for a skeleton of many joints: ask for the rest next.
       if (response.stop > range.start && response.stop < range.stop) queue.unshift({ start: response.stop, stop: range.stop });
       onChunk();
+      await gate;
     }
   };
   try {

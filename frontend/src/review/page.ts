@@ -37,7 +37,7 @@ export async function renderReview(root: HTMLElement, captureId: number): Promis
   const project = listOf(projects).find((p) => p.id === capture.project);
   if (!isReady(capture)) return renderNotReady(root, capture);
   // Poses start streaming now, in parallel with the review and the signal.
-  const frames = new FrameFeed(capture, maxJoints(me));
+  const frames = new FrameFeed(capture, maxJoints(me), !signalsAfterPoses());
   try {
     const [opened, signal] = await Promise.all([
       // Reading does not start a review: the first edit does (saver.ts).
@@ -66,14 +66,47 @@ class FrameFeed {
   readonly abort = new AbortController();
   readonly started = performance.now();
   readonly done: Promise<void>;
+  /** Settles when the first chunk has landed (the first pose can be drawn), or loading ended. */
+  readonly first: Promise<void>;
+  /** Lets the poses after the first chunk load (see signalsWait); aborting does too. */
+  resume: () => void = () => {};
   onChunk: () => void = () => {};
 
-  constructor(capture: ReadyCapture, maxJoints: number) {
+  constructor(capture: ReadyCapture, maxJoints: number, holdAfterFirst: boolean) {
     // Poses the player will not draw are not fetched (nor memory set aside for them).
     const drawable = jointCount(capture) <= maxJoints;
     this.store = new FrameStore(capture.n_frames, drawable ? jointCount(capture) : 0);
-    this.done = drawable ? loadFrames(capture.id, this.store, frameFromUrl(capture.n_frames), () => this.onChunk(), this.abort.signal) : Promise.resolve();
+    let landed = () => {};
+    this.first = new Promise<void>((resolve) => (landed = resolve));
+    const onChunk = () => {
+      landed();
+      this.onChunk();
+    };
+    const gate = new Promise<void>((resolve) => (this.resume = resolve));
+    if (!holdAfterFirst) this.resume();
+    this.abort.signal.addEventListener("abort", () => this.resume());
+    this.done = drawable ? loadFrames(capture.id, this.store, frameFromUrl(capture.n_frames), onChunk, this.abort.signal, gate) : Promise.resolve();
+    void this.done.finally(landed);
   }
+}
+
+/**
+ * The previous request order, `?signals=after-poses`: the full-resolution signals asked for
+ * once every pose has loaded. Kept so benchmarks/review_long_take.py can time both orders
+ * in the same run.
+ */
+function signalsAfterPoses(search = location.search): boolean {
+  return new URLSearchParams(search).get("signals") === "after-poses";
+}
+
+/**
+ * When the full-resolution signals are asked for: once the first pose is on screen. The
+ * other poses wait until the lanes are drawn (FrameFeed.resume): an hour-long take's poses
+ * take seconds to load, its signals a fraction of one, and on a small server the signals'
+ * request would otherwise queue behind pose chunks.
+ */
+function signalsWait(frames: FrameFeed): Promise<void> {
+  return signalsAfterPoses() ? frames.done : frames.first;
 }
 
 function jointCount(capture: ReadyCapture): number {
@@ -188,7 +221,7 @@ class ReviewPage {
     this.abort = frames.abort;
     frames.onChunk = () => this.onFramesLoaded(frames.started);
     if (this.store.loadedFrames) this.onFramesLoaded(frames.started);
-    void frames.done.then(() => this.loadFullSignals());
+    void signalsWait(frames).then(() => this.loadFullSignals()).finally(frames.resume);
     document.addEventListener("keydown", this.onKey);
     this.refresh();
     void this.loadEvents();
@@ -312,8 +345,9 @@ class ReviewPage {
   }
 
   /**
-   * The first paint uses signals decimated to a few thousand points; once the poses are
-   * in, fetch them at full frame resolution so zooming in shows every frame.
+   * The first paint uses signals decimated to a few thousand points; once the first pose
+   * is on screen (signalsWait), fetch them at full frame resolution so zooming in shows
+   * every frame.
    */
   private async loadFullSignals(): Promise<void> {
     if (this.abort.signal.aborted || !this.signals.some((sig) => sig.step > 1)) return;
@@ -323,6 +357,9 @@ class ReviewPage {
     this.signals = full.signals.map(({ data, ...sig }) => ({ ...sig, values: Array.from(decodeFloat32(data)) }));
     this.el.timeline.dataset.signalStep = String(Math.max(1, ...this.signals.map((sig) => sig.step)));
     this.refresh();
+    // The timeline draws on the next animation frame, before this callback (queued after
+    // its own): milliseconds from navigation to every lane drawn at full resolution.
+    requestAnimationFrame(() => (this.el.timeline.dataset.lanesMs = String(Math.round(performance.now()))));
   }
 
   // ---- editing -------------------------------------------------------------------------
