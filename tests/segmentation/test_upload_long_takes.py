@@ -37,10 +37,10 @@ class UploadingRealTake(BaseTestCase):
         """The response, and the uploaded file as the upload service received it."""
         seen = {}
 
-        def spy(project, user, upload, asf=None):
+        def spy(project, user, upload, asf=None, **options):
             seen["upload"] = upload
             seen["on_disk"] = isinstance(upload, TemporaryUploadedFile)
-            return do_upload_capture(project, user, upload, asf)
+            return do_upload_capture(project, user, upload, asf, **options)
 
         do_upload_capture = services.do_upload_capture
         with mock.patch.object(services, "do_upload_capture", spy):
