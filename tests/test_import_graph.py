@@ -24,6 +24,8 @@ import ast
 import collections
 from pathlib import Path
 
+from tests.graphs import cycles
+
 ROOT = Path(__file__).resolve().parent.parent
 PACKAGES = ("cutroom", "segmentation")
 PARTS = ("segmentation.api", "segmentation.services", "segmentation.models",
@@ -89,37 +91,6 @@ def coarsened(graph, group):
     return coarse
 
 
-def cycles(graph):
-    """The strongly connected components of more than one node (Tarjan), each sorted."""
-    index, low, stack, on_stack, found = {}, {}, [], set(), []
-
-    def visit(node):
-        index[node] = low[node] = len(index)
-        stack.append(node)
-        on_stack.add(node)
-        for target in graph.get(node, ()):
-            if target not in index:
-                visit(target)
-                low[node] = min(low[node], low[target])
-            elif target in on_stack:
-                low[node] = min(low[node], index[target])
-        if low[node] == index[node]:
-            component = []
-            while True:
-                member = stack.pop()
-                on_stack.discard(member)
-                component.append(member)
-                if member == node:
-                    break
-            if len(component) > 1:
-                found.append(sorted(component))
-
-    for node in sorted(graph):
-        if node not in index:
-            visit(node)
-    return found
-
-
 def part(module):
     return next((p for p in PARTS if module == p or module.startswith(p + ".")), module)
 
@@ -160,7 +131,7 @@ def test_the_graph_sees_imports_inside_functions_and_url_includes():
 
 
 def test_it_finds_a_cycle():
-    graph = {"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}}
+    graph = {"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}, "e": {"e"}}
     assert cycles(graph) == [["a", "b", "c"]]
 
 

@@ -10,6 +10,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+from tests.graphs import cycles
+
 # Runs in a fresh interpreter, so nothing this test process imported counts. It imports
 # every module in turn and names the first one after which a forbidden package is loaded.
 WALK = r"""
@@ -99,42 +101,10 @@ def _type_checking(test: ast.expr) -> bool:
         (isinstance(test, ast.Attribute) and test.attr == "TYPE_CHECKING")
 
 
-def import_circles(graph: dict[str, set[str]]) -> list[list[str]]:
-    """The strongly connected components of more than one module (Tarjan's algorithm)."""
-    index: dict[str, int] = {}
-    low: dict[str, int] = {}
-    stack: list[str] = []
-    circles = []
-
-    def visit(node: str) -> None:
-        index[node] = low[node] = len(index)
-        stack.append(node)
-        for other in sorted(graph[node]):
-            if other not in index:
-                visit(other)
-                low[node] = min(low[node], low[other])
-            elif other in stack:
-                low[node] = min(low[node], index[other])
-        if low[node] == index[node]:
-            component = []
-            while True:
-                other = stack.pop()
-                component.append(other)
-                if other == node:
-                    break
-            if len(component) > 1:
-                circles.append(sorted(component))
-
-    for node in sorted(graph):
-        if node not in index:
-            visit(node)
-    return circles
-
-
 def test_no_two_motionlib_modules_import_each_other_even_through_others():
     modules = set(motionlib_modules())
     graph = {name: imported(name, modules) & modules for name in modules}
-    assert import_circles(graph) == []
+    assert cycles(graph) == []
 
 
 def test_imports_only_type_checkers_see_are_not_counted(tmp_path, monkeypatch):
@@ -144,8 +114,3 @@ def test_imports_only_type_checkers_see_are_not_counted(tmp_path, monkeypatch):
         "def late():\n    import re\n")
     monkeypatch.syspath_prepend(str(tmp_path))
     assert imported("typed_only", set()) == {"typing", "json", "os", "re"}
-
-
-def test_the_circle_finder_finds_circles():
-    graph = {"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}, "e": {"e"}}
-    assert import_circles(graph) == [["a", "b", "c"]]
