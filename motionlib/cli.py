@@ -9,13 +9,9 @@ Adding a command is adding one such function to :data:`COMMANDS`. Errors a user 
 from __future__ import annotations
 
 import argparse
-import sys
 
-from motionlib.arguments import add_animation, animation_arg
-from motionlib.errors import CaptureError
+from motionlib.arguments import EXIT_USAGE, add_animation, animation_arg, run
 from motionlib.segmenters.command import add_segment
-
-EXIT_USAGE = 2
 
 
 def add_info(subparsers) -> None:
@@ -127,10 +123,4 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; return the exit status."""
-    args = build_parser().parse_args(argv)
-    try:
-        return args.handler(args)
-    except (CaptureError, ValueError, OSError) as exc:
-        message = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-        print(f"motionlib {args.command}: error: {message}", file=sys.stderr)
-        return EXIT_USAGE
+    return run(build_parser(), argv, "motionlib")

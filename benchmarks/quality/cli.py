@@ -4,13 +4,10 @@ motionlib's speed tables. Errors a user can fix print one line on stderr, exit s
 from __future__ import annotations
 
 import argparse
-import sys
 
 from benchmarks.quality import bench
 from benchmarks.quality.speed import add_speed
-from motionlib.errors import CaptureError
-
-EXIT_USAGE = 2
+from motionlib.arguments import run
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -46,10 +43,4 @@ def run_quality(args) -> int:
 
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; return the exit status."""
-    args = build_parser().parse_args(argv)
-    try:
-        return args.handler(args)
-    except (CaptureError, ValueError, OSError) as exc:
-        message = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-        print(f"benchmarks.quality {args.command}: error: {message}", file=sys.stderr)
-        return EXIT_USAGE
+    return run(build_parser(), argv, "benchmarks.quality")
