@@ -17,11 +17,6 @@ class CaptureQuerySet(ClaimQuerySet):
         """Captures of the projects the user is a member of."""
         return self.filter(project__in=Project.objects.for_user(user))
 
-    def requeue_failed(self, pk):
-        """As for any job; the next try's failure decides afresh whether it is the file's."""
-        self.filter(pk=pk, status="failed").update(error_permanent=False)
-        return super().requeue_failed(pk)
-
 
 def original_path(capture, filename):
     return f"captures/{capture.project_id}/{uuid.uuid4().hex}/{filename}"

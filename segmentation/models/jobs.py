@@ -48,9 +48,11 @@ class ClaimQuerySet(models.QuerySet):
 
     def requeue_failed(self, pk):
         """Put a failed job back in the queue with a fresh attempt count; 0 rows updated
-        means it was not failed (a concurrent retry, or nothing to retry)."""
+        means it was not failed (a concurrent retry, or nothing to retry). The next try's
+        failure decides afresh whether it is permanent."""
         return self.filter(pk=pk, status="failed").update(
-            status="queued", error="", claim_token="", claimed_at=timezone.now(), attempts=0
+            status="queued", error="", error_permanent=False, claim_token="",
+            claimed_at=timezone.now(), attempts=0,
         ) == 1
 
     def waiting_too_long(self):
