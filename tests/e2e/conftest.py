@@ -161,16 +161,10 @@ def ingested_capture(studio):
     task functions, run here in-process as a worker would."""
     from django.core.files.uploadedfile import SimpleUploadedFile
 
-    from segmentation import services, tasks
-    from segmentation.models import Capture, DetectionRun
+    from tests.segmentation.base import ingested
 
     upload = SimpleUploadedFile("warmup_session.bvh", synthetic_bvh(seed=5, duration=40.0))
-    capture, _created = services.do_upload_capture(studio["project"], studio["alice"], upload)
-    tasks.ingest(capture.pk)
-    for run in DetectionRun.objects.filter(capture=capture, status="queued"):
-        tasks.detect(run.pk)
-    capture = Capture.objects.get(pk=capture.pk)
-    assert capture.status == "ready", capture.error
+    capture = ingested(studio["project"], studio["alice"], upload)
     run = capture.latest_finished_run()
     assert run is not None and len(run.candidates) >= 4, "the detector proposed too few cuts"
     return capture

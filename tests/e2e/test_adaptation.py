@@ -7,8 +7,9 @@ from playwright.sync_api import expect
 
 from motionlib import synth
 from segmentation import services, tasks
-from segmentation.models import Capture, DetectionRun, ProjectCutModel
+from segmentation.models import ProjectCutModel
 from tests.e2e.conftest import synthetic_bvh
+from tests.segmentation.base import ingested
 
 SECONDS = 30.0
 
@@ -16,13 +17,7 @@ SECONDS = 30.0
 def ingest(studio, seed):
     """Upload a synthetic take and run the worker's jobs for it here, in-process."""
     upload = SimpleUploadedFile(f"session_{seed}.bvh", synthetic_bvh(seed=seed, duration=SECONDS))
-    capture, _ = services.do_upload_capture(studio["project"], studio["alice"], upload)
-    tasks.ingest(capture.pk)
-    for run in DetectionRun.objects.filter(capture=capture, status="queued"):
-        tasks.detect(run.pk)
-    capture = Capture.objects.get(pk=capture.pk)
-    assert capture.status == "ready", capture.error
-    return capture
+    return ingested(studio["project"], studio["alice"], upload)
 
 
 def review_to_the_truth(capture, user, seed):

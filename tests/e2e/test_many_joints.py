@@ -45,17 +45,11 @@ def crowded_capture(studio, settings):
     from django.core.files.uploadedfile import SimpleUploadedFile
 
     from motionlib.take import DEFAULT_LIMITS
-    from segmentation import services, tasks
-    from segmentation.models import Capture, DetectionRun
+    from tests.segmentation.base import ingested
 
     n_joints = settings.CUTROOM_MAX_JOINTS or DEFAULT_LIMITS.max_joints
     upload = SimpleUploadedFile("markers.bvh", many_joint_bvh(n_joints))
-    capture, _created = services.do_upload_capture(studio["project"], studio["alice"], upload)
-    tasks.ingest(capture.pk)
-    for run in DetectionRun.objects.filter(capture=capture, status="queued"):
-        tasks.detect(run.pk)
-    capture = Capture.objects.get(pk=capture.pk)
-    assert capture.status == "ready", capture.error
+    capture = ingested(studio["project"], studio["alice"], upload)
     assert capture.n_joints == n_joints
     return capture
 

@@ -29,18 +29,11 @@ def body_pixels(png: bytes) -> int:
 def kinect_capture(studio):
     from django.core.files.uploadedfile import SimpleUploadedFile
 
-    from segmentation import services, tasks
-    from segmentation.models import Capture, DetectionRun
+    from tests.segmentation.base import ingested
 
     path = points_file("utkinect", "s01_e01.csv")
     upload = SimpleUploadedFile(path.name, path.read_bytes())
-    capture, _ = services.do_upload_capture(studio["project"], studio["alice"], upload)
-    tasks.ingest(capture.pk)
-    for run in DetectionRun.objects.filter(capture=capture, status="queued"):
-        tasks.detect(run.pk)
-    capture = Capture.objects.get(pk=capture.pk)
-    assert capture.status == "ready", capture.error
-    return capture
+    return ingested(studio["project"], studio["alice"], upload)
 
 
 def open_at(page, base, capture, frame):

@@ -30,6 +30,19 @@ def synthetic_bvh(seed=0, **kwargs):
     return text.getvalue().encode()
 
 
+def ingested(project, user, upload):
+    """``upload`` uploaded to ``project`` by ``user``, then ingested and its default detection
+    run by the service's own task functions, here in-process as a worker would; the capture,
+    ready."""
+    capture, _ = services.do_upload_capture(project, user, upload)
+    tasks.ingest(capture.pk)
+    for run in DetectionRun.objects.filter(capture=capture, status="queued"):
+        tasks.detect(run.pk)
+    capture = Capture.objects.get(pk=capture.pk)
+    assert capture.status == "ready", capture.error
+    return capture
+
+
 class BaseTestCase(TestCase):
     @classmethod
     def setUpTestData(cls):

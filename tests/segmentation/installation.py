@@ -58,17 +58,9 @@ def populate():
 
 
 def _ingested(project, user, name, seed):
-    from segmentation import services, tasks
-    from segmentation.models import Capture, DetectionRun
+    from tests.segmentation.base import ingested
 
-    upload = SimpleUploadedFile(name, synthetic_bvh(seed))
-    capture, _ = services.do_upload_capture(project, user, upload)
-    tasks.ingest(capture.pk)
-    for run in DetectionRun.objects.filter(capture=capture, status="queued"):
-        tasks.detect(run.pk)
-    capture = Capture.objects.get(pk=capture.pk)
-    assert capture.status == "ready", capture.error
-    return capture
+    return ingested(project, user, SimpleUploadedFile(name, synthetic_bvh(seed)))
 
 
 def _review(capture, user, labels, submit):
