@@ -17,6 +17,14 @@ A descriptor has two parts, stacked in one ``(3 + n_samples, n_features)`` array
 
 Ranking is two-stage: the profile distance (one matrix operation over the whole library)
 keeps a shortlist; profile distance + ``DTW_WEIGHT`` x DTW orders it.
+
+Points of no known marker set (``point_descriptor``) have no limbs to measure, so their
+per-frame features are distributions that need no skeleton and no point order: quantiles of
+the distances between every two points, of each point's height above and horizontal
+distance from the points' centroid, and of the points' speeds, all divided by the take's
+point spread (``point_scale``). The profile and trajectory are built from them as above,
+with as many features as a body descriptor, so one project's vectors share one width; the
+service compares a descriptor only with those of its own kind (docs/points.md).
 """
 
 from __future__ import annotations
@@ -27,6 +35,7 @@ import numpy as np
 
 from motionlib.errors import InputError
 from motionlib.features import body_frame_positions, bone_angles
+from motionlib.gaps import filled
 
 N_SAMPLES = 32
 PROFILE_ROWS = 3
@@ -120,11 +129,129 @@ def segment_descriptor(positions: np.ndarray, joints: dict[str, int], start: int
     if fps <= 0:
         raise InputError(f"fps: must be positive, got {fps}")
     scale = body_scale(positions, joints) if scale is None else scale
-    features = frame_features(positions[start:stop], joints, scale)
+    return describe(frame_features(positions[start:stop], joints, scale), fps=fps,
+                    n_samples=n_samples)
+
+
+def describe(features: np.ndarray, *, fps: float, n_samples: int = N_SAMPLES) -> np.ndarray:
+    """Profile and trajectory of per-frame features.
+
+    Parameters
+    ----------
+    features : (n_frames, n_features), n_frames >= 1.
+    fps : frames per second (speeds are per ``SPEED_WINDOW_S``).
+
+    Returns
+    -------
+    (3 + n_samples, n_features) float32: mean, standard deviation and mean absolute speed
+    of each feature, then the features resampled to ``n_samples`` steps.
+    """
     step = np.abs(np.diff(features, axis=0)) if len(features) > 1 else np.zeros_like(features)
     speed = step.mean(axis=0) * fps * SPEED_WINDOW_S
     profile = np.stack([features.mean(axis=0), features.std(axis=0), speed])
     return np.vstack([profile, resample(features, n_samples)]).astype(np.float32)
+
+
+# Quantiles per frame of each distribution a bare point descriptor reads; 11 + 8 + 8 + 8
+# is the width of a body descriptor (8 bone angles + 3 x 9 key joints), see the docstring.
+PAIR_QUANTILES = np.linspace(0.0, 1.0, 11)
+HEIGHT_QUANTILES = np.linspace(0.0, 1.0, 8)
+REACH_QUANTILES = np.linspace(0.0, 1.0, 8)
+SPEED_QUANTILES = np.linspace(0.0, 1.0, 8)
+N_POINT_FEATURES = (len(PAIR_QUANTILES) + len(HEIGHT_QUANTILES) + len(REACH_QUANTILES)
+                    + len(SPEED_QUANTILES))
+
+
+def seen_points(points: np.ndarray) -> np.ndarray:
+    """The points a bare descriptor reads: those seen in at least one frame, gaps closed.
+
+    Parameters
+    ----------
+    points : (n_frames, n_points, 3) Y-up positions, NaN where a point was not seen.
+
+    Returns
+    -------
+    (n_frames, n_seen, 3) float64 (``motionlib.gaps.filled``); at least 2 points.
+    """
+    points = filled(np.asarray(points, dtype=float))
+    points = points[:, ~np.isnan(points).any(axis=(0, 2))]
+    if points.shape[1] < 2:
+        raise InputError(f"point descriptor: {points.shape[1]} point(s) seen in the take; "
+                         "distances need at least 2")
+    return points
+
+
+def point_scale(points: np.ndarray) -> float:
+    """Spread of the points: root mean square distance from their centroid, median over
+    frames. A size of the performer (and of what they hold) that does not depend on units.
+
+    Parameters
+    ----------
+    points : (n_frames, n_points, 3) without gaps (``seen_points``).
+    """
+    centred = points - points.mean(axis=1, keepdims=True)
+    scale = float(np.median(np.sqrt((centred ** 2).sum(axis=-1).mean(axis=1))))
+    if not scale > 0:
+        raise InputError(f"point scale: the points have no spread ({scale})")
+    return scale
+
+
+def point_frame_features(points: np.ndarray, scale: float, *, fps: float) -> np.ndarray:
+    """Per-frame features of points without known body parts.
+
+    Parameters
+    ----------
+    points : (n_frames, n_points, 3) Y-up positions without gaps (``seen_points``).
+    scale : ``point_scale`` of the whole take, in the points' unit.
+    fps : frames per second (speeds are the change over ``SPEED_WINDOW_S``).
+
+    Returns
+    -------
+    (n_frames, N_POINT_FEATURES) quantiles of: the distance between every two points, each
+    point's height above the centroid, its horizontal distance from the centroid, and its
+    speed, divided by ``scale``. None depends on where the points stand, which way they
+    face, their unit or their order.
+    """
+    n = points.shape[1]
+    i, j = np.triu_indices(n, 1)
+    pairs = np.linalg.norm(points[:, i] - points[:, j], axis=-1)
+    centred = points - points.mean(axis=1, keepdims=True)
+    height = centred[..., 1]
+    reach = np.hypot(centred[..., 0], centred[..., 2])
+    if len(points) > 1:
+        moved = np.linalg.norm(np.diff(points, axis=0), axis=-1)
+        moved = np.vstack([moved, moved[-1:]]) * fps * SPEED_WINDOW_S
+    else:
+        moved = np.zeros(points.shape[:2])
+    parts = [(pairs, PAIR_QUANTILES), (height, HEIGHT_QUANTILES), (reach, REACH_QUANTILES),
+             (moved, SPEED_QUANTILES)]
+    return np.hstack([np.quantile(x, q, axis=1).T for x, q in parts]) / scale
+
+
+def point_descriptor(points: np.ndarray, start: int, stop: int, *, fps: float,
+                     scale: float | None = None, n_samples: int = N_SAMPLES) -> np.ndarray:
+    """The descriptor of frames ``[start, stop)`` of a take of bare points.
+
+    Parameters
+    ----------
+    points : (n_frames, n_points, 3) Y-up positions of the whole take without gaps
+        (``seen_points``).
+    start, stop : 0-based frame range, stop exclusive.
+    fps : frames per second of the take.
+    scale : ``point_scale``; computed from the whole take when not given.
+
+    Returns
+    -------
+    (3 + n_samples, N_POINT_FEATURES) float32, as ``segment_descriptor``.
+    """
+    if not 0 <= start < stop <= len(points):
+        raise InputError(f"segment [{start}, {stop}) is empty or outside the take's "
+                         f"{len(points)} frames")
+    if fps <= 0:
+        raise InputError(f"fps: must be positive, got {fps}")
+    scale = point_scale(points) if scale is None else scale
+    return describe(point_frame_features(points[start:stop], scale, fps=fps), fps=fps,
+                    n_samples=n_samples)
 
 
 def dtw_distance(a: np.ndarray, b: np.ndarray, *, band: float = 0.25) -> float:

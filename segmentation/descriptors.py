@@ -5,6 +5,7 @@ import logging
 from types import SimpleNamespace
 
 import numpy as np
+from django.db.models import Q
 
 import motionlib
 from motionlib import markersets, similarity
@@ -30,14 +31,35 @@ def point_marker_set(capture):
     return skeleton.get("marker_set") if skeleton.get("kind") == "points" else None
 
 
+def is_bare_points(capture):
+    """True for a point capture of no known marker set (described by its points alone)."""
+    skeleton = capture.skeleton or {}
+    return skeleton.get("kind") == "points" and skeleton.get("marker_set") is None
+
+
+def same_kind(capture):
+    """Q of the library segments whose descriptors may be compared with ``capture``'s.
+
+    A body descriptor (a skeleton's joints, or a known marker set's body parts) and a bare
+    point descriptor have the same width but measure different things
+    (``motionlib.similarity``), so each is compared only with its own kind.
+    """
+    if is_bare_points(capture):
+        return Q(capture__skeleton__kind="points", capture__skeleton__marker_set=None)
+    # Not the negation of the above: a JSON key a skeleton lacks compares as NULL, and NOT
+    # NULL keeps no row.
+    return (~Q(capture__skeleton__has_key="kind")
+            | Q(capture__skeleton__marker_set__in=sorted(markersets.PARTS)))
+
+
 def body_positions(capture):
-    """``(positions, joints)`` a capture's motion descriptors are computed from, or None
+    """``(positions, joints)`` a capture's body descriptors are computed from, or None
     when it has no stored positions or no body parts are known.
 
     A skeleton's stored joint positions as they are; a point capture's body parts from its
     marker set (``markersets.body_parts``, gaps closed for this only); points of no known
-    set have none. Positions as stored (float32) for a skeleton. OSError / ValueError when
-    the stored positions cannot be read.
+    set have none (``Describer`` describes them by their points). Positions as stored
+    (float32) for a skeleton. OSError / ValueError when the stored positions cannot be read.
     """
     if not capture.positions:
         return None
@@ -53,19 +75,49 @@ def body_positions(capture):
     return storage.load_npy(capture.positions), joints
 
 
-def descriptors(capture, spans):
-    """The float32 descriptor of each ``(start, stop)`` span of a capture, or Nones when
-    its skeleton (or its points) cannot be mapped to body parts."""
-    try:
+class Describer:
+    """The descriptors of spans of one capture: its positions are read once.
+
+    Body parts when the capture has them (``body_positions``:
+    ``similarity.segment_descriptor``); the points themselves for a point capture of no
+    known marker set (``similarity.point_descriptor``). ``usable`` is False when neither
+    applies. OSError / ValueError when the stored positions cannot be read.
+    """
+
+    def __init__(self, capture):
+        self.fps = capture.fps
+        self.joints = self.points = None
+        if is_bare_points(capture) and capture.positions:
+            self.points = similarity.seen_points(storage.load_npy(capture.positions))
+            self.scale = similarity.point_scale(self.points)
+            return
         body = body_positions(capture)
-        if body is None:
+        if body is not None:
+            self.points, self.joints = body
+            self.scale = similarity.body_scale(np.asarray(self.points, dtype=float), self.joints)
+
+    @property
+    def usable(self):
+        return self.points is not None
+
+    def __call__(self, start, stop):
+        """The float32 descriptor of frames ``[start, stop)``."""
+        frames = np.asarray(self.points[start:stop], dtype=float)
+        if self.joints is None:
+            return similarity.point_descriptor(frames, 0, len(frames), fps=self.fps,
+                                               scale=self.scale)
+        return similarity.segment_descriptor(frames, self.joints, 0, len(frames), fps=self.fps,
+                                             scale=self.scale)
+
+
+def descriptors(capture, spans):
+    """The float32 descriptor of each ``(start, stop)`` span of a capture (``Describer``),
+    or Nones when it cannot be described."""
+    try:
+        describe = Describer(capture)
+        if not describe.usable:
             return [None] * len(spans)
-        positions, joints = np.asarray(body[0], dtype=float), body[1]
-        scale = similarity.body_scale(positions, joints)
-        return [
-            similarity.segment_descriptor(positions, joints, start, stop, fps=capture.fps, scale=scale)
-            for start, stop in spans
-        ]
+        return [describe(start, stop) for start, stop in spans]
     except (OSError, ValueError) as exc:
         # A lost positions file must not stop a review from being submitted; the segments
         # are still listed and exported, only similarity has nothing to go on.

@@ -4,7 +4,7 @@ import numpy as np
 
 from motionlib import similarity
 from segmentation import similar_index
-from segmentation.descriptors import profile_pool
+from segmentation.descriptors import profile_pool, same_kind
 from segmentation.errors import Invalid
 from segmentation.models import LibrarySegment
 
@@ -17,8 +17,9 @@ SHORTLIST = 20
 def similar(segment, visible, k=10):
     """The ``k`` visible segments of the same project that move most like ``segment``.
 
-    Segments overlapping it in the same capture are left out (other annotators' versions
-    of the same motion), and so are duplicates of one span. Two stages: the profiles
+    Only segments described as it is are compared (``descriptors.same_kind``: a body or
+    bare points). Segments overlapping it in the same capture are left out (other
+    annotators' versions of the same motion), and so are duplicates of one span. Two stages: the profiles
     nearest to the query's pick a shortlist, whose full descriptors are ranked. The
     shortlist comes from the project's vector index (``similar_index``) when it has a
     usable one, else from the profiles of up to ``SIMILAR_POOL`` recent segments.
@@ -27,8 +28,9 @@ def similar(segment, visible, k=10):
     query = segment.descriptor_array()
     if query is None:
         raise Invalid(f"segment {segment.pk}: its skeleton could not be mapped to body "
-                      "parts, so it has no motion descriptor")
-    pool = (visible.filter(project_id=segment.project_id, profile__isnull=False)
+                      "parts and it is not a take of points, so it has no motion descriptor")
+    pool = (visible.filter(same_kind(segment.capture), project_id=segment.project_id,
+                           profile__isnull=False)
             .exclude(capture_id=segment.capture_id, start__lt=segment.stop, stop__gt=segment.start))
     n = max(SHORTLIST, k)
     index = similar_index.open_index(segment.project_id)

@@ -32,7 +32,7 @@ from django.utils import timezone
 
 from motionlib import similarity
 from segmentation import workers
-from segmentation.descriptors import body_positions, load_descriptors, profile_pool
+from segmentation.descriptors import Describer, load_descriptors, profile_pool, same_kind
 from segmentation.models import Capture, LabelSuggestion, LibrarySegment, Review, SuggestionRequest
 from segmentation.search import SHORTLIST, SIMILAR_POOL
 
@@ -50,10 +50,12 @@ LOW_PRIORITY = 10
 
 def pool(capture, annotator):
     """The library segments suggestions for ``annotator``'s review of ``capture`` draw on:
-    none of a retired label, which could not be applied (retiring or restoring one changes
-    the pool's state, so stored suggestions follow)."""
+    described as ``capture`` is (``descriptors.same_kind``), and none of a retired label,
+    which could not be applied (retiring or restoring one changes the pool's state, so
+    stored suggestions follow)."""
     return (LibrarySegment.objects.visible_to(annotator).preferred()
-            .filter(project_id=capture.project_id, profile__isnull=False, label__retired=False)
+            .filter(same_kind(capture), project_id=capture.project_id, profile__isnull=False,
+                    label__retired=False)
             .exclude(capture_id=capture.pk))
 
 
@@ -218,33 +220,27 @@ class Suggester:
 
     def __init__(self, capture, annotator):
         self.capture = capture
-        self.joints = self.positions = self.scale = None
+        self.describe = None
         try:
-            body = body_positions(capture)
-            if body is not None:
-                self.positions, self.joints = body
-                self.scale = similarity.body_scale(np.asarray(self.positions, dtype=float),
-                                                   self.joints)
+            self.describe = Describer(capture)
         except (OSError, ValueError) as exc:
             log.warning("no label suggestions for capture %s: %s", capture.pk, exc)
-            self.joints = None
         self.ids, self.profiles, self.names = [], None, {}
-        if self.joints is not None:
+        if self.usable:
             rows = list(pool(capture, annotator).order_by("-is_gold", "-id")
                         .values_list("id", "profile", "label_id")[:SIMILAR_POOL])
             self.names = {pk: name for pk, _, name in rows}
             self.rows = [(pk, blob) for pk, blob, _ in rows]
 
-    def descriptor(self, start, stop):
-        frames = np.asarray(self.positions[start:stop], dtype=float)
-        return similarity.segment_descriptor(frames, self.joints, 0, len(frames),
-                                             fps=self.capture.fps, scale=self.scale)
+    @property
+    def usable(self):
+        return self.describe is not None and self.describe.usable
 
     def labels(self, spans):
         """A label id or None for each ``(start, stop)``."""
-        if self.joints is None or not self.names:
+        if not self.usable or not self.names:
             return [None] * len(spans)
-        queries = [self.descriptor(s, e) for s, e in spans]
+        queries = [self.describe(s, e) for s, e in spans]
         if self.profiles is None:
             self.ids, profiles = profile_pool(self.rows, queries[0].shape[1])
             self.profiles = profiles.astype(float)

@@ -5,7 +5,9 @@ Layout: header lines ``KEY<tab>value...`` (``NO_OF_FRAMES``, ``FREQUENCY``,
 ``Frame<tab>Time<tab><marker> X<tab><marker> Y<tab><marker> Z...`` and rows of those
 columns, or (older exports) rows of X, Y, Z per marker in ``MARKER_NAMES`` order, frames
 numbered from 1. Positions are in millimetres, Z up (Qualisys' global frame). An empty cell
-is a marker not seen. ``NO_OF_FRAMES`` is the recording's length, which an export of a
+is a marker not seen, and so is a marker whose three coordinates are all exactly 0: some
+exports write ``0.000`` there instead of leaving the cells empty, and a tracked marker at
+the very origin of the lab to the micrometre is not a position a take holds. ``NO_OF_FRAMES`` is the recording's length, which an export of a
 part of it does not have, so the rows decide the frames.
 """
 
@@ -53,6 +55,7 @@ def read_qualisys_tsv(path: str | os.PathLike, *,
                else np.arange(1, len(values) + 1))
     first = 2 if framed else 0
     coordinates = values[:, first:].reshape(len(values), len(names), 3)
+    coordinates[(coordinates == 0).all(axis=-1)] = np.nan
     coordinates = on_clock(numbers, coordinates, max_frames_for(
         len(names), 3 * len(names), len(data), limits), path)
     return make_point_take(name=Path(path).stem, format="tsv", fps=fps,

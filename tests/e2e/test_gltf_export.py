@@ -91,3 +91,68 @@ def test_it_shows_the_framed_skeleton_of_a_bvh_clips_glb(live_server, new_page, 
     assert 1.0 < float(preview.get_attribute("data-gltf-height")) < 2.0  # metres
     page.screenshot(path=str(screenshots / "library-gltf-bvh.png"))
     assert page.errors == []
+
+
+# Where the preview's drawn pixels (not the background #161a21) lie: how many, and their box
+# as shares of the canvas's width and height.
+DRAWN_BOX = """(box) => {
+  const canvas = box.querySelector("canvas");
+  const copy = document.createElement("canvas");
+  copy.width = canvas.width;
+  copy.height = canvas.height;
+  const context = copy.getContext("2d");
+  context.drawImage(canvas, 0, 0);
+  const data = context.getImageData(0, 0, canvas.width, canvas.height).data;
+  let pixels = 0, left = canvas.width, right = -1, top = canvas.height, bottom = -1;
+  for (let i = 0; i < data.length; i += 4) {
+    const off = Math.abs(data[i] - 0x16) + Math.abs(data[i + 1] - 0x1a) + Math.abs(data[i + 2] - 0x21);
+    if (off > 60) {
+      pixels++;
+      const x = (i / 4) % canvas.width, y = Math.floor(i / 4 / canvas.width);
+      left = Math.min(left, x); right = Math.max(right, x);
+      top = Math.min(top, y); bottom = Math.max(bottom, y);
+    }
+  }
+  return { pixels, left: left / canvas.width, right: (right + 1) / canvas.width,
+           top: top / canvas.height, bottom: (bottom + 1) / canvas.height };
+}"""
+
+
+@pytest.fixture
+def walking_segment(studio):
+    """The first 4 s of CMU 86_01 (AMC), in which the actor walks about 2 m: one segment."""
+    from django.core.files.uploadedfile import SimpleUploadedFile
+
+    from segmentation.models import LibrarySegment
+    from tests.motionlib.conftest import cmu_file
+    from tests.segmentation.base import ingested
+
+    amc, asf = cmu_file("amc", "86_01.amc"), cmu_file("asf", "86.asf")
+    capture = ingested(studio["project"], studio["alice"],
+                       SimpleUploadedFile("86_01.amc", amc.read_bytes()),
+                       asf=SimpleUploadedFile("86.asf", asf.read_bytes()))
+    submit_review(capture, studio["ann"], [480], ["walk", None])
+    return LibrarySegment.objects.get(capture=capture, start=0)
+
+
+def test_the_preview_keeps_a_walking_clip_in_view_from_start_to_end(live_server, new_page,
+                                                                    walking_segment, screenshots):
+    """The camera frames the whole clip's motion, not its first pose: the walker stays on
+    the canvas, whole, through a full loop of the clip."""
+    page = new_page("ann")
+    page.goto(f"{live_server.url}/library/")
+    page.get_by_test_id(f"play-glb-{walking_segment.pk}").click()
+    preview = page.get_by_test_id("preview")
+    expect(preview).to_have_attribute("data-playing", f"glb:{walking_segment.pk}", timeout=90_000)
+    duration = float(preview.get_attribute("data-gltf-duration"))
+    assert duration == pytest.approx(4.0, abs=0.01)
+    samples = []
+    for _ in range(int(duration / 0.2) + 5):  # more than one loop
+        samples.append(preview.evaluate(DRAWN_BOX))
+        if len(samples) == 12:  # about half way through the walk
+            page.screenshot(path=str(screenshots / "library-gltf-walk.png"))
+        page.wait_for_timeout(200)
+    cut = [s for s in samples if s["pixels"] < 300 or s["left"] <= 0.01 or s["right"] >= 0.99
+           or s["top"] <= 0.01 or s["bottom"] >= 0.99]
+    assert cut == [], f"{len(cut)} of {len(samples)} moments leave the view: {cut[:3]}"
+    assert page.errors == []

@@ -98,3 +98,36 @@ def test_it_names_frames_out_of_order(tmp_path):
     with pytest.raises(motionlib.CaptureError, match=r"take\.tsv:7: column 1 \(Frame\): frame "
                        r"1 comes after frame 2"):
         motionlib.read(path)
+
+
+# A Qualisys Track Manager export as it comes: ten header lines, the column line, then rows
+# with `0.000 0.000 0.000` where a marker was not seen (older exports write zeros there).
+REAL_HEAD = ("NO_OF_FRAMES\t3\nNO_OF_CAMERAS\t7\nNO_OF_MARKERS\t2\nFREQUENCY\t60\n"
+             "NO_OF_ANALOG\t0\nANALOG_FREQUENCY\t0\nDESCRIPTION\t--\n"
+             "TIME_STAMP\t2015-11-12, 11:51:16\t6281.31358754\nDATA_INCLUDED\t3D\n"
+             "MARKER_NAMES\tShoulder\tElbow\n"
+             "Frame\tTime\tShoulder X\tShoulder Y\tShoulder Z\tElbow X\tElbow Y\tElbow Z\t\n")
+ZERO_ROWS = ("1\t0.00000\t477.630\t335.852\t153.909\t0.000\t0.000\t0.000\t\n"
+             "2\t0.01667\t0.000\t0.000\t0.000\t428.860\t335.450\t-73.206\t\n"
+             "3\t0.03333\t0.000\t335.852\t153.909\t428.860\t0.000\t-73.206\t\n")
+
+
+def test_a_marker_written_as_three_zeros_is_a_gap(tmp_path):
+    take = motionlib.read(write(tmp_path, REAL_HEAD + ZERO_ROWS))
+    assert (take.n_frames, take.fps, take.point_names) == (3, 60.0, ["Shoulder", "Elbow"])
+    assert np.isnan(take.channels[0, 3:]).all() and np.isnan(take.channels[1, :3]).all()
+    assert np.isnan(take.positions[0, 1]).all() and np.isnan(take.positions[1, 0]).all()
+    np.testing.assert_array_equal(take.channels[0, :3], [477.630, 335.852, 153.909])
+
+
+def test_a_single_zero_coordinate_is_a_value(tmp_path):
+    take = motionlib.read(write(tmp_path, REAL_HEAD + ZERO_ROWS))
+    np.testing.assert_array_equal(take.channels[2], [0.0, 335.852, 153.909, 428.860, 0.0, -73.206])
+
+
+def test_three_zeros_are_a_gap_in_an_export_without_a_column_line(tmp_path):
+    head = REAL_HEAD[:REAL_HEAD.index("Frame\t")]
+    rows = "".join("\t".join(row.split("\t")[2:]) for row in ZERO_ROWS.splitlines(keepends=True))
+    take = motionlib.read(write(tmp_path, head + rows))
+    assert take.n_frames == 3
+    assert np.isnan(take.channels[0, 3:]).all() and np.isnan(take.channels[1, :3]).all()

@@ -1,6 +1,9 @@
 """Segment descriptors and motion similarity: invariances, the DTW distance against a
-plain oracle, and nearest-neighbour search on the labelled CMU takes."""
+plain oracle, and nearest-neighbour search on the labelled CMU takes and, for points of no
+known marker set, on the labelled vMCI takes."""
 
+import json
+from collections import Counter
 from functools import cache
 
 import numpy as np
@@ -9,16 +12,21 @@ from numpy.testing import assert_allclose
 
 import motionlib
 from motionlib.similarity import (
+    N_POINT_FEATURES,
     PROFILE_ROWS,
     body_scale,
     dtw_distance,
     dtw_distances,
+    point_descriptor,
+    point_scale,
     rank_similar,
     resample,
+    seen_points,
     segment_descriptor,
 )
 from motionlib.synth import generate
 from tests.motionlib.conftest import DATA, cmu_file
+from tests.motionlib.points_data import points_file
 
 
 @pytest.fixture(scope="module")
@@ -159,3 +167,62 @@ def test_it_finds_the_same_action_in_another_take_of_the_same_actor(action):
         indices, _ = rank_similar(queries[q], library, k=3)
         found = [names[i] for i in indices]
         assert found[0] == action and found.count(action) >= 2, found
+
+
+@pytest.fixture(scope="module")
+def vmci_run():
+    take = motionlib.read(points_file("vmci", "subject1_run1.tsv"))
+    return take, seen_points(take.positions)
+
+
+def test_a_point_descriptor_is_as_wide_as_a_body_descriptor(synth_take, vmci_run):
+    take, positions, joints = synth_take
+    body = segment_descriptor(positions, joints, 0, 100, fps=take.fps)
+    points = point_descriptor(vmci_run[1], 0, 100, fps=60.0)
+    assert points.shape == body.shape == (PROFILE_ROWS + 32, N_POINT_FEATURES)
+
+
+def test_a_point_descriptor_ignores_placement_heading_unit_and_point_order(vmci_run):
+    _, points = vmci_run
+    a = point_descriptor(points, 100, 300, fps=60.0)
+    moved = turned(points, 61.0, [800.0, 0.0, -2500.0])[:, ::-1] / 1000.0
+    assert_allclose(a, point_descriptor(moved, 100, 300, fps=60.0), atol=1e-4)
+
+
+def test_seen_points_closes_gaps_and_leaves_out_points_never_seen():
+    points = np.zeros((4, 3, 3))
+    points[:, 1] = [[0, 0, 0], [np.nan] * 3, [np.nan] * 3, [3, 3, 3]]
+    points[:, 2] = np.nan
+    points[:, 0] = 5.0
+    assert_allclose(seen_points(points)[:, 1, 0], [0, 1, 2, 3])
+    assert seen_points(points).shape == (4, 2, 3)
+
+
+def test_a_point_descriptor_needs_two_points():
+    with pytest.raises(ValueError, match=r"1 point\(s\) seen in the take; distances need at least 2"):
+        seen_points(np.ones((5, 1, 3)))
+
+
+def test_point_descriptors_name_the_action_of_the_other_subjects_vmci_segments():
+    """vMCI pick-and-place, top-level labels (7 actions): each segment of subject 2 is
+    named by the 5 nearest of subject 1's, and the other way round."""
+    items = []
+    for path in sorted(points_file("vmci", "subject1_run1.tsv").parent.glob("*.tsv")):
+        take = motionlib.read(path)
+        points = seen_points(take.positions)
+        scale = point_scale(points)
+        labels = json.loads(path.with_name(f"{path.stem}_manually_segmented.json").read_text())
+        for row in labels:
+            start, stop = (row[k] - take.first_number for k in ("start index", "end index"))
+            if not row["label"].endswith("_part") and stop > start:
+                items.append((path.stem.split("_")[0], row["label"],
+                              point_descriptor(points, start, stop, fps=take.fps, scale=scale)))
+    right = 0
+    for subject, label, descriptor in items:
+        others = [(name, d) for s, name, d in items if s != subject]
+        order, distances = rank_similar(descriptor, np.stack([d for _, d in others]), k=5)
+        votes = Counter()
+        for i, d in zip(order, distances, strict=True):
+            votes[others[i][0]] += 1.0 / (d * d + 1e-9)
+        right += votes.most_common(1)[0][0] == label
+    assert right >= 0.75 * len(items), (right, len(items))

@@ -30,11 +30,11 @@ def synthetic_bvh(seed=0, **kwargs):
     return text.getvalue().encode()
 
 
-def ingested(project, user, upload):
-    """``upload`` uploaded to ``project`` by ``user``, then ingested and its default detection
-    run by the service's own task functions, here in-process as a worker would; the capture,
-    ready."""
-    capture, _ = services.do_upload_capture(project, user, upload)
+def ingested(project, user, upload, asf=None):
+    """``upload`` (with its ``asf`` skeleton for an AMC) uploaded to ``project`` by ``user``,
+    then ingested and its default detection run by the service's own task functions, here
+    in-process as a worker would; the capture, ready."""
+    capture, _ = services.do_upload_capture(project, user, upload, asf=asf)
     tasks.ingest(capture.pk)
     for run in DetectionRun.objects.filter(capture=capture, status="queued"):
         tasks.detect(run.pk)

@@ -1,9 +1,11 @@
 """Point takes in the service: C3D, Qualisys TSV and joint-position CSV uploads are ingested
 with their points, links and gaps, detected, exported as C3D and CSV (and refused as BVH),
-and their library segments get motion descriptors for similar search."""
+and their library segments get motion descriptors for similar search and label suggestions
+(by body parts, or by the points themselves when no marker set is known)."""
 
 import base64
 import io
+import json
 import tempfile
 import zipfile
 from pathlib import Path
@@ -11,10 +13,10 @@ from pathlib import Path
 import numpy as np
 
 import motionlib
-from segmentation import importing, storage
-from segmentation.models import LibrarySegment
+from segmentation import importing, services, storage, suggestions, tasks
+from segmentation.models import Label, LibrarySegment
 from tests.motionlib.points_data import HDM05, points_file
-from tests.segmentation.base import BaseTestCase
+from tests.segmentation.base import BaseTestCase, synthetic_bvh
 from tests.segmentation.test_library import submit_review
 
 
@@ -147,3 +149,81 @@ class PointLibraryTest(BaseTestCase):
         assert response.status_code == 200, response.content
         assert [r["id"] for r in response.json()["results"]] != []
 
+
+
+def vmci_truth(take, run):
+    """[(start, stop, label)] of the top-level labelled segments of a vMCI run, take frames."""
+    rows = json.loads(points_file("vmci", f"{run}_manually_segmented.json").read_text())
+    return sorted((r["start index"] - take.first_number, r["end index"] - take.first_number,
+                   r["label"]) for r in rows if not r["label"].endswith("_part"))
+
+
+def cut_at(truth, n_frames):
+    """Cuts at every labelled segment's ends, and each segment's label (None between)."""
+    cuts = sorted({f for start, stop, _ in truth for f in (start, stop) if 0 < f < n_frames})
+    bounds = [0, *cuts, n_frames]
+    labels = {(start, stop): label for start, stop, label in truth}
+    return cuts, [labels.get(span) for span in zip(bounds[:-1], bounds[1:], strict=True)]
+
+
+class BarePointSimilarTest(BaseTestCase):
+    """Two vMCI runs (13 arm, back and box markers: no known marker set) labelled by bob,
+    a third cut but not labelled, and a skeleton take labelled with the same names."""
+
+    def setUp(self):
+        super().setUp()
+        self.login(self.alice)
+        self.truth = {}
+        for run in ("subject1_run1", "subject1_run2", "subject1_run3"):
+            path = points_file("vmci", f"{run}.tsv")
+            capture = self.ingest(self.upload(path.read_bytes(), name=path.name).json()["id"])
+            assert capture.status == "ready", capture.error
+            self.truth[run] = (capture, vmci_truth(motionlib.read(path), run))
+        for label in sorted({r[2] for _, truth in self.truth.values() for r in truth} | {"idle"}):
+            if not Label.objects.filter(project=self.project, name=label).exists():
+                services.do_add_label(self.project, label)
+        for run in ("subject1_run1", "subject1_run2"):
+            capture, truth = self.truth[run]
+            submit_review(capture, self.bob, *cut_at(truth, capture.n_frames))
+        self.skeleton = self.ingest(self.upload(synthetic_bvh(seed=4), name="walk.bvh").json()["id"])
+        submit_review(self.skeleton, self.bob, [100, 200],
+                      ["approach_forward", "move_obj_table", "idle"])
+
+    def test_bare_point_segments_have_descriptors(self):
+        capture, _ = self.truth["subject1_run1"]
+        assert all(s.descriptor for s in LibrarySegment.objects.filter(capture=capture))
+
+    def test_similar_finds_the_same_action_and_no_skeleton_clip(self):
+        capture, truth = self.truth["subject1_run2"]
+        self.login(self.bob)
+        found = 0
+        for start, stop, label in truth:
+            segment = LibrarySegment.objects.get(capture=capture, start=start, stop=stop)
+            response = self.client.get(f"/api/segments/{segment.pk}/similar/")
+            assert response.status_code == 200, response.content
+            results = response.json()["results"]
+            assert self.skeleton.pk not in {r["capture"]["id"] for r in results}
+            found += results[0]["label"] == label
+        # Six actions, one other run labelled: chance is one in six.
+        assert found >= 4, (found, len(truth))
+
+    def test_a_skeleton_clip_finds_no_bare_point_clip(self):
+        segment = LibrarySegment.objects.filter(capture=self.skeleton).first()
+        self.login(self.bob)
+        results = self.client.get(f"/api/segments/{segment.pk}/similar/").json()["results"]
+        assert [r for r in results if r["id"] in set(LibrarySegment.objects.exclude(
+            capture=self.skeleton).values_list("id", flat=True))] == []
+
+    def test_label_suggestions_name_the_actions_of_an_unlabelled_run(self):
+        capture, truth = self.truth["subject1_run3"]
+        review = services.get_or_create_review(capture, self.bob)
+        cuts, _ = cut_at(truth, capture.n_frames)
+        for cut in list(review.cuts.all()):
+            review = services.do_change_cut(review, self.bob, cut, review.version, fate="deleted")
+        for frame in cuts:
+            review = services.do_insert_cut(review, self.bob, frame, review.version)
+        tasks.suggest(capture.pk, self.bob.pk)
+        body = suggestions.for_review(capture, self.bob)
+        suggested = {(s["start"], s["stop"]): s["label"] for s in body["suggestions"]}
+        right = sum(suggested.get((start, stop)) == label for start, stop, label in truth)
+        assert right >= 0.8 * len(truth), (right, len(truth), suggested)

@@ -5,7 +5,7 @@
 import { get } from "../api/client";
 import type { CaptureSummary, Project } from "../api/types";
 import { assign, STATE_TEXT, type Member } from "../queue/api";
-import { clear, h, toast } from "../ui/dom";
+import { clear, clip, h, toast } from "../ui/dom";
 
 export function teamCell(team: CaptureSummary["team"]): (HTMLElement | string)[] {
   if (!team || (!team.assigned.length && !team.reviews.length)) return ["—"];
@@ -14,7 +14,7 @@ export function teamCell(team: CaptureSummary["team"]): (HTMLElement | string)[]
   return names.map((name) => {
     const status = reviewed.get(name);
     const state = status ?? "assigned";
-    return h("span", { class: "who", title: team.assigned.includes(name) ? "assigned" : "picked it up" }, `${name} `, h("span", { class: `badge badge-q-${state}` }, STATE_TEXT[state]));
+    return h("span", { class: "who", title: team.assigned.includes(name) ? "assigned" : "picked it up" }, clip(name, { class: "who-name" }), " ", h("span", { class: `badge badge-q-${state}` }, STATE_TEXT[state]));
   });
 }
 

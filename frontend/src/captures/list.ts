@@ -4,7 +4,7 @@
 import "../queue/queue.css";
 import { get, post } from "../api/client";
 import type { CaptureSummary, Me, Page, Project, Role } from "../api/types";
-import { clear, formatDuration, h, toast } from "../ui/dom";
+import { clear, clip, formatDuration, h, toast } from "../ui/dom";
 import { accountLinks, appLinks } from "../ui/appnav";
 import { assignmentBar, teamCell } from "./assign";
 import { invitationsBox } from "./invitations";
@@ -252,7 +252,7 @@ function row(c: CaptureSummary, project: string, role: Role | undefined, reload:
     "tr",
     { class: "capture-row", "data-testid": `capture-${c.id}`, tabindex: 0, onclick: open, onkeydown: (e: Event) => (e as KeyboardEvent).key === "Enter" && open() },
     h("td", { onclick: (e: Event) => e.stopPropagation() }, check),
-    h("td", {}, h("a", { href: `/captures/${c.id}/`, onclick: (e: Event) => e.preventDefault() }, c.name), c.status === "failed" && c.error ? h("div", { class: "error-text small" }, c.error) : null, c.status === "failed" ? failedAction(c, reload) : null),
+    h("td", {}, clip(c.name, { href: `/captures/${c.id}/`, onclick: (e: Event) => e.preventDefault() }), c.status === "failed" && c.error ? h("div", { class: "error-text small" }, c.error) : null, c.status === "failed" ? failedAction(c, reload) : null),
     h("td", {}, project),
     h("td", {}, status),
     h("td", { class: "num" }, c.n_frames?.toLocaleString() ?? "—"),

@@ -2,7 +2,7 @@
 // throughput and edits from the audit log, and agreement per label.
 
 import { get } from "../api/client";
-import { clear, h } from "../ui/dom";
+import { clear, clip, h } from "../ui/dom";
 import { teamCell } from "../captures/assign";
 import { topbar } from "./nav";
 import type { CaptureState, Dashboard } from "./types";
@@ -22,7 +22,7 @@ export async function renderDashboard(root: HTMLElement, projectId: number): Pro
     h(
       "tr",
       { "data-testid": `dash-capture-${c.id}` },
-      h("td", {}, h("a", { href: `/captures/${c.id}/` }, c.name)),
+      h("td", {}, clip(c.name, { href: `/captures/${c.id}/` })),
       h("td", {}, h("span", { class: `badge state-badge state-${c.state}` }, STATE_NAMES[c.state])),
       h("td", { class: "num" }, `${c.submitted} / ${c.reviews}`),
       h("td", { class: "team-cell" }, ...teamCell({ assigned: c.assigned ?? [], reviews: c.review_states ?? [] })),
@@ -35,7 +35,7 @@ export async function renderDashboard(root: HTMLElement, projectId: number): Pro
     h(
       "tr",
       {},
-      h("td", {}, a.username),
+      h("td", {}, clip(a.username)),
       h("td", { class: "num" }, String(a.submitted)),
       h("td", { class: "num" }, String(a.in_progress)),
       h("td", { class: "num" }, String(a.edits_total)),
@@ -44,7 +44,7 @@ export async function renderDashboard(root: HTMLElement, projectId: number): Pro
       h("td", { class: "num" }, a.median_minutes_per_review === null ? "—" : `${num(a.median_minutes_per_review, 1)} min`),
     ),
   );
-  const labels = d.labels.map((l) => h("tr", {}, h("td", {}, l.label), h("td", { class: "num" }, num(l.overlap)), h("td", { class: "num" }, l.frames.toLocaleString()), h("td", { class: "num" }, String(l.captures))));
+  const labels = d.labels.map((l) => h("tr", {}, h("td", {}, clip(l.label)), h("td", { class: "num" }, num(l.overlap)), h("td", { class: "num" }, l.frames.toLocaleString()), h("td", { class: "num" }, String(l.captures))));
   clear(
     root,
     h(

@@ -4,7 +4,8 @@
 //
 // The skeleton is drawn from the nodes the animation moves, not from a skin: a clip of a BVH or
 // AMC capture is an armature without a mesh, whose joints three.js loads as plain nodes, and
-// the camera frames those joints (a bounding box of meshes alone would be empty).
+// the camera frames those joints over the whole clip (a bounding box of meshes alone would be
+// empty, and the first pose alone would let a walk leave the view).
 
 import * as THREE from "three";
 import { type GLTF, GLTFLoader } from "three/examples/jsm/loaders/GLTFLoader.js";
@@ -93,11 +94,26 @@ export class JointLines {
   }
 }
 
-/** What the camera frames: the posed joints and any mesh (a mesh's box alone is empty for an
- * armature without one). */
-export function frameBox(gltf: GLTF, skeleton: JointLines): THREE.Box3 {
+// Poses the framing looks at: this many per second of the clip, at most FRAME_SAMPLES_MAX.
+const FRAME_SAMPLES_PER_S = 30;
+const FRAME_SAMPLES_MAX = 240;
+
+/** What the camera frames: the joints in every pose of the clip (sampled evenly from its
+ * first frame to its last), so a walk or a jump stays in view as it travels, and any mesh as
+ * first posed (a mesh's box alone is empty for an armature without one). Leaves the mixer at
+ * the clip's start. */
+export function frameBox(gltf: GLTF, skeleton: JointLines, mixer: THREE.AnimationMixer, duration: number): THREE.Box3 {
+  const box = new THREE.Box3();
+  const samples = duration > 0 ? Math.min(FRAME_SAMPLES_MAX, Math.max(2, Math.ceil(duration * FRAME_SAMPLES_PER_S) + 1)) : 1;
+  for (let i = 0; i < samples; i++) {
+    // The last sample stays a hair before the end: a looping action at its full duration
+    // wraps around to the first pose.
+    mixer.setTime(samples > 1 ? Math.min(duration * (i / (samples - 1)), duration * 0.9999) : 0);
+    gltf.scene.updateMatrixWorld(true);
+    box.union(skeleton.box());
+  }
+  mixer.setTime(0);
   gltf.scene.updateMatrixWorld(true);
-  const box = skeleton.box();
   const meshes = new THREE.Box3().setFromObject(gltf.scene);
   if (!meshes.isEmpty()) box.union(meshes);
   return box;
@@ -138,10 +154,11 @@ export class GlbPreview {
     scene.add(new THREE.HemisphereLight("#ffffff", "#2a3140", 2.5), gltf.scene, skeleton.object);
     const mixer = new THREE.AnimationMixer(gltf.scene);
     if (gltf.animations[0]) mixer.clipAction(gltf.animations[0]).play();
-    mixer.update(0); // the first frame's pose, to frame
-    const box = frameBox(gltf, skeleton);
+    const box = frameBox(gltf, skeleton, mixer, gltf.animations[0]?.duration ?? 0);
     const extent = box.isEmpty() ? new THREE.Vector3(1, 1, 1) : box.getSize(new THREE.Vector3());
-    this.box.setAttribute("data-gltf-height", extent.y.toFixed(3));
+    // The performer's height as first posed (the framed box also holds where they travel).
+    const first = skeleton.box();
+    this.box.setAttribute("data-gltf-height", (first.isEmpty() ? 0 : first.max.y - first.min.y).toFixed(3));
     const size = Math.max(extent.length(), 0.1);
     const centre = box.isEmpty() ? new THREE.Vector3() : box.getCenter(new THREE.Vector3());
     const camera = new THREE.PerspectiveCamera(40, 1, size * 0.01, size * 100);

@@ -4,7 +4,7 @@
 import { get } from "../api/client";
 import type { Me, Page, Project } from "../api/types";
 import type { Member } from "../queue/api";
-import { clear, formatDuration, h, toast } from "../ui/dom";
+import { clear, clip, formatDuration, h, toast } from "../ui/dom";
 import { downloadWithProgress } from "./download";
 import { topbar } from "./nav";
 import { GlbPreview } from "./gltfPreview";
@@ -171,11 +171,11 @@ export async function renderLibrary(root: HTMLElement): Promise<() => void> {
     return h(
       "tr",
       { "data-testid": `segment-${s.id}` },
-      h("td", {}, h("span", { class: "label-dot", style: `background:${s.color}` }), s.label, s.gold ? h("span", { class: "badge badge-ready gold-badge" }, "gold") : null),
-      h("td", {}, h("a", { href: `/captures/${s.capture.id}/?frame=${s.start}`, title: "Open in its capture" }, s.capture.name)),
+      h("td", {}, h("span", { class: "label-dot", style: `background:${s.color}` }), clip(s.label), s.gold ? h("span", { class: "badge badge-ready gold-badge" }, "gold") : null),
+      h("td", {}, clip(s.capture.name, { href: `/captures/${s.capture.id}/?frame=${s.start}` })),
       h("td", { class: "num" }, `${s.start}–${s.stop}`),
       h("td", { class: "num" }, formatDuration(s.duration)),
-      h("td", {}, s.annotator?.username ?? "—"),
+      h("td", {}, s.annotator ? clip(s.annotator.username) : "—"),
       h("td", { class: "num" }, s.distance !== undefined ? `d ${s.distance.toFixed(2)}` : pct(s.agreement)),
       h(
         "td",

@@ -6,7 +6,7 @@
 import { api, get, patch } from "../api/client";
 import type { Me } from "../api/types";
 import { accountLinks, appLinks } from "../ui/appnav";
-import { clear, formatDuration, h, toast } from "../ui/dom";
+import { clear, clip, formatDuration, h, toast } from "../ui/dom";
 import { loadQueue, STATE_TEXT, type Assignment, type Member, type QueueItem, type QueueState } from "./api";
 import "./queue.css";
 
@@ -111,7 +111,7 @@ export async function renderQueue(root: HTMLElement): Promise<() => void> {
     return h(
       "tr",
       { class: `queue-row state-${i.state}`, "data-testid": `queue-item-${i.capture.id}`, "data-state": i.state },
-      h("td", {}, h("a", { href: `/captures/${i.capture.id}/` }, i.capture.name), i.assigned ? null : h("span", { class: "muted small" }, " (picked)")),
+      h("td", {}, clip(i.capture.name, { href: `/captures/${i.capture.id}/` }), i.assigned ? null : h("span", { class: "muted small" }, " (picked)")),
       h("td", {}, h("span", { class: `badge badge-q-${i.state}` }, STATE_TEXT[i.state])),
       h("td", { title: i.since }, new Date(i.since).toLocaleString()),
       h("td", { class: "num" }, i.capture.duration ? formatDuration(i.capture.duration) : "—"),

@@ -3,7 +3,7 @@
 
 import type { Me, ReadyCapture } from "../api/types";
 import { SPEEDS } from "../player/clock";
-import { formatDuration, h } from "../ui/dom";
+import { clip, formatDuration, h } from "../ui/dom";
 import { accountLinks, appLinks } from "../ui/appnav";
 import { icon } from "../ui/icons";
 import type { Command } from "./keymap";
@@ -55,12 +55,13 @@ function buttonMaker(el: Elements): ButtonMaker {
 
 function topbar(c: ReadyCapture, me: Me, el: Elements, button: ButtonMaker, actions: LayoutActions): HTMLElement {
   const duration = formatDuration(c.duration ?? c.n_frames / c.fps);
+  const facts = `${c.n_frames.toLocaleString()} frames · ${c.fps} fps · ${duration} · ${c.format.toUpperCase()}`;
   return h(
     "header",
     { class: "topbar" },
     h("a", { class: "brand", href: "/" }, "Cutroom"),
-    h("nav", { class: "crumbs" }, h("a", { href: "/" }, "Captures"), h("span", {}, "/"), h("strong", { "data-testid": "capture-name" }, c.name)),
-    h("span", { class: "meta" }, `${c.n_frames.toLocaleString()} frames · ${c.fps} fps · ${duration} · ${c.format.toUpperCase()}`),
+    h("nav", { class: "crumbs" }, h("a", { href: "/" }, "Captures"), h("span", {}, "/"), clip(c.name, { class: "current", "data-testid": "capture-name" })),
+    h("span", { class: "meta", title: facts }, facts),
     h("span", { class: "spacer" }),
     (el.reviewPicker = h("span", { class: "review-picker" })),
     (el.saveState = h("span", { class: "save-state", "data-testid": "save-state" }, "Saved")),

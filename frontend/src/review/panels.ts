@@ -18,7 +18,7 @@ export function renderLabels(el: HTMLElement, labels: Label[], current: string |
         class: `label-chip${current === label.name ? " current" : ""}`,
         "data-testid": `label-${label.name}`,
         disabled,
-        title: `Label the segment under the playhead${label.hotkey ? ` (${label.hotkey})` : ""}`,
+        title: `${label.name}: label the segment under the playhead${label.hotkey ? ` (${label.hotkey})` : ""}`,
         onclick: (e: Event) => {
           (e.currentTarget as HTMLElement).blur();
           pick(label.name);
@@ -82,7 +82,7 @@ export function renderEvents(el: HTMLElement, events: ReviewEvent[]): void {
       "li",
       { "data-action": e.action },
       h("span", { class: "ev-action" }, e.action.replace(/_/g, " ")),
-      h("span", { class: "ev-detail" }, eventDetail(e)),
+      h("span", { class: "ev-detail", title: eventDetail(e) }, eventDetail(e)),
       h("time", { datetime: e.created_at, title: e.created_at }, new Date(e.created_at).toLocaleTimeString()),
     );
   clear(el, ...events.slice().reverse().map(item));

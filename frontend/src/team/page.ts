@@ -6,7 +6,7 @@ import { api, ApiError, get, patch, post } from "../api/client";
 import type { Invitation, Label, Me, Project, Role } from "../api/types";
 import type { Member } from "../queue/api";
 import { accountLinks, appLinks } from "../ui/appnav";
-import { clear, confirmDialog, dialog, h, toast } from "../ui/dom";
+import { clear, clip, confirmDialog, dialog, h, toast } from "../ui/dom";
 import { taxonomyEditor } from "./taxonomy";
 import "./team.css";
 
@@ -21,7 +21,7 @@ export async function renderTeam(root: HTMLElement, projectId: number): Promise<
     h(
       "div",
       { class: "list-page team-page" },
-      h("header", { class: "topbar" }, h("a", { class: "brand", href: "/" }, "Cutroom"), h("nav", { class: "crumbs" }, h("a", { href: "/" }, "Captures"), h("span", {}, "/"), h("span", {}, project.name), h("span", {}, "/"), h("strong", {}, "Team")), h("span", { class: "spacer" }), ...appLinks(project.id, project.role), ...accountLinks(me.username)),
+      h("header", { class: "topbar" }, h("a", { class: "brand", href: "/" }, "Cutroom"), h("nav", { class: "crumbs" }, h("a", { href: "/" }, "Captures"), h("span", {}, "/"), clip(project.name), h("span", {}, "/"), h("strong", {}, "Team")), h("span", { class: "spacer" }), ...appLinks(project.id, project.role), ...accountLinks(me.username)),
       main,
     ),
   );
@@ -46,7 +46,7 @@ export async function renderTeam(root: HTMLElement, projectId: number): Promise<
     return h(
       "tr",
       { "data-testid": `member-${m.username}` },
-      h("td", {}, m.username, m.id === me.id ? h("span", { class: "muted" }, " (you)") : null),
+      h("td", {}, clip(m.username), m.id === me.id ? h("span", { class: "muted" }, " (you)") : null),
       h("td", {}, role),
       h("td", {}, h("a", { class: "btn btn-small", href: `/queue/?project=${projectId}&user=${encodeURIComponent(m.username)}` }, "Queue")),
       h(

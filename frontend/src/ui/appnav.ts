@@ -11,10 +11,13 @@ let me: Promise<Me> | null = null;
 /** The signed-in user's name (filled in once /api/me/ answers, asked once per page load) and
  * the sign-out button. */
 export function accountLinks(username?: string): HTMLElement[] {
-  const user = h("span", { class: "user", "data-testid": "nav-user" }, username ?? "");
+  const user = h("span", { class: "user", "data-testid": "nav-user", title: username ?? "" }, username ?? "");
   if (username === undefined) {
     me ??= get<Me>("/api/me/");
-    me.then((m) => (user.textContent = m.username)).catch(() => undefined);
+    me.then((m) => {
+      user.textContent = m.username;
+      user.title = m.username;
+    }).catch(() => undefined);
   }
   return [user, logoutButton()];
 }

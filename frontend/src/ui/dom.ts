@@ -16,6 +16,13 @@ export function h<K extends keyof HTMLElementTagNameMap>(tag: K, attrs: Attrs = 
   return el;
 }
 
+/** Text that may be too long for its place: cut short with an ellipsis by CSS (``.clip``),
+ * whole in its tooltip. An ``href`` makes it a link. */
+export function clip(text: string, attrs: Attrs = {}): HTMLElement {
+  const cls = ["clip", attrs.class].filter(Boolean).join(" ");
+  return h(attrs.href ? "a" : "span", { ...attrs, class: cls, title: text }, text);
+}
+
 export function append(el: HTMLElement, children: Child[]): void {
   for (const child of children) {
     if (child === null || child === undefined || child === false) continue;

@@ -1,10 +1,11 @@
 """A C3D, a Qualisys TSV and a joint-position CSV upload, each through real workers on
-PostgreSQL + Redis to candidate cuts."""
+PostgreSQL + Redis to candidate cuts; label suggestions for a take of bare points."""
 
 from pathlib import Path
 
 import pytest
 
+from segmentation import services
 from segmentation.models import Capture
 from tests.motionlib.points_data import HDM05, points_file
 from tests.segmentation.integration.conftest import wait_for
@@ -33,3 +34,29 @@ def test_a_point_take_upload_reaches_candidates(running_workers, people, parts, 
     stored = Capture.objects.get(pk=capture_id)
     assert (stored.format, stored.n_frames, stored.n_joints,
             stored.skeleton["marker_set"]) == expected
+
+
+def test_a_worker_suggests_labels_for_a_take_of_points_of_no_known_set(running_workers, people):
+    """Two vMCI runs (13 markers, no known marker set): bob labels the first, and the review
+    of the second asks for suggestions, which a real worker computes from the points alone."""
+    project, alice, bob = people
+    services.do_add_label(project, "reach")
+    first, second = (upload(client_for(alice), project, points_file("vmci", name).read_bytes(),
+                            name=name) for name in ("subject1_run1.tsv", "subject1_run2.tsv"))
+    wait_for(lambda: settled(first) and settled(second), timeout=120, what="ingest and detection")
+    bob_client = client_for(bob)
+    review = bob_client.post(f"/api/captures/{first}/review/").json()
+    for index in range(len(review["segments"])):
+        review = bob_client.patch(f"/api/captures/{first}/review/segments/{index}/",
+                                  {"label": "reach", "version": review["version"]}, format="json").json()
+    bob_client.post(f"/api/captures/{first}/review/submit/", {"version": review["version"]}, format="json")
+
+    url = f"/api/captures/{second}/review/suggestions/"
+    assert bob_client.get(url).json()["pending"] is True
+    wait_for(lambda: bob_client.get(url).json()["pending"] is False, timeout=120, interval=0.5,
+             what="suggestions")
+    body = bob_client.get(url).json()
+    segments = bob_client.get(f"/api/captures/{second}/review/").json()["segments"]
+    assert [(s["start"], s["stop"]) for s in body["suggestions"]] == \
+        [(s["start"], s["stop"]) for s in segments]
+    assert {s["label"] for s in body["suggestions"]} == {"reach"}
