@@ -2,9 +2,10 @@
 
 People type a name with stray spaces, in another case, or in a compatibility form
 (full-width letters, ligatures, circled letters); all of these name one account.
-``key(name)`` is that one form (stripped, NFKC, case-folded), and sign-in, the sign-in
-throttle and account creation all compare keys, so no spelling of a locked name gets
-round its lock and no new account can differ from an existing one by case or form only.
+``key(name)`` is that one form (stripped, NFKC, case-folded), stored for every account
+(``models.UsernameKey``); sign-in, the sign-in throttle and account creation all compare
+keys, so no spelling of a locked name gets round its lock and no new account can differ
+from an existing one by case or form only.
 
 A new name may also not hold characters that show as nothing or pass for others:
 format characters (zero-width spaces and joiners, direction marks), control and private
@@ -13,9 +14,12 @@ look-alike letters (Latin, Greek, Cyrillic...), as in a Cyrillic "а" in "pаypa
 Cyrillic or Greek letters drawn like Latin ones (a Cyrillic "асе").
 """
 
+import hashlib
 import unicodedata
 
 from django.contrib.auth import get_user_model
+
+from segmentation.models import UsernameKey
 
 MAX_LENGTH = 150  # Django's own limit on usernames
 
@@ -91,11 +95,15 @@ def _script(char):
     return unicodedata.name(char, "").split(" ", 1)[0] or None
 
 
+def digest(name):
+    """The stored form of ``key(name)`` (``UsernameKey.digest``): its SHA-256, in hex."""
+    return hashlib.sha256(key(name).encode("utf-8", "surrogatepass")).hexdigest()
+
+
 def find_user(name):
     """The account ``name`` names, whatever its spelling, or None.
 
-    The exact stored form is one indexed lookup; other spellings are looked up among the
-    accounts the database finds case-insensitively, and compared by key.
+    The exact stored form first, then the key: two indexed lookups.
     """
     users = get_user_model()._default_manager
     stored = unicodedata.normalize("NFKC", name.strip())
@@ -104,23 +112,33 @@ def find_user(name):
     user = users.filter(username=stored).first()
     if user is not None:
         return user
-    wanted = key(name)
-    for candidate in users.filter(username__iexact=stored)[:20]:
-        if key(candidate.username) == wanted:
-            return candidate
-    return None
+    return users.filter(username_key__digest=digest(name)).first()
 
 
 def check_available(name, exclude=None):
-    """UsernameError if an account other than ``exclude`` has a name with ``name``'s key.
-
-    Compares keys of all usernames: creating accounts is a site admin's action, rare
-    beside sign-ins, and the database cannot case-fold every script the same way.
-    """
-    wanted = key(name)
-    users = get_user_model()._default_manager.all()
+    """UsernameError if an account other than ``exclude`` has a name with ``name``'s key."""
+    users = get_user_model()._default_manager.filter(username_key__digest=digest(name))
     if exclude is not None and exclude.pk is not None:
         users = users.exclude(pk=exclude.pk)
-    for existing in users.values_list("username", flat=True).iterator():
-        if key(existing) == wanted:
-            raise UsernameError(f"an account named {existing!r} already exists")
+    existing = users.values_list("username", flat=True).first()
+    if existing is not None:
+        raise UsernameError(f"an account named {existing!r} already exists")
+
+
+def remember(user, created):
+    """Store the key of ``user``'s name after the account is saved.
+
+    A new account's row is inserted as is: when another account took the same key a
+    moment earlier, the unique index raises IntegrityError and the creation (in its
+    transaction) is undone. A renamed account whose new name clashes with an older
+    account's keeps no key (it signs in by its exact name only).
+    """
+    wanted = digest(user.username)
+    if created:
+        UsernameKey.objects.create(user=user, digest=wanted)
+        return
+    if UsernameKey.objects.filter(user=user, digest=wanted).exists():
+        return
+    if UsernameKey.objects.filter(digest=wanted).exclude(user=user).exists():
+        wanted = None
+    UsernameKey.objects.update_or_create(user=user, defaults={"digest": wanted})

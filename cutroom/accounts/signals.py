@@ -43,3 +43,12 @@ def check_new_username(sender, instance, raw=False, **kwargs):
         return
     instance.username = usernames.clean(instance.username)
     usernames.check_available(instance.username)
+
+
+@receiver(post_save, sender=settings.AUTH_USER_MODEL)
+def remember_username_key(sender, instance, created, raw=False, update_fields=None, **kwargs):
+    """Store the key of the account's name, however the account was made or renamed
+    (a restored backup brings its keys with it)."""
+    if raw or (update_fields is not None and "username" not in update_fields):
+        return
+    usernames.remember(instance, created)

@@ -37,6 +37,21 @@ def _c3d():
     return c3d
 
 
+def _parameters_reader():
+    """``c3d.Reader`` that takes the parameter section as it is.
+
+    The header repeats a few parameters (point count, scale, rate) for old programs; the
+    C3D specification makes the parameters authoritative, and writers do leave the two
+    apart (a header rate of 120.5 beside ``POINT:RATE`` 120). ``c3d`` refuses such a file
+    with an assertion; everything read here comes from the parameters.
+    """
+    class Reader(_c3d().Reader):
+        def _check_metadata(self):
+            pass
+
+    return Reader
+
+
 def read_c3d(path: str | os.PathLike, *, limits: Limits = DEFAULT_LIMITS) -> PointTake:
     """Read the 3D points of a C3D file.
 
@@ -86,9 +101,9 @@ def _reader(data: bytes, path):
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            return _c3d().Reader(io.BytesIO(data))
+            return _parameters_reader()(io.BytesIO(data))
     except (struct.error, ValueError, KeyError, IndexError, TypeError, AttributeError,
-            UnicodeDecodeError, OverflowError) as exc:
+            UnicodeDecodeError, OverflowError, AssertionError) as exc:
         raise CaptureError(f"parameter section (from block {parameter_block}): cannot be "
                            f"read ({shorten(exc, 120)})", path=path) from None
 
@@ -143,7 +158,12 @@ def _layout(reader, data: bytes, path, limits: Limits) -> dict:
         raise CaptureError(f"parameter POINT:RATE is {rate}; frames per second must be between "
                            f"{1 / limits.max_frame_time:g} and {1 / limits.min_frame_time:g}",
                            path=path)
-    first, last = int(reader.first_frame), int(reader.last_frame)
+    try:
+        first, last = int(reader.first_frame), int(reader.last_frame)
+    except (struct.error, ValueError, IndexError, TypeError, OverflowError) as exc:
+        raise CaptureError("header words 4-5 and parameters TRIAL:ACTUAL_START_FIELD, "
+                           "TRIAL:ACTUAL_END_FIELD, POINT:LONG_FRAMES, POINT:FRAMES: the frame range "
+                           f"cannot be read ({shorten(exc, 80)})", path=path) from None
     n_frames = last - first + 1
     if n_frames < 0:
         raise CaptureError(f"header: the last frame {last} comes before the first {first}",
@@ -151,7 +171,11 @@ def _layout(reader, data: bytes, path, limits: Limits) -> dict:
     check_size(n_frames, n_points, 3 * n_points, len(data), limits, path=path)
     is_float = scale < 0
     word = 4 if is_float else 2
-    analog = int(reader.analog_used) * int(reader.analog_per_frame)
+    try:
+        analog = int(reader.analog_used) * int(reader.analog_per_frame)
+    except (struct.error, ValueError, IndexError, TypeError, OverflowError) as exc:
+        raise CaptureError("parameters ANALOG:USED, ANALOG:RATE: the analog channels per "
+                           f"frame cannot be read ({shorten(exc, 80)})", path=path) from None
     data_block = int(header.data_block)
     start = (data_block - 1) * BLOCK
     if data_block < 2 or start > len(data):
@@ -180,7 +204,8 @@ def _frames(data: bytes, layout: dict, path) -> np.ndarray:
         else:
             values = np.frombuffer(raw, dtype=">f4" if big else "<f4").reshape(n, words)
         points = values[:, : 4 * p].reshape(n, p, 4)
-        xyz = points[..., :3].astype(np.float64)
+        with np.errstate(invalid="ignore"):  # NaN words are gaps, marked below
+            xyz = points[..., :3].astype(np.float64)
         residual = _residual_of_float(points[..., 3])
     else:
         values = np.frombuffer(raw, dtype=">i2" if big else "<i2").reshape(n, words)

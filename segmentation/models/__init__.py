@@ -6,13 +6,15 @@
 - ``reviews``: reviews, cuts, segment labels, the review audit log;
 - ``library``: library segments, gold versions, agreement, label suggestions;
 - ``workers``: the Celery workers' heartbeats;
-- ``locks``: named row locks for counting against a limit atomically.
+- ``locks``: named row locks for counting against a limit atomically;
+- ``accounts``: the key of each account's username.
 
 Rules about one record live on the models; lookups live on the managers
 (``Capture.objects.visible_to(user)``). Workflows that touch several records are the
 ``do_*`` functions in ``segmentation.services``.
 """
 
+from segmentation.models.accounts import UsernameKey
 from segmentation.models.captures import (
     Assignment,
     Capture,
@@ -72,5 +74,6 @@ __all__ = [
     "derived_path",
     "original_path",
     "ThrottleLock",
+    "UsernameKey",
     "WorkerHeartbeat",
 ]

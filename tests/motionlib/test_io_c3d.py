@@ -173,3 +173,22 @@ def test_an_int16_c3d_reads_as_an_independent_reader_reads_it_with_its_gaps(tmp_
     assert (take.n_frames, take.fps, take.point_names) == (20, 100.0, ["A", "B"])
     np.testing.assert_array_equal(take.channels, xyz)
     assert np.isnan(take.channels[5]).all()
+
+
+def test_the_parameters_win_over_a_header_that_disagrees_with_them(original, hdm05, tmp_path):
+    # Header words 2 (point count) and 11-12 (rate) repeat POINT:USED and POINT:RATE for old
+    # programs; the C3D specification makes the parameters authoritative.
+    data = bytearray(original)
+    data[2:4] = (131).to_bytes(2, "little")
+    data[20:22] = b"\xff\xff"
+    take = motionlib.read(broken(tmp_path, data))
+    assert (take.n_points, take.fps, take.n_frames) == (44, 120.0, 5920)
+    np.testing.assert_array_equal(take.channels, hdm05.channels)
+
+
+def test_it_names_the_frame_range_parameters_it_cannot_read(original, tmp_path):
+    data = bytearray(original)
+    data[578:580] = b"\x00\x00"  # a dimension of TRIAL:ACTUAL_START_FIELD / END_FIELD: empty
+    with pytest.raises(motionlib.CaptureError, match=r"broken\.c3d: header words 4-5 and "
+                       r"parameters TRIAL:ACTUAL_START_FIELD.*the frame range cannot be read"):
+        motionlib.read(broken(tmp_path, data))

@@ -1,7 +1,12 @@
 """Usernames: every spelling of a name (spaces around it, case, compatibility forms) is
 one account, and names with invisible or look-alike characters cannot be created."""
 
+import io
+from unittest import mock
+
 from django.contrib.auth import get_user_model
+from django.core.management import CommandError, call_command
+from django.db import IntegrityError, transaction
 from django.test import Client, SimpleTestCase
 
 from segmentation import usernames
@@ -119,3 +124,73 @@ class AnyWayOfCreatingTestCase(BaseTestCase):
     def test_renaming_is_left_to_the_forms_and_saving_an_account_again_is_not_refused(self):
         self.bob.first_name = "Bob"
         self.bob.save()
+
+
+class KeyedSignInTestCase(BaseTestCase):
+    """Sign-in finds an account by its stored key, so other cases of any script sign in on
+    every database (SQLite's own case-insensitive match knows only ASCII)."""
+
+    def sign_in(self, username, password):
+        return self.client.post("/api/auth/token/", {"username": username, "password": password},
+                                format="json")
+
+    def test_a_greek_name_typed_in_capitals_signs_in(self):
+        get_user_model().objects.create_user("\u0395\u03bb\u03ad\u03bd\u03b7", password="p-Elena-9")
+        for spelling in ("\u0395\u039b\u0388\u039d\u0397", "\u03b5\u03bb\u03ad\u03bd\u03b7 "):
+            self.assertEqual(self.sign_in(spelling, "p-Elena-9").status_code, 200, spelling)
+
+    def test_a_cyrillic_name_typed_in_another_case_is_the_same_account_for_creation(self):
+        get_user_model().objects.create_user("\u0421\u0435\u0440\u0433\u0435\u0439", password="x")
+        with self.assertRaises(usernames.UsernameError):
+            get_user_model().objects.create_user("\u0421\u0415\u0420\u0413\u0415\u0419", password="x")
+
+    def test_the_database_refuses_a_second_account_of_one_key_made_at_the_same_moment(self):
+        # Both creations passed the check before either was saved: the unique key decides.
+        users = get_user_model().objects
+        users.create_user("dora", password="x")
+        with mock.patch.object(usernames, "check_available"):
+            with self.assertRaises(IntegrityError), transaction.atomic():
+                users.create_user("DORA", password="x")
+        self.assertEqual(list(users.filter(username__iexact="dora").values_list("username", flat=True)),
+                         ["dora"])
+
+    def test_a_rename_follows_the_key_and_a_clashing_rename_keeps_none(self):
+        self.assertEqual(usernames.find_user("BOB"), self.bob)
+        self.bob.username = "robert"
+        self.bob.save()
+        self.assertEqual(usernames.find_user("ROBERT"), self.bob)
+        self.assertIsNone(usernames.find_user("BOB"))
+        self.bob.username = "Alice"  # an admin's rename into a clash with alice
+        self.bob.save()
+        self.assertEqual(usernames.find_user("alice"), self.alice)
+        self.assertEqual(usernames.find_user("Alice"), self.bob)  # its exact name only
+
+
+class CheckUsernamesCommandTestCase(BaseTestCase):
+    def run_command(self):
+        out = io.StringIO()
+        try:
+            call_command("check_usernames", stdout=out)
+        except CommandError as exc:
+            return out.getvalue(), str(exc)
+        return out.getvalue(), None
+
+    def test_it_says_all_is_well_when_it_is(self):
+        out, error = self.run_command()
+        self.assertIsNone(error)
+        self.assertIn("every username follows the rules", out)
+
+    def test_it_lists_accounts_made_before_the_rules(self):
+        users = get_user_model().objects
+        # Rows written past the rules, as an older release could leave them.
+        with mock.patch.object(usernames, "clean", side_effect=lambda name: name), \
+                mock.patch.object(usernames, "check_available"):
+            lookalike = users.create_user("p\u0430ypal", password="x")
+        twin = users.create_user("twin", password="x")
+        twin.username = "BOB"
+        twin.save()
+        out, error = self.run_command()
+        self.assertEqual(error, "2 account(s) to rename")
+        self.assertIn(f"account {lookalike.pk} 'p\u0430ypal': mixes letters of the Cyrillic and Latin", out)
+        self.assertIn(f"account {twin.pk} 'BOB': differs only in case or form from account "
+                      f"{self.bob.pk} 'bob'", out)
