@@ -136,6 +136,26 @@ def test_every_page_has_the_same_navigation(live_server, new_page, ingested_capt
     assert page.errors == []
 
 
+def test_an_annotator_is_offered_no_page_that_would_refuse_them(live_server, new_page,
+                                                               ingested_capture, studio):
+    """The dashboard and the team page are for the project's reviewers and admins: an
+    annotator's top bar leaves them out on every page, rather than leading to an error."""
+    page = new_page("ann")
+    expected = ["nav-queue", "nav-library", "nav-user", "logout"]
+    for path in ["/", "/queue/", "/library/", f"/captures/{ingested_capture.pk}/"]:
+        page.goto(f"{live_server.url}{path}")
+        expect(page.get_by_test_id("nav-user")).to_have_text("ann")
+        assert page.evaluate(NAV) == expected, path
+    assert page.errors == []
+
+
+def test_the_file_chooser_and_drop_zone_take_point_takes(live_server, new_page, studio):
+    page = new_page("alice")
+    expect(page.get_by_test_id("dropzone")).to_contain_text(".c3d")
+    accept = page.locator("input[type=file]").get_attribute("accept").split(",")
+    assert {".bvh", ".fbx", ".amc", ".asf", ".c3d", ".tsv", ".csv"} <= set(accept)
+
+
 def test_the_capture_list_speaks_to_a_first_upload(live_server, new_page, ingested_capture,
                                                   studio):
     """The drop zone names every format taken; a file that can never parse offers no Retry;

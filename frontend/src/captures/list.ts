@@ -46,7 +46,7 @@ export async function renderCaptureList(root: HTMLElement): Promise<() => void> 
   const rows = h("tbody", { "data-testid": "capture-rows" });
   const pager = h("div", { class: "pager" });
   const uploads = h("div", { class: "uploads", "data-testid": "uploads" });
-  const fileInput = h("input", { type: "file", multiple: true, accept: ".bvh,.fbx,.amc,.asf", hidden: true });
+  const fileInput = h("input", { type: "file", multiple: true, accept: ".bvh,.fbx,.amc,.asf,.c3d,.tsv,.csv", hidden: true });
   const projectName = new Map(projects.map((p) => [p.id, p.name]));
   const projectRole = new Map(projects.map((p) => [p.id, p.role]));
 
@@ -110,7 +110,7 @@ export async function renderCaptureList(root: HTMLElement): Promise<() => void> 
   const assignProject = () => Number(filters.project) || (projects.length === 1 ? projects[0].id : null);
   const assignBar = assignmentBar(projects, assignProject, selection, () => void load());
   drawNav();
-  const dropzone = h("div", { class: "dropzone", "data-testid": "dropzone" }, h("b", {}, "Drop .bvh, .fbx, or .amc with its .asf, here"), h("span", {}, " or "), h("button", { class: "btn btn-primary", onclick: () => fileInput.click() }, "Choose files"));
+  const dropzone = h("div", { class: "dropzone", "data-testid": "dropzone" }, h("b", {}, "Drop .bvh, .fbx, .amc with its .asf, or point takes (.c3d, .tsv, .csv) here"), h("span", {}, " or "), h("button", { class: "btn btn-primary", onclick: () => fileInput.click() }, "Choose files"));
   const page = h(
     "div",
     { class: "list-page" },

@@ -1,5 +1,6 @@
 // Links every page's top bar carries, in the same order on every page: the queue, the
-// library and, for a project, its dashboard and team; then who is signed in and "Log out".
+// library and, for a project its reviewers and admins run, its dashboard and team; then who
+// is signed in and "Log out". An annotator is not offered pages that would refuse them.
 
 import { get } from "../api/client";
 import type { Me } from "../api/types";
@@ -27,7 +28,9 @@ export function appLinks(project?: number | null, role?: string | null): HTMLEle
     h("a", { class: "btn btn-ghost", href: "/queue/", "data-testid": "nav-queue" }, "My queue"),
     h("a", { class: "btn btn-ghost", href: "/library/", "data-testid": "nav-library" }, "Library"),
   ];
-  if (project) links.push(h("a", { class: "btn btn-ghost", href: `/projects/${project}/dashboard/`, "data-testid": "nav-dashboard" }, "Dashboard"));
-  if (project && role && role !== "annotator") links.push(h("a", { class: "btn btn-ghost", href: `/projects/${project}/team/`, "data-testid": "nav-team" }, "Team"));
+  if (project && role && role !== "annotator") {
+    links.push(h("a", { class: "btn btn-ghost", href: `/projects/${project}/dashboard/`, "data-testid": "nav-dashboard" }, "Dashboard"));
+    links.push(h("a", { class: "btn btn-ghost", href: `/projects/${project}/team/`, "data-testid": "nav-team" }, "Team"));
+  }
   return links;
 }
