@@ -220,16 +220,23 @@ def detect(run, take):
     return result, {"model_version": newest.version, "model_n_takes": newest.n_takes}
 
 
-@functools.lru_cache(maxsize=32)
 def _loaded(pk, version):
-    """A stored model, parsed once per worker process (rows never change once trained).
+    """A stored model, parsed once per worker process.
 
-    A model this version of motionlib cannot read (stored by an older release) is logged
-    and detection falls back to the zero-shot detector until the project retrains.
+    The cache is keyed by the stored text, not the row: a row id can come back after its
+    project was deleted (SQLite reuses the highest one), and a model parsed for the old
+    row must not stand in for the new one.
     """
+    text = ProjectCutModel.objects.values_list("model", flat=True).get(pk=pk)
+    return _parsed(text, version, pk)
+
+
+@functools.lru_cache(maxsize=32)
+def _parsed(text, version, pk):
+    """A model this version of motionlib cannot read (stored by an older release) is logged
+    and detection falls back to the zero-shot detector until the project retrains."""
     from motionlib import adapt
 
-    text = ProjectCutModel.objects.values_list("model", flat=True).get(pk=pk)
     try:
         return adapt.CutModel.from_json(text)
     except ValueError:

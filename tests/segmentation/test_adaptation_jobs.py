@@ -175,6 +175,20 @@ class ExamplesTestCase(AdaptationTestCase):
         self.submit_review(capture, self.rachel, keep={300})
         self.assertEqual(adaptation.project_examples(self.project.pk), [(capture, [100, 300])])
 
+    def test_one_under_cutting_annotator_among_three_removes_no_cut(self):
+        capture = self.ready_capture(candidates=(100, 300, 500), n_frames=700)
+        self.submit_review(capture, self.bob)
+        self.submit_review(capture, self.alice, keep=set())
+        self.submit_review(capture, self.rachel)
+        self.assertEqual(adaptation.project_examples(self.project.pk), [(capture, [100, 300, 500])])
+
+    def test_a_cut_only_one_of_three_annotators_kept_is_left_out(self):
+        capture = self.ready_capture(candidates=(100, 300, 500), n_frames=700)
+        self.submit_review(capture, self.bob, keep={300})
+        self.submit_review(capture, self.alice, keep={100, 300})
+        self.submit_review(capture, self.rachel, keep={300, 500})
+        self.assertEqual(adaptation.project_examples(self.project.pk), [(capture, [300])])
+
     def test_reviews_in_progress_do_not_count(self):
         self.login(self.bob)
         self.client.post(f"/api/captures/{self.ready_capture().pk}/review/")
