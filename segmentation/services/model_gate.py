@@ -136,14 +136,14 @@ def judge(examples, current, current_model, *, fit, detect, take_of):
     reasons = [_reason(new, old, was_learnt, current)
                for was_learnt, (new, old) in groups.items()
                if new.takes and not new.not_worse_than(old)]
-    return Verdict(figure, "; ".join(reasons))
+    return Verdict(figure, "refused: " + "; ".join(reasons) if reasons else "")
 
 
 def _reason(new, old, was_learnt, current):
     """Why the candidate lost on one group of takes, with both figures."""
     takes = f"{new.takes} held-out reviewed take{'s' if new.takes != 1 else ''}"
     if current is None:
-        return f"refused: on {takes} it needs {new.text()}, the zero-shot detector {old.text()}"
+        return f"on {takes} it needs {new.text()}, the zero-shot detector {old.text()}"
     whose = "learnt from" if was_learnt else "did not learn from"
-    return (f"refused: on {takes} that the current model v{current.version} {whose} it needs "
+    return (f"on {takes} that the current model v{current.version} {whose} it needs "
             f"{new.text()}, the current model {old.text()}")
