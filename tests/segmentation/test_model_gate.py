@@ -185,3 +185,47 @@ class ScoredTakesTestCase(BaseTestCase):
     def test_a_group_with_fewer_takes_leaves_its_places_to_the_other(self):
         self.assertEqual(self.scored(12, [1, 2]), [12, 11, 10, 9, 8, 7, 6, 5, 2, 1])
         self.assertEqual(self.scored(12, range(1, 12)), [12, 11, 10, 9, 8, 7, 6, 5, 4, 3])
+
+
+class FigureTestCase(BaseTestCase):
+    """How the gate compares two models' figures (model_gate.Figure)."""
+
+    def figure(self, *takes):
+        figure = model_gate.Figure()
+        for found, truth in takes:
+            figure.add(found, truth, 120.0)
+        return figure
+
+    def test_edits_and_f1_are_pooled_over_the_takes_cuts(self):
+        # Take 1: 3 of 4 true cuts found, one insert; take 2: one extra candidate, a delete.
+        figure = self.figure(([100, 500, 900], [100, 500, 900, 1300]), ([200, 800], [200]))
+        self.assertEqual((figure.takes, figure.edits, figure.true_cuts), (2, 2, 5))
+        self.assertAlmostEqual(figure.edits_per_cut, 0.4)
+        self.assertAlmostEqual(figure.f1, 2 * 0.8 * 0.8 / 1.6)
+
+    def test_a_take_without_true_cuts_counts_its_candidates_as_deletes(self):
+        self.assertEqual(self.figure(([100, 500], [])).edits_per_cut, 2.0)
+        self.assertEqual(self.figure(([], [])).f1, 1.0)
+
+    def test_more_edits_per_cut_is_worse(self):
+        truth = [100, 500, 900, 1300]
+        current = self.figure(([100, 500, 900, 1300], truth))
+        self.assertFalse(self.figure(([100, 500, 900], truth)).not_worse_than(current))
+
+    def test_fewer_edits_with_an_f1_a_little_lower_is_not_worse(self):
+        truth = [100 + 400 * i for i in range(20)]
+        # The current model finds every cut but places 10 of them 0.5 s late (10 moves);
+        # the candidate places 19 exactly and misses one (one insert).
+        current = self.figure(([t + (60 if i < 10 else 0) for i, t in enumerate(truth)], truth))
+        candidate = self.figure((truth[:-1], truth))
+        self.assertLess(candidate.f1, current.f1)
+        self.assertTrue(candidate.not_worse_than(current))
+
+    def test_an_f1_much_lower_is_worse_whatever_the_edits(self):
+        truth = [100 + 400 * i for i in range(10)]
+        # The current model finds all ten, nine of them 0.5 s late (nine moves); the
+        # candidate finds eight exactly (two inserts): fewer edits, F1 0.11 lower.
+        current = self.figure(([t + (60 if i else 0) for i, t in enumerate(truth)], truth))
+        candidate = self.figure((truth[:8], truth))
+        self.assertLess(candidate.edits_per_cut, current.edits_per_cut)
+        self.assertFalse(candidate.not_worse_than(current))
