@@ -150,7 +150,8 @@ def _train(job):
     if not examples:
         raise Invalid("the project has no submitted review or gold version to learn from")
     stored = takecache.StoredStudies(Capture._meta.get_field("original").storage)
-    # The full fit first: it keeps the stored studies those of the examples as they are.
+    # The full fit first, with the stored studies: they stay those of the examples as they
+    # are, which the next training reads (the gate's refits keep theirs in memory).
     model = fit_examples(examples, stored)
     # One training at a time per project: no other version appears before this one ends.
     current = ProjectCutModel.objects.newest(job.project_id)
@@ -188,7 +189,8 @@ def fit_examples(examples, studies):
 
 def _candidates(take, cut_model):
     """The candidate frames the default detector with ``cut_model`` (None: zero-shot)
-    proposes on ``take``, as the service's default runs would."""
+    proposes on ``take``, with the detector's own parameters as the fit learns from them
+    (a project's ``default_params`` are left out of both)."""
     from motionlib import adapt
 
     return [int(f) for f in adapt.detect(take, cut_model).cuts]
