@@ -120,8 +120,9 @@ def time_stored_fit(project):
 
 def review_again(project, index):
     """A second annotator's submitted review of the project's ``index``-th take, with one
-    cut more than the first's, halfway through its first segment: two reviews, so the
-    consensus keeps it and the take's example changes."""
+    cut more than the first's, halfway through its longest segment (no new shortest
+    segment, which would change what every take shows): two reviews, so the consensus
+    keeps it and the take's example changes."""
     from django.contrib.auth import get_user_model
 
     from segmentation.models import Cut, Review
@@ -131,7 +132,13 @@ def review_again(project, index):
     other, _ = get_user_model().objects.get_or_create(username="bench-second")
     review = Review.objects.create(capture=capture, annotator=other, status="submitted")
     Cut.objects.bulk_create(Cut(review=review, origin="inserted", fate="accepted", frame=f)
-                            for f in [cuts[0] // 2, *cuts])
+                            for f in sorted({*cuts, _middle_of_longest(cuts, capture.n_frames)}))
+
+
+def _middle_of_longest(cuts, n_frames):
+    bounds = [0, *cuts, n_frames]
+    start, stop = max(zip(bounds[:-1], bounds[1:], strict=True), key=lambda s: s[1] - s[0])
+    return (start + stop) // 2
 
 
 def main():
