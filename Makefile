@@ -78,6 +78,7 @@ bench: install
 	@command -v wrk >/dev/null || { apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq wrk; } \
 		|| echo "wrk not installed: the capture list benchmark uses its Python client"
 	$(RECORD) $(RESULTS)/capture-list-load.md -- $(PY) benchmarks/capture_list_load.py
+	$(RECORD) $(RESULTS)/poisoning.md -- $(PY) benchmarks/poisoning.py
 
 # The README's screenshots, taken by the browser tests.
 screenshots: install frontend browser

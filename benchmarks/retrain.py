@@ -9,11 +9,14 @@ has claimed the row) is timed end to end:
 1. the first training: parses every original (then cached, `segmentation.takecache`) and
    analyses every take, storing what it learnt from each (its study);
 2. a retraining with nothing changed: every study is stored;
-3. retrainings after one more submitted review (each on another take): what a project
-   pays after each submit, as the one changed take is read and analysed again;
+3. retrainings after one more submitted review (each on another take, with one cut the
+   first review did not have, so the take's consensus example changes): what a project
+   pays after each submit, as the one changed take is read and analysed again, and the
+   gate (`segmentation.services.model_gate`) scores the new model against the current
+   one on up to 10 reviewed takes (refits from the studies, detections on those takes);
 4. for comparison in the same run, what each retraining cost before studies were stored:
    the parsed takes read from their cache and fitted anew (`fit_cut_model` without
-   `studies`).
+   `studies`), and what the fit alone costs with the studies (a training without the gate).
 
     .venv/bin/python benchmarks/retrain.py [--takes 50] [--minutes 5] [--repeats 3]
 
@@ -103,9 +106,23 @@ def time_fresh_fit(project):
     return time.process_time() - started
 
 
+def time_stored_fit(project):
+    """CPU seconds of the training's fit alone, from the stored studies (no gate)."""
+    from segmentation import takecache
+    from segmentation.models import Capture
+    from segmentation.services import adaptation
+
+    started = time.process_time()
+    examples = adaptation.project_examples(project.pk)
+    adaptation.fit_examples(examples, takecache.StoredStudies(Capture._meta.get_field("original").storage))
+    return time.process_time() - started
+
+
 def review_again(project, index):
-    """A second annotator's submitted review of the project's ``index``-th take, one cut
-    fewer than the first's."""
+    """A second annotator's submitted review of the project's ``index``-th take, with one
+    cut more than the first's, halfway through its longest segment (no new shortest
+    segment, which would change what every take shows): two reviews, so the consensus
+    keeps it and the take's example changes."""
     from django.contrib.auth import get_user_model
 
     from segmentation.models import Cut, Review
@@ -115,7 +132,13 @@ def review_again(project, index):
     other, _ = get_user_model().objects.get_or_create(username="bench-second")
     review = Review.objects.create(capture=capture, annotator=other, status="submitted")
     Cut.objects.bulk_create(Cut(review=review, origin="inserted", fate="accepted", frame=f)
-                            for f in cuts[:-1])
+                            for f in sorted({*cuts, _middle_of_longest(cuts, capture.n_frames)}))
+
+
+def _middle_of_longest(cuts, n_frames):
+    bounds = [0, *cuts, n_frames]
+    start, stop = max(zip(bounds[:-1], bounds[1:], strict=True), key=lambda s: s[1] - s[0])
+    return (start + stop) // 2
 
 
 def main():
@@ -155,10 +178,14 @@ def run(args, var):
         review_again(project, repeat)
         total, cpu, job = time_training(project)
         after.append(cpu)
-        show(f"3. retraining after one more review ({repeat + 1} of {args.repeats})", total, cpu)
+        show(f"3. retraining after one more review ({repeat + 1} of {args.repeats}; "
+             f"{'refused' if job.refused else f'v{job.version}'}, {job.held_out_takes} scored)", total, cpu)
     fresh = [time_fresh_fit(project) for _ in range(args.repeats)]
     print(f"4. fitting anew from the parsed takes (before studies were stored): CPU s "
           f"{', '.join(f'{x:.2f}' for x in fresh)}")
+    stored = [time_stored_fit(project) for _ in range(args.repeats)]
+    print(f"5. the fit alone from the stored studies (a training without the gate): CPU s "
+          f"{', '.join(f'{x:.2f}' for x in stored)}")
     # CPU seconds of this single-threaded process: what the job costs one core, even when
     # the machine is shared (its wall time then also counts the other processes).
     median = statistics.median(after)

@@ -71,9 +71,12 @@ class CaptureAdmin(admin.ModelAdmin):
 
 @admin.register(ProjectCutModel)
 class ProjectCutModelAdmin(admin.ModelAdmin):
-    list_display = ("id", "project", "version", "status", "n_takes", "n_cuts", "created_at", "finished_at")
+    list_display = ("id", "project", "version", "status", "n_takes", "n_cuts", "held_out_edits_per_cut",
+                    "held_out_f1", "refused", "created_at", "finished_at")
     list_filter = ("status", "project")
-    readonly_fields = ("error_permanent", "claim_token", "claimed_at", "attempts")
+    # What the gate decided is the record of a training, not a setting to edit.
+    readonly_fields = ("error_permanent", "claim_token", "claimed_at", "attempts", "trained_on",
+                       "held_out_takes", "held_out_edits_per_cut", "held_out_f1", "refused")
 
 
 @admin.register(DetectionRun)

@@ -3,22 +3,46 @@ import type { Adaptation, CaptureSummary } from "../src/api/types";
 import { canRedetect } from "../src/captures/list";
 import { adaptationLines } from "../src/review/panels";
 
-const zeroShot: Adaptation = { model_version: null, n_takes: null, project_model: null, training: false, training_error: null };
+const zeroShot: Adaptation = { model_version: null, n_takes: null, held_out: null, project_model: null, training: false, training_error: null, training_refused: null };
+const figure = { n_takes: 5, edits_per_cut: 0.3, f1: 0.912 };
 
 describe("adaptation line of the review page", () => {
   it("test_it_says_candidates_are_not_adapted_yet", () => {
-    expect(adaptationLines(zeroShot)).toEqual({ line: "Candidates not adapted yet (zero-shot detector).", notes: [] });
+    expect(adaptationLines(zeroShot)).toEqual({ line: "Candidates not adapted yet (zero-shot detector).", figure: "", notes: [] });
   });
 
   it("test_it_says_how_many_reviewed_takes_the_candidates_came_from", () => {
-    const a = { ...zeroShot, model_version: 3, n_takes: 12, project_model: { version: 3, n_takes: 12, n_cuts: 80 } };
-    expect(adaptationLines(a)).toEqual({ line: "Candidates adapted from 12 reviewed takes (model v3).", notes: [] });
+    const a = { ...zeroShot, model_version: 3, n_takes: 12, project_model: { version: 3, n_takes: 12, n_cuts: 80, held_out: null } };
+    expect(adaptationLines(a)).toEqual({ line: "Candidates adapted from 12 reviewed takes (model v3).", figure: "", notes: [] });
     expect(adaptationLines({ ...a, n_takes: 1 }).line).toBe("Candidates adapted from 1 reviewed take (model v3).");
   });
 
   it("test_it_mentions_a_newer_project_model", () => {
-    const a = { ...zeroShot, project_model: { version: 2, n_takes: 5, n_cuts: 30 } };
+    const a = { ...zeroShot, project_model: { version: 2, n_takes: 5, n_cuts: 30, held_out: null } };
     expect(adaptationLines(a).notes).toEqual(["The project's model is now v2, from 5 reviewed takes."]);
+    const withFigure = { ...a, project_model: { ...a.project_model, held_out: figure } };
+    expect(adaptationLines(withFigure).notes).toEqual([
+      "The project's model is now v2, from 5 reviewed takes; on 5 held-out reviewed takes 0.30 edits per cut, F1 0.91.",
+    ]);
+  });
+
+  it("test_it_shows_the_models_own_figure_on_held_out_reviewed_takes", () => {
+    const a = { ...zeroShot, model_version: 2, n_takes: 5, held_out: figure, project_model: { version: 2, n_takes: 5, n_cuts: 30, held_out: figure } };
+    expect(adaptationLines(a).figure).toBe("Learnt from 5 reviewed takes; on 5 held-out reviewed takes 0.30 edits per cut, F1 0.91.");
+    expect(adaptationLines({ ...a, held_out: { ...figure, n_takes: 1 } }).figure).toBe(
+      "Learnt from 5 reviewed takes; on 1 held-out reviewed take 0.30 edits per cut, F1 0.91.",
+    );
+  });
+
+  it("test_it_has_no_figure_for_the_zero_shot_detector_or_a_model_without_one", () => {
+    expect(adaptationLines({ ...zeroShot, held_out: figure }).figure).toBe("");
+    expect(adaptationLines({ ...zeroShot, model_version: 1, n_takes: 2 }).figure).toBe("");
+  });
+
+  it("test_it_says_why_the_last_model_was_refused_and_what_is_kept", () => {
+    const refused = "refused: on 2 held-out reviewed takes that the current model v1 learnt from it needs 1.00 edits per true cut (F1 0.00), the current model 0.25 edits per true cut (F1 1.00)";
+    const a = { ...zeroShot, project_model: { version: 1, n_takes: 2, n_cuts: 8, held_out: null }, model_version: 1, n_takes: 2, training_refused: refused };
+    expect(adaptationLines(a).notes).toEqual([`Last retraining ${refused}. The project keeps model v1.`]);
   });
 
   it("test_it_says_why_the_last_training_failed_and_what_is_kept", () => {

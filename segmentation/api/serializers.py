@@ -160,15 +160,16 @@ class RunSerializer(serializers.ModelSerializer):
 
 
 class CutModelSerializer(serializers.ModelSerializer):
-    """One training of a project's cut model: a version, or why it failed."""
+    """One training of a project's cut model: a version, why it failed, or why the model
+    was refused (``refused``; no version)."""
 
     error = ErrorField()
 
     class Meta:
         model = ProjectCutModel
         fields = [
-            "id", "version", "status", "error", "n_takes", "n_cuts", "seconds", "created_at",
-            "finished_at",
+            "id", "version", "status", "error", "refused", "n_takes", "n_cuts", "held_out_takes",
+            "held_out_edits_per_cut", "held_out_f1", "seconds", "created_at", "finished_at",
         ]
 
 
@@ -340,10 +341,19 @@ class ReviewSegmentSerializer(serializers.Serializer):
     label = serializers.CharField(allow_null=True)
 
 
+class HeldOutSerializer(serializers.Serializer):
+    """A model's own figure: each reviewed take scored by a model fitted without it."""
+
+    n_takes = serializers.IntegerField(help_text="Reviewed takes scored.")
+    edits_per_cut = serializers.FloatField(help_text="Review edits per true cut there (manual cutting: 1).")
+    f1 = serializers.FloatField(help_text="Boundary F1 there, within 1 s.")
+
+
 class ProjectModelSerializer(serializers.Serializer):
     version = serializers.IntegerField()
     n_takes = serializers.IntegerField()
     n_cuts = serializers.IntegerField()
+    held_out = HeldOutSerializer(allow_null=True, help_text="null: trained before the figure was kept.")
 
 
 class AdaptationSerializer(serializers.Serializer):
@@ -352,9 +362,13 @@ class AdaptationSerializer(serializers.Serializer):
     model_version = serializers.IntegerField(allow_null=True,
                                              help_text="The review's run; null: the zero-shot detector.")
     n_takes = serializers.IntegerField(allow_null=True, help_text="Reviewed takes that model learnt from.")
+    held_out = HeldOutSerializer(allow_null=True, help_text="That model's own figure; null: zero-shot, "
+                                 "or trained before the figure was kept.")
     project_model = ProjectModelSerializer(allow_null=True)
     training = serializers.BooleanField(help_text="A training is queued or running.")
     training_error = serializers.CharField(allow_null=True, help_text="Why the last training failed.")
+    training_refused = serializers.CharField(
+        allow_null=True, help_text="Why the model of the last training was refused (the project keeps its model).")
 
 
 # A review's statuses, and that of the review a caller has not started yet (the schema's

@@ -168,8 +168,13 @@ class CutModelQuerySet(ClaimQuerySet):
         return super(CutModelQuerySet, self.filter(~models.Exists(busy))).claim(pk, token)
 
     def newest(self, project_id):
-        """The project's newest trained model, or None (zero-shot)."""
-        return self.filter(project_id=project_id, status="ready").order_by("-version").first()
+        """The project's newest model in use, or None (zero-shot). A refused model has no
+        version and is never in use."""
+        return (
+            self.filter(project_id=project_id, status="ready", version__isnull=False)
+            .order_by("-version")
+            .first()
+        )
 
 
 class ProjectCutModel(Job):
@@ -177,9 +182,15 @@ class ProjectCutModel(Job):
 
     A row is one request: queued when a review is submitted or a gold version saved
     (later requests fold into the queued one), then trained by a worker. A trained row
-    gets the project's next ``version``; a failed one keeps its ``error`` and no version,
-    and detection goes on with the newest trained version. ``model`` is
-    ``motionlib.adapt.CutModel.to_json()``.
+    gets the project's next ``version`` if the gate accepts it; a model the gate refused
+    is kept (``status`` ready) with no version and the reason in ``refused``; a failed
+    training keeps its ``error`` and no version. Detection goes on with the newest
+    version. ``model`` is ``motionlib.adapt.CutModel.to_json()``.
+
+    ``trained_on`` lists the captures the model learnt from, so that a later training
+    can score it on the takes it did not see; ``held_out_*`` is the model's own figure,
+    each reviewed take scored by a model fitted without it (see
+    ``services.model_gate``).
     """
 
     project = models.ForeignKey(Project, models.CASCADE, related_name="cut_models")
@@ -190,6 +201,11 @@ class ProjectCutModel(Job):
     seconds = models.FloatField(null=True, blank=True)
     created_at = models.DateTimeField(default=timezone.now)
     finished_at = models.DateTimeField(null=True, blank=True)
+    trained_on = models.JSONField(default=list, blank=True)
+    held_out_takes = models.PositiveIntegerField(null=True, blank=True)
+    held_out_edits_per_cut = models.FloatField(null=True, blank=True)
+    held_out_f1 = models.FloatField(null=True, blank=True)
+    refused = models.TextField(blank=True)
 
     objects = CutModelQuerySet.as_manager()
     task = "retrain"

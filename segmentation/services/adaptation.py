@@ -1,13 +1,16 @@
 """Learning each project's cutting from its own reviews.
 
 A project's examples are its reviewed takes: the gold version of a capture where one was
-saved, else its most recently submitted review (one example per take, so every take
-weighs the same and "learnt from N reviewed takes" counts takes). After a submit or a
-gold save, ``request_training`` queues one training per project (requests made while one
-waits join it); a worker trains with ``motionlib.adapt.fit_cut_model`` and stores the
-model as the project's next version. Runs of the ``default`` method detect with the
-newest version; a project without one uses the zero-shot detector. A failed training
-stores its reason and leaves the newest version in use.
+saved, else the consensus of all its submitted reviews (``consensus.consensus_cuts``: one
+example per take, so every take weighs the same and "learnt from N reviewed takes" counts
+takes, and no single annotator decides a take's cuts). After a submit or a gold save,
+``request_training`` queues one training per project (requests made while one waits join
+it); a worker trains with ``motionlib.adapt.fit_cut_model``, scores the new model against
+the current one on reviewed takes each did not learn from (``model_gate``) and stores it
+as the project's next version only if it is not worse; a refused model is stored with the
+reason and no version. Runs of the ``default`` method detect with the newest version; a
+project without one uses the zero-shot detector. A failed training stores its reason and
+leaves the newest version in use.
 
 What the fit learnt from each reviewed take (its study) is stored beside the parsed take
 (``takecache.StoredStudies``), so a retraining after one more submit reads and analyses
@@ -19,6 +22,7 @@ import dataclasses
 import functools
 import logging
 import time
+from collections import defaultdict
 
 from django.conf import settings
 from django.db import IntegrityError, transaction
@@ -28,9 +32,10 @@ from django.utils import timezone
 from motionlib.errors import MotionlibError
 from motionlib.segmenters import get_segmenter
 from segmentation import takecache
+from segmentation.consensus import consensus_cuts
 from segmentation.errors import CutroomError, Invalid
 from segmentation.models import Capture, ProjectCutModel, Review
-from segmentation.services import jobs
+from segmentation.services import jobs, model_gate
 from segmentation.services.jobs import Kind, register
 from segmentation.storage import read_take
 
@@ -74,27 +79,34 @@ def request_training(project_id):
 # ---- training ----------------------------------------------------------------------------
 
 
+# Two annotators' cuts within this many seconds are the same cut (the learner's and the
+# gate's matching tolerance too).
+CONSENSUS_S = 1.0
+
+
 def project_examples(project_id):
-    """``[(capture, cuts)]``: each reviewed ready capture of the project with its gold
-    cuts, else the kept cuts of its most recently submitted review (0-based frames)."""
+    """``[(capture, cuts)]``, by capture id: each reviewed ready capture of the project with
+    its gold cuts, else the consensus of the kept cuts of all its submitted reviews
+    (0-based frames)."""
     captures = Capture.objects.filter(project_id=project_id, status="ready").select_related(
         "adjudication"
     ).order_by("id")
     reviews = (
         Review.objects.filter(capture__project_id=project_id, status="submitted")
         .prefetch_related("cuts")
-        .order_by("capture_id", "-submitted_at", "-id")
+        .order_by("capture_id", "id")
     )
-    latest = {}
+    submitted = defaultdict(list)
     for review in reviews:
-        latest.setdefault(review.capture_id, review)
+        submitted[review.capture_id].append([c.frame for c in review.kept_cuts()])
     examples = []
     for capture in captures:
         gold = getattr(capture, "adjudication", None)
         if gold is not None:
             examples.append((capture, sorted(gold.cuts)))
-        elif capture.pk in latest:
-            examples.append((capture, sorted(c.frame for c in latest[capture.pk].kept_cuts())))
+        elif capture.pk in submitted:
+            tolerance = int(round(CONSENSUS_S * capture.fps))
+            examples.append((capture, consensus_cuts(submitted[capture.pk], tolerance)))
     return examples
 
 
@@ -137,22 +149,51 @@ def _train(job):
     examples = project_examples(job.project_id)
     if not examples:
         raise Invalid("the project has no submitted review or gold version to learn from")
-    from motionlib import adapt
-
-    model = adapt.fit_cut_model(
-        [example(capture, cuts) for capture, cuts in examples],
-        studies=takecache.StoredStudies(Capture._meta.get_field("original").storage),
+    stored = takecache.StoredStudies(Capture._meta.get_field("original").storage)
+    # The full fit first, with the stored studies: they stay those of the examples as they
+    # are, which the next training reads (the gate's refits keep theirs in memory).
+    model = fit_examples(examples, stored)
+    # One training at a time per project: no other version appears before this one ends.
+    current = ProjectCutModel.objects.newest(job.project_id)
+    refits = model_gate.FoldStudies(stored)
+    verdict = model_gate.judge(
+        examples, current, _loaded(current.pk, current.version) if current else None,
+        fit=lambda chosen: fit_examples(chosen, refits) if chosen else None,
+        detect=lambda take, cut_model: _candidates(take, cut_model),
+        take_of=example_take,
     )
     with transaction.atomic():
         newest = ProjectCutModel.objects.filter(project_id=job.project_id).aggregate(v=Max("version"))
         job.finish(
-            version=(newest["v"] or 0) + 1,
+            version=None if verdict.refused else (newest["v"] or 0) + 1,
+            refused=verdict.refused,
             model=model.to_json(),
             n_takes=model.n_takes,
             n_cuts=model.n_cuts,
+            trained_on=[capture.pk for capture, _cuts in examples],
+            held_out_takes=verdict.figure.takes,
+            held_out_edits_per_cut=round(verdict.figure.edits_per_cut, 4),
+            held_out_f1=round(verdict.figure.f1, 4),
             seconds=round(time.perf_counter() - started, 3),
             finished_at=timezone.now(),
         )
+
+
+def fit_examples(examples, studies):
+    """``motionlib.adapt.fit_cut_model`` over ``[(capture, cuts)]``."""
+    from motionlib import adapt
+
+    return adapt.fit_cut_model([example(capture, cuts) for capture, cuts in examples],
+                               studies=studies)
+
+
+def _candidates(take, cut_model):
+    """The candidate frames the default detector with ``cut_model`` (None: zero-shot)
+    proposes on ``take``, with the detector's own parameters as the fit learns from them
+    (a project's ``default_params`` are left out of both)."""
+    from motionlib import adapt
+
+    return [int(f) for f in adapt.detect(take, cut_model).cuts]
 
 
 RETRAIN = register(Kind("retrain", ProjectCutModel, "Training", _train, "CUTROOM_RETRAIN_TIME_LIMIT"))
@@ -181,16 +222,23 @@ def detect(run, take):
     return result, {"model_version": newest.version, "model_n_takes": newest.n_takes}
 
 
-@functools.lru_cache(maxsize=32)
 def _loaded(pk, version):
-    """A stored model, parsed once per worker process (rows never change once trained).
+    """A stored model, parsed once per worker process.
 
-    A model this version of motionlib cannot read (stored by an older release) is logged
-    and detection falls back to the zero-shot detector until the project retrains.
+    The cache is keyed by the stored text, not the row: a row id can come back after its
+    project was deleted (SQLite reuses the highest one), and a model parsed for the old
+    row must not stand in for the new one.
     """
+    text = ProjectCutModel.objects.values_list("model", flat=True).get(pk=pk)
+    return _parsed(text, version, pk)
+
+
+@functools.lru_cache(maxsize=32)
+def _parsed(text, version, pk):
+    """A model this version of motionlib cannot read (stored by an older release) is logged
+    and detection falls back to the zero-shot detector until the project retrains."""
     from motionlib import adapt
 
-    text = ProjectCutModel.objects.values_list("model", flat=True).get(pk=pk)
     try:
         return adapt.CutModel.from_json(text)
     except ValueError:
@@ -203,7 +251,8 @@ def _loaded(pk, version):
 
 def adaptation_summary(run, project_id):
     """What a review page says about adaptation: the model its candidates came from
-    (None: zero-shot) and the project's current model and last failed training."""
+    (None: zero-shot) with its own held-out figure, the project's current model, and why
+    the last training failed or was refused."""
     newest = ProjectCutModel.objects.newest(project_id)
     # Trainings end in the order they were asked for (one at a time per project).
     last = (
@@ -214,14 +263,31 @@ def adaptation_summary(run, project_id):
     training = ProjectCutModel.objects.filter(
         project_id=project_id, status__in=("queued", "processing")
     ).exists()
+    version = run.model_version if run else None
+    used = newest if newest is not None and newest.version == version else (
+        ProjectCutModel.objects.filter(project_id=project_id, version=version).first()
+        if version is not None else None
+    )
     return {
-        "model_version": run.model_version if run else None,
+        "model_version": version,
         "n_takes": run.model_n_takes if run else None,
+        "held_out": held_out(used),
         "project_model": (
-            {"version": newest.version, "n_takes": newest.n_takes, "n_cuts": newest.n_cuts}
+            {"version": newest.version, "n_takes": newest.n_takes, "n_cuts": newest.n_cuts,
+             "held_out": held_out(newest)}
             if newest else None
         ),
         "training": training,
         "training_error": last.error if last is not None and last.status == "failed" else None,
+        "training_refused": (last.refused or None) if last is not None and last.status == "ready" else None,
     }
 
+
+def held_out(row):
+    """A trained model's own figure (``model_gate``): the reviewed takes it was scored on,
+    each by a model fitted without it, with the review edits per true cut and F1 there;
+    None for a model trained before the figure was kept."""
+    if row is None or row.held_out_takes is None:
+        return None
+    return {"n_takes": row.held_out_takes, "edits_per_cut": row.held_out_edits_per_cut,
+            "f1": row.held_out_f1}

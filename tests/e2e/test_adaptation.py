@@ -2,6 +2,9 @@
 reviewer re-detects an untouched capture from the capture list (an annotator is not
 offered to)."""
 
+import re
+
+import pytest
 from django.core.files.uploadedfile import SimpleUploadedFile
 from playwright.sync_api import expect
 
@@ -50,6 +53,40 @@ def test_the_review_page_says_how_many_reviewed_takes_the_candidates_came_from(l
     page.goto(f"{live_server.url}/captures/{capture.pk}/")
 
     expect(page.get_by_test_id("adaptation-line")).to_have_text("Candidates adapted from 2 reviewed takes (model v1).")
+    assert page.errors == []
+
+
+def retrain(studio):
+    """Run the project's queued training here, in-process, as a worker would."""
+    job = ProjectCutModel.objects.get(project=studio["project"], status="queued")
+    tasks.retrain(job.pk)
+    return ProjectCutModel.objects.get(pk=job.pk)
+
+
+def test_the_review_page_shows_the_models_figure_and_why_a_retraining_was_refused(live_server, new_page, studio):
+    for seed in (86, 87):
+        review_to_the_truth(ingest(studio, seed), studio["bob"], seed)
+    v1 = retrain(studio)
+    # ann under-cuts: she deletes every candidate of five takes and inserts nothing.
+    for seed in (88, 89, 90, 91, 92):
+        review = services.get_or_create_review(ingest(studio, seed), studio["ann"])
+        for cut in list(review.cuts.all()):
+            services.do_change_cut(review, studio["ann"], cut, review.version, fate="deleted")
+        services.do_submit_review(review, studio["ann"], review.version)
+    refused = retrain(studio)
+    assert (v1.version, refused.version) == (1, None), refused.error
+    capture = ingest(studio, seed=93)
+
+    page = new_page("bob")
+    page.goto(f"{live_server.url}/captures/{capture.pk}/")
+
+    figure = page.get_by_test_id("adaptation-figure")
+    expect(figure).to_have_text(re.compile(
+        r"Learnt from 2 reviewed takes; on 2 held-out reviewed takes \d\.\d\d edits per cut, F1 \d\.\d\d\."))
+    shown = [float(x) for x in re.findall(r"\d\.\d\d", figure.inner_text())]
+    assert shown == pytest.approx([v1.held_out_edits_per_cut, v1.held_out_f1], abs=0.0051)  # rounded to 2 decimals
+    expect(page.get_by_test_id("adaptation-note")).to_have_text(
+        f"Last retraining {refused.refused}. The project keeps model v1.")
     assert page.errors == []
 
 

@@ -101,18 +101,24 @@ class StoredStudiesTestCase(ReviewedTakesTestCase):
         examples = adaptation.project_examples(self.project.pk)
         return adapt.fit_cut_model([(adaptation.example_take(c), cuts) for c, cuts in examples])
 
-    def test_a_retraining_reads_no_take_whose_study_is_stored(self):
+    def test_a_refit_reads_no_take_whose_study_is_stored(self):
+        # The training's fit; its gate then detects on the takes it scores (model_gate).
         first = self.train([81, 82])
-        captures = [c for c, _ in adaptation.project_examples(self.project.pk)]
-        storage = captures[0].original.storage
-        for capture in captures:
+        examples = adaptation.project_examples(self.project.pk)
+        storage = examples[0][0].original.storage
+        for capture, _cuts in examples:
             self.assertTrue(storage.exists(StoredStudies.name(takecache.example_key(capture))))
             # Without its original and its parsed copy, a take that had to be read would
-            # fail the training.
+            # fail the fit.
             for name in (capture.original.name, *takecache.cache_names(capture)):
                 storage.delete(name)
+        again = adaptation.fit_examples(examples, StoredStudies(storage))
+        self.assertEqual(again.to_json(), first.model)
+
+    def test_a_retraining_on_the_same_examples_is_accepted_as_the_next_version(self):
+        first = self.train([81, 82])
         again = self.retrain()
-        self.assertEqual((again.version, again.model), (first.version + 1, first.model))
+        self.assertEqual((again.version, again.model, again.refused), (first.version + 1, first.model, ""))
 
     def test_a_take_reviewed_again_is_analysed_again_and_the_model_is_as_learnt_afresh(self):
         self.train([83, 84])

@@ -145,7 +145,8 @@ class FailedTrainingTestCase(AdaptationTestCase):
         self.login(self.bob)
         adapted = self.client.get(f"/api/captures/{self.capture.pk}/review/").json()["adaptation"]
         self.assertIn("broken", adapted["training_error"])
-        self.assertEqual(adapted["project_model"], {"version": 1, "n_takes": 2, "n_cuts": 6})
+        self.assertEqual(adapted["project_model"],
+                         {"version": 1, "n_takes": 2, "n_cuts": 6, "held_out": None})
 
     def test_a_later_successful_state_clears_the_failure_note(self):
         self.train()
@@ -167,11 +168,26 @@ class ExamplesTestCase(AdaptationTestCase):
         gold.do_save_gold(capture, self.rachel, [120, 250], ["walk", "punch", None], 0)
         self.assertEqual(adaptation.project_examples(self.project.pk), [(capture, [120, 250])])
 
-    def test_a_take_reviewed_twice_is_one_example_the_latest_submitted(self):
-        capture = self.ready_capture(candidates=(100, 200, 300))
+    def test_a_take_reviewed_twice_is_one_example_keeping_the_cuts_either_made(self):
+        # Two reviews: a cut one of them made has the support of half of them.
+        capture = self.ready_capture(candidates=(100, 300, 500), n_frames=700)
         self.submit_review(capture, self.bob, keep={100})
-        self.submit_review(capture, self.rachel, keep={200})
-        self.assertEqual(adaptation.project_examples(self.project.pk), [(capture, [200])])
+        self.submit_review(capture, self.rachel, keep={300})
+        self.assertEqual(adaptation.project_examples(self.project.pk), [(capture, [100, 300])])
+
+    def test_one_under_cutting_annotator_among_three_removes_no_cut(self):
+        capture = self.ready_capture(candidates=(100, 300, 500), n_frames=700)
+        self.submit_review(capture, self.bob)
+        self.submit_review(capture, self.alice, keep=set())
+        self.submit_review(capture, self.rachel)
+        self.assertEqual(adaptation.project_examples(self.project.pk), [(capture, [100, 300, 500])])
+
+    def test_a_cut_only_one_of_three_annotators_kept_is_left_out(self):
+        capture = self.ready_capture(candidates=(100, 300, 500), n_frames=700)
+        self.submit_review(capture, self.bob, keep={300})
+        self.submit_review(capture, self.alice, keep={100, 300})
+        self.submit_review(capture, self.rachel, keep={300, 500})
+        self.assertEqual(adaptation.project_examples(self.project.pk), [(capture, [300])])
 
     def test_reviews_in_progress_do_not_count(self):
         self.login(self.bob)

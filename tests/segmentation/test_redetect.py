@@ -84,8 +84,8 @@ class ReviewAdaptationTestCase(BaseTestCase):
         adapted = self.adaptation(self.ready_capture())
         self.assertEqual(
             adapted,
-            {"model_version": None, "n_takes": None, "project_model": None, "training": False,
-             "training_error": None},
+            {"model_version": None, "n_takes": None, "held_out": None, "project_model": None,
+             "training": False, "training_error": None, "training_refused": None},
         )
 
     def test_it_names_the_model_and_the_reviewed_takes_it_learnt_from(self):
@@ -95,7 +95,8 @@ class ReviewAdaptationTestCase(BaseTestCase):
                                        model="{}", n_takes=12, n_cuts=40)
         adapted = self.adaptation(capture)
         self.assertEqual((adapted["model_version"], adapted["n_takes"]), (3, 12))
-        self.assertEqual(adapted["project_model"], {"version": 3, "n_takes": 12, "n_cuts": 40})
+        self.assertEqual(adapted["project_model"],
+                         {"version": 3, "n_takes": 12, "n_cuts": 40, "held_out": None})
 
     def test_it_says_when_a_training_is_under_way(self):
         ProjectCutModel.objects.create(project=self.project)

@@ -865,11 +865,15 @@ export interface components {
             model_version: number | null;
             /** @description Reviewed takes that model learnt from. */
             n_takes: number | null;
+            /** @description That model's own figure; null: zero-shot, or trained before the figure was kept. */
+            held_out: components["schemas"]["HeldOut"] | null;
             project_model: components["schemas"]["ProjectModel"] | null;
             /** @description A training is queued or running. */
             training: boolean;
             /** @description Why the last training failed. */
             training_error: string | null;
+            /** @description Why the model of the last training was refused (the project keeps its model). */
+            training_refused: string | null;
         };
         Adjudication: {
             capture: components["schemas"]["AdjudicationCapture"];
@@ -1075,17 +1079,27 @@ export interface components {
          * @enum {string}
          */
         CutFateEnum: "pending" | "accepted" | "moved" | "deleted";
-        /** @description One training of a project's cut model: a version, or why it failed. */
+        /**
+         * @description One training of a project's cut model: a version, why it failed, or why the model
+         *     was refused (``refused``; no version).
+         */
         CutModel: {
             readonly id: number;
             /** Format: int64 */
             version: number | null;
             status: components["schemas"]["JobStatusEnum"];
             readonly error: string | null;
+            refused: string;
             /** Format: int64 */
             n_takes: number;
             /** Format: int64 */
             n_cuts: number;
+            /** Format: int64 */
+            held_out_takes: number | null;
+            /** Format: double */
+            held_out_edits_per_cut: number | null;
+            /** Format: double */
+            held_out_f1: number | null;
             /** Format: double */
             seconds: number | null;
             /** Format: date-time */
@@ -1168,6 +1182,21 @@ export interface components {
             labels: (string | null)[];
             version: number;
             source_review?: number | null;
+        };
+        /** @description A model's own figure: each reviewed take scored by a model fitted without it. */
+        HeldOut: {
+            /** @description Reviewed takes scored. */
+            n_takes: number;
+            /**
+             * Format: double
+             * @description Review edits per true cut there (manual cutting: 1).
+             */
+            edits_per_cut: number;
+            /**
+             * Format: double
+             * @description Boundary F1 there, within 1 s.
+             */
+            f1: number;
         };
         InsertCutRequest: {
             version: number;
@@ -1455,6 +1484,8 @@ export interface components {
             version: number;
             n_takes: number;
             n_cuts: number;
+            /** @description null: trained before the figure was kept. */
+            held_out: components["schemas"]["HeldOut"] | null;
         };
         ProjectRequest: {
             name: string;

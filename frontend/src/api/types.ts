@@ -59,6 +59,8 @@ export type OpenedReview = Schemas["ReviewPage"];
 export type Review = Omit<ApiReview, "cuts" | "segments"> & { cuts: Cut[]; segments: Segment[] };
 /** Where a review's candidates came from, and the project's learnt model. */
 export type Adaptation = Schemas["Adaptation"];
+/** A model's own figure: each reviewed take scored by a model fitted without it. */
+export type HeldOut = Schemas["HeldOut"];
 export type ReviewEvent = Schemas["Event"];
 
 export function isReady(capture: Capture): capture is ReadyCapture {

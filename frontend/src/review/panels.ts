@@ -1,6 +1,6 @@
 // The side panels of the review page, each redrawn whole from the current state.
 
-import type { Adaptation, Cut, Label, Review, ReviewEvent, Segment } from "../api/types";
+import type { Adaptation, Cut, HeldOut, Label, Review, ReviewEvent, Segment } from "../api/types";
 import { clear, formatDuration, h } from "../ui/dom";
 import { eventDetail } from "./events";
 import { FATE_TEXT } from "./state";
@@ -93,25 +93,37 @@ const takes = (n: number) => `${n} reviewed take${n === 1 ? "" : "s"}`;
 
 /**
  * Where the candidates came from — "adapted from 12 reviewed takes" or "not adapted yet" —
- * then the project's newer model, a training under way, or why the last one failed.
+ * that model's own figure on held-out reviewed takes, then the project's newer model, a
+ * training under way, or why the last one failed or its model was refused.
  */
-export function adaptationLines(a: Adaptation | undefined): { line: string; notes: string[] } {
-  if (!a) return { line: "", notes: [] };
+export function adaptationLines(a: Adaptation | undefined): { line: string; figure: string; notes: string[] } {
+  if (!a) return { line: "", figure: "", notes: [] };
   const adapted = a.model_version !== null && a.n_takes !== null;
   const line = adapted ? `Candidates adapted from ${takes(a.n_takes!)} (model v${a.model_version}).` : "Candidates not adapted yet (zero-shot detector).";
+  const figure = adapted && a.held_out ? `Learnt from ${takes(a.n_takes!)}; ${heldOut(a.held_out)}.` : "";
   const notes: string[] = [];
   const project = a.project_model;
-  if (project && project.version !== a.model_version) notes.push(`The project's model is now v${project.version}, from ${takes(project.n_takes)}.`);
+  if (project && project.version !== a.model_version) {
+    notes.push(`The project's model is now v${project.version}, from ${takes(project.n_takes)}${project.held_out ? `; ${heldOut(project.held_out)}` : ""}.`);
+  }
   if (a.training) notes.push("Retraining on the newest reviews…");
-  if (a.training_error) notes.push(`Last retraining failed: ${a.training_error} The project keeps ${project ? `model v${project.version}` : "the zero-shot detector"}.`);
-  return { line, notes };
+  const kept = project ? `model v${project.version}` : "the zero-shot detector";
+  if (a.training_error) notes.push(`Last retraining failed: ${a.training_error} The project keeps ${kept}.`);
+  if (a.training_refused) notes.push(`Last retraining ${a.training_refused}. The project keeps ${kept}.`);
+  return { line, figure, notes };
+}
+
+/** "on 5 held-out reviewed takes 0.30 edits per cut, F1 0.91" */
+function heldOut(h: HeldOut): string {
+  return `on ${h.n_takes} held-out reviewed take${h.n_takes === 1 ? "" : "s"} ${h.edits_per_cut.toFixed(2)} edits per cut, F1 ${h.f1.toFixed(2)}`;
 }
 
 export function renderAdaptation(el: HTMLElement, a: Adaptation | undefined): void {
-  const { line, notes } = adaptationLines(a);
+  const { line, figure, notes } = adaptationLines(a);
   clear(
     el,
     line ? h("div", { "data-testid": "adaptation-line" }, line) : null,
-    ...notes.map((note) => h("div", { class: note.startsWith("Last retraining failed") ? "error-text small" : "muted small", "data-testid": "adaptation-note" }, note)),
+    figure ? h("div", { class: "muted small", "data-testid": "adaptation-figure" }, figure) : null,
+    ...notes.map((note) => h("div", { class: note.startsWith("Last retraining") ? "error-text small" : "muted small", "data-testid": "adaptation-note" }, note)),
   );
 }

@@ -182,3 +182,35 @@ def test_an_annotator_cannot_redetect(running_workers, studio):
     response = client_for(studio["bob"]).post(f"/api/captures/{capture.pk}/redetect/")
     assert response.status_code == 403
     assert DetectionRun.objects.filter(capture=capture).count() == 1
+
+
+def test_a_model_learnt_from_an_under_cutting_annotator_is_refused_and_the_page_says_why(running_workers, studio):
+    train_on(studio, [81, 82])
+    assert ProjectCutModel.objects.newest(studio["project"].pk).version == 1
+    dave = get_user_model().objects.create_user("dave", password="dave-password")
+    services.do_set_member(studio["project"], "dave", "annotator")
+    # dave deletes every candidate of five takes, inserts nothing, and submits them in a burst.
+    client = client_for(dave)
+    edited = []
+    for capture in [upload(studio, seed) for seed in (83, 84, 85, 86, 87)]:
+        url = f"/api/captures/{capture.pk}/review"
+        review = client.post(f"{url}/").json()
+        for cut in review["cuts"]:
+            review = client.patch(f"{url}/cuts/{cut['id']}/", {"fate": "deleted", "version": review["version"]},
+                                  format="json").json()
+        edited.append((url, review["version"]))
+    for url, version in edited:
+        response = client.post(f"{url}/submit/", {"version": version}, format="json")
+        assert response.status_code == 200, response.content
+    wait_for(lambda: ProjectCutModel.objects.filter(project=studio["project"], n_takes=7).exists()
+             and trainings_settled(studio["project"]), timeout=180, what="the retraining")
+
+    refused = ProjectCutModel.objects.get(project=studio["project"], n_takes=7)
+    assert (refused.status, refused.version) == ("ready", None), refused.error
+    assert refused.refused.startswith("refused: on 2 held-out reviewed takes that the current model v1 learnt from")
+    assert ProjectCutModel.objects.newest(studio["project"].pk).version == 1
+    capture = upload(studio, 88)
+    assert capture.latest_run().model_version == 1
+    adaptation = client_for(studio["bob"]).get(f"/api/captures/{capture.pk}/review/").json()["adaptation"]
+    assert adaptation["training_refused"] == refused.refused
+    assert adaptation["held_out"]["n_takes"] == 2
