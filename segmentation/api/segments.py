@@ -8,6 +8,7 @@
 Annotators see their own segments and gold segments; reviewers and admins everybody's.
 """
 
+import heapq
 import itertools
 import operator
 
@@ -44,10 +45,10 @@ class SegmentPagination(PageNumberPagination):
     or none at all on the last page); beyond it ``count`` is the cap and ``count_capped``
     is true, so a page of a huge library costs as much as a page of a small one.
 
-    The query comes as ordered parts whose concatenation is the list (see
-    ``ordered_parts``): one part, or one per label name when ordered by label, so that
-    each part is read in its order from an index, and a deep page skips whole parts by
-    counting them (capped at what is left to skip) instead of sorting every match.
+    The query comes as ordered ``Part``s whose concatenation is the list (see
+    ``ordered_parts``): one, or one per label name when ordered by label, so that each is
+    read in its order from an index, and a deep page skips whole parts by counting them
+    (capped at what is left to skip) instead of sorting every match.
     """
 
     page_size = 50
@@ -58,7 +59,7 @@ class SegmentPagination(PageNumberPagination):
     def paginate_queryset(self, queryset, request, view=None, parts=None):
         """The page's rows of ``queryset``, read as ``parts`` (default: the query whole)."""
         self.request = request
-        parts = [queryset] if parts is None else parts
+        parts = [Part([queryset])] if parts is None else parts
         size = self.get_page_size(request)
         self.number = int_param(request, self.page_query_param, 1, 1, 1_000_000)
         offset = (self.number - 1) * size
@@ -105,8 +106,36 @@ class SegmentPagination(PageNumberPagination):
         return page
 
 
+class Part:
+    """One ordered run of the list: a query, or one query per label merged by id.
+
+    A filter on several labels (one name in several projects) cannot be read in id order
+    from one index; one query per label, each pinned to its label's project, can, and
+    merging them costs as many ids per label as the page needs.
+    """
+
+    def __init__(self, queries, descending=False):
+        self.queries, self.descending = queries, descending
+
+    def count(self, cap):
+        """How many rows the part holds, counting no further than ``cap``."""
+        total = 0
+        for query in self.queries:
+            total += query.order_by()[:cap - total].count()
+            if total >= cap:
+                break
+        return total
+
+    def ids(self, offset, limit):
+        if len(self.queries) == 1:
+            return list(self.queries[0].values_list("id", flat=True)[offset:offset + limit])
+        runs = [list(q.values_list("id", flat=True)[:offset + limit]) for q in self.queries]
+        merged = heapq.merge(*runs, reverse=self.descending)
+        return list(itertools.islice(merged, offset, offset + limit))
+
+
 def page_ids(parts, offset, limit):
-    """Ids ``offset`` to ``offset + limit`` of the concatenation of the ordered ``parts``.
+    """Ids ``offset`` to ``offset + limit`` of the concatenation of the ``parts``.
 
     A part wholly before the window is only counted, at most ``offset`` rows of it.
     """
@@ -115,11 +144,11 @@ def page_ids(parts, offset, limit):
         if len(ids) >= limit:
             break
         if offset:
-            skipped = part.order_by()[:offset].count()
+            skipped = part.count(offset)
             if skipped < offset:
                 offset -= skipped
                 continue
-        ids += part.values_list("id", flat=True)[offset:offset + limit - len(ids)]
+        ids += part.ids(offset, limit - len(ids))
         offset = 0
     return ids
 
@@ -128,7 +157,7 @@ def capped_count(parts, cap):
     """How many rows ``parts`` hold together, counting no further than ``cap + 1``."""
     total = 0
     for part in parts:
-        total += part.order_by()[:cap + 1 - total].count()
+        total += part.count(cap + 1 - total)
         if total > cap:
             break
     return total
@@ -220,17 +249,26 @@ def visible_labels(request):
 
 
 def ordered_parts(request, segments):
-    """``segments`` (a ``segment_query``) as ordered parts whose concatenation is the list.
+    """``segments`` (a ``segment_query``) as ``Part``s whose concatenation is the list.
 
     Ordered by label, the list is each label name's segments by id, names in the
-    database's order: one part per name, each read from the label index in id order,
-    rather than the whole library joined to its labels and sorted.
+    database's order: one part per name, read from the label index in id order, rather
+    than the whole library joined to its labels and sorted. Newest first with a label
+    name that several projects use, one part merging each label's segments.
     """
-    if (request.query_params.get("ordering") or "recent") != "label":
-        return [segments]
-    labels = visible_labels(request).order_by("name", "id").values_list("name", "id")
-    return [segments.filter(**one_of("label_id", [pk for _, pk in group])).order_by("id")
-            for _, group in itertools.groupby(labels, key=operator.itemgetter(0))]
+    ordering = request.query_params.get("ordering") or "recent"
+    labels = visible_labels(request).order_by("name", "id").values_list("name", "id", "project_id")
+    if ordering == "label":
+        return [Part([segments.filter(project_id=project, label_id=pk).order_by("id")
+                      for _, pk, project in group])
+                for _, group in itertools.groupby(labels, key=operator.itemgetter(0))]
+    name = request.query_params.get("label")
+    if ordering == "recent" and name:
+        labels = list(labels.filter(name=name))
+        if len(labels) > 1:
+            return [Part([segments.filter(project_id=project, label_id=pk)
+                          for _, pk, project in labels], descending=True)]
+    return [Part([segments])]
 
 
 def segment_for(user, pk):
