@@ -137,13 +137,14 @@ class Part:
 def page_ids(parts, offset, limit):
     """Ids ``offset`` to ``offset + limit`` of the concatenation of the ``parts``.
 
-    A part wholly before the window is only counted, at most ``offset`` rows of it.
+    A part wholly before the window is only counted, at most ``offset`` rows of it (the
+    last part need not be: its window is empty or its rows).
     """
     ids = []
-    for part in parts:
+    for index, part in enumerate(parts):
         if len(ids) >= limit:
             break
-        if offset:
+        if offset and index < len(parts) - 1:
             skipped = part.count(offset)
             if skipped < offset:
                 offset -= skipped
