@@ -219,9 +219,7 @@ def segment_query(request):
     if request.query_params.get("label"):
         # By the ids the name has in the caller's projects, not by joining the label table,
         # so that the filter is a column of the list's indexes.
-        ids = list(visible_labels(request).filter(name=request.query_params["label"])
-                   .values_list("id", flat=True))
-        segments = segments.filter(**one_of("label_id", ids))
+        segments = segments.filter(**one_of("label_id", [pk for _, pk, _ in named_labels(request)]))
     for name, lookup, high in (("min_duration", "duration__gte", None),
                                ("max_duration", "duration__lte", None),
                                ("min_agreement", "agreement__gte", 1)):
@@ -249,6 +247,15 @@ def visible_labels(request):
     return labels if project is None else labels.filter(project_id=project)
 
 
+def named_labels(request):
+    """``(name, id, project id)`` of the caller's labels the ``label`` filter names (read
+    once per request: the filter and ``ordered_parts`` both need them)."""
+    if not hasattr(request, "_named_labels"):
+        request._named_labels = list(visible_labels(request).filter(
+            name=request.query_params["label"]).values_list("name", "id", "project_id"))
+    return request._named_labels
+
+
 def ordered_parts(request, segments):
     """``segments`` (a ``segment_query``) as ``Part``s whose concatenation is the list.
 
@@ -263,9 +270,8 @@ def ordered_parts(request, segments):
         return [Part([segments.filter(project_id=project, label_id=pk).order_by("id")
                       for _, pk, project in group])
                 for _, group in itertools.groupby(labels, key=operator.itemgetter(0))]
-    name = request.query_params.get("label")
-    if ordering == "recent" and name:
-        labels = list(labels.filter(name=name))
+    if ordering == "recent" and request.query_params.get("label"):
+        labels = named_labels(request)
         if len(labels) > 1:
             return [Part([segments.filter(project_id=project, label_id=pk)
                           for _, pk, project in labels], descending=True)]
