@@ -69,11 +69,12 @@ pytest: install
 RECORD := $(PY) benchmarks/record.py
 RESULTS := benchmarks/results
 
-bench: install
+bench: install bpy
 	$(RECORD) $(RESULTS)/speed-io.md -- $(PY) -m benchmarks.quality speed io
 	$(RECORD) $(RESULTS)/quality.md -- $(PY) -m benchmarks.quality --loo
 	$(RECORD) $(RESULTS)/points-read.md -- $(PY) -m benchmarks.points_read
 	$(RECORD) $(RESULTS)/points-similar.md -- $(PY) -m benchmarks.points_similar
+	$(RECORD) $(RESULTS)/fbx-read.md -- $(PY) benchmarks/fbx_read.py
 	$(RECORD) $(RESULTS)/upload-to-candidates.md -- $(PY) benchmarks/upload_to_candidates.py
 	@command -v wrk >/dev/null || { apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq wrk; } \
 		|| echo "wrk not installed: the capture list benchmark uses its Python client"

@@ -8,6 +8,10 @@
 Annotators see their own segments and gold segments; reviewers and admins everybody's.
 """
 
+import heapq
+import itertools
+import operator
+
 from django.contrib.auth import get_user_model
 from django.http import HttpResponse, StreamingHttpResponse
 from django.urls import path
@@ -23,7 +27,7 @@ from segmentation import exports
 from segmentation.api.params import bool_param, float_param, int_param
 from segmentation.api.serializers import NamedRefSerializer, UserRefSerializer
 from segmentation.errors import Invalid
-from segmentation.models import LibrarySegment
+from segmentation.models import Label, LibrarySegment, Membership
 from segmentation.storage import read_take
 
 ORDERINGS = {
@@ -40,6 +44,11 @@ class SegmentPagination(PageNumberPagination):
     The count is exact up to ``count_cap`` matches (a count of at most that many rows,
     or none at all on the last page); beyond it ``count`` is the cap and ``count_capped``
     is true, so a page of a huge library costs as much as a page of a small one.
+
+    The query comes as ordered ``Part``s whose concatenation is the list (see
+    ``ordered_parts``): one, or one per label name when ordered by label, so that each is
+    read in its order from an index, and a deep page skips whole parts by counting them
+    (capped at what is left to skip) instead of sorting every match.
     """
 
     page_size = 50
@@ -47,14 +56,16 @@ class SegmentPagination(PageNumberPagination):
     max_page_size = 500
     count_cap = 10_000
 
-    def paginate_queryset(self, queryset, request, view=None):
+    def paginate_queryset(self, queryset, request, view=None, parts=None):
+        """The page's rows of ``queryset``, read as ``parts`` (default: the query whole)."""
         self.request = request
+        parts = [Part([queryset])] if parts is None else parts
         size = self.get_page_size(request)
         self.number = int_param(request, self.page_query_param, 1, 1, 1_000_000)
         offset = (self.number - 1) * size
         # The page's ids first (an index can answer that alone, however deep the page),
         # then its rows by id.
-        ids = list(queryset.values_list("id", flat=True)[offset:offset + size + 1])
+        ids = page_ids(parts, offset, size + 1)
         self.has_next = len(ids) > size
         found = queryset.order_by().in_bulk(ids[:size])
         rows = [found[pk] for pk in ids[:size] if pk in found]
@@ -62,7 +73,7 @@ class SegmentPagination(PageNumberPagination):
             self.count, self.capped = offset + len(rows), False
         else:
             cap = max(self.count_cap, offset + size + 1)
-            self.count = queryset.order_by()[:cap + 1].count()
+            self.count = capped_count(parts, cap)
             self.capped = self.count > cap
             self.count = min(self.count, cap)
         if not rows and self.number > 1:
@@ -93,6 +104,64 @@ class SegmentPagination(PageNumberPagination):
         page = super().get_paginated_response_schema(schema)
         page["properties"]["count_capped"] = {"type": "boolean"}
         return page
+
+
+class Part:
+    """One ordered run of the list: a query, or one query per label merged by id.
+
+    A filter on several labels (one name in several projects) cannot be read in id order
+    from one index; one query per label, each pinned to its label's project, can, and
+    merging them costs as many ids per label as the page needs.
+    """
+
+    def __init__(self, queries, descending=False):
+        self.queries, self.descending = queries, descending
+
+    def count(self, cap):
+        """How many rows the part holds, counting no further than ``cap``."""
+        total = 0
+        for query in self.queries:
+            total += query.order_by()[:cap - total].count()
+            if total >= cap:
+                break
+        return total
+
+    def ids(self, offset, limit):
+        if len(self.queries) == 1:
+            return list(self.queries[0].values_list("id", flat=True)[offset:offset + limit])
+        runs = [list(q.values_list("id", flat=True)[:offset + limit]) for q in self.queries]
+        merged = heapq.merge(*runs, reverse=self.descending)
+        return list(itertools.islice(merged, offset, offset + limit))
+
+
+def page_ids(parts, offset, limit):
+    """Ids ``offset`` to ``offset + limit`` of the concatenation of the ``parts``.
+
+    A part wholly before the window is only counted, at most ``offset`` rows of it (the
+    last part need not be: its window is empty or its rows).
+    """
+    ids = []
+    for index, part in enumerate(parts):
+        if len(ids) >= limit:
+            break
+        if offset and index < len(parts) - 1:
+            skipped = part.count(offset)
+            if skipped < offset:
+                offset -= skipped
+                continue
+        ids += part.ids(offset, limit - len(ids))
+        offset = 0
+    return ids
+
+
+def capped_count(parts, cap):
+    """How many rows ``parts`` hold together, counting no further than ``cap + 1``."""
+    total = 0
+    for part in parts:
+        total += part.count(cap + 1 - total)
+        if total > cap:
+            break
+    return total
 
 
 class SegmentSerializer(serializers.ModelSerializer):
@@ -129,10 +198,12 @@ def segment_query(request):
     """The caller's visible segments filtered by the query string (shared by list and zip)."""
     segments = LibrarySegment.objects.visible_to(request.user)
     gold = bool_param(request, "gold")
+    # ``__in`` rather than ``=``: on SQLite Django writes a boolean filter as ``NOT "column"``,
+    # which no index can seek to; ``IN (0)`` is an equality every index here can use.
     if gold is None:
-        segments = segments.preferred()
+        segments = segments.filter(superseded__in=[False])  # LibrarySegment.preferred()
     else:
-        segments = segments.filter(is_gold=gold)
+        segments = segments.filter(is_gold__in=[gold])
     for name, field in (("project", "project_id"), ("capture", "capture_id")):
         value = int_param(request, name, None, 1)
         if value is not None:
@@ -141,11 +212,14 @@ def segment_query(request):
     if annotator.isdigit():  # a user id (what the API said)
         segments = segments.filter(annotator_id=int_param(request, "annotator", None, 1))
     elif annotator:  # a username (what the page and a person write)
-        if not get_user_model().objects.filter(username=annotator).exists():
+        user_id = get_user_model().objects.filter(username=annotator).values_list("id", flat=True).first()
+        if user_id is None:
             raise Invalid(f"annotator: no user named {annotator[:150]!r}")
-        segments = segments.filter(annotator__username=annotator)
+        segments = segments.filter(annotator_id=user_id)
     if request.query_params.get("label"):
-        segments = segments.filter(label__name=request.query_params["label"])
+        # By the ids the name has in the caller's projects, not by joining the label table,
+        # so that the filter is a column of the list's indexes.
+        segments = segments.filter(**one_of("label_id", [pk for _, pk, _ in named_labels(request)]))
     for name, lookup, high in (("min_duration", "duration__gte", None),
                                ("max_duration", "duration__lte", None),
                                ("min_agreement", "agreement__gte", 1)):
@@ -156,6 +230,52 @@ def segment_query(request):
     if ordering not in ORDERINGS:
         raise Invalid(f"ordering: must be one of {', '.join(ORDERINGS)}, got {ordering!r}")
     return segments.order_by(*ORDERINGS[ordering])
+
+
+def one_of(field, values):
+    """A filter on ``field`` being one of ``values``: an equality when there is one, which
+    SQLite's planner reads as an index prefix that keeps the index's order (an ``IN``, even
+    of one value, makes it sort or scan another index instead)."""
+    return {field: values[0]} if len(values) == 1 else {f"{field}__in": values}
+
+
+def visible_labels(request):
+    """The labels of the caller's projects, or of the project the query asks for."""
+    labels = Label.objects.filter(
+        project_id__in=Membership.objects.filter(user=request.user).values_list("project_id"))
+    project = int_param(request, "project", None, 1)
+    return labels if project is None else labels.filter(project_id=project)
+
+
+def named_labels(request):
+    """``(name, id, project id)`` of the caller's labels the ``label`` filter names (read
+    once per request: the filter and ``ordered_parts`` both need them)."""
+    if not hasattr(request, "_named_labels"):
+        request._named_labels = list(visible_labels(request).filter(
+            name=request.query_params["label"]).values_list("name", "id", "project_id"))
+    return request._named_labels
+
+
+def ordered_parts(request, segments):
+    """``segments`` (a ``segment_query``) as ``Part``s whose concatenation is the list.
+
+    Ordered by label, the list is each label name's segments by id, names in the
+    database's order: one part per name, read from the label index in id order, rather
+    than the whole library joined to its labels and sorted. Newest first with a label
+    name that several projects use, one part merging each label's segments.
+    """
+    ordering = request.query_params.get("ordering") or "recent"
+    labels = visible_labels(request).order_by("name", "id").values_list("name", "id", "project_id")
+    if ordering == "label":
+        return [Part([segments.filter(project_id=project, label_id=pk).order_by("id")
+                      for _, pk, project in group])
+                for _, group in itertools.groupby(labels, key=operator.itemgetter(0))]
+    if ordering == "recent" and request.query_params.get("label"):
+        labels = named_labels(request)
+        if len(labels) > 1:
+            return [Part([segments.filter(project_id=project, label_id=pk)
+                          for _, pk, project in labels], descending=True)]
+    return [Part([segments])]
 
 
 def segment_for(user, pk):
@@ -171,10 +291,12 @@ class SegmentListView(APIView):
 
     @extend_schema(responses=SegmentSerializer(many=True))
     def get(self, request):
-        segments = segment_query(request).select_related("capture", "annotator", "label").defer(
-            "descriptor", "profile", "capture__skeleton")
+        segments = segment_query(request)
         paginator = self.pagination_class()
-        page = paginator.paginate_queryset(segments, request, view=self)
+        page = paginator.paginate_queryset(
+            segments.select_related("capture", "annotator", "label").defer(
+                "descriptor", "profile", "capture__skeleton"),
+            request, view=self, parts=ordered_parts(request, segments))
         return paginator.get_paginated_response(SegmentSerializer(page, many=True).data)
 
 

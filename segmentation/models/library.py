@@ -36,7 +36,8 @@ class LibrarySegmentQuerySet(models.QuerySet):
         staff, annotating = [], []
         for project_id, role in roles:
             (staff if role in ("reviewer", "admin") else annotating).append(project_id)
-        own = Q(annotator=user) | Q(is_gold=True)
+        # ``is_gold__in``: see ``segmentation.api.segments.segment_query``.
+        own = Q(annotator=user) | Q(is_gold__in=[True])
         return self.filter(Q(project_id__in=staff) | Q(project_id__in=annotating) & own)
 
     def preferred(self):

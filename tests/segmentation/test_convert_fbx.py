@@ -1,12 +1,15 @@
 """FBX uploads: the convert job (Blender, in its own process) then the usual ingest, run
 in-process by calling the task functions; the integration tests run them in real workers."""
 
+import numpy as np
 import pytest
 from django.core.files.uploadedfile import SimpleUploadedFile
 from django.test import override_settings
 
+import motionlib
 from segmentation import services, tasks
 from segmentation.models import Capture, DetectionRun
+from segmentation.storage import read_take
 from tests.fbx.files import shared_fbx
 from tests.segmentation.base import BaseTestCase, synthetic_bvh
 
@@ -53,6 +56,28 @@ class ConvertTestCase(FbxUploadsTestCase):
         self.assertEqual((first.name, first.n_frames), ("two_actions.fbx#breakdance", 106))
         self.assertEqual((other.status, other.n_frames, other.source_id), ("ready", 31, first.pk))
         self.assertEqual(other.original.name, first.original.name)
+
+    def test_every_animation_reads_back_as_blenders_read_of_the_file(self):
+        path = self.made / "two_actions.fbx"
+        self.convert_and_ingest(self.upload_file(path))
+        for capture in Capture.objects.filter(project=self.project):
+            stored = read_take(capture)
+            blender = motionlib.read(path, animation=capture.animation)
+            np.testing.assert_array_equal(stored.channels, blender.channels)
+            self.assertEqual((stored.skeleton.names, stored.skeleton.channels, stored.fps),
+                             (blender.skeleton.names, blender.skeleton.channels, blender.fps))
+            np.testing.assert_array_equal(stored.skeleton.offsets, blender.skeleton.offsets)
+            np.testing.assert_array_equal(stored.skeleton.parents, blender.skeleton.parents)
+            self.assertEqual((stored.frame_time, stored.rest_pose_frame, stored.animation),
+                             (blender.frame_time, blender.rest_pose_frame, blender.animation))
+
+    def test_a_converted_take_is_read_from_its_stored_take_not_from_the_original(self):
+        capture = self.convert_and_ingest(self.upload_file(shared_fbx("flair.fbx")))
+        converted = read_take(capture)
+        # Were the original read again (by Blender), this would fail: it is no FBX any more.
+        with open(capture.original.path, "wb") as handle:
+            handle.write(b"not an FBX")
+        np.testing.assert_array_equal(read_take(capture).channels, converted.channels)
 
     def test_it_converts_a_file_again_without_duplicating_its_animations(self):
         capture_id = self.upload_file(self.made / "two_actions.fbx")
