@@ -1,10 +1,12 @@
-"""Adapting the default detector to example takes with human cuts (motionlib.adapt)."""
+"""The first model format (motionlib.adapt ThresholdModel): stored models load and detect as
+before, and its learner still learns what it learnt."""
 
 import numpy as np
 import pytest
 
 from motionlib import metrics, synth
-from motionlib.adapt import CutModel, ExampleError, detect, fit_cut_model
+from motionlib.adapt import ExampleError, ThresholdModel, detect
+from motionlib.adapt import fit_threshold_model as fit_cut_model
 
 FPS = 60.0
 
@@ -58,16 +60,17 @@ def test_it_counts_the_examples_it_learnt_from():
 
 
 def test_it_round_trips_a_model_through_json():
-    model = CutModel(n_takes=2, n_cuts=9, threshold=0.2, prominence=0.1, min_segment_s=1.5,
+    model = ThresholdModel(n_takes=2, n_cuts=9, threshold=0.2, prominence=0.1, min_segment_s=1.5,
                      scale_min_s=3.0, scale_max_s=6.0, placement="split", offset_s=-0.1)
     text = model.to_json()
     assert '"format": 1' in text
-    assert CutModel.from_json(text) == model
+    assert ThresholdModel.from_json(text) == model
 
 
 @pytest.mark.parametrize("text, fault", [
     ("{", "not JSON"),
     ('{"format": 2}', "format 2"),
+    ('{"format": 3}', "format 3"),
     ('{"format": 1, "n_takes": 1, "n_cuts": 1, "threshold": "x", "min_segment_s": 1, '
      '"prominence": 1, "scale_min_s": 3, "scale_max_s": 6, "offset_s": 0, "placement": "pause"}', "threshold"),
     ('{"format": 1, "n_takes": 1, "n_cuts": 1, "threshold": 1, "min_segment_s": 1, '
@@ -75,13 +78,13 @@ def test_it_round_trips_a_model_through_json():
 ])
 def test_it_refuses_a_stored_model_it_cannot_read(text, fault):
     with pytest.raises(ValueError, match=fault):
-        CutModel.from_json(text)
+        ThresholdModel.from_json(text)
 
 
 def test_it_reads_a_stored_model_from_before_the_prominence_test_as_it_was():
     text = ('{"format": 1, "n_takes": 1, "n_cuts": 4, "threshold": 0.3, "min_segment_s": 2, '
             '"scale_min_s": 3, "scale_max_s": 6, "offset_s": 0, "placement": "pause"}')
-    assert CutModel.from_json(text).prominence == 0.0
+    assert ThresholdModel.from_json(text).prominence == 0.0
 
 
 def test_it_refuses_a_cut_outside_the_example_take():
@@ -121,7 +124,7 @@ UNUSUAL = _peaks([0.5, 0.15, 0.15, 0.15, 0.15], [100])
 
 
 def test_one_unusual_example_among_several_does_not_move_the_count():
-    from motionlib.adapt import _count
+    from motionlib.adapt._threshold import _count
 
     # Summed over the four examples a prominence above 0.15 scores best (3.0 against 0:
     # the unusual one's four false peaks are four deletes), but only because of the
@@ -130,14 +133,14 @@ def test_one_unusual_example_among_several_does_not_move_the_count():
 
 
 def test_examples_that_agree_still_move_the_count():
-    from motionlib.adapt import _count
+    from motionlib.adapt._threshold import _count
 
     assert _count([UNUSUAL, UNUSUAL, UNUSUAL], 0.1)[1] > 0.15
     assert _count([USUAL, USUAL, USUAL], 0.1)[1] == 0.1
 
 
 def test_examples_move_the_count_from_a_zero_shot_without_the_prominence_test():
-    from motionlib.adapt import _count
+    from motionlib.adapt._threshold import _count
 
     with np.errstate(divide="raise"):
         assert _count([UNUSUAL, UNUSUAL, UNUSUAL], 0.0)[1] > 0.15
@@ -146,7 +149,7 @@ def test_examples_move_the_count_from_a_zero_shot_without_the_prominence_test():
 
 
 def test_the_count_keeps_weak_peaks_only_if_they_save_a_reviewer_edits():
-    from motionlib.adapt import _count
+    from motionlib.adapt._threshold import _count
 
     # Two strong peaks on cuts; five weak ones (0.2), two of them on the other two cuts.
     # Keeping the weak ones raises F1 (8/11 against 4/6) but costs three deletes to save
@@ -159,7 +162,7 @@ def test_the_count_keeps_weak_peaks_only_if_they_save_a_reviewer_edits():
 
 
 def test_a_take_of_one_activity_weighs_its_false_peak_like_any_other_example():
-    from motionlib.adapt import _count
+    from motionlib.adapt._threshold import _count
 
     # A reviewed take labelled as one activity (no cut) where the detector found one peak,
     # beside a take of five cuts whose weakest true peak is 0.2. Counted per cut of its own
@@ -174,7 +177,7 @@ def test_a_take_of_one_activity_weighs_its_false_peak_like_any_other_example():
 
 
 def test_two_examples_keep_the_fixed_prior():
-    from motionlib.adapt import _count
+    from motionlib.adapt._threshold import _count
 
     # Too few to leave one out: the fixed prior lets the two examples' sum decide.
     assert _count([USUAL, UNUSUAL], 0.1)[1] > 0.15
@@ -253,7 +256,8 @@ def test_an_example_counts_both_sides_of_a_short_activity_the_detector_cuts():
     # 6 s, 1.8 s, 6 s: the long windows see the short activity as one peak, and the
     # detector's unmatched-poses step makes it two cuts; the study the count is learnt
     # from must hold both, where the detector places them, at the zero-shot prominence.
-    from motionlib.adapt import Example, MemoryStudies, matched_count
+    from motionlib.adapt import Example, MemoryStudies
+    from motionlib.adapt._threshold import matched_count
     from motionlib.segmenters.default import Default
 
     take, segments = synth.generate(seed=1, fps=FPS, plan=[("idle", 6.0), ("kick", 1.8),

@@ -1,0 +1,331 @@
+"""A studio's cutting convention learnt as a scorer over over-complete candidates.
+
+Every take is described by many candidate cuts with a few evidence features each
+(``_candidates``). A :class:`CutModel` keeps a candidate when a logistic scorer over
+those features says it is more likely a human cut than not (a reviewer gains from a
+candidate only then: a false one costs a delete, a missing one an insert), keeps no two
+kept candidates closer than its ``min_segment_s`` (the convention's fineness), and cuts
+each at its ``placement`` step moved by ``offset_s``.
+
+The scorer is a maximum-a-posteriori logistic regression whose Gaussian prior is centred
+on the zero-shot decision (keep exactly the zero-shot cuts): with no example it *is* the
+zero-shot detector, a few examples move it a little, many move it as far as they agree.
+Takes are weighted before the final fit: each is predicted by a model fitted on the
+others, and one that disagrees far more than the rest (a reviewer who cut half the
+cuts, or twice as many) is down-weighted, so that a minority of bad reviews cannot
+drag the model. Fineness and placement are medians over takes for the same reason.
+How the fixed settings were chosen is in ``docs/detector/adaptation.md``.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.special import expit
+
+from motionlib import metrics
+from motionlib.adapt._candidates import FEATURES, study_take
+from motionlib.errors import InputError
+from motionlib.segmenters.default import PLACEMENTS, shipped_stage
+
+FORMAT = 2
+# Fixed centres of the features (typical values), so that the intercept means "a typical
+# candidate" and the prior on it is not dodged through a feature's offset.
+CENTRES = np.array([0.0, -2.3, -2.3, -1.0, -2.3, 0.0, 0.0, 1.0])
+# The zero-shot decision as a scorer: a zero-shot cut has odds e^3 of being kept, any
+# other candidate e^-3; nothing else counts.
+PRIOR_INTERCEPT = -3.0
+PRIOR_ZERO_SHOT = 6.0
+# Prior precision on every weight, in units of one candidate's worth of evidence.
+PRIOR_PRECISION = 20.0
+# Take weighting: a take whose held-out loss lies more than this many robust standard
+# deviations above the others' median is weighted down as (limit / z)².
+OUTLIER_Z = 2.5
+# Fineness: the shortest segment an example shows, times this, bounds how close two kept
+# candidates may lie; never below MIN_SEGMENT_S nor above the zero-shot setting.
+MIN_SEGMENT_FACTOR = 0.75
+MIN_SEGMENT_S = 0.3
+# A placement other than the zero-shot one needs this many matched example cuts and must
+# cut the median placement error by this fraction and this many seconds.
+PLACEMENT_MIN_CUTS = 6
+PLACEMENT_GAIN = (0.2, 0.03)
+STUDY_VERSION = 1
+
+
+@dataclass(frozen=True)
+class CutModel:
+    """A studio's convention over the default detector's candidates (format 2).
+
+    n_takes, n_cuts : example takes and human cuts it learnt from (0: zero-shot).
+    weights : one per ``features`` plus the intercept last: the logistic scorer over the
+        centred evidence features.
+    features : names of the features the weights are for (``_candidates.FEATURES``).
+    min_segment_s : no two kept candidates lie closer (s), except two zero-shot cuts.
+    placement : the placement step cuts are taken from (``PLACEMENTS``).
+    offset_s : signed shift (s) added to every cut; positive moves cuts later.
+    tolerance_s : how far (s) a candidate may lie from a human cut to count as it.
+    down_weighted : example takes weighted down as disagreeing with the others.
+    """
+
+    n_takes: int
+    n_cuts: int
+    weights: tuple[float, ...]
+    features: tuple[str, ...]
+    min_segment_s: float
+    placement: str
+    offset_s: float
+    tolerance_s: float
+    down_weighted: int = 0
+
+    @classmethod
+    def zero_shot(cls, tolerance_s: float = 1.0, min_segment_s: float = 1.5) -> CutModel:
+        """The prior: detects exactly what the zero-shot detector does."""
+        return cls(n_takes=0, n_cuts=0, weights=tuple(_prior().tolist()), features=FEATURES,
+                   min_segment_s=min_segment_s, placement=shipped_stage({"onset": True}),
+                   offset_s=0.0, tolerance_s=tolerance_s)
+
+    def to_json(self) -> str:
+        """Stable JSON text (sorted keys) with ``"format": 2``."""
+        data = {"format": FORMAT, "n_takes": self.n_takes, "n_cuts": self.n_cuts,
+                "weights": list(self.weights), "features": list(self.features),
+                "min_segment_s": self.min_segment_s, "placement": self.placement,
+                "offset_s": self.offset_s, "tolerance_s": self.tolerance_s,
+                "down_weighted": self.down_weighted}
+        return json.dumps(data, sort_keys=True)
+
+    @classmethod
+    def from_json(cls, text: str):
+        """Parse a stored model of any format: a :class:`CutModel` (format 2) or a
+        ``ThresholdModel`` (format 1, detecting as it always did); InputError (a
+        ValueError) naming what is wrong."""
+        from motionlib.adapt._threshold import ThresholdModel
+
+        try:
+            data = json.loads(text)
+        except (TypeError, json.JSONDecodeError) as exc:
+            raise InputError(f"cut model: not JSON: {exc}") from None
+        if not isinstance(data, dict):
+            raise InputError(f"cut model: expected a JSON object, got {type(data).__name__}")
+        if data.get("format") == 1:
+            return ThresholdModel.from_json(text)
+        if data.get("format") != FORMAT:
+            raise InputError(f"cut model: unsupported format {data.get('format')!r} "
+                             f"(expected 1 or {FORMAT})")
+
+        def fault(message):
+            raise InputError(f"cut model: {message}")
+        return cls.from_dict(data, fault)
+
+    @classmethod
+    def from_dict(cls, data: dict, fault) -> CutModel:
+        """A format-2 model from parsed JSON; ``fault(message)`` raises for bad values."""
+        if data.get("features") != list(FEATURES):
+            fault(f"features must be {list(FEATURES)}, got {data.get('features')!r}")
+        weights = data.get("weights")
+        if not isinstance(weights, list) or len(weights) != len(FEATURES) + 1 or not all(
+                _finite(w) for w in weights):
+            fault(f"weights must be {len(FEATURES) + 1} finite numbers, got {weights!r}")
+        values = {}
+        for name, kind in (("n_takes", int), ("n_cuts", int), ("down_weighted", int),
+                           ("min_segment_s", float), ("offset_s", float),
+                           ("tolerance_s", float)):
+            value = data.get(name)
+            if not _finite(value) or (kind is int and value != int(value)):
+                fault(f"{name} must be a finite {'integer' if kind is int else 'number'}, "
+                      f"got {value!r}")
+            values[name] = kind(value)
+        if data.get("placement") not in PLACEMENTS:
+            fault(f"placement must be one of {', '.join(PLACEMENTS)}, "
+                  f"got {data.get('placement')!r}")
+        return cls(**values, weights=tuple(float(w) for w in weights), features=FEATURES,
+                   placement=data["placement"])
+
+
+def _finite(value) -> bool:
+    return isinstance(value, int | float) and not isinstance(value, bool) and \
+        math.isfinite(value)
+
+
+def _prior() -> np.ndarray:
+    w = np.zeros(len(FEATURES) + 1)
+    w[FEATURES.index("zero_shot")] = PRIOR_ZERO_SHOT
+    w[-1] = PRIOR_INTERCEPT
+    return w
+
+
+def design(features: np.ndarray) -> np.ndarray:
+    """(n, len(FEATURES) + 1) the centred features and a column of ones."""
+    return np.hstack([features - CENTRES, np.ones((len(features), 1))])
+
+
+def study_key(p: dict) -> str:
+    """What a take's study depends on besides the take: the detector settings."""
+    text = json.dumps([STUDY_VERSION, sorted(p.items())])
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+def study(take, p: dict) -> dict[str, np.ndarray] | None:
+    """A take's candidates (``_candidates.study_take``)."""
+    return study_take(take, p)
+
+
+# ---- detection from a study ----------------------------------------------------------------
+
+def keep_probability(model: CutModel, one: dict) -> np.ndarray:
+    """(n,) each candidate's probability of being a cut of the convention."""
+    return expit(design(one["features"]) @ np.asarray(model.weights))
+
+
+def select(model: CutModel, one: dict) -> tuple[np.ndarray, np.ndarray]:
+    """The cuts ``model`` keeps among a study's candidates: (frames, probability),
+    in frame order."""
+    prob = keep_probability(model, one)
+    fps = float(one["fps"])
+    frames = placed(model, one)
+    zero = one["zero_shot"]
+    gap = int(round(model.min_segment_s * fps))
+    kept: list[int] = []
+    for i in np.argsort(-prob, kind="stable").tolist():
+        if prob[i] <= 0.5:
+            break
+        if all(abs(frames[i] - frames[j]) >= gap or (zero[i] and zero[j]) for j in kept):
+            kept.append(i)
+    kept = np.asarray(sorted(kept, key=lambda i: frames[i]), dtype=np.int64)
+    return frames[kept], prob[kept]
+
+
+def placed(model: CutModel, one: dict) -> np.ndarray:
+    """(n,) every candidate's frame at the model's placement step and offset."""
+    fps, n = float(one["fps"]), int(one["n_frames"])
+    frames = one["stages"][:, PLACEMENTS.index(model.placement)] + \
+        int(round(model.offset_s * fps))
+    return np.clip(frames, 1, max(1, n - 1))
+
+
+# ---- learning ------------------------------------------------------------------------------
+
+def fit(studies: list[dict], cuts: list[np.ndarray], *, tolerance_s: float,
+        zero_min_segment_s: float) -> CutModel:
+    """Learn a :class:`CutModel` from example studies and their human cuts (take frames)."""
+    prior = CutModel.zero_shot(tolerance_s, zero_min_segment_s)
+    placement, offset = _placement(studies, cuts, tolerance_s)
+    base = CutModel(**{**prior.__dict__, "placement": placement, "offset_s": offset})
+    data = [_labelled(base, one, c) for one, c in zip(studies, cuts, strict=True)]
+    weights = _take_weights(data)
+    w = _map_fit(data, weights)
+    fine = _min_segment([c for c, wt in zip(cuts, weights, strict=True) if wt >= 0.5] or cuts,
+                        [float(s["fps"]) for s in studies], zero_min_segment_s)
+    return CutModel(n_takes=len(studies), n_cuts=int(sum(len(c) for c in cuts)),
+                    weights=tuple(float(v) for v in w), features=FEATURES,
+                    min_segment_s=fine, placement=placement, offset_s=offset,
+                    tolerance_s=tolerance_s, down_weighted=int(np.sum(weights < 0.5)))
+
+
+def _labelled(model: CutModel, one: dict, cuts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(design matrix, 0/1 labels): a candidate is a cut when, placed as ``model``
+    places it, it is matched one-to-one to a human cut within the tolerance."""
+    frames = placed(model, one)
+    y = np.zeros(len(frames))
+    ci, _ = metrics.match(frames, cuts, tolerance=int(round(model.tolerance_s *
+                                                               float(one["fps"]))))
+    y[ci] = 1.0
+    return design(one["features"]), y
+
+
+def _map_fit(data, take_weights: np.ndarray) -> np.ndarray:
+    """MAP logistic regression: summed weighted log-loss plus the Gaussian prior around
+    the zero-shot scorer (Newton's method; the objective is strictly convex)."""
+    w0 = _prior()
+    if not data:
+        return w0
+    x = np.vstack([d[0] for d in data])
+    y = np.concatenate([d[1] for d in data])
+    sw = np.concatenate([np.full(len(d[1]), wt) for d, wt in zip(data, take_weights,
+                                                                  strict=True)])
+    w = w0.copy()
+    eye = PRIOR_PRECISION * np.eye(len(w))
+    for _ in range(50):
+        p = expit(x @ w)
+        grad = x.T @ (sw * (p - y)) + PRIOR_PRECISION * (w - w0)
+        hess = (x * (sw * p * (1 - p))[:, None]).T @ x + eye
+        step = np.linalg.solve(hess, grad)
+        w -= step
+        if np.abs(step).max() < 1e-8:
+            break
+    return w
+
+
+def _log_loss(w: np.ndarray, x: np.ndarray, y: np.ndarray) -> float:
+    z = x @ w
+    return float(np.mean(np.logaddexp(0, z) - y * z)) if len(y) else 0.0
+
+
+def _take_weights(data) -> np.ndarray:
+    """Each example's weight: 1, or less for a take that a model fitted on the others
+    predicts far worse than it predicts the rest (robust z-score of the held-out mean
+    log-loss). From three takes on; with fewer there is no majority to disagree with."""
+    n = len(data)
+    weights = np.ones(n)
+    if n < 3:
+        return weights
+    loss = np.empty(n)
+    for i in range(n):
+        others = np.ones(n)
+        others[i] = 0.0
+        loss[i] = _log_loss(_map_fit(data, others), *data[i])
+    centre = np.median(loss)
+    spread = max(1.4826 * np.median(np.abs(loss - centre)), 0.1 * centre, 1e-6)
+    z = (loss - centre) / spread
+    bad = z > OUTLIER_Z
+    weights[bad] = (OUTLIER_Z / z[bad]) ** 2
+    return weights
+
+
+def _min_segment(cuts: list[np.ndarray], fps: list[float], zero: float) -> float:
+    """The convention's fineness: MIN_SEGMENT_FACTOR x the median over examples of each
+    one's shortest inner segment, within [MIN_SEGMENT_S, zero]; ``zero`` without one."""
+    shortest = [np.diff(np.sort(c)).min() / f for c, f in zip(cuts, fps, strict=True)
+                if len(c) > 1]
+    if not shortest:
+        return zero
+    return float(np.clip(MIN_SEGMENT_FACTOR * np.median(shortest), MIN_SEGMENT_S, zero))
+
+
+def _placement(studies, cuts, tolerance_s: float) -> tuple[str, float]:
+    """The placement step and shift (s) that follow the human cuts best, if clearly so:
+    residuals (human - placed) of the zero-shot cuts matched to a human cut, each take's
+    median first and the median over takes after (a take with odd cuts moves it little)."""
+    zero = shipped_stage({"onset": True})
+    per_take = {name: [] for name in PLACEMENTS}
+    count = 0
+    for one, c in zip(studies, cuts, strict=True):
+        fps = float(one["fps"])
+        tol = int(round(tolerance_s * fps))
+        stages = one["stages"][one["zero_shot"]]
+        for j, name in enumerate(PLACEMENTS):
+            ci, ti = metrics.match(stages[:, j], c, tolerance=tol)
+            if len(ci):
+                per_take[name].append((c[ti] - stages[ci, j]) / fps)
+        count += len(metrics.match(stages[:, PLACEMENTS.index(zero)], c, tolerance=tol)[0])
+    if count < PLACEMENT_MIN_CUTS or not per_take[zero]:
+        return zero, 0.0
+
+    def error(name, offset):
+        return float(np.median([np.median(np.abs(r - offset)) for r in per_take[name]]))
+
+    base = error(zero, 0.0)
+    best, best_error = (zero, 0.0), base
+    for name in PLACEMENTS:
+        if not per_take[name]:
+            continue
+        offset = float(np.median([np.median(r) for r in per_take[name]]))
+        if error(name, offset) < best_error:
+            best, best_error = (name, round(offset, 4)), error(name, offset)
+    ratio, seconds = PLACEMENT_GAIN
+    if best_error > min((1 - ratio) * base, base - seconds):
+        return zero, 0.0
+    return best
