@@ -8,10 +8,13 @@ take is first described by many more candidates than any convention keeps:
 - every other peak of the zero-shot novelty curve (any prominence down to
   ``LONG_PROMINENCE``);
 - every peak of a short-window novelty curve (``SHORT_WINDOWS``), which sees activities
-  shorter than the zero-shot windows.
+  shorter than the zero-shot windows;
+- every turning point of the motion (a minimum of the 3 Hz pose speed) deeper than
+  ``TURN_DEPTH`` times the take's median speed: where conventions that cut movement
+  phases (reach, grasp, lift) cut, finer than any novelty window sees.
 
 Peaks closer than ``MERGE_S`` to a candidate already listed add nothing (the earlier
-source wins: zero-shot cut, then long, then short). Each candidate carries a few evidence
+source wins: zero-shot cut, then long, then short, then turning point). Each candidate carries a few evidence
 features (``FEATURES``) and its frame at each placement step of the detector (the
 anchors a model picks from). Nothing here depends on a studio's cuts, so a take's
 candidates are computed once and serve every model and every refit.
@@ -33,11 +36,12 @@ SHORT_WINDOWS = (1.0, 2.0)
 # candidates may lie (s).
 LONG_PROMINENCE = 0.005
 SHORT_PROMINENCE = 0.01
-MERGE_S = 0.4
+MERGE_S = 0.3
+TURN_DEPTH = 0.1
 # Evidence features, in the order of a study's ``features`` columns. MMD² values are
 # logged (their scale is multiplicative) with a floor well below the weakest peak listed.
 FEATURES = ("zero_shot", "long_height", "long_prominence", "short_height",
-            "short_prominence", "support", "speed", "near_zero_shot")
+            "short_prominence", "support", "speed", "near_zero_shot", "turn_depth")
 FLOOR = 0.003
 
 
@@ -68,9 +72,10 @@ def candidates_of(take, p: dict):
     merge = max(1, int(round(MERGE_S * rate)))
     long_peaks, long_prom = _all_peaks(analysis.novelty, merge, LONG_PROMINENCE)
     short_peaks, short_prom = _all_peaks(short.novelty, merge, SHORT_PROMINENCE)
+    turns = _turns(analysis, merge)
     samples = list(found.samples.tolist())
     zero = len(samples)
-    for extra in (long_peaks, short_peaks):
+    for extra in (long_peaks, short_peaks, turns):
         for k in extra.tolist():
             if all(abs(k - s) >= merge for s in samples):
                 samples.append(k)
@@ -97,6 +102,25 @@ def candidates_of(take, p: dict):
               "stages": stages[order], "fps": np.asarray(analysis.fps),
               "n_frames": np.asarray(len(analysis.x) + analysis.first)}
     return arrays, analysis, placed.speed
+
+
+def _turns(analysis, merge: int) -> np.ndarray:
+    """Novelty samples of the turning points deeper than TURN_DEPTH x the median speed."""
+    fine = analysis.speeds[1]
+    typical = max(float(np.median(fine)), 1e-9)
+    frames, _ = find_peaks(-fine, prominence=TURN_DEPTH * typical,
+                           distance=max(1, merge * analysis.step))
+    return np.unique(frames // analysis.step)
+
+
+def _depth(fine: np.ndarray, frames: np.ndarray, fps: float) -> np.ndarray:
+    """How far the pose speed dips at each frame: the highest speed within 0.5 s less the
+    lowest within 0.15 s, over the take's median speed."""
+    _n, wide, narrow = len(fine), int(round(0.5 * fps)), max(1, int(round(0.15 * fps)))
+    typical = max(float(np.median(fine)), 1e-9)
+    return np.asarray([(fine[max(0, f - wide):f + wide + 1].max() -
+                        fine[max(0, f - narrow):f + narrow + 1].min()) / typical
+                       for f in frames.tolist()])
 
 
 def _all_peaks(curve: np.ndarray, distance: int, prominence: float):
@@ -151,4 +175,5 @@ def _features(analysis, short, samples, zero, long, short_peaks) -> np.ndarray:
         np.log(np.minimum(support, 20.0) + 0.05),
         np.log(speed[frames] / typical + 0.05),
         np.log(near + 0.1),
+        np.log(_depth(analysis.speeds[1], frames, analysis.fps) + 0.05),
     ], axis=1)

@@ -35,16 +35,26 @@ from motionlib.segmenters.default import PLACEMENTS, shipped_stage
 FORMAT = 2
 # Fixed centres of the features (typical values), so that the intercept means "a typical
 # candidate" and the prior on it is not dodged through a feature's offset.
-CENTRES = np.array([0.0, -2.3, -2.3, -1.0, -2.3, 0.0, 0.0, 1.0])
+CENTRES = np.array([0.0, -2.3, -2.3, -1.0, -2.3, 0.0, 0.0, 1.0, 0.0])
 # The zero-shot decision as a scorer: a zero-shot cut has odds e^3 of being kept, any
 # other candidate e^-3; nothing else counts.
 PRIOR_INTERCEPT = -3.0
 PRIOR_ZERO_SHOT = 6.0
-# Prior precision on every weight, in units of one candidate's worth of evidence.
-PRIOR_PRECISION = 20.0
+# Prior precision on every weight, in units of one candidate's worth of evidence: fixed
+# (strong: a take or two move the scorer little) below CV_TAKES examples; from there on
+# chosen among PRECISIONS (inf: the zero-shot scorer itself) by cross-validation over
+# the example takes (CV_FOLDS folds at most), held-out F1 deciding, ties to the stronger
+# prior. Examples that agree with each other move the scorer; a lucky fit does not.
+FIXED_PRECISION = 100.0
+PRECISIONS = (math.inf, 100.0, 10.0, 1.0)
+CV_TAKES = 3
+CV_FOLDS = 5
+# The precision the take weighting's held-out fits use.
+WEIGHTING_PRECISION = 10.0
 # Take weighting: a take whose held-out loss lies more than this many robust standard
 # deviations above the others' median is weighted down as (limit / z)².
 OUTLIER_Z = 2.5
+COUNT_SPREAD = 0.15
 # Fineness: the shortest segment an example shows, times this, bounds how close two kept
 # candidates may lie; never below MIN_SEGMENT_S nor above the zero-shot setting.
 MIN_SEGMENT_FACTOR = 0.75
@@ -52,6 +62,7 @@ MIN_SEGMENT_S = 0.3
 # A placement other than the zero-shot one needs this many matched example cuts and must
 # cut the median placement error by this fraction and this many seconds.
 PLACEMENT_MIN_CUTS = 6
+PLACEMENT_MIN_TAKES = 2
 PLACEMENT_GAIN = (0.2, 0.03)
 STUDY_VERSION = 1
 
@@ -69,6 +80,7 @@ class CutModel:
     offset_s : signed shift (s) added to every cut; positive moves cuts later.
     tolerance_s : how far (s) a candidate may lie from a human cut to count as it.
     down_weighted : example takes weighted down as disagreeing with the others.
+    precision : the prior precision the scorer was fitted with (inf: the zero-shot one).
     """
 
     n_takes: int
@@ -80,6 +92,7 @@ class CutModel:
     offset_s: float
     tolerance_s: float
     down_weighted: int = 0
+    precision: float = math.inf
 
     @classmethod
     def zero_shot(cls, tolerance_s: float = 1.0, min_segment_s: float = 1.5) -> CutModel:
@@ -94,7 +107,8 @@ class CutModel:
                 "weights": list(self.weights), "features": list(self.features),
                 "min_segment_s": self.min_segment_s, "placement": self.placement,
                 "offset_s": self.offset_s, "tolerance_s": self.tolerance_s,
-                "down_weighted": self.down_weighted}
+                "down_weighted": self.down_weighted,
+                "precision": self.precision if math.isfinite(self.precision) else None}
         return json.dumps(data, sort_keys=True)
 
     @classmethod
@@ -141,8 +155,12 @@ class CutModel:
         if data.get("placement") not in PLACEMENTS:
             fault(f"placement must be one of {', '.join(PLACEMENTS)}, "
                   f"got {data.get('placement')!r}")
+        precision = data.get("precision")
+        if precision is not None and not (_finite(precision) and precision > 0):
+            fault(f"precision must be a positive number or null, got {precision!r}")
         return cls(**values, weights=tuple(float(w) for w in weights), features=FEATURES,
-                   placement=data["placement"])
+                   placement=data["placement"],
+                   precision=math.inf if precision is None else float(precision))
 
 
 def _finite(value) -> bool:
@@ -215,14 +233,17 @@ def fit(studies: list[dict], cuts: list[np.ndarray], *, tolerance_s: float,
     placement, offset = _placement(studies, cuts, tolerance_s)
     base = CutModel(**{**prior.__dict__, "placement": placement, "offset_s": offset})
     data = [_labelled(base, one, c) for one, c in zip(studies, cuts, strict=True)]
-    weights = _take_weights(data)
-    w = _map_fit(data, weights)
-    fine = _min_segment([c for c, wt in zip(cuts, weights, strict=True) if wt >= 0.5] or cuts,
-                        [float(s["fps"]) for s in studies], zero_min_segment_s)
+    weights = _take_weights(base, studies, cuts, data)
+    precision = _precision(base, studies, cuts, data, weights)
+    w = _map_fit(data, weights, precision)
+    trusted = [(c, float(s["fps"])) for c, s, wt in zip(cuts, studies, weights, strict=True)
+               if wt >= 0.5]
+    fine = _min_segment(trusted, zero_min_segment_s)
     return CutModel(n_takes=len(studies), n_cuts=int(sum(len(c) for c in cuts)),
                     weights=tuple(float(v) for v in w), features=FEATURES,
                     min_segment_s=fine, placement=placement, offset_s=offset,
-                    tolerance_s=tolerance_s, down_weighted=int(np.sum(weights < 0.5)))
+                    tolerance_s=tolerance_s, down_weighted=int(np.sum(weights < 0.5)),
+                    precision=precision)
 
 
 def _labelled(model: CutModel, one: dict, cuts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -236,24 +257,62 @@ def _labelled(model: CutModel, one: dict, cuts: np.ndarray) -> tuple[np.ndarray,
     return design(one["features"]), y
 
 
-def _map_fit(data, take_weights: np.ndarray) -> np.ndarray:
-    """MAP logistic regression: summed weighted log-loss plus the Gaussian prior around
-    the zero-shot scorer (Newton's method; the objective is strictly convex)."""
+def _precision(base: CutModel, studies, cuts, data, weights) -> float:
+    """The prior precision: FIXED_PRECISION below CV_TAKES examples, else the one of
+    PRECISIONS whose models, fitted without a fold of example takes, cut those takes
+    with the best weighted mean F1 (at the model's tolerance)."""
+    n = len(data)
+    if n < CV_TAKES:
+        return FIXED_PRECISION
+    folds = min(n, CV_FOLDS)
+    best, best_score = math.inf, -math.inf
+    for precision in PRECISIONS:
+        total = 0.0
+        for fold in range(folds):
+            held = np.arange(n) % folds == fold
+            w = _map_fit(data, np.where(held, 0.0, weights), precision)
+            model = CutModel(**{**base.__dict__, "weights": tuple(w)})
+            for i in np.flatnonzero(held).tolist():
+                found = select(model, studies[i])[0]
+                total += weights[i] * metrics.boundary_scores(
+                    found, cuts[i], fps=float(studies[i]["fps"]),
+                    tolerance_s=base.tolerance_s)["f1"]
+        if total > best_score + 1e-9:
+            best, best_score = precision, total
+    return best
+
+
+def _map_fit(data, take_weights: np.ndarray, precision: float) -> np.ndarray:
+    """MAP logistic regression: summed weighted log-loss plus the Gaussian prior of
+    ``precision`` around the zero-shot scorer (Newton's method; the objective is
+    strictly convex). An infinite precision is the prior itself."""
     w0 = _prior()
-    if not data:
+    if not data or not math.isfinite(precision):
         return w0
     x = np.vstack([d[0] for d in data])
     y = np.concatenate([d[1] for d in data])
     sw = np.concatenate([np.full(len(d[1]), wt) for d, wt in zip(data, take_weights,
                                                                   strict=True)])
+    def objective(w):
+        z = x @ w
+        return float(sw @ (np.logaddexp(0, z) - y * z)) + \
+            precision / 2 * float((w - w0) @ (w - w0))
+
     w = w0.copy()
-    eye = PRIOR_PRECISION * np.eye(len(w))
+    eye = precision * np.eye(len(w))
+    current = objective(w)
     for _ in range(50):
         p = expit(x @ w)
-        grad = x.T @ (sw * (p - y)) + PRIOR_PRECISION * (w - w0)
+        grad = x.T @ (sw * (p - y)) + precision * (w - w0)
         hess = (x * (sw * p * (1 - p))[:, None]).T @ x + eye
         step = np.linalg.solve(hess, grad)
-        w -= step
+        # Damped: a full Newton step can overshoot where the log-loss is nearly flat.
+        for _ in range(30):
+            trial = objective(w - step)
+            if trial <= current:
+                break
+            step = step / 2
+        w, current = w - step, min(trial, current)
         if np.abs(step).max() < 1e-8:
             break
     return w
@@ -264,32 +323,50 @@ def _log_loss(w: np.ndarray, x: np.ndarray, y: np.ndarray) -> float:
     return float(np.mean(np.logaddexp(0, z) - y * z)) if len(y) else 0.0
 
 
-def _take_weights(data) -> np.ndarray:
-    """Each example's weight: 1, or less for a take that a model fitted on the others
-    predicts far worse than it predicts the rest (robust z-score of the held-out mean
-    log-loss). From three takes on; with fewer there is no majority to disagree with."""
+def _take_weights(base: CutModel, studies, cuts, data) -> np.ndarray:
+    """Each example's weight: 1, or less for a take that disagrees with a model fitted on
+    the others, by either of two robust z-scores over the takes (``_down_weight``):
+
+    - its held-out mean log-loss (candidates labelled unlike the others would);
+    - the log ratio of its human cuts to the cuts that model keeps in it: the signature
+      of a reviewer who cut half the cuts, or twice as many (deviations within
+      ``COUNT_SPREAD`` are never outliers: takes differ that much by themselves).
+
+    From three takes on; with fewer there is no majority to disagree with."""
     n = len(data)
-    weights = np.ones(n)
     if n < 3:
-        return weights
-    loss = np.empty(n)
+        return np.ones(n)
+    loss, ratio = np.empty(n), np.empty(n)
     for i in range(n):
         others = np.ones(n)
         others[i] = 0.0
-        loss[i] = _log_loss(_map_fit(data, others), *data[i])
-    centre = np.median(loss)
-    spread = max(1.4826 * np.median(np.abs(loss - centre)), 0.1 * centre, 1e-6)
-    z = (loss - centre) / spread
+        w = _map_fit(data, others, WEIGHTING_PRECISION)
+        loss[i] = _log_loss(w, *data[i])
+        kept = len(select(CutModel(**{**base.__dict__, "weights": tuple(w)}), studies[i])[0])
+        ratio[i] = math.log((len(cuts[i]) + 1) / (kept + 1))
+    by_loss = _down_weight(loss, 0.1 * float(np.median(loss)), upper_only=True)
+    return np.minimum(by_loss, _down_weight(ratio, COUNT_SPREAD, upper_only=False))
+
+
+def _down_weight(values: np.ndarray, floor: float, *, upper_only: bool) -> np.ndarray:
+    """1 within OUTLIER_Z robust standard deviations (MAD, at least ``floor``) of the
+    median, else (OUTLIER_Z / z)²."""
+    centre = np.median(values)
+    spread = max(1.4826 * float(np.median(np.abs(values - centre))), floor, 1e-6)
+    z = (values - centre) / spread
+    if not upper_only:
+        z = np.abs(z)
+    out = np.ones(len(values))
     bad = z > OUTLIER_Z
-    weights[bad] = (OUTLIER_Z / z[bad]) ** 2
-    return weights
+    out[bad] = (OUTLIER_Z / z[bad]) ** 2
+    return out
 
 
-def _min_segment(cuts: list[np.ndarray], fps: list[float], zero: float) -> float:
-    """The convention's fineness: MIN_SEGMENT_FACTOR x the median over examples of each
-    one's shortest inner segment, within [MIN_SEGMENT_S, zero]; ``zero`` without one."""
-    shortest = [np.diff(np.sort(c)).min() / f for c, f in zip(cuts, fps, strict=True)
-                if len(c) > 1]
+def _min_segment(cuts: list[tuple[np.ndarray, float]], zero: float) -> float:
+    """The convention's fineness: MIN_SEGMENT_FACTOR x the median over examples (cuts,
+    fps) of each one's shortest inner segment, within [MIN_SEGMENT_S, zero]; ``zero``
+    without one."""
+    shortest = [np.diff(np.sort(c)).min() / f for c, f in cuts if len(c) > 1]
     if not shortest:
         return zero
     return float(np.clip(MIN_SEGMENT_FACTOR * np.median(shortest), MIN_SEGMENT_S, zero))
@@ -311,7 +388,7 @@ def _placement(studies, cuts, tolerance_s: float) -> tuple[str, float]:
             if len(ci):
                 per_take[name].append((c[ti] - stages[ci, j]) / fps)
         count += len(metrics.match(stages[:, PLACEMENTS.index(zero)], c, tolerance=tol)[0])
-    if count < PLACEMENT_MIN_CUTS or not per_take[zero]:
+    if count < PLACEMENT_MIN_CUTS or len(per_take[zero]) < PLACEMENT_MIN_TAKES:
         return zero, 0.0
 
     def error(name, offset):
