@@ -73,13 +73,10 @@ def candidates_of(take, p: dict):
     long_peaks, long_prom = _all_peaks(analysis.novelty, merge, LONG_PROMINENCE)
     short_peaks, short_prom = _all_peaks(short.novelty, merge, SHORT_PROMINENCE)
     turns = _turns(analysis, merge)
-    samples = list(found.samples.tolist())
+    samples = np.asarray(found.samples, dtype=np.int64)
     zero = len(samples)
     for extra in (long_peaks, short_peaks, turns):
-        for k in extra.tolist():
-            if all(abs(k - s) >= merge for s in samples):
-                samples.append(k)
-    samples = np.asarray(samples, dtype=np.int64)
+        samples = np.concatenate([samples, _apart(extra, samples, merge)])
     stages = np.empty((len(samples), len(PLACEMENTS)), dtype=np.int64)
     for j, name in enumerate(PLACEMENTS):
         stages[:zero, j] = placed.stages[name]
@@ -123,6 +120,20 @@ def _depth(fine: np.ndarray, frames: np.ndarray, fps: float) -> np.ndarray:
                        for f in frames.tolist()])
 
 
+def _apart(new: np.ndarray, old: np.ndarray, merge: int) -> np.ndarray:
+    """The samples of ``new`` at least ``merge`` from every sample of ``old`` and from
+    the ones of ``new`` kept before them (in order)."""
+    kept: list[int] = []
+    ordered = np.sort(old)
+    for k in np.asarray(new, dtype=np.int64).tolist():
+        i = int(np.searchsorted(ordered, k))
+        near_old = (i < len(ordered) and ordered[i] - k < merge) or \
+            (i > 0 and k - ordered[i - 1] < merge)
+        if not near_old and all(abs(k - j) >= merge for j in kept[-2:]):
+            kept.append(k)
+    return np.asarray(kept, dtype=np.int64)
+
+
 def _all_peaks(curve: np.ndarray, distance: int, prominence: float):
     """Peaks of ``curve`` (samples) at least ``distance`` apart, and their prominences."""
     padded = np.concatenate([[0.0], curve, [0.0]])
@@ -135,10 +146,12 @@ def _near(samples: np.ndarray, peaks: np.ndarray, values: np.ndarray, reach: int
     out = np.zeros(len(samples))
     if len(peaks) == 0:
         return out
-    for i, k in enumerate(samples.tolist()):
-        j = int(np.argmin(np.abs(peaks - k)))
-        if abs(int(peaks[j]) - k) <= reach:
-            out[i] = values[j]
+    j = np.clip(np.searchsorted(peaks, samples), 1, len(peaks)) - 1
+    j = np.where((j + 1 < len(peaks)) & (np.abs(peaks[np.minimum(j + 1, len(peaks) - 1)]
+                                                - samples) < np.abs(peaks[j] - samples)),
+                 j + 1, j)
+    near = np.abs(peaks[j] - samples) <= reach
+    out[near] = values[j[near]]
     return out
 
 

@@ -56,9 +56,10 @@ WEIGHTING_PRECISION = 10.0
 OUTLIER_Z = 2.5
 COUNT_SPREAD = 0.15
 # Fineness: the shortest segment an example shows, times this, bounds how close two kept
-# candidates may lie; never below MIN_SEGMENT_S nor above the zero-shot setting.
+# candidates may lie, within [MIN_SEGMENT_S, MAX_SEGMENT_S].
 MIN_SEGMENT_FACTOR = 0.75
 MIN_SEGMENT_S = 0.3
+MAX_SEGMENT_S = 8.0
 # A placement other than the zero-shot one needs this many matched example cuts and must
 # cut the median placement error by this fraction and this many seconds.
 PLACEMENT_MIN_CUTS = 6
@@ -75,7 +76,7 @@ class CutModel:
     weights : one per ``features`` plus the intercept last: the logistic scorer over the
         centred evidence features.
     features : names of the features the weights are for (``_candidates.FEATURES``).
-    min_segment_s : no two kept candidates lie closer (s), except two zero-shot cuts.
+    min_segment_s : no two kept candidates lie closer (s); the more probable one stays.
     placement : the placement step cuts are taken from (``PLACEMENTS``).
     offset_s : signed shift (s) added to every cut; positive moves cuts later.
     tolerance_s : how far (s) a candidate may lie from a human cut to count as it.
@@ -95,10 +96,11 @@ class CutModel:
     precision: float = math.inf
 
     @classmethod
-    def zero_shot(cls, tolerance_s: float = 1.0, min_segment_s: float = 1.5) -> CutModel:
-        """The prior: detects exactly what the zero-shot detector does."""
+    def zero_shot(cls, tolerance_s: float = 1.0) -> CutModel:
+        """The prior: detects exactly what the zero-shot detector does (it keeps only the
+        zero-shot cuts, spaced as the detector spaces them: ``min_segment_s`` 0)."""
         return cls(n_takes=0, n_cuts=0, weights=tuple(_prior().tolist()), features=FEATURES,
-                   min_segment_s=min_segment_s, placement=shipped_stage({"onset": True}),
+                   min_segment_s=0.0, placement=shipped_stage({"onset": True}),
                    offset_s=0.0, tolerance_s=tolerance_s)
 
     def to_json(self) -> str:
@@ -204,13 +206,12 @@ def select(model: CutModel, one: dict) -> tuple[np.ndarray, np.ndarray]:
     prob = keep_probability(model, one)
     fps = float(one["fps"])
     frames = placed(model, one)
-    zero = one["zero_shot"]
     gap = int(round(model.min_segment_s * fps))
     kept: list[int] = []
     for i in np.argsort(-prob, kind="stable").tolist():
         if prob[i] <= 0.5:
             break
-        if all(abs(frames[i] - frames[j]) >= gap or (zero[i] and zero[j]) for j in kept):
+        if all(abs(frames[i] - frames[j]) >= gap for j in kept):
             kept.append(i)
     kept = np.asarray(sorted(kept, key=lambda i: frames[i]), dtype=np.int64)
     return frames[kept], prob[kept]
@@ -229,7 +230,7 @@ def placed(model: CutModel, one: dict) -> np.ndarray:
 def fit(studies: list[dict], cuts: list[np.ndarray], *, tolerance_s: float,
         zero_min_segment_s: float) -> CutModel:
     """Learn a :class:`CutModel` from example studies and their human cuts (take frames)."""
-    prior = CutModel.zero_shot(tolerance_s, zero_min_segment_s)
+    prior = CutModel.zero_shot(tolerance_s)
     placement, offset = _placement(studies, cuts, tolerance_s)
     base = CutModel(**{**prior.__dict__, "placement": placement, "offset_s": offset})
     data = [_labelled(base, one, c) for one, c in zip(studies, cuts, strict=True)]
@@ -364,12 +365,13 @@ def _down_weight(values: np.ndarray, floor: float, *, upper_only: bool) -> np.nd
 
 def _min_segment(cuts: list[tuple[np.ndarray, float]], zero: float) -> float:
     """The convention's fineness: MIN_SEGMENT_FACTOR x the median over examples (cuts,
-    fps) of each one's shortest inner segment, within [MIN_SEGMENT_S, zero]; ``zero``
-    without one."""
+    fps) of each one's shortest inner segment, within [MIN_SEGMENT_S, MAX_SEGMENT_S];
+    ``zero`` (the detector's setting) when no example has two cuts."""
     shortest = [np.diff(np.sort(c)).min() / f for c, f in cuts if len(c) > 1]
     if not shortest:
         return zero
-    return float(np.clip(MIN_SEGMENT_FACTOR * np.median(shortest), MIN_SEGMENT_S, zero))
+    return float(np.clip(MIN_SEGMENT_FACTOR * np.median(shortest), MIN_SEGMENT_S,
+                         MAX_SEGMENT_S))
 
 
 def _placement(studies, cuts, tolerance_s: float) -> tuple[str, float]:
