@@ -72,6 +72,8 @@ RESULTS := benchmarks/results
 bench: install
 	$(RECORD) $(RESULTS)/speed-io.md -- $(PY) -m benchmarks.quality speed io
 	$(RECORD) $(RESULTS)/quality.md -- $(PY) -m benchmarks.quality --loo
+	$(RECORD) $(RESULTS)/learning-curve.md -- $(PY) -m benchmarks.quality learning-curve
+	$(RECORD) $(RESULTS)/speed-adapt.md -- $(PY) -m benchmarks.quality speed adapt
 	$(RECORD) $(RESULTS)/points-read.md -- $(PY) -m benchmarks.points_read
 	$(RECORD) $(RESULTS)/upload-to-candidates.md -- $(PY) benchmarks/upload_to_candidates.py
 	@command -v wrk >/dev/null || { apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq wrk; } \

@@ -85,7 +85,8 @@ def candidates_of(take, p: dict):
         # step bounded half-way to its neighbours as the detector bounds its own cuts.
         order = np.argsort(samples, kind="stable")
         extra_stages, _ = place_stages(analysis.x, analysis.peak_frames(samples[order]),
-                                       analysis.fps, analysis.gamma, p, analysis.speeds)
+                                       analysis.fps, analysis.gamma, p, analysis.speeds,
+                                       only=order >= zero)
         back = np.empty_like(order)
         back[order] = np.arange(len(order))
         for j, name in enumerate(PLACEMENTS):

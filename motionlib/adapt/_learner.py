@@ -19,10 +19,11 @@ How the fixed settings were chosen is in ``docs/detector/adaptation.md``.
 
 from __future__ import annotations
 
+import bisect
 import hashlib
 import json
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy.special import expit
@@ -48,7 +49,11 @@ PRIOR_ZERO_SHOT = 6.0
 FIXED_PRECISION = 100.0
 PRECISIONS = (math.inf, 100.0, 10.0, 1.0)
 CV_TAKES = 3
-CV_FOLDS = 5
+CV_FOLDS = 3
+# The count calibration's search: logit thresholds within +-CALIBRATION_RANGE, halved
+# this many times.
+CALIBRATION_RANGE = 8.0
+CALIBRATION_STEPS = 8
 # The precision the take weighting's held-out fits use.
 WEIGHTING_PRECISION = 10.0
 # Take weighting: a take whose held-out loss lies more than this many robust standard
@@ -82,6 +87,8 @@ class CutModel:
     tolerance_s : how far (s) a candidate may lie from a human cut to count as it.
     down_weighted : example takes weighted down as disagreeing with the others.
     precision : the prior precision the scorer was fitted with (inf: the zero-shot one).
+    threshold : the scorer's logit a candidate must exceed: 0 keeps those more likely
+        true than not; another value makes the typical example take's count right.
     """
 
     n_takes: int
@@ -94,6 +101,7 @@ class CutModel:
     tolerance_s: float
     down_weighted: int = 0
     precision: float = math.inf
+    threshold: float = 0.0
 
     @classmethod
     def zero_shot(cls, tolerance_s: float = 1.0) -> CutModel:
@@ -110,7 +118,8 @@ class CutModel:
                 "min_segment_s": self.min_segment_s, "placement": self.placement,
                 "offset_s": self.offset_s, "tolerance_s": self.tolerance_s,
                 "down_weighted": self.down_weighted,
-                "precision": self.precision if math.isfinite(self.precision) else None}
+                "precision": self.precision if math.isfinite(self.precision) else None,
+                "threshold": self.threshold}
         return json.dumps(data, sort_keys=True)
 
     @classmethod
@@ -148,7 +157,7 @@ class CutModel:
         values = {}
         for name, kind in (("n_takes", int), ("n_cuts", int), ("down_weighted", int),
                            ("min_segment_s", float), ("offset_s", float),
-                           ("tolerance_s", float)):
+                           ("tolerance_s", float), ("threshold", float)):
             value = data.get(name)
             if not _finite(value) or (kind is int and value != int(value)):
                 fault(f"{name} must be a finite {'integer' if kind is int else 'number'}, "
@@ -195,26 +204,27 @@ def study(take, p: dict) -> dict[str, np.ndarray] | None:
 
 # ---- detection from a study ----------------------------------------------------------------
 
-def keep_probability(model: CutModel, one: dict) -> np.ndarray:
-    """(n,) each candidate's probability of being a cut of the convention."""
-    return expit(design(one["features"]) @ np.asarray(model.weights))
-
-
 def select(model: CutModel, one: dict) -> tuple[np.ndarray, np.ndarray]:
     """The cuts ``model`` keeps among a study's candidates: (frames, probability),
-    in frame order."""
-    prob = keep_probability(model, one)
+    in frame order. Most probable first, a candidate is kept when its scorer's logit
+    exceeds the model's ``threshold`` and no kept cut lies within ``min_segment_s``."""
+    logit = design(one["features"]) @ np.asarray(model.weights)
     fps = float(one["fps"])
     frames = placed(model, one)
     gap = int(round(model.min_segment_s * fps))
     kept: list[int] = []
-    for i in np.argsort(-prob, kind="stable").tolist():
-        if prob[i] <= 0.5:
+    taken: list[int] = []  # kept frames, sorted
+    for i in np.argsort(-logit, kind="stable").tolist():
+        if logit[i] <= model.threshold:
             break
-        if all(abs(frames[i] - frames[j]) >= gap for j in kept):
-            kept.append(i)
+        f = int(frames[i])
+        at = bisect.bisect_left(taken, f)
+        if (at < len(taken) and taken[at] - f < gap) or (at and f - taken[at - 1] < gap):
+            continue
+        taken.insert(at, f)
+        kept.append(i)
     kept = np.asarray(sorted(kept, key=lambda i: frames[i]), dtype=np.int64)
-    return frames[kept], prob[kept]
+    return frames[kept], expit(logit[kept])
 
 
 def placed(model: CutModel, one: dict) -> np.ndarray:
@@ -232,19 +242,39 @@ def fit(studies: list[dict], cuts: list[np.ndarray], *, tolerance_s: float,
     """Learn a :class:`CutModel` from example studies and their human cuts (take frames)."""
     prior = CutModel.zero_shot(tolerance_s)
     placement, offset = _placement(studies, cuts, tolerance_s)
-    base = CutModel(**{**prior.__dict__, "placement": placement, "offset_s": offset})
+    fine = _min_segment([(c, float(s["fps"])) for c, s in zip(cuts, studies, strict=True)],
+                        zero_min_segment_s)
+    base = replace(prior, placement=placement, offset_s=offset, min_segment_s=fine)
     data = [_labelled(base, one, c) for one, c in zip(studies, cuts, strict=True)]
     weights = _take_weights(base, studies, cuts, data)
-    precision = _precision(base, studies, cuts, data, weights)
-    w = _map_fit(data, weights, precision)
-    trusted = [(c, float(s["fps"])) for c, s, wt in zip(cuts, studies, weights, strict=True)
-               if wt >= 0.5]
-    fine = _min_segment(trusted, zero_min_segment_s)
-    return CutModel(n_takes=len(studies), n_cuts=int(sum(len(c) for c in cuts)),
-                    weights=tuple(float(v) for v in w), features=FEATURES,
-                    min_segment_s=fine, placement=placement, offset_s=offset,
-                    tolerance_s=tolerance_s, down_weighted=int(np.sum(weights < 0.5)),
-                    precision=precision)
+    precision, calibrate = _choose(base, studies, cuts, data, weights)
+    model = replace(base, weights=tuple(float(v) for v in _map_fit(data, weights, precision)),
+                    n_takes=len(studies), n_cuts=int(sum(len(c) for c in cuts)),
+                    down_weighted=int(np.sum(weights < 0.5)), precision=precision)
+    if calibrate:
+        trusted = weights >= 0.5
+        model = replace(model, threshold=_calibrated(
+            model, [s for s, t in zip(studies, trusted, strict=True) if t],
+            [c for c, t in zip(cuts, trusted, strict=True) if t]))
+    return model
+
+
+def _calibrated(model: CutModel, studies, cuts) -> float:
+    """The logit threshold at which the median example take keeps as many cuts as its
+    reviewers made (bisection; more threshold, fewer cuts). A count set by the median
+    take, so a minority of under- or over-cut takes moves it little."""
+    def excess(threshold):
+        m = replace(model, threshold=threshold)
+        return float(np.median([math.log((len(select(m, s)[0]) + 1) / (len(c) + 1))
+                                for s, c in zip(studies, cuts, strict=True)]))
+    lo, hi = -CALIBRATION_RANGE, CALIBRATION_RANGE
+    for _ in range(CALIBRATION_STEPS):
+        mid = (lo + hi) / 2
+        if excess(mid) > 0:
+            lo = mid
+        else:
+            hi = mid
+    return round((lo + hi) / 2, 4)
 
 
 def _labelled(model: CutModel, one: dict, cuts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -258,28 +288,35 @@ def _labelled(model: CutModel, one: dict, cuts: np.ndarray) -> tuple[np.ndarray,
     return design(one["features"]), y
 
 
-def _precision(base: CutModel, studies, cuts, data, weights) -> float:
-    """The prior precision: FIXED_PRECISION below CV_TAKES examples, else the one of
-    PRECISIONS whose models, fitted without a fold of example takes, cut those takes
-    with the best weighted mean F1 (at the model's tolerance)."""
+def _choose(base: CutModel, studies, cuts, data, weights) -> tuple[float, bool]:
+    """The prior precision, and whether to calibrate the count (``_calibrated``) rather
+    than keep what is more likely true than not: FIXED_PRECISION and no calibration
+    below CV_TAKES examples; else the pair whose models, fitted without a fold of example
+    takes, cut those takes with the best weighted mean F1 (at the model's tolerance),
+    ties going to the stronger prior and to no calibration."""
     n = len(data)
     if n < CV_TAKES:
-        return FIXED_PRECISION
+        return FIXED_PRECISION, False
     folds = min(n, CV_FOLDS)
-    best, best_score = math.inf, -math.inf
+    best, best_score = (math.inf, False), -math.inf
     for precision in PRECISIONS:
-        total = 0.0
+        scores = {False: 0.0, True: 0.0}
         for fold in range(folds):
             held = np.arange(n) % folds == fold
-            w = _map_fit(data, np.where(held, 0.0, weights), precision)
-            model = CutModel(**{**base.__dict__, "weights": tuple(w)})
-            for i in np.flatnonzero(held).tolist():
-                found = select(model, studies[i])[0]
-                total += weights[i] * metrics.boundary_scores(
-                    found, cuts[i], fps=float(studies[i]["fps"]),
-                    tolerance_s=base.tolerance_s)["f1"]
-        if total > best_score + 1e-9:
-            best, best_score = precision, total
+            train = np.where(held, 0.0, weights)
+            model = replace(base, weights=tuple(_map_fit(data, train, precision)))
+            trusted = [i for i in range(n) if not held[i] and weights[i] >= 0.5]
+            calibrated = replace(model, threshold=_calibrated(
+                model, [studies[i] for i in trusted], [cuts[i] for i in trusted]))
+            for calibrate, m in ((False, model), (True, calibrated)):
+                for i in np.flatnonzero(held).tolist():
+                    found = select(m, studies[i])[0]
+                    scores[calibrate] += weights[i] * metrics.boundary_scores(
+                        found, cuts[i], fps=float(studies[i]["fps"]),
+                        tolerance_s=base.tolerance_s)["f1"]
+        for calibrate in (False, True):
+            if scores[calibrate] > best_score + 1e-9:
+                best, best_score = (precision, calibrate), scores[calibrate]
     return best
 
 
