@@ -27,6 +27,7 @@ from __future__ import annotations
 import os
 import sys
 import time
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -172,7 +173,9 @@ def curve(label: LabelSet) -> dict:
                 chosen = [pool[i] for i in rng.choice(len(pool), kk, replace=False)]
                 model = fit(chosen, label.tolerance_s)
                 rows.append(scored(item, adapt.cuts_in(item.study, model), label.tolerance_s))
-            per_take.append(np.nanmean(rows, axis=0))
+            with np.errstate(all="ignore"), warnings.catch_warnings():
+                warnings.simplefilter("ignore", RuntimeWarning)  # no match: NaN error
+                per_take.append(np.nanmean(rows, axis=0))
         out[k] = (np.nanmean(per_take, axis=0), min(sizes), max(sizes))
     return out
 
@@ -323,9 +326,11 @@ def targets(curves: dict, conv: float | None, poison: dict, out) -> None:
               f"+{TARGET_CONVENTION}: {'met' if conv >= TARGET_CONVENTION else 'NOT met'})",
               file=out)
     for (name, mode), (mean, absolute) in poison.items():
-        print(f"poisoning {name} {mode}: mean dF1 {mean:+.3f}, mean |dF1| {absolute:.3f} "
-              f"(|mean dF1| < {TARGET_POISON}: "
-              f"{'met' if abs(mean) < TARGET_POISON else 'NOT met'})", file=out)
+        print(f"poisoning {name} {mode}: mean dF1 {mean:+.3f} (the project's F1: "
+              f"{'met' if abs(mean) < TARGET_POISON else 'NOT met'}), mean |dF1| "
+              f"{absolute:.3f} (each next take: "
+              f"{'met' if absolute < TARGET_POISON else 'NOT met'}; target < {TARGET_POISON})",
+              file=out)
 
 
 def main(root: Path | None = None, out=None) -> int:

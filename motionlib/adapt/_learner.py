@@ -247,6 +247,8 @@ def fit(studies: list[dict], cuts: list[np.ndarray], *, tolerance_s: float,
     base = replace(prior, placement=placement, offset_s=offset, min_segment_s=fine)
     data = [_labelled(base, one, c) for one, c in zip(studies, cuts, strict=True)]
     weights = _take_weights(base, studies, cuts, data)
+    if len(studies) < CV_TAKES:  # one or two takes do not show how finely a studio cuts
+        base = replace(base, min_segment_s=0.0)
     precision, calibrate = _choose(base, studies, cuts, data, weights)
     model = replace(base, weights=tuple(float(v) for v in _map_fit(data, weights, precision)),
                     n_takes=len(studies), n_cuts=int(sum(len(c) for c in cuts)),
@@ -289,11 +291,11 @@ def _labelled(model: CutModel, one: dict, cuts: np.ndarray) -> tuple[np.ndarray,
 
 
 def _choose(base: CutModel, studies, cuts, data, weights) -> tuple[float, bool]:
-    """The prior precision, and whether to calibrate the count (``_calibrated``) rather
-    than keep what is more likely true than not: FIXED_PRECISION and no calibration
-    below CV_TAKES examples; else the pair whose models, fitted without a fold of example
-    takes, cut those takes with the best weighted mean F1 (at the model's tolerance),
-    ties going to the stronger prior and to no calibration."""
+    """(prior precision, calibrate the count): below CV_TAKES examples FIXED_PRECISION
+    and no calibration (keep what is more likely true than not; ``_calibrated``
+    otherwise); else the pair whose models, fitted without a fold of example takes, cut
+    those takes with the best weighted mean F1 (at the model's tolerance), ties going
+    to the stronger prior and to no calibration."""
     n = len(data)
     if n < CV_TAKES:
         return FIXED_PRECISION, False
@@ -303,12 +305,12 @@ def _choose(base: CutModel, studies, cuts, data, weights) -> tuple[float, bool]:
         scores = {False: 0.0, True: 0.0}
         for fold in range(folds):
             held = np.arange(n) % folds == fold
-            train = np.where(held, 0.0, weights)
-            model = replace(base, weights=tuple(_map_fit(data, train, precision)))
+            weights_in = np.where(held, 0.0, weights)
+            fitted = replace(base, weights=tuple(_map_fit(data, weights_in, precision)))
             trusted = [i for i in range(n) if not held[i] and weights[i] >= 0.5]
-            calibrated = replace(model, threshold=_calibrated(
-                model, [studies[i] for i in trusted], [cuts[i] for i in trusted]))
-            for calibrate, m in ((False, model), (True, calibrated)):
+            calibrated = replace(fitted, threshold=_calibrated(
+                fitted, [studies[i] for i in trusted], [cuts[i] for i in trusted]))
+            for calibrate, m in ((False, fitted), (True, calibrated)):
                 for i in np.flatnonzero(held).tolist():
                     found = select(m, studies[i])[0]
                     scores[calibrate] += weights[i] * metrics.boundary_scores(
