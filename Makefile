@@ -72,6 +72,8 @@ RESULTS := benchmarks/results
 bench: install bpy
 	$(RECORD) $(RESULTS)/speed-io.md -- $(PY) -m benchmarks.quality speed io
 	$(RECORD) $(RESULTS)/quality.md -- $(PY) -m benchmarks.quality --loo
+	$(RECORD) $(RESULTS)/learning-curve.md -- $(PY) -m benchmarks.quality learning-curve
+	$(RECORD) $(RESULTS)/speed-adapt.md -- $(PY) -m benchmarks.quality speed adapt
 	$(RECORD) $(RESULTS)/points-read.md -- $(PY) -m benchmarks.points_read
 	$(RECORD) $(RESULTS)/points-similar.md -- $(PY) -m benchmarks.points_similar
 	$(RECORD) $(RESULTS)/fbx-read.md -- $(PY) benchmarks/fbx_read.py

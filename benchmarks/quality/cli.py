@@ -32,8 +32,22 @@ def build_parser() -> argparse.ArgumentParser:
                         help="with --loo, choose on the other takes under --data only")
     subparsers = parser.add_subparsers(dest="command", metavar="command")
     add_speed(subparsers)
+    curve = subparsers.add_parser(
+        "learning-curve", help="how a studio's cut model learns from reviewed takes",
+        description="Per labelled set: models fitted on k = 0, 1, 3, 5, 10 reviewed takes "
+                    "of other subjects, scored on the held-out take; convention-following "
+                    "and poisoning (benchmarks/quality/learning.py).")
+    curve.add_argument("--data", help="benchmark data folder (default: $CUTROOM_BENCH_DATA "
+                                      "or ../shared/data)")
+    curve.set_defaults(handler=run_learning)
     parser.set_defaults(handler=run_quality, command="quality")  # no command: quality
     return parser
+
+
+def run_learning(args) -> int:
+    from benchmarks.quality import learning
+
+    return learning.main(args.data)
 
 
 def run_quality(args) -> int:

@@ -5,6 +5,8 @@ its README) is found, whatever its name:
 
 - ``labels/mocap6/segments/<take>.csv`` (runs of 10 fps blocks, AMC frames 1-based) and
   ``labels/cmu86_kruger2017/<take>.csv`` (Krüger et al. 2017 transition windows);
+- ``labels/cmu86_baak/intervals.csv`` (Baak / Müller's sparse intervals of the same
+  subject-86 takes, another convention: ``baak_takes``, not among ``discover``'s takes);
 - their motion: ``cmu/bvh/<take>.bvh`` where present (label frames shifted by the BVH's
   extra T-pose lines), else ``cmu/amc/<take>.amc`` with ``cmu/asf/<subject>.asf``, else
   ``cmu/channels4d/<take>.4d.txt`` (four AMC channels per frame: a *four-channel take*,
@@ -198,6 +200,57 @@ def kruger_truth(path: Path) -> np.ndarray:
     mid = windows[:, 1]
     mid = np.where((mid < lo) | (mid > hi), (lo + hi) // 2, mid)
     return np.stack([lo, mid, hi], axis=1)
+
+
+# Baak's interval starts and ends closer than this (s) are one boundary (its README).
+BAAK_MERGE_S = 0.5
+
+
+def baak_truth(spans: list[tuple[int, int]], *, fps: float = CMU_FPS) -> np.ndarray:
+    """True cuts from Baak's sparse, possibly overlapping intervals of one take.
+
+    ``spans`` are ``(start_frame, end_frame)``, 1-based inclusive AMC frames. Every start
+    (0-based frame ``start - 1``) and every end (the next frame starts after it: 0-based
+    ``end``) inside the take is a boundary; boundaries closer than ``BAAK_MERGE_S`` to the
+    previous one are one cut, the window ``(first, mean, last)``. The take's length is its
+    last labelled frame (the README), so its last end is no cut.
+    """
+    if not spans:
+        return np.zeros((0, 3), dtype=np.int64)
+    length = max(end for _, end in spans)
+    marks = sorted({f for start, end in spans for f in (start - 1, end) if 0 < f < length})
+    gap = BAAK_MERGE_S * fps
+    groups: list[list[int]] = []
+    for f in marks:
+        if groups and f - groups[-1][-1] <= gap:
+            groups[-1].append(f)
+        else:
+            groups.append([f])
+    rows = [(g[0], int(round(np.mean(g))), g[-1]) for g in groups]
+    return np.asarray(rows, dtype=np.int64).reshape(-1, 3)
+
+
+def baak_takes(root: Path | None = None) -> list[LabelledTake]:
+    """The subject-86 takes of ``labels/cmu86_baak/intervals.csv`` that have motion (their
+    four channels, where present, so that both conventions score the same view; else
+    the AMC), with Baak's cuts (``baak_truth``)."""
+    root = Path(root) if root is not None else data_dir()
+    path = root / "labels" / "cmu86_baak" / "intervals.csv"
+    if not path.is_file():
+        return []
+    spans: dict[str, list[tuple[int, int]]] = {}
+    for line, row in _rows(path, ("take", "start_frame", "end_frame")):
+        spans.setdefault(row["take"], []).append((_int(path, line, row, "start_frame"),
+                                                  _int(path, line, row, "end_frame")))
+    cmu, out = root / "cmu", []
+    for name, rows in sorted(spans.items()):
+        four = cmu / "channels4d" / f"{name}.4d.txt"
+        if four.is_file():
+            out.append(LabelledTake(name, four, None, baak_truth(rows), "baak", "channels",
+                                    path))
+        elif (files := _amc_asf(name, cmu)) is not None:
+            out.append(LabelledTake(name, *files, baak_truth(rows), "baak", labels=path))
+    return out
 
 
 LABEL_SOURCES = (("mocap6", "mocap6/segments"), ("kruger2017", "cmu86_kruger2017"))

@@ -9,8 +9,10 @@ same files; the machine's load average is printed since other work skews wall ti
 and peak traced memory of read + FK against the file size; plus the time to synthesise a
 five-minute take.
 
-``adapt``: the adapted default detector's speed on five-minute 120 fps synthetic takes:
-detection with an adapted model (median of several runs), and fitting a model on 50 such
+``adapt``: the adapted default detector's speed on five-minute 120 fps synthetic takes,
+for the first model format (threshold model) and the current one (candidate scorer) in
+one run: detection zero-shot and with a model (median of several runs), and fitting a
+model on 50 such
 takes (10 distinct takes, each given five times, so the examples fit in memory; fitting
 visits every example in full either way), and refitting them after one example's cuts
 changed with every example's study stored (``adapt.MemoryStudies``; what the service
@@ -160,36 +162,52 @@ def _run_adapt(args) -> int:
         take, segments = synth.generate(seed=seed, fps=120.0, duration=60.0 * minutes)
         takes.append((take, np.asarray([s[0] for s in segments[1:]])))
     examples = [takes[i % distinct] for i in range(args.takes)]
-    fit_wall, fit_cpu, model = _timed(lambda: adapt.fit_cut_model(examples))
+    target, _ = synth.generate(seed=99, fps=120.0, duration=60.0 * minutes)
+    print(f"{'case':<58}{'wall s':>9}{'cpu s':>9}{'target s':>10}")
+    for title, fit in (("format 1, threshold model (before)", adapt.fit_threshold_model),
+                       ("format 2, candidate scorer (now)", adapt.fit_cut_model)):
+        print(title)
+        _time_learner(fit, examples, target, minutes, args)
+    print("ok/MISSED compare the CPU time of this single-threaded process, its time on one "
+          "free core;\nwall time also counts waiting for a core on a busy machine.")
+    print("threads: one BLAS thread, as the workers run; "
+          f"load average during the run: {' '.join(f'{x:.2f}' for x in os.getloadavg())}")
+    return 0
+
+
+def _time_learner(fit, examples, target, minutes, args) -> None:
+    from motionlib import adapt
+
+    fit_wall, fit_cpu, model = _timed(lambda: fit(examples))
     # As the service refits after a submit: every example's study stored, one example's
     # cuts changed (its last cut removed).
     keyed = [adapt.Example(name=f"take {i}", cuts=cuts, fps=take.fps, n_frames=take.n_frames,
                            read=lambda take=take: take, key=f"take-{i}")
              for i, (take, cuts) in enumerate(examples)]
     studies = adapt.MemoryStudies()
-    adapt.fit_cut_model(keyed, studies=studies)
+    fit(keyed, studies=studies)
     keyed[0] = dataclasses.replace(keyed[0], cuts=keyed[0].cuts[:-1])
-    refit_wall, refit_cpu, _ = _timed(lambda: adapt.fit_cut_model(keyed, studies=studies))
-    target, _ = synth.generate(seed=99, fps=120.0, duration=60.0 * minutes)
+    refit_wall, refit_cpu, _ = _timed(lambda: fit(keyed, studies=studies))
     adapt.detect(target, model)  # warm up
     runs = [_timed(lambda: adapt.detect(target, model))[:2] for _ in range(args.runs)]
     detect_wall = statistics.median(r[0] for r in runs)
     detect_cpu = statistics.median(r[1] for r in runs)
-    print(f"{'case':<48}{'wall s':>9}{'cpu s':>9}{'target s':>10}")
-    print(f"{f'detect, adapted model, {minutes:g}-min 120 fps take':<48}{detect_wall:>9.3f}"
-          f"{detect_cpu:>9.3f}{TARGET_DETECT_S:>10.1f}  "
-          f"{'ok' if detect_cpu <= TARGET_DETECT_S else 'MISSED'} (median of {args.runs})")
-    print(f"{f'fit on {args.takes} {minutes:g}-min 120 fps takes':<48}{fit_wall:>9.3f}"
-          f"{fit_cpu:>9.3f}{TARGET_FIT_S:>10.1f}  "
-          f"{'ok' if fit_cpu <= TARGET_FIT_S else 'MISSED'} ({model.n_cuts} cuts)")
-    print(f"{f'refit, 1 of {args.takes} changed, studies stored':<48}{refit_wall:>9.3f}"
-          f"{refit_cpu:>9.3f}{TARGET_FIT_S:>10.1f}  "
-          f"{'ok' if refit_cpu <= TARGET_FIT_S else 'MISSED'} (as after a submit)")
-    print("ok/MISSED compare the CPU time of this single-threaded process, its time on one "
-          "free core;\nwall time also counts waiting for a core on a busy machine.")
-    print("threads: one BLAS thread, as the workers run; "
-          f"load average during the run: {' '.join(f'{x:.2f}' for x in os.getloadavg())}")
-    return 0
+    zero = [_timed(lambda: adapt.detect(target))[:2] for _ in range(args.runs)]
+    rows = [
+        (f"  detect, zero-shot, {minutes:g}-min 120 fps take",
+         statistics.median(r[0] for r in zero), statistics.median(r[1] for r in zero),
+         None, f"(median of {args.runs})"),
+        (f"  detect, with a model, {minutes:g}-min 120 fps take", detect_wall, detect_cpu,
+         TARGET_DETECT_S, f"(median of {args.runs})"),
+        (f"  fit on {args.takes} {minutes:g}-min 120 fps takes, none stored", fit_wall,
+         fit_cpu, TARGET_FIT_S, f"({model.n_cuts} cuts)"),
+        (f"  refit, 1 of {args.takes} changed, studies stored", refit_wall, refit_cpu,
+         TARGET_FIT_S, "(as after a submit)"),
+    ]
+    for case, wall, cpu, target_s, note in rows:
+        verdict = "" if target_s is None else ("ok" if cpu <= target_s else "MISSED")
+        shown = "" if target_s is None else f"{target_s:.1f}"
+        print(f"{case:<58}{wall:>9.3f}{cpu:>9.3f}{shown:>10}  {verdict} {note}")
 
 
 def add_speed(subparsers) -> None:

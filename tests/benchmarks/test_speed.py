@@ -48,12 +48,19 @@ def test_it_says_when_the_captures_are_missing(tmp_path, capsys):
         "benchmarks.quality speed io: error: CMU captures not found under")
 
 
-def test_the_adapt_benchmark_times_detection_fitting_and_a_refit(capsys):
+def test_the_adapt_benchmark_times_both_model_formats(capsys):
     assert main(["speed", "adapt", "--takes", "3", "--minutes", "0.5", "--runs", "1"]) == 0
     lines = capsys.readouterr().out.splitlines()
-    cases = [line[:48].strip() for line in lines[1:4]]
-    assert cases == ["detect, adapted model, 0.5-min 120 fps take", "fit on 3 0.5-min 120 fps takes",
-                     "refit, 1 of 3 changed, studies stored"]
-    for line in lines[1:4]:
-        wall, cpu, target = (float(v) for v in line[48:].split()[:3])
-        assert wall > 0 and cpu > 0 and target > 0
+    assert [lines[1], lines[6]] == ["format 1, threshold model (before)",
+                                    "format 2, candidate scorer (now)"]
+    for block in (lines[2:6], lines[7:11]):
+        cases = [line[:58].strip() for line in block]
+        assert cases == ["detect, zero-shot, 0.5-min 120 fps take",
+                         "detect, with a model, 0.5-min 120 fps take",
+                         "fit on 3 0.5-min 120 fps takes, none stored",
+                         "refit, 1 of 3 changed, studies stored"]
+        for line in block:
+            wall, cpu = (float(v) for v in line[58:].split()[:2])
+            assert wall > 0 and cpu > 0
+        for line in block[1:]:
+            assert float(line[58:].split()[2]) > 0  # the target

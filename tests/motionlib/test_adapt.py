@@ -1,10 +1,23 @@
-"""Adapting the default detector to example takes with human cuts (motionlib.adapt)."""
+"""Learning a studio's cutting convention from reviewed takes (motionlib.adapt, format 2)."""
+
+from dataclasses import replace
 
 import numpy as np
 import pytest
 
 from motionlib import metrics, synth
-from motionlib.adapt import CutModel, ExampleError, detect, fit_cut_model
+from motionlib.adapt import (
+    CutModel,
+    Example,
+    ExampleError,
+    MemoryStudies,
+    ThresholdModel,
+    cuts_in,
+    detect,
+    fit_cut_model,
+    score,
+    study,
+)
 
 FPS = 60.0
 
@@ -14,74 +27,100 @@ def _take(seed, **kw):
     return take, np.asarray([start for start, _, _ in segments[1:]], dtype=np.int64)
 
 
-def _signed_errors(cuts, truth, fps):
-    ci, ti = metrics.match(cuts, truth, tolerance=int(fps))
-    return (np.asarray(truth)[ti] - np.asarray(cuts)[ci]) / fps
+def _f1(cuts, truth, tolerance_s=1.0):
+    return metrics.boundary_scores(cuts, truth, fps=FPS, tolerance_s=tolerance_s)["f1"]
 
 
-def test_it_moves_placement_to_where_the_annotators_cut():
-    # These annotators mark the onset of the next activity, 0.6 s after the cross-fade.
+def test_the_prior_model_detects_exactly_the_zero_shot_cuts():
+    for seed in (1, 2, 3):
+        take, _ = _take(seed)
+        assert detect(take, CutModel.zero_shot()).cuts.tolist() == detect(take).cuts.tolist()
+
+
+def test_it_cuts_a_new_take_closer_to_the_convention_it_was_taught():
+    # Two studios cut the same activity changes, one at the cross-fade, the other 0.6 s
+    # later (at the onset of the next activity).
     late = int(0.6 * FPS)
-    examples = [(take, cuts + late) for take, cuts in (_take(1), _take(2))]
-    model = fit_cut_model(examples)
+    takes = [_take(seed) for seed in (1, 2, 4, 5)]
+    at_change = fit_cut_model(takes)
+    at_onset = fit_cut_model([(take, cuts + late) for take, cuts in takes])
     take, cuts = _take(3)
-    zero_shot = np.median(_signed_errors(detect(take).cuts, cuts + late, FPS))
-    adapted = np.median(_signed_errors(detect(take, model).cuts, cuts + late, FPS))
-    assert zero_shot > 0.3
-    assert abs(adapted) < 0.15
+    for model, taught, other in ((at_change, cuts, cuts + late),
+                                 (at_onset, cuts + late, cuts)):
+        found = detect(take, model).cuts
+        assert _f1(found, taught, 0.25) > _f1(found, other, 0.25) + 0.15
 
 
 def test_it_learns_that_a_studio_cuts_nothing_in_such_takes():
-    model = fit_cut_model([(_take(4)[0], []), (_take(5)[0], [])])
+    model = fit_cut_model([(_take(seed)[0], []) for seed in (4, 5, 10)])
     assert len(detect(_take(6)[0], model).cuts) == 0
 
 
-def test_it_learns_the_shortest_activity_from_the_examples():
-    short = dict(segment_seconds=(1.5, 2.5), duration=30.0)
-    model = fit_cut_model([_take(7, **short), _take(8, **short)])
-    assert model.min_segment_s < 1.5
-    assert model.scale_min_s < 3.0  # windows short enough to see such an activity
-    take, cuts = _take(9, **short)
-    found = metrics.boundary_scores(detect(take, model).cuts, cuts, fps=FPS, tolerance_s=0.5)
-    zero_shot = metrics.boundary_scores(detect(take).cuts, cuts, fps=FPS, tolerance_s=0.5)
-    assert found["recall"] > zero_shot["recall"]
+def test_it_learns_how_finely_a_studio_segments():
+    long = dict(segment_seconds=(8.0, 12.0), duration=60.0)
+    model = fit_cut_model([_take(seed, **long) for seed in (1, 2, 3)])
+    assert model.min_segment_s > 3.0
 
 
-def test_it_keeps_the_zero_shot_windows_without_short_activities():
-    model = fit_cut_model([_take(1), _take(2)])
-    assert (model.scale_min_s, model.scale_max_s) == (3.0, 6.0)
+@pytest.mark.parametrize("mode", ["under", "over"])
+def test_a_minority_of_bad_reviews_barely_moves_the_model(mode):
+    takes = [_take(seed, duration=40.0) for seed in range(20, 30)]
+    rng = np.random.default_rng(0)
 
+    def bad(take, cuts):
+        if mode == "under":
+            return cuts[::2]
+        extra = rng.integers(1, take.n_frames - 1, size=len(cuts))
+        return np.unique(np.concatenate([cuts, extra]))
 
-def test_it_counts_the_examples_it_learnt_from():
-    model = fit_cut_model([_take(1), _take(2)])
-    assert (model.n_takes, model.n_cuts) == (2, len(_take(1)[1]) + len(_take(2)[1]))
+    reviewed = [(take, bad(take, cuts) if i in (1, 4, 7) else cuts)
+                for i, (take, cuts) in enumerate(takes)]
+    clean, poisoned = fit_cut_model(takes), fit_cut_model(reviewed)
+    assert poisoned.down_weighted >= 2
+    for seed in (40, 41):
+        take, cuts = _take(seed)
+        moved = _f1(detect(take, poisoned).cuts, cuts) - _f1(detect(take, clean).cuts, cuts)
+        assert abs(moved) < 0.05
 
 
 def test_it_round_trips_a_model_through_json():
-    model = CutModel(n_takes=2, n_cuts=9, threshold=0.2, prominence=0.1, min_segment_s=1.5,
-                     scale_min_s=3.0, scale_max_s=6.0, placement="split", offset_s=-0.1)
+    model = fit_cut_model([_take(1), _take(2), _take(4)])
     text = model.to_json()
-    assert '"format": 1' in text
+    assert '"format": 2' in text
     assert CutModel.from_json(text) == model
 
 
+def test_it_reads_a_model_of_the_first_format_and_detects_with_it_as_before():
+    from motionlib.adapt._threshold import detect_threshold
+
+    text = ('{"format": 1, "n_takes": 2, "n_cuts": 9, "threshold": 0.2, "prominence": 0.1, '
+            '"min_segment_s": 1.5, "scale_min_s": 3, "scale_max_s": 6, "offset_s": -0.1, '
+            '"placement": "split"}')
+    model = CutModel.from_json(text)
+    assert isinstance(model, ThresholdModel)
+    take, _ = _take(3)
+    assert detect(take, model).cuts.tolist() == detect_threshold(take, model).cuts.tolist()
+
+
 @pytest.mark.parametrize("text, fault", [
-    ("{", "not JSON"),
-    ('{"format": 2}', "format 2"),
-    ('{"format": 1, "n_takes": 1, "n_cuts": 1, "threshold": "x", "min_segment_s": 1, '
-     '"prominence": 1, "scale_min_s": 3, "scale_max_s": 6, "offset_s": 0, "placement": "pause"}', "threshold"),
-    ('{"format": 1, "n_takes": 1, "n_cuts": 1, "threshold": 1, "min_segment_s": 1, '
-     '"prominence": 1, "scale_min_s": 3, "scale_max_s": 6, "offset_s": 0, "placement": "middle"}', "placement"),
+    ("[1]", "JSON object"),
+    ('{"format": 3}', "format 3"),
+    ('{"format": 2, "features": ["zero_shot"]}', "features"),
 ])
 def test_it_refuses_a_stored_model_it_cannot_read(text, fault):
     with pytest.raises(ValueError, match=fault):
         CutModel.from_json(text)
 
 
-def test_it_reads_a_stored_model_from_before_the_prominence_test_as_it_was():
-    text = ('{"format": 1, "n_takes": 1, "n_cuts": 4, "threshold": 0.3, "min_segment_s": 2, '
-            '"scale_min_s": 3, "scale_max_s": 6, "offset_s": 0, "placement": "pause"}')
-    assert CutModel.from_json(text).prominence == 0.0
+def test_it_refuses_weights_of_the_wrong_length():
+    data = CutModel.zero_shot().to_json().replace('"weights": [', '"weights": [1.0, ')
+    with pytest.raises(ValueError, match="weights must be 10 finite numbers"):
+        CutModel.from_json(data)
+
+
+def test_it_refuses_an_empty_example_list():
+    with pytest.raises(ExampleError, match="no example takes"):
+        fit_cut_model([])
 
 
 def test_it_refuses_a_cut_outside_the_example_take():
@@ -96,102 +135,11 @@ def test_it_names_an_example_take_too_short_to_learn_from():
         fit_cut_model([(_take(2)[0], []), (take.slice(0, 3), [1])])
 
 
-def test_it_refuses_an_empty_example_list():
-    with pytest.raises(ExampleError, match="no example takes"):
-        fit_cut_model([])
-
-
-def test_it_detects_zero_shot_exactly_as_the_default_segmenter():
-    from motionlib.segmenters.default import Default
-
-    take, _ = _take(1, duration=20.0)
-    assert detect(take).cuts.tolist() == Default().fit_predict(take).cuts.tolist()
-
-
-def _peaks(prominences, cuts):
-    """One example's novelty peaks (every 100 frames) as the count sees them."""
-    frames = 100 * np.arange(1, len(prominences) + 1)
-    return frames, np.asarray(prominences, float), np.asarray(cuts), 10, frames
-
-
-# At the zero-shot prominence (0.1) a usual example's peaks are its cuts; a higher
-# prominence loses one. The unusual one holds weak peaks where its annotators cut nothing.
-USUAL = _peaks([0.5, 0.5, 0.12, 0.05], [100, 200, 300])
-UNUSUAL = _peaks([0.5, 0.15, 0.15, 0.15, 0.15], [100])
-
-
-def test_one_unusual_example_among_several_does_not_move_the_count():
-    from motionlib.adapt import _count
-
-    # Summed over the four examples a prominence above 0.15 scores best (3.0 against 0:
-    # the unusual one's four false peaks are four deletes), but only because of the
-    # unusual one: chosen without it, the others keep 0.1.
-    assert _count([USUAL, USUAL, USUAL, UNUSUAL], 0.1)[1] == 0.1
-
-
-def test_examples_that_agree_still_move_the_count():
-    from motionlib.adapt import _count
-
-    assert _count([UNUSUAL, UNUSUAL, UNUSUAL], 0.1)[1] > 0.15
-    assert _count([USUAL, USUAL, USUAL], 0.1)[1] == 0.1
-
-
-def test_examples_move_the_count_from_a_zero_shot_without_the_prominence_test():
-    from motionlib.adapt import _count
-
-    with np.errstate(divide="raise"):
-        assert _count([UNUSUAL, UNUSUAL, UNUSUAL], 0.0)[1] > 0.15
-        # The usual examples' false peak (0.05) goes, their weakest cut (0.12) stays.
-        assert 0.05 < _count([USUAL, USUAL, USUAL], 0.0)[1] <= 0.12
-
-
-def test_the_count_keeps_weak_peaks_only_if_they_save_a_reviewer_edits():
-    from motionlib.adapt import _count
-
-    # Two strong peaks on cuts; five weak ones (0.2), two of them on the other two cuts.
-    # Keeping the weak ones raises F1 (8/11 against 4/6) but costs three deletes to save
-    # two inserts: the count drops them.
-    example = _peaks([1.0, 1.0, 0.2, 0.2, 0.2, 0.2, 0.2], [100, 200, 300, 400])
-    assert _count([example], 0.2)[1] > 0.2
-    # Three of five true: they save a reviewer one edit, and stay.
-    example = _peaks([1.0, 1.0, 0.2, 0.2, 0.2, 0.2, 0.2], [100, 200, 300, 400, 500])
-    assert _count([example], 0.2)[1] == 0.2
-
-
-def test_a_take_of_one_activity_weighs_its_false_peak_like_any_other_example():
-    from motionlib.adapt import _count
-
-    # A reviewed take labelled as one activity (no cut) where the detector found one peak,
-    # beside a take of five cuts whose weakest true peak is 0.2. Counted per cut of its own
-    # take, the one false peak would weigh as much as five of the other take's cuts and
-    # push the count above 0.3, losing that cut everywhere; counted like any other edit it
-    # weighs less than the cut.
-    cuts = _peaks([0.5, 0.5, 0.5, 0.5, 0.2], [100, 200, 300, 400, 500])
-    whole = _peaks([0.3], [])
-    assert _count([cuts, whole], 0.1)[1] == 0.1
-    # Three false peaks in it outweigh the one cut.
-    assert _count([cuts, _peaks([0.3, 0.3, 0.3], [])], 0.1)[1] > 0.3
-
-
-def test_two_examples_keep_the_fixed_prior():
-    from motionlib.adapt import _count
-
-    # Too few to leave one out: the fixed prior lets the two examples' sum decide.
-    assert _count([USUAL, UNUSUAL], 0.1)[1] > 0.15
-
-
-def test_a_studio_that_cuts_nothing_teaches_it_with_three_examples():
-    model = fit_cut_model([(_take(seed)[0], []) for seed in (4, 5, 10)])
-    assert len(detect(_take(6)[0], model).cuts) == 0
-
-
-def _examples(seeds, reads, **kw):
+def _examples(seeds, reads):
     """Keyed examples that record each time their take is read."""
-    from motionlib.adapt import Example
-
     out = []
     for seed in seeds:
-        take, cuts = _take(seed, **kw)
+        take, cuts = _take(seed)
 
         def read(take=take, seed=seed):
             reads.append(seed)
@@ -201,70 +149,32 @@ def _examples(seeds, reads, **kw):
     return out
 
 
-def test_a_refit_reads_only_the_examples_whose_study_is_not_stored():
-    from dataclasses import replace
-
-    from motionlib.adapt import MemoryStudies
-
+def test_a_refit_reads_only_the_takes_it_has_not_studied():
     studies, reads = MemoryStudies(), []
     examples = _examples((1, 2, 3), reads)
     first = fit_cut_model(examples, studies=studies)
-    assert reads == [1, 2, 3] and set(studies.items) == {"take-1", "take-2", "take-3"}
     reads.clear()
     assert fit_cut_model(examples, studies=studies) == first
-    assert reads == []
-    # A review changes the cuts of one take: only that take is read and analysed again.
+    # A review changes one take's cuts: its candidates stand as they were.
     examples[1] = replace(examples[1], cuts=examples[1].cuts[:-1])
-    refit = fit_cut_model(examples, studies=studies)
-    assert reads == [2]
-    assert refit == fit_cut_model([(e.read(), e.cuts) for e in examples])
-
-
-def test_a_study_made_with_other_settings_is_not_used():
-    from motionlib.adapt import MemoryStudies
-
-    studies, reads = MemoryStudies(), []
-    fit_cut_model(_examples((7, 8), reads), studies=studies)
-    # A third example with a much shorter activity changes the minimum segment, and so
-    # what every example's peaks are: all three are analysed again.
-    short = _examples((9,), reads, segment_seconds=(1.5, 2.5), duration=30.0)
+    changed = fit_cut_model(examples, studies=studies)
+    assert changed == fit_cut_model([(e.read(), e.cuts) for e in examples])
     reads.clear()
-    fit_cut_model(_examples((7, 8), reads) + short, studies=studies)
-    assert sorted(reads) == [7, 8, 9]
+    fit_cut_model(examples + _examples((4,), reads), studies=studies)
+    assert reads == [4]
 
 
-def test_examples_without_a_key_are_never_stored():
-    from motionlib.adapt import MemoryStudies
-
-    studies = MemoryStudies()
-    fit_cut_model([_take(1), _take(2)], studies=studies)
-    assert studies.items == {}
+def test_detection_from_stored_candidates_equals_detection_from_the_take():
+    model = fit_cut_model([_take(1), _take(2), _take(4)])
+    take, _ = _take(3)
+    assert cuts_in(study(take), model).tolist() == detect(take, model).cuts.tolist()
 
 
-def test_it_starts_from_the_settings_it_is_given():
-    model = fit_cut_model([_take(1), _take(2)], base={"threshold": 0.2, "min_segment_s": 1.0})
-    assert model.threshold == 0.2
-    assert model.min_segment_s <= 1.0  # never longer than where it started
-    zero_shot = fit_cut_model([_take(1), _take(2)])
-    assert (zero_shot.threshold, zero_shot.min_segment_s) == (0.1, 1.5)
-
-
-def test_an_example_counts_both_sides_of_a_short_activity_the_detector_cuts():
-    # 6 s, 1.8 s, 6 s: the long windows see the short activity as one peak, and the
-    # detector's unmatched-poses step makes it two cuts; the study the count is learnt
-    # from must hold both, where the detector places them, at the zero-shot prominence.
-    from motionlib.adapt import Example, MemoryStudies, matched_count
-    from motionlib.segmenters.default import Default
-
-    take, segments = synth.generate(seed=1, fps=FPS, plan=[("idle", 6.0), ("kick", 1.8),
-                                                           ("walk", 6.0)])
-    cuts = np.asarray([start for start, _, _ in segments[1:]], dtype=np.int64)
-    assert matched_count(detect(take).cuts, cuts, int(FPS)) == 2
-    studies = MemoryStudies()
-    fit_cut_model([Example(name="short", cuts=cuts, fps=FPS, n_frames=take.n_frames,
-                           read=lambda: take, key="short")], studies=studies)
-    study = studies.items["short"][1]
-    kept = study["placed_frames"][study["placed_prominence"] >=
-                                  Default.params["prominence"].default]
-    assert matched_count(kept, cuts, int(FPS)) == 2
-    assert len(kept) == 2
+def test_it_scores_a_model_on_a_reviewed_take():
+    take, cuts = _take(3)
+    found = detect(take).cuts
+    figure = score(None, take, cuts, tolerance_s=1.0)
+    assert figure["f1"] == pytest.approx(_f1(found, cuts))
+    assert figure["edits_per_cut"] == pytest.approx(
+        metrics.edit_cost(found, cuts, fps=FPS)["edits_per_cut"])
+    assert (figure["n_cuts"], figure["n_true"]) == (len(found), len(cuts))

@@ -170,11 +170,13 @@ def pose_speeds(x: np.ndarray, fps: float) -> tuple[np.ndarray, np.ndarray]:
 
 
 def place_stages(x: np.ndarray, peaks: np.ndarray, fps: float, gamma: float, p: dict,
-                 speeds: tuple[np.ndarray, np.ndarray] | None = None):
+                 speeds: tuple[np.ndarray, np.ndarray] | None = None,
+                 only: np.ndarray | None = None):
     """Each placement step's estimate of every cut (see the module docstring).
 
     ``speeds``: ``pose_speeds(x, fps)`` when already computed (tuning places many sets
-    of peaks on one take).
+    of peaks on one take). ``only``: (n_cuts,) bool, place only these cuts (each still
+    bounded by all its neighbours); the others' estimates are their own frame.
 
     Returns
     -------
@@ -190,6 +192,10 @@ def place_stages(x: np.ndarray, peaks: np.ndarray, fps: float, gamma: float, p: 
     onset_radius = int(round(ONSET_MAX_S * fps))
     stages = {name: [] for name in PLACEMENTS}
     for i, cut in enumerate(int(c) for c in peaks):
+        if only is not None and not only[i]:
+            for name in PLACEMENTS:
+                stages[name].append(cut)
+            continue
         # Never look past half-way to a neighbouring cut: that stretch is theirs.
         lo = max(0, cut - context, (int(peaks[i - 1]) + cut) // 2 if i else 0)
         hi = min(len(x), cut + context)
