@@ -4,9 +4,7 @@ when the training started."""
 
 import datetime
 
-from django.db import connection
-from django.db.migrations.executor import MigrationExecutor
-from django.test import TransactionTestCase
+from tests.segmentation.migrations import MigrationTestCase
 
 BEFORE = [("segmentation", "0018_username_keys")]
 AFTER = [("segmentation", "0019_cut_model_gate")]
@@ -17,13 +15,7 @@ def at(minutes):
     return T0 + datetime.timedelta(minutes=minutes)
 
 
-class CutModelGateMigrationTest(TransactionTestCase):
-    def migrate(self, targets):
-        executor = MigrationExecutor(connection)
-        executor.loader.build_graph()
-        executor.migrate(targets)
-        return executor.loader.project_state(targets).apps
-
+class CutModelGateMigrationTest(MigrationTestCase):
     def setUp(self):
         apps = self.migrate(BEFORE)
         model = lambda name: apps.get_model("segmentation", name)  # noqa: E731
@@ -50,10 +42,6 @@ class CutModelGateMigrationTest(TransactionTestCase):
         self.failed = cut_models.create(project=project, status="failed", error="x", claimed_at=at(30))
         self.ids = {"early": early.pk, "gold": adjudicated.pk}
         self.apps = self.migrate(AFTER)
-
-    def tearDown(self):
-        executor = MigrationExecutor(connection)
-        self.migrate(executor.loader.graph.leaf_nodes("segmentation"))
 
     def test_a_trained_model_learnt_from_the_takes_reviewed_before_its_training_started(self):
         row = self.apps.get_model("segmentation", "ProjectCutModel").objects.get(pk=self.v1.pk)

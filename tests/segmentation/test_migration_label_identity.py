@@ -6,21 +6,13 @@ The rows are made in the 0012 schema as the service used to leave them after ren
 label added since.
 """
 
-from django.db import connection
-from django.db.migrations.executor import MigrationExecutor
-from django.test import TransactionTestCase
+from tests.segmentation.migrations import MigrationTestCase
 
 BEFORE = [("segmentation", "0012_library_scale")]
 AFTER = [("segmentation", "0016_segment_label_identity")]
 
 
-class LabelIdentityMigrationTest(TransactionTestCase):
-    def migrate(self, targets):
-        executor = MigrationExecutor(connection)
-        executor.loader.build_graph()
-        executor.migrate(targets)
-        return executor.loader.project_state(targets).apps
-
+class LabelIdentityMigrationTest(MigrationTestCase):
     def setUp(self):
         apps = self.migrate(BEFORE)
         model = lambda name: apps.get_model("segmentation", name)  # noqa: E731
@@ -54,13 +46,6 @@ class LabelIdentityMigrationTest(TransactionTestCase):
             per_label={"punch": {"overlap": 0.5, "frames": 10}, "gone": {"overlap": 1, "frames": 1}})
         self.apps = self.migrate(AFTER)
         self.model = lambda name: self.apps.get_model("segmentation", name)
-
-    def tearDown(self):
-        self.migrate(self.migrate_latest())
-
-    def migrate_latest(self):
-        executor = MigrationExecutor(connection)
-        return executor.loader.graph.leaf_nodes("segmentation")
 
     def test_gold_labels_become_the_ids_their_names_meant(self):
         gold = self.model("Adjudication").objects.get()

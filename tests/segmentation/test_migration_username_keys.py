@@ -1,21 +1,13 @@
 """Migration 0018 stores the key of every existing account's username; of accounts made
 before the rules whose names differ only in case or form, the oldest holds the key."""
 
-from django.db import connection
-from django.db.migrations.executor import MigrationExecutor
-from django.test import TransactionTestCase
+from tests.segmentation.migrations import MigrationTestCase
 
 BEFORE = [("segmentation", "0017_auth_limits")]
 AFTER = [("segmentation", "0018_username_keys")]
 
 
-class UsernameKeyMigrationTest(TransactionTestCase):
-    def migrate(self, targets):
-        executor = MigrationExecutor(connection)
-        executor.loader.build_graph()
-        executor.migrate(targets)
-        return executor.loader.project_state(targets).apps
-
+class UsernameKeyMigrationTest(MigrationTestCase):
     def setUp(self):
         apps = self.migrate(BEFORE)
         users = apps.get_model("auth", "User").objects
@@ -23,10 +15,6 @@ class UsernameKeyMigrationTest(TransactionTestCase):
         self.big_bob = users.create(username="BOB")
         self.elena = users.create(username="\u0395\u03bb\u03ad\u03bd\u03b7")
         self.apps = self.migrate(AFTER)
-
-    def tearDown(self):
-        executor = MigrationExecutor(connection)
-        self.migrate(executor.loader.graph.leaf_nodes("segmentation"))
 
     def test_every_account_gets_a_row_and_the_oldest_of_a_key_holds_it(self):
         from segmentation import usernames
