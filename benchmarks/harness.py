@@ -3,9 +3,11 @@ a chosen environment, stopping a child process group, and `make up`'s own script
 
 import importlib.util
 import os
+import shutil
 import signal
 import subprocess
 import sys
+import tempfile
 from pathlib import Path
 from urllib.parse import urlparse, urlunparse
 
@@ -59,6 +61,22 @@ def start_django(unset=(), **env):
     from django.core.management import call_command
 
     call_command("migrate", verbosity=0)
+
+
+def in_scratch_installation(prefix, run, args):
+    """``run(args, var)`` with Django set up on the embedded default in a scratch ``var``
+    folder (removed afterwards) and numpy on one core: the service as one worker process
+    runs it, whatever the caller's environment points at."""
+    # numpy is imported with Django below: set before, it must not fan out to other cores.
+    for name in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+        os.environ.setdefault(name, "1")
+    var = Path(tempfile.mkdtemp(prefix=prefix))
+    try:
+        start_django(unset=("DATABASE_URL", "CELERY_BROKER_URL", "CUTROOM_MEDIA_ROOT",
+                            "CELERY_BROKER_DIR"), CUTROOM_VAR_DIR=str(var))
+        run(args, var)
+    finally:
+        shutil.rmtree(var, ignore_errors=True)
 
 
 def stop(proc):

@@ -31,13 +31,10 @@ Target (issue 34): the poisoner moves the F1 on the next takes by < 0.05.
 import argparse
 import io
 import os
-import shutil
 import sys
-import tempfile
 import time
-from pathlib import Path
 
-from harness import start_django
+from harness import in_scratch_installation
 
 FPS = 120.0
 # (takes in the project, which of them the poisoner reviews)
@@ -170,19 +167,10 @@ def score(model, held_out):
 
 
 def main():
-    args = parse_args()
-    for name in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
-        os.environ.setdefault(name, "1")
-    var = Path(tempfile.mkdtemp(prefix="cutroom-poisoning-"))
-    try:
-        run(args, var)
-    finally:
-        shutil.rmtree(var, ignore_errors=True)
+    in_scratch_installation("cutroom-poisoning-", run, parse_args())
 
 
 def run(args, var):
-    start_django(unset=("DATABASE_URL", "CELERY_BROKER_URL", "CUTROOM_MEDIA_ROOT", "CELERY_BROKER_DIR"),
-                 CUTROOM_VAR_DIR=str(var))
     from segmentation.services import adaptation
 
     started = time.perf_counter()

@@ -26,14 +26,11 @@ the retrainings after a submit (3).
 
 import argparse
 import os
-import shutil
 import statistics
 import sys
-import tempfile
 import time
-from pathlib import Path
 
-from harness import start_django
+from harness import in_scratch_installation
 
 TARGET_SECONDS = 10.0
 
@@ -142,20 +139,10 @@ def _middle_of_longest(cuts, n_frames):
 
 
 def main():
-    args = parse_args()
-    # "On one core": numpy (imported with Django below) must not fan out to other cores.
-    for name in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
-        os.environ.setdefault(name, "1")
-    var = Path(tempfile.mkdtemp(prefix="cutroom-retrain-"))
-    try:
-        run(args, var)
-    finally:
-        shutil.rmtree(var, ignore_errors=True)
+    in_scratch_installation("cutroom-retrain-", run, parse_args())
 
 
 def run(args, var):
-    start_django(unset=("DATABASE_URL", "CELERY_BROKER_URL", "CUTROOM_MEDIA_ROOT", "CELERY_BROKER_DIR"),
-                 CUTROOM_VAR_DIR=str(var))
     built = time.perf_counter()
     project, n_cuts = build_project(args.takes, args.minutes, args.fps)
     print(f"load: {args.takes} reviewed takes x {args.minutes:g} min at {args.fps:g} fps "
