@@ -4,7 +4,8 @@ side all have look-alikes on the other side is inside one activity, not between 
 import numpy as np
 import pytest
 
-from motionlib import adapt, metrics
+from motionlib import metrics
+from motionlib.adapt import _threshold
 from motionlib.segmenters.default import Analysis, Default, candidates
 from motionlib.segmenters.default._peaks import SUPPORT_GAP_S, SUPPORT_SIDE_S, cross_support
 from tests.motionlib.conftest import labelled_takes, skeleton_takes
@@ -100,8 +101,8 @@ def test_window_peaks_drops_the_unsupported_peak_only():
     assert strength.tolist() == pytest.approx([1.0])
 
 
-def test_an_adapted_count_cannot_bring_back_a_dropped_peak():
-    # The examples' study holds every peak at every prominence, but not one the support
+def test_a_threshold_models_count_cannot_bring_back_a_dropped_peak():
+    # A format-1 model's study holds every peak at every prominence, but not one the support
     # test drops: no prominence the count is learnt at can cut there.
     analysis = _two_joins()
     on = Default.validate_params({})
@@ -109,7 +110,7 @@ def test_an_adapted_count_cannot_bring_back_a_dropped_peak():
     for p, kept in ((off, [100, 200]), (on, [200])):
         peaks, _ = candidates(analysis, Default.peaks(analysis, p), p)
         assert peaks.tolist() == kept
-        study = adapt._all_peaks("zero", analysis, Default.peaks(analysis, p), p, {})
+        study = _threshold._all_peaks("zero", analysis, Default.peaks(analysis, p), p, {})
         assert study["zero_raw"].tolist() == analysis.peak_frames(kept).tolist()
 
 
