@@ -62,6 +62,7 @@ __all__ = [
     "ThresholdModel",
     "cuts_in",
     "detect",
+    "example_study",
     "fit_cut_model",
     "fit_threshold_model",
     "read_examples",
@@ -111,6 +112,19 @@ def fit_cut_model(examples: Sequence, *, studies: Studies | None = None,
     found = [_study(example, p, studies) for example, _ in checked]
     return _learner.fit(found, [cuts for _, cuts in checked], tolerance_s=float(tolerance_s),
                         zero_min_segment_s=p["min_segment_s"])
+
+
+def example_study(example: Example, *, studies: Studies | None = None,
+                  base: dict | None = None) -> dict:
+    """The candidates of an example's take (:func:`study`), as :func:`fit_cut_model`
+    finds them: read from ``studies`` when kept there, else computed (and kept). With
+    :func:`cuts_in` they give what a model detects in that take without reading it again.
+
+    Raises
+    ------
+    ExampleError for a take too short to analyse.
+    """
+    return _study(_as_example(example), Default.validate_params(base or {}), studies)
 
 
 def _study(example: Example, p: dict, studies: Studies | None) -> dict:

@@ -159,8 +159,7 @@ def _train(job):
     verdict = model_gate.judge(
         examples, current, _loaded(current.pk, current.version) if current else None,
         fit=lambda chosen: fit_examples(chosen, refits) if chosen else None,
-        detect=lambda take, cut_model: _candidates(take, cut_model),
-        take_of=example_take,
+        detect=lambda capture, cut_model: _candidates(capture, cut_model, stored),
     )
     with transaction.atomic():
         newest = ProjectCutModel.objects.filter(project_id=job.project_id).aggregate(v=Max("version"))
@@ -187,13 +186,20 @@ def fit_examples(examples, studies):
                                studies=studies)
 
 
-def _candidates(take, cut_model):
+def _candidates(capture, cut_model, studies):
     """The candidate frames the default detector with ``cut_model`` (None: zero-shot)
-    proposes on ``take``, with the detector's own parameters as the fit learns from them
-    (a project's ``default_params`` are left out of both)."""
+    proposes on ``capture``'s take, with the detector's own parameters as the fit learns
+    from them (a project's ``default_params`` are left out of both).
+
+    A candidate-scorer model (and zero-shot, its prior) chooses among the take's stored
+    candidates, which the fit just read or made: the take is not read or analysed again.
+    A model of the older threshold format detects on the take as it always did."""
     from motionlib import adapt
 
-    return [int(f) for f in adapt.detect(take, cut_model).cuts]
+    if cut_model is None or isinstance(cut_model, adapt.CutModel):
+        arrays = adapt.example_study(example(capture, []), studies=studies)
+        return [int(f) for f in adapt.cuts_in(arrays, cut_model or adapt.CutModel.zero_shot())]
+    return [int(f) for f in adapt.detect(example_take(capture), cut_model).cuts]
 
 
 RETRAIN = register(Kind("retrain", ProjectCutModel, "Training", _train, "CUTROOM_RETRAIN_TIME_LIMIT"))

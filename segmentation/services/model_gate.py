@@ -15,8 +15,8 @@ import dataclasses
 
 from motionlib import metrics
 
-# Takes scored per training, most recently uploaded first: each costs two refits (cheap,
-# from the stored studies) and up to two detections.
+# Takes scored per training, most recently uploaded first: each costs up to two refits
+# from the stored studies and two choices among its stored candidates.
 FOLDS = 10
 # Within this many seconds a candidate matches a true cut, for F1 and for review edits.
 TOLERANCE_S = 1.0
@@ -109,7 +109,7 @@ def scored_takes(examples, learnt):
     return new[:n_new] + old[:FOLDS - n_new]
 
 
-def judge(examples, current, current_model, *, fit, detect, take_of):
+def judge(examples, current, current_model, *, fit, detect):
     """Score the candidate fitted on ``examples`` against the project's current model.
 
     Parameters
@@ -118,8 +118,7 @@ def judge(examples, current, current_model, *, fit, detect, take_of):
     current : the project's current ProjectCutModel row, or None (zero-shot).
     current_model : its loaded CutModel, or None (zero-shot, or unreadable).
     fit : [(capture, cuts)] -> CutModel, or None for an empty list (zero-shot).
-    detect : (take, CutModel or None) -> candidate cut frames.
-    take_of : capture -> its take.
+    detect : (capture, CutModel or None) -> candidate cut frames in its take.
 
     Returns
     -------
@@ -133,9 +132,8 @@ def judge(examples, current, current_model, *, fit, detect, take_of):
         candidate = fit(others)
         was_learnt = capture.pk in learnt
         rival = fit([e for e in others if e[0].pk in learnt]) if was_learnt else current_model
-        take = take_of(capture)
-        found = detect(take, candidate)
-        rival_found = found if rival == candidate else detect(take, rival)
+        found = detect(capture, candidate)
+        rival_found = found if rival == candidate else detect(capture, rival)
         figure.add(found, cuts, capture.fps)
         groups[was_learnt][0].add(found, cuts, capture.fps)
         groups[was_learnt][1].add(rival_found, cuts, capture.fps)

@@ -14,6 +14,7 @@ from motionlib.adapt import (
     ThresholdModel,
     cuts_in,
     detect,
+    example_study,
     fit_cut_model,
     score,
     study,
@@ -168,6 +169,18 @@ def test_detection_from_stored_candidates_equals_detection_from_the_take():
     model = fit_cut_model([_take(1), _take(2), _take(4)])
     take, _ = _take(3)
     assert cuts_in(study(take), model).tolist() == detect(take, model).cuts.tolist()
+
+
+def test_an_examples_study_is_read_from_where_the_fit_kept_it():
+    studies, reads = MemoryStudies(), []
+    examples = _examples((1, 2, 3), reads)
+    model = fit_cut_model(examples, studies=studies)
+    reads.clear()
+    arrays = example_study(examples[0], studies=studies)
+    assert reads == []  # the take is not read again
+    assert cuts_in(arrays, model).tolist() == detect(examples[0].read(), model).cuts.tolist()
+    zero = cuts_in(arrays, CutModel.zero_shot()).tolist()
+    assert zero == detect(examples[0].read()).cuts.tolist()
 
 
 def test_it_scores_a_model_on_a_reviewed_take():
