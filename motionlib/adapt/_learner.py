@@ -208,23 +208,32 @@ def select(model: CutModel, one: dict) -> tuple[np.ndarray, np.ndarray]:
     """The cuts ``model`` keeps among a study's candidates: (frames, probability),
     in frame order. Most probable first, a candidate is kept when its scorer's logit
     exceeds the model's ``threshold`` and no kept cut lies within ``min_segment_s``."""
+    logits, order, frames, kept = _ranked(model, one)
+    chosen = order[kept & (logits > model.threshold)]
+    chosen = chosen[np.argsort(frames[chosen], kind="stable")]
+    return frames[chosen], expit(logits[np.argsort(order)][chosen])
+
+
+def _ranked(model: CutModel, one: dict):
+    """(logits, order, frames, kept): the candidates' logits from the most probable down,
+    their indices, every candidate's frame (``placed``), and which of the ranked
+    candidates ``select`` keeps at a threshold below all of them. A candidate's fate
+    depends only on those ranked before it, so at any threshold ``select`` keeps exactly
+    the kept ones above it: one pass serves every threshold (``_calibrated``)."""
     logit = design(one["features"]) @ np.asarray(model.weights)
-    fps = float(one["fps"])
     frames = placed(model, one)
-    gap = int(round(model.min_segment_s * fps))
-    kept: list[int] = []
+    gap = int(round(model.min_segment_s * float(one["fps"])))
+    order = np.argsort(-logit, kind="stable")
+    kept = np.zeros(len(order), dtype=bool)
     taken: list[int] = []  # kept frames, sorted
-    for i in np.argsort(-logit, kind="stable").tolist():
-        if logit[i] <= model.threshold:
-            break
+    for rank, i in enumerate(order.tolist()):
         f = int(frames[i])
         at = bisect.bisect_left(taken, f)
         if (at < len(taken) and taken[at] - f < gap) or (at and f - taken[at - 1] < gap):
             continue
         taken.insert(at, f)
-        kept.append(i)
-    kept = np.asarray(sorted(kept, key=lambda i: frames[i]), dtype=np.int64)
-    return frames[kept], expit(logit[kept])
+        kept[rank] = True
+    return logit[order], order, frames, kept
 
 
 def placed(model: CutModel, one: dict) -> np.ndarray:
@@ -265,10 +274,16 @@ def _calibrated(model: CutModel, studies, cuts) -> float:
     """The logit threshold at which the median example take keeps as many cuts as its
     reviewers made (bisection; more threshold, fewer cuts). A count set by the median
     take, so a minority of under- or over-cut takes moves it little."""
+    ranked = []
+    for one, c in zip(studies, cuts, strict=True):
+        logits, _, _, kept = _ranked(model, one)
+        ranked.append((-logits, np.concatenate([[0], np.cumsum(kept)]), len(c)))
+
     def excess(threshold):
-        m = replace(model, threshold=threshold)
-        return float(np.median([math.log((len(select(m, s)[0]) + 1) / (len(c) + 1))
-                                for s, c in zip(studies, cuts, strict=True)]))
+        # The ranked candidates above the threshold are a prefix; count its kept ones.
+        return float(np.median([
+            math.log((kept[np.searchsorted(descending, -threshold, side="left")] + 1) /
+                     (n_true + 1)) for descending, kept, n_true in ranked]))
     lo, hi = -CALIBRATION_RANGE, CALIBRATION_RANGE
     for _ in range(CALIBRATION_STEPS):
         mid = (lo + hi) / 2
