@@ -337,10 +337,12 @@ def _choose(base: CutModel, studies, cuts, data, weights) -> tuple[float, bool]:
     return best
 
 
-def _map_fit(data, take_weights: np.ndarray, precision: float) -> np.ndarray:
+def _map_fit(data, take_weights: np.ndarray, precision: float,
+             start: np.ndarray | None = None) -> np.ndarray:
     """MAP logistic regression: summed weighted log-loss plus the Gaussian prior of
-    ``precision`` around the zero-shot scorer (Newton's method; the objective is
-    strictly convex). An infinite precision is the prior itself."""
+    ``precision`` around the zero-shot scorer (Newton's method from ``start``, the prior
+    by default; the objective is strictly convex, so every start reaches its one
+    minimum). An infinite precision is the prior itself."""
     w0 = _prior()
     if not data or not math.isfinite(precision):
         return w0
@@ -353,7 +355,7 @@ def _map_fit(data, take_weights: np.ndarray, precision: float) -> np.ndarray:
         return float(sw @ (np.logaddexp(0, z) - y * z)) + \
             precision / 2 * float((w - w0) @ (w - w0))
 
-    w = w0.copy()
+    w = (w0 if start is None else start).copy()
     eye = precision * np.eye(len(w))
     current = objective(w)
     for _ in range(50):
@@ -392,10 +394,12 @@ def _take_weights(base: CutModel, studies, cuts, data) -> np.ndarray:
     if n < 3:
         return np.ones(n)
     loss, ratio = np.empty(n), np.empty(n)
+    # Leaving one take out moves the fit little: Newton starts from the fit on all.
+    everyone = _map_fit(data, np.ones(n), WEIGHTING_PRECISION)
     for i in range(n):
         others = np.ones(n)
         others[i] = 0.0
-        w = _map_fit(data, others, WEIGHTING_PRECISION)
+        w = _map_fit(data, others, WEIGHTING_PRECISION, start=everyone)
         loss[i] = _log_loss(w, *data[i])
         kept = len(select(CutModel(**{**base.__dict__, "weights": tuple(w)}), studies[i])[0])
         ratio[i] = math.log((len(cuts[i]) + 1) / (kept + 1))
