@@ -159,7 +159,7 @@ def _train(job):
     verdict = model_gate.judge(
         examples, current, _loaded(current.pk, current.version) if current else None,
         fit=lambda chosen: fit_examples(chosen, refits) if chosen else None,
-        detect=lambda capture, cut_model: _candidates(capture, cut_model, stored),
+        detect=lambda capture, cut_model: _candidates(capture, cut_model, refits),
     )
     with transaction.atomic():
         newest = ProjectCutModel.objects.filter(project_id=job.project_id).aggregate(v=Max("version"))

@@ -78,20 +78,21 @@ class Verdict:
 
 
 class FoldStudies:
-    """``motionlib.adapt.Studies`` for the refits: reads the stored studies, keeps what the
-    refits make in memory. A refit without the take holding the project's shortest
-    segment learns with other settings; storing its studies would replace the ones the
-    full fit stored (one per take) and cost the next training a new analysis of each take."""
+    """``motionlib.adapt.Studies`` for the refits: reads each stored study once and keeps it,
+    and what the refits make, in memory (every refit reads the studies of all the other
+    takes). A refit without the take holding the project's shortest segment learns with
+    other settings; storing its studies would replace the ones the full fit stored (one
+    per take) and cost the next training a new analysis of each take."""
 
     def __init__(self, stored):
         self.stored = stored
         self.made = {}
 
     def load(self, example_key, study_key):
-        made = self.made.get((example_key, study_key))
-        if made is not None:
-            return made
-        return self.stored.load(example_key, study_key) if self.stored is not None else None
+        key = (example_key, study_key)
+        if key not in self.made and self.stored is not None:
+            self.made[key] = self.stored.load(example_key, study_key)
+        return self.made.get(key)
 
     def save(self, example_key, study_key, arrays):
         self.made[(example_key, study_key)] = arrays
