@@ -1,40 +1,40 @@
-"""The approximate nearest-neighbour index behind "find similar": one file per project.
+"""The approximate nearest-neighbour index behind "find similar": one folder per project.
 
 What it indexes: each described library segment's *profile* (the first
 ``similarity.PROFILE_ROWS`` rows of its descriptor, flattened: 3 x 35 = 105 numbers),
 under the squared Euclidean distance, which is the first stage of the exact search
-(``similarity.shortlist_by_profile``). The index only proposes candidates; their exact
-profile distances and the DTW re-ranking are computed from the database rows, so an
-index can make a search slower or (rarely) miss a neighbour, never return a segment the
-database no longer has or one the caller may not see.
+(``similarity.shortlist_by_profile``). The index only proposes candidates; the database
+says which of them exist and the caller may see, so an index can make a search slower or
+(rarely) miss a neighbour, never return a segment the database no longer has or one the
+caller may not see.
 
 Files, in ``settings.SIMILAR_INDEX_DIR`` (``$CUTROOM_SIMILAR_INDEX_DIR``, default
 ``var/similar``):
 
-- ``project_<id>.g<generation>/``: an inverted-file index (``motionlib.vector_index``:
-  k-means centres, and the float16 vectors with their segment ids grouped by centre).
-  Web processes map ids and vectors read-only, so all of them on a machine share one
-  copy in the page cache (a million segments: about 220 MB).
-- ``project_<id>.json``: the manifest, replaced atomically last: format version, vector
-  width, the index file's name and size, how many vectors it holds and the highest
-  segment id it has seen. A crash while writing leaves the previous manifest and file in
-  force (a new generation is written beside the old one and only then named; the old
-  one is deleted after, and processes that still map it keep reading it until they see
-  the new manifest).
+- ``project_<id>.g<generation>/``: a ``motionlib.vector_index`` folder: a faiss
+  inverted-file index written when the generation was built, and the keys and vectors
+  added and the keys removed since, appended. Web processes map it read-only, so all of
+  them on a machine share one copy in the page cache.
+- ``project_<id>.json``: the manifest, replaced atomically after every write: format
+  version, the generation's folder, how many base, added and removed records count (the
+  folder's *state*), how many vectors it holds and the highest segment id it has seen. A
+  reader sees exactly the records its manifest counts, so a crash while appending leaves
+  the previous state in force, and an update is visible to every process at once.
 
 Staying in step with the database (which is the truth):
 
 - Segments newer than the manifest's ``max_id`` (the *delta*) are read with each
   search's candidates, in the same query, and measured exactly, so a search never waits
   for the index.
-- Deleted segments left in the file are dropped when candidates are read back.
 - ``update`` (a Celery task queued when library rows change, and run by
-  ``manage.py similar_index``) compares the index's keys with the database's ids, removes
-  and adds the difference (added vectors join their nearest existing centre) and writes a
-  new generation; ``build`` trains new centres and writes one from scratch, which
-  ``update`` does itself when much was removed or the library has doubled.
-- ``open_index`` checks a manifest the first time a process sees it: a missing or
-  unreadable file, another format or width, or a vector count that disagrees with the
+  ``manage.py similar_index``) compares the index's keys with the database's ids and
+  appends the difference: it writes the added vectors and removed keys, not the index.
+  When the appended records outgrow ``COMPACT_SHARE`` of the base, or there is no usable
+  index, it *compacts*: ``build`` trains new centres over the whole library and writes a
+  new generation beside the old one before naming it (processes that still map the old
+  one keep reading it until they see the new manifest).
+- ``open_index`` checks a manifest the first time a process sees a generation: a missing
+  or short file, another format or width, or a vector count that disagrees with the
   database all mean "not usable": the search falls back to the exact scan and a rebuild
   is queued.
 """
@@ -54,22 +54,21 @@ import numpy as np
 from django.conf import settings
 from django.db import connections, transaction
 
-from motionlib import similarity
-from motionlib.vector_index import IvfIndex
+from motionlib import similarity, vector_index
+from motionlib.errors import InputError
 from segmentation import workers
 from segmentation.models import LibrarySegment
 
 log = logging.getLogger(__name__)
 
-FORMAT = 1
-# A search scans at least this share of the index (nearest clusters first): chosen on the
-# million-segment benchmark for recall@10 >= 0.95 against the exact scan.
-PROBE_SHARE = 0.005
-# An update that would remove more than this share of the vectors, or grow the index past
-# GROWTH times the size its centres were trained on, retrains instead (clusters drift).
-REBUILD_SHARE = 0.25
-GROWTH = 2.0
-# When the delta (segments newer than the file) grows past this, an update is queued.
+FORMAT = 2
+# An update compacts (retrains and rewrites the generation) once the added and removed
+# records outnumber this share of the base: a search compares the query with every added
+# vector, and clusters drift as the library changes.
+COMPACT_SHARE = 0.05
+# ... and never for fewer records than this (a small library would compact at each update).
+COMPACT_MIN = 2000
+# When the delta (segments newer than the index) grows past this, an update is queued.
 DELTA_LIMIT = 5000
 READ_CHUNK = 20000
 
@@ -121,15 +120,17 @@ def read_manifest(project_id):
     if not isinstance(manifest, dict) or manifest.get("format") != FORMAT:
         raise IndexUnusable(f"{path}: format {manifest.get('format') if isinstance(manifest, dict) else '?'}"
                             f", this version reads format {FORMAT}")
-    folder = index_dir() / str(manifest.get("file"))
     try:
-        sizes = {p.name: p.stat().st_size for p in folder.glob("*.npy")}
-    except OSError as exc:
-        raise IndexUnusable(f"{folder}: unreadable ({exc.strerror})") from exc
-    if sizes != manifest.get("bytes_per_file"):
-        raise IndexUnusable(f"{folder}: files {sizes or 'missing'}, the manifest says "
-                            f"{manifest.get('bytes_per_file')}")
+        vector_index.check(folder_of(manifest), manifest["state"])
+    except (KeyError, TypeError) as exc:
+        raise IndexUnusable(f"{path}: no {exc} in it") from exc
+    except InputError as exc:
+        raise IndexUnusable(str(exc)) from exc
     return manifest
+
+
+def folder_of(manifest) -> Path:
+    return index_dir() / str(manifest["file"])
 
 
 def _fingerprint(project_id):
@@ -141,31 +142,15 @@ def _fingerprint(project_id):
     return [found["n"], found["top"] or 0, int(found["total"] or 0)]
 
 
-def _write_generation(project_id, index, max_id, fingerprint, trained_on):
-    """Save ``index`` as a new generation and name it in the manifest (atomically).
-
-    ``fingerprint`` is the database's, read before the index was."""
-    generation = time.time_ns()
-    name = f"project_{project_id}.g{generation}"
-    folder = index_dir() / name
-    sizes = index.save(folder)
-    for path in folder.iterdir():
-        _fsync(path)
-    _fsync(folder)
-    manifest = {"format": FORMAT, "ndim": index.ndim, "file": name, "bytes": sum(sizes.values()),
-                "bytes_per_file": sizes, "count": len(index), "lists": len(index.centroids),
-                "trained_on": trained_on, "max_id": int(max_id), "generation": generation,
-                "fingerprint": fingerprint,
-                "built_at": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())}
+def _publish(project_id, manifest):
+    """Replace the project's manifest atomically (written, fsynced, renamed)."""
+    manifest = {**manifest, "updated_at": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
+                "bytes": sum(p.stat().st_size for p in folder_of(manifest).iterdir())}
     tmp = manifest_path(project_id).with_suffix(".json.tmp")
     tmp.write_text(json.dumps(manifest, indent=1))
     _fsync(tmp)
     os.replace(tmp, manifest_path(project_id))
     _fsync(index_dir())
-    for old in index_dir().glob(f"project_{project_id}.g*"):
-        if old.name != name:
-            # Processes that map the old files keep them (unlinked inodes live on).
-            shutil.rmtree(old, ignore_errors=True)
     return manifest
 
 
@@ -200,6 +185,7 @@ def _build(project_id):
     parts = list(_chunks(described(project_id)))
     if not parts:
         manifest_path(project_id).unlink(missing_ok=True)
+        _remove_generations(project_id, keep=None)
         return None
     widths = {v.shape[1] for _, v in parts}
     if len(widths) > 1:
@@ -208,34 +194,49 @@ def _build(project_id):
     ids = np.concatenate([k for k, _ in parts])
     vectors = np.concatenate([v for _, v in parts])
     del parts
-    index = IvfIndex.build(ids, vectors, seed=project_id)
-    manifest = _write_generation(project_id, index, int(ids[-1]), fingerprint, len(ids))
+    generation = time.time_ns()
+    name = f"project_{project_id}.g{generation}"
+    state = vector_index.build(index_dir() / name, ids, vectors, seed=project_id)
+    lists = state.pop("lists")
+    manifest = _publish(project_id, {
+        "format": FORMAT, "file": name, "generation": generation, "state": state,
+        "count": len(ids), "lists": lists, "max_id": int(ids[-1]), "fingerprint": fingerprint,
+        "built_at": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())})
+    _remove_generations(project_id, keep=name)
     log.info("similar index of project %s built: %s vectors", project_id, manifest["count"])
     return manifest
 
 
+def _remove_generations(project_id, keep):
+    for old in index_dir().glob(f"project_{project_id}.g*"):
+        if old.name != keep:
+            # Processes that map the old files keep them (unlinked inodes live on).
+            shutil.rmtree(old, ignore_errors=True)
+
+
 def update(project_id):
-    """Bring a project's index in step with the database: remove the vectors of deleted
-    segments, add the missing ones, write a new generation. Builds when there is no usable
-    index, too much would be removed, or the library outgrew the index's centres.
+    """Bring a project's index in step with the database: append the vectors of segments
+    it lacks and the keys of deleted ones. Compacts (``build``) when there is no usable
+    index, or the appended records would outgrow ``COMPACT_SHARE`` of the base.
     Returns the manifest (unchanged when in step)."""
     with _locked(project_id):
         try:
             manifest = read_manifest(project_id)
-            index = IvfIndex.open(index_dir() / manifest["file"], mmap=False)
-        except (IndexUnusable, ValueError) as exc:
+            index = vector_index.VectorIndex.open(folder_of(manifest), manifest["state"])
+        except (IndexUnusable, InputError) as exc:
             log.info("similar index of project %s rebuilt: %s", project_id, exc)
             return _build(project_id)
         fingerprint = _fingerprint(project_id)
         if fingerprint == manifest.get("fingerprint"):
             return manifest
-        keys = np.asarray(index.ids, dtype=np.int64)
+        keys = index.keys()
         ids = np.fromiter(described(project_id).values_list("id", flat=True).iterator(chunk_size=20000),
                           dtype=np.int64)
         removed = np.setdiff1d(keys, ids, assume_unique=True)
         added = np.setdiff1d(ids, keys, assume_unique=True)
-        if (len(removed) > REBUILD_SHARE * max(len(keys), 1)
-                or len(ids) > GROWTH * manifest.get("trained_on", len(keys))):
+        state = manifest["state"]
+        appended = state["delta"] + state["removed"] + len(added) + len(removed)
+        if appended > max(COMPACT_MIN, COMPACT_SHARE * state["base"]):
             return _build(project_id)
         add_ids, add_vectors = [], []
         for first in range(0, len(added), READ_CHUNK):
@@ -247,10 +248,11 @@ def update(project_id):
         vectors = as_vectors(add_vectors, index.ndim // similarity.PROFILE_ROWS)
         if len(vectors) and vectors.shape[1] != index.ndim:
             return _build(project_id)
-        index = index.changed(removed, np.array(add_ids, dtype=np.int64), vectors)
+        state = vector_index.append(folder_of(manifest), state, add_ids, vectors, removed)
         max_id = max(int(ids.max()) if len(ids) else 0, manifest["max_id"])
-        return _write_generation(project_id, index, max_id, fingerprint,
-                                 manifest.get("trained_on", len(keys)))
+        return _publish(project_id, {**manifest, "state": state, "max_id": max_id,
+                                     "count": len(keys) - len(removed) + len(add_ids),
+                                     "fingerprint": fingerprint})
 
 
 def schedule_update(project_id):
@@ -287,9 +289,9 @@ def _candidates_or_newer(pool, ids, project_id, after):
 
 @dataclass
 class OpenIndex:
-    """A project's index as this process sees it: its manifest and the mapped file.
+    """A project's index as this process sees it: its manifest and the mapped folder.
 
-    Segments newer than the file (the *delta*) are not cached here: every search reads
+    Segments newer than the index (the *delta*) are not cached here: every search reads
     them from the database in the same query as its candidates (``shortlist``), filtered
     by what the caller may see, so a search costs no query of its own for freshness."""
 
@@ -299,12 +301,12 @@ class OpenIndex:
     update_queued: bool = False
 
     def nearest(self, vector, count):
-        """Up to ``count`` segment ids of the file nearest to a profile vector, nearest
-        first. Ids may include deleted segments."""
-        return self.index.search(vector, count, probe_share=PROBE_SHARE)[0]
+        """Up to ``count`` segment ids of the index nearest to a profile vector, nearest
+        first. Ids may include segments deleted since the last update."""
+        return self.index.search(vector, count)[0]
 
     def note_delta(self, newer):
-        """Queue an update (once per generation) when ``newer`` segments outnumber
+        """Queue an update (once per manifest) when ``newer`` segments outnumber
         ``DELTA_LIMIT``: every search reads them."""
         if newer > DELTA_LIMIT and not self.update_queued:
             self.update_queued = True
@@ -312,7 +314,7 @@ class OpenIndex:
 
     @property
     def size(self):
-        return len(self.index)
+        return self.manifest["count"]
 
 
 _open = {}
@@ -322,12 +324,14 @@ _open_lock = threading.Lock()
 def open_index(project_id):
     """The project's usable index for this process, or None (the caller scans exactly).
 
-    The manifest is re-read when its file changes, so a new generation is picked up at
-    the next search. The first time a process sees a generation it checks it against the
-    database; an index that cannot be used queues a rebuild.
+    The manifest is re-read when it is replaced, so an update is seen at the next search
+    (the mapped base is kept while the generation is the same). The first time a process
+    sees a generation it checks it against the database; an index that cannot be used
+    queues a rebuild.
     """
     try:
-        stamp = manifest_path(project_id).stat().st_mtime_ns
+        found = manifest_path(project_id).stat()
+        stamp = (found.st_ino, found.st_mtime_ns, found.st_size)
     except OSError:
         stamp = None
     with _open_lock:
@@ -335,26 +339,30 @@ def open_index(project_id):
         if current is not None and current[0] == stamp:
             opened = current[1]
         else:
-            opened = _open_checked(project_id)
+            opened = _open_checked(project_id, current[1] if current else None)
             _open[project_id] = (stamp, opened)
     return opened
 
 
-def _open_checked(project_id):
+def _open_checked(project_id, previous=None):
     try:
         manifest = read_manifest(project_id)
-        index = IvfIndex.open(index_dir() / manifest["file"])
-        if len(index) != manifest["count"]:
-            raise IndexUnusable(f"{manifest['file']}: holds {len(index)} vectors, the "
-                                f"manifest says {manifest['count']}")
+        state = manifest["state"]
+        if previous is not None and previous.manifest["file"] == manifest["file"]:
+            return OpenIndex(project_id, manifest, previous.index.at(state))
+        index = vector_index.VectorIndex.open(folder_of(manifest), state)
+        if state["base"] + state["delta"] - state["removed"] != manifest["count"]:
+            raise IndexUnusable(f"{manifest['file']}: holds {state['base']} + {state['delta']}"
+                                f" - {state['removed']} vectors, the manifest says "
+                                f"{manifest['count']}")
         in_db = described(project_id).filter(id__lte=manifest["max_id"]).count()
         if in_db != manifest["count"]:
-            # Rows changed since the file was written (a crash before the update, or
+            # Rows changed since the index was written (a crash before the update, or
             # transactions that committed out of id order): usable, but queue an update.
             log.info("similar index of project %s: %s vectors, %s segments in the database; "
                      "updating", project_id, manifest["count"], in_db)
             schedule_update(project_id)
-    except (IndexUnusable, ValueError) as exc:
+    except (IndexUnusable, InputError, KeyError, TypeError) as exc:
         if described(project_id).exists():
             log.warning("similar index of project %s not used: %s; rebuilding", project_id, exc)
             schedule_update(project_id)
@@ -385,7 +393,7 @@ def shortlist(index, query, pool, n):
         rows = _candidates_or_newer(pool, [int(c) for c in candidates], index.project_id, after)
         index.note_delta(sum(r[0] > after for r in rows))
         found = _nearest_unique(rows, query, n)
-        exhausted = len(candidates) < count
+        exhausted = len(candidates) < count and count >= index.size
         if len(found) >= n or exhausted:
             return found
         if count >= MAX_CANDIDATES:
