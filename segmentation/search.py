@@ -4,7 +4,7 @@ import numpy as np
 
 from motionlib import similarity
 from segmentation import similar_index
-from segmentation.descriptors import profile_pool
+from segmentation.descriptors import load_descriptors, profile_pool
 from segmentation.errors import Invalid
 from segmentation.models import LibrarySegment
 
@@ -20,7 +20,8 @@ def similar(segment, visible, k=10):
     Segments overlapping it in the same capture are left out (other annotators' versions
     of the same motion), and so are duplicates of one span. Two stages: the profiles
     nearest to the query's pick a shortlist, whose full descriptors are ranked. The
-    shortlist comes from the project's vector index (``similar_index``) when it has a
+    shortlist comes from the project's vector index (``similar_index``), with the
+    shortlisted descriptors read in the same query as the candidates, when it has a
     usable one, else from the profiles of up to ``SIMILAR_POOL`` recent segments.
     Returns ``[(segment, distance)]``, most similar first.
     """
@@ -34,18 +35,18 @@ def similar(segment, visible, k=10):
     index = similar_index.open_index(segment.project_id)
     short = similar_index.shortlist(index, query, pool, n) if index else None
     if short is None:
-        short = exact_shortlist(query, pool, n)
-    if not short:
-        return []
-    # The shortlist's rows, with what the caller shows of them, in one query.
-    rows = (LibrarySegment.objects.select_related("capture", "annotator", "label")
-            .defer("profile", "capture__skeleton").in_bulk(short))
-    short = [pk for pk in short if pk in rows]  # a capture's rows rebuilt meanwhile
+        ids = exact_shortlist(query, pool, n)
+        short = list(zip(ids, load_descriptors(ids), strict=True)) if ids else []
     if not short:
         return []
     order, distances = similarity.rank_similar(
-        query, np.stack([rows[pk].descriptor_array() for pk in short]), k=k, shortlist=len(short))
-    return [(rows[short[i]], float(d)) for i, d in zip(order, distances, strict=True)]
+        query, np.stack([d for _, d in short]), k=k, shortlist=len(short))
+    winners = [short[i][0] for i in order]
+    # What the caller shows of the winners, in one query (their descriptors are not needed).
+    rows = (LibrarySegment.objects.select_related("capture", "annotator", "label")
+            .defer("descriptor", "profile", "capture__skeleton").in_bulk(winners))
+    # A row deleted since it was shortlisted is left out.
+    return [(rows[pk], float(d)) for pk, d in zip(winners, distances, strict=True) if pk in rows]
 
 
 def exact_shortlist(query, pool, n):

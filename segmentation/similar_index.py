@@ -57,6 +57,7 @@ from django.db import connections, transaction
 from motionlib import similarity, vector_index
 from motionlib.errors import InputError
 from segmentation import workers
+from segmentation.errors import Invalid
 from segmentation.models import LibrarySegment
 
 log = logging.getLogger(__name__)
@@ -265,7 +266,8 @@ def schedule_update(project_id):
 
 def _candidates_or_newer(pool, ids, project_id, after):
     """``pool``'s rows that are among ``ids`` or newer than the index file (the delta), in
-    one query: [(id, capture, start, stop, profile)].
+    one query: [(id, capture, start, stop, descriptor bytes)]. The descriptors come with
+    the candidates, so that ranking the shortlist needs no query of its own.
 
     The delta is found by row comparisons on (project, id), so that the database walks
     the ``libseg_described`` index from ``(project, after)`` to the project's end: with a
@@ -284,7 +286,7 @@ def _candidates_or_newer(pool, ids, project_id, after):
     else:
         where = f'("{table}"."id" IN ({marks or "NULL"}) OR "{table}"."id" IN ({newer}))'
     return list(pool.extra(where=[where], params=[*ids, project_id, after, project_id + 1])
-                .values_list("id", "capture_id", "start", "stop", "profile"))
+                .values_list("id", "capture_id", "start", "stop", "descriptor"))
 
 
 @dataclass
@@ -370,15 +372,20 @@ def _open_checked(project_id, previous=None):
     return OpenIndex(project_id, manifest, index)
 
 
-# The first look at the index asks for this many candidates per shortlisted segment; a
-# look that finds too few visible ones asks for four times as many, up to MAX_CANDIDATES.
-OVERSAMPLE = 4
+# The first look at the index asks for CANDIDATES x the shortlist (at least
+# MIN_CANDIDATES): the index ranks by the exact profile distance, so only rows the caller
+# may not see, or spans seen twice, need the margin. A look that finds too few visible
+# ones asks for GROW times as many, up to MAX_CANDIDATES.
+CANDIDATES = 2
+MIN_CANDIDATES = 48
+GROW = 4
 MAX_CANDIDATES = 4096
 
 
 def shortlist(index, query, pool, n):
-    """Ids of the ``n`` segments of ``pool`` whose profiles are nearest to ``query``'s,
-    nearest first, as the exact scan orders them (ties: newest first; one span once).
+    """The ``n`` segments of ``pool`` whose profiles are nearest to ``query``'s, nearest
+    first, as the exact scan orders them (ties: newest first; one span once), as
+    ``[(id, descriptor)]``.
 
     ``pool`` is the caller's visible, filtered queryset; the index proposes candidates
     and ``pool`` decides which exist and may be shown. Returns None when even
@@ -386,23 +393,26 @@ def shortlist(index, query, pool, n):
     caller then scans exactly.
     """
     vector = np.asarray(query[:similarity.PROFILE_ROWS], dtype=np.float32).ravel()
-    count = max(OVERSAMPLE * n, 64)
+    count = max(CANDIDATES * n, MIN_CANDIDATES)
     after = index.manifest["max_id"]
     while True:
         candidates = index.nearest(vector, count)
         rows = _candidates_or_newer(pool, [int(c) for c in candidates], index.project_id, after)
         index.note_delta(sum(r[0] > after for r in rows))
-        found = _nearest_unique(rows, query, n)
+        found = nearest_unique(rows, query, n)
         exhausted = len(candidates) < count and count >= index.size
         if len(found) >= n or exhausted:
             return found
         if count >= MAX_CANDIDATES:
             return None
-        count *= OVERSAMPLE
+        count *= GROW
 
 
-def _nearest_unique(rows, query, n):
-    """The exact scan's order over ``rows`` (id, capture, start, stop, profile)."""
+def nearest_unique(rows, query, n):
+    """The exact scan's order over ``rows`` (id, capture, start, stop, descriptor bytes):
+    the ``n`` nearest by profile distance, one row per span (its newest), as
+    ``[(id, descriptor)]``. Invalid when the stored descriptors are not of the query's
+    shape (a library described by another version)."""
     if not rows:
         return []
     rows.sort(key=lambda r: -r[0])
@@ -411,9 +421,13 @@ def _nearest_unique(rows, query, n):
         if (capture_id, start, stop) not in seen:
             seen.add((capture_id, start, stop))
             unique.append((pk, blob))
-    profiles = as_vectors([b for _, b in unique]).reshape(len(unique), similarity.PROFILE_ROWS, -1)
-    order = similarity.shortlist_by_profile(query, profiles, n)
-    return [unique[i][0] for i in order]
+    flat = np.stack([np.frombuffer(bytes(b), dtype="<f4") for _, b in unique])
+    if flat.shape[1] != query.size:
+        raise Invalid(f"library descriptors have {flat.shape[1]} numbers, the query's "
+                      f"{query.shape[0]} x {query.shape[1]}; rebuild the library")
+    descs = flat.reshape(len(unique), *query.shape)
+    order = similarity.shortlist_by_profile(query, descs, n)
+    return [(unique[i][0], descs[i]) for i in order]
 
 
 def forget():
