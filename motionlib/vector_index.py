@@ -8,9 +8,13 @@ One index is a folder holding:
 - ``delta_ids.i64`` / ``delta_vectors.f32``: keys and vectors added since, appended as raw
   records.
 - ``removed.i64``: keys removed since, appended.
+- ``payload.f32`` / ``delta_payload.f32`` (optional): a fixed-width float32 row per base
+  key (in ``base_ids`` order, which is ascending) and per added key, for what a caller
+  needs of a result besides its key (the similar-clip search keeps the full motion
+  descriptors there, so ranking reads no database row).
 
 How many records of each file count is the caller's *state* (``{"ndim", "base", "delta",
-"removed"}``), kept in a manifest that the caller replaces atomically after an append. A
+"removed", "payload"}``, the last the payload's width), kept in a manifest that the caller replaces atomically after an append. A
 reader opens a folder at a state and sees exactly those records: bytes appended later, or
 left by a writer that crashed, lie past its counts, and the next append overwrites them.
 So an update writes only what changed, and every process sees a consistent index.
@@ -33,6 +37,7 @@ from motionlib.errors import InputError
 
 BASE, BASE_IDS = "base.faiss", "base_ids.npy"
 DELTA_IDS, DELTA_VECTORS, REMOVED = "delta_ids.i64", "delta_vectors.f32", "removed.i64"
+PAYLOAD, DELTA_PAYLOAD = "payload.f32", "delta_payload.f32"
 # Vectors per list the index aims for (n_lists = n / LIST_SIZE, at least 1).
 LIST_SIZE = 1024
 # Lists a search scans: the nearest centres first.
@@ -42,17 +47,26 @@ NPROBE = 24
 faiss.omp_set_num_threads(1)
 
 
-def empty_state(ndim: int, base: int) -> dict:
-    return {"ndim": int(ndim), "base": int(base), "delta": 0, "removed": 0}
+def empty_state(ndim: int, base: int, payload: int = 0) -> dict:
+    return {"ndim": int(ndim), "base": int(base), "delta": 0, "removed": 0,
+            "payload": int(payload)}
 
 
 def build(folder: Path, ids: np.ndarray, vectors: np.ndarray, *, n_lists: int | None = None,
-          seed: int = 0, threads: int | None = None) -> dict:
-    """Train centres on ``vectors`` (n, d), write the index of ``ids`` (n,) into the new
-    ``folder`` (fsynced) and return its state.
+          seed: int = 0, threads: int | None = None, payload: Path | None = None,
+          payload_width: int = 0) -> dict:
+    """Train centres on ``vectors`` (n, d), write the index of ``ids`` (n,, ascending) into
+    the new ``folder`` (fsynced) and return its state.
 
-    ``threads``: cores for training and grouping (default: all; searches use one)."""
+    ``payload``: a file of ``payload_width`` float32 per key, in ``ids`` order, moved into
+    the folder. ``threads``: cores for training and grouping (default: all; searches use
+    one)."""
     ids = np.ascontiguousarray(ids, dtype=np.int64)
+    if len(ids) > 1 and not np.all(np.diff(ids) > 0):
+        raise InputError("ids: must be ascending and unique")
+    if payload is not None and payload.stat().st_size != len(ids) * payload_width * 4:
+        raise InputError(f"{payload}: {payload.stat().st_size} bytes, expected {len(ids)} rows "
+                         f"of {payload_width} float32")
     vectors = np.ascontiguousarray(vectors, dtype=np.float32)
     if vectors.ndim != 2 or len(vectors) != len(ids) or not len(ids):
         raise InputError(f"vectors: expected ({len(ids)}, d) with at least one row, got "
@@ -66,12 +80,14 @@ def build(folder: Path, ids: np.ndarray, vectors: np.ndarray, *, n_lists: int | 
     folder.mkdir(parents=True)
     faiss.write_index(index, str(folder / BASE))
     np.save(folder / BASE_IDS, ids)
-    for name in (DELTA_IDS, DELTA_VECTORS, REMOVED):
+    if payload is not None:
+        os.replace(payload, folder / PAYLOAD)
+    for name in (DELTA_IDS, DELTA_VECTORS, REMOVED, DELTA_PAYLOAD) + (() if payload else (PAYLOAD,)):
         (folder / name).touch()
     for path in folder.iterdir():
         _fsync(path)
     _fsync(folder)
-    return empty_state(d, n) | {"lists": n_lists}
+    return empty_state(d, n, payload_width if payload is not None else 0) | {"lists": n_lists}
 
 
 def _trained(vectors, n_lists, seed, threads):
@@ -100,19 +116,24 @@ def _add_keyed(index, ids, vectors, threads):
         faiss.omp_set_num_threads(previous)
 
 
-def append(folder: Path, state: dict, add_ids=(), add_vectors=None, remove_ids=()) -> dict:
-    """Append added keys and vectors, and removed keys, after ``state``'s records (bytes
-    past them are overwritten); fsync and return the new state. The caller serialises
-    writers and publishes the state."""
-    d = state["ndim"]
+def append(folder: Path, state: dict, add_ids=(), add_vectors=None, remove_ids=(),
+           add_payload=None) -> dict:
+    """Append added keys, vectors and payload rows, and removed keys, after ``state``'s
+    records (bytes past them are overwritten); fsync and return the new state. The caller
+    serialises writers and publishes the state."""
+    d, w = state["ndim"], state.get("payload", 0)
     add_ids = np.ascontiguousarray(add_ids, dtype="<i8")
     add_vectors = np.ascontiguousarray(
         np.zeros((0, d)) if add_vectors is None else add_vectors, dtype="<f4").reshape(-1, d)
     remove_ids = np.ascontiguousarray(remove_ids, dtype="<i8")
-    if len(add_vectors) != len(add_ids):
-        raise InputError(f"add_vectors: expected ({len(add_ids)}, {d}), got {add_vectors.shape}")
+    add_payload = (np.ascontiguousarray(add_payload, dtype="<f4").reshape(-1, w)
+                   if w and add_payload is not None else np.zeros((0, w), dtype="<f4"))
+    if len(add_vectors) != len(add_ids) or (w and len(add_payload) != len(add_ids)):
+        raise InputError(f"add_vectors, add_payload: expected ({len(add_ids)}, {d}) and "
+                         f"({len(add_ids)}, {w}), got {add_vectors.shape}, {add_payload.shape}")
     for name, at, data in ((DELTA_IDS, state["delta"] * 8, add_ids),
                            (DELTA_VECTORS, state["delta"] * 4 * d, add_vectors),
+                           (DELTA_PAYLOAD, state["delta"] * 4 * w, add_payload),
                            (REMOVED, state["removed"] * 8, remove_ids)):
         with open(folder / name, "r+b") as fh:
             fh.truncate(at)
@@ -126,9 +147,10 @@ def append(folder: Path, state: dict, add_ids=(), add_vectors=None, remove_ids=(
 
 def check(folder: Path, state: dict) -> None:
     """InputError naming a file of ``folder`` that is missing or shorter than ``state``."""
-    d = state["ndim"]
+    d, w = state["ndim"], state.get("payload", 0)
     need = {BASE: 1, BASE_IDS: 1, DELTA_IDS: state["delta"] * 8,
-            DELTA_VECTORS: state["delta"] * 4 * d, REMOVED: state["removed"] * 8}
+            DELTA_VECTORS: state["delta"] * 4 * d, REMOVED: state["removed"] * 8,
+            PAYLOAD: state["base"] * 4 * w, DELTA_PAYLOAD: state["delta"] * 4 * w}
     for name, size in need.items():
         try:
             found = (folder / name).stat().st_size
@@ -160,6 +182,10 @@ class VectorIndex:
         self.delta_vectors = _mapped(folder / DELTA_VECTORS, "<f4", (state["delta"], d))
         self._delta_norms = np.einsum("ij,ij->i", self.delta_vectors, self.delta_vectors)
         self.removed = np.unique(_mapped(folder / REMOVED, "<i8", (state["removed"],)))
+        w = state.get("payload", 0)
+        self._payload = _mapped(folder / PAYLOAD, "<f4", (state["base"] if w else 0, w))
+        self._delta_payload = _mapped(folder / DELTA_PAYLOAD, "<f4", (state["delta"] if w else 0, w))
+        self._delta_rows = None
 
     @classmethod
     def open(cls, folder: Path, state: dict) -> VectorIndex:
@@ -176,6 +202,31 @@ class VectorIndex:
     @property
     def n_lists(self):
         return self.base.nlist
+
+    def payload(self, keys) -> tuple[np.ndarray, np.ndarray]:
+        """(found, rows): which of ``keys`` the index holds (base or added, removed or
+        not), and their payload rows (len(keys), width) float32, zeros where not found."""
+        keys = np.asarray(keys, dtype=np.int64)
+        w = self.state.get("payload", 0)
+        rows = np.zeros((len(keys), w), dtype=np.float32)
+        found = np.zeros(len(keys), dtype=bool)
+        if not w or not len(keys):
+            return found, rows
+        at = np.searchsorted(self.base_ids, keys)
+        inside = at < len(self.base_ids)
+        hit = inside.copy()
+        hit[inside] = np.asarray(self.base_ids[at[inside]]) == keys[inside]
+        for i in np.flatnonzero(hit):
+            rows[i] = self._payload[at[i]]
+        if len(self.delta_ids):
+            if self._delta_rows is None:
+                self._delta_rows = {int(k): r for r, k in enumerate(self.delta_ids)}
+            for i in np.flatnonzero(~hit):
+                r = self._delta_rows.get(int(keys[i]))
+                if r is not None:
+                    rows[i], hit[i] = self._delta_payload[r], True
+        found[:] = hit
+        return found, rows
 
     def keys(self) -> np.ndarray:
         """The live keys (base and added, less removed), sorted."""

@@ -53,6 +53,7 @@ from pathlib import Path
 import numpy as np
 from django.conf import settings
 from django.db import connections, transaction
+from django.db.models import BinaryField, Case, F, When
 
 from motionlib import similarity, vector_index
 from motionlib.errors import InputError
@@ -164,15 +165,26 @@ def _fsync(path):
 
 
 def _chunks(queryset):
-    """(ids, vectors) of a queryset of described segments, READ_CHUNK rows at a time."""
+    """(ids, profile vectors, descriptor bytes) of a queryset of described segments,
+    READ_CHUNK rows at a time, by id."""
     last = 0
     while True:
         rows = list(queryset.filter(id__gt=last).order_by("id")
-                    .values_list("id", "profile")[:READ_CHUNK])
+                    .values_list("id", "profile", "descriptor")[:READ_CHUNK])
         if not rows:
             return
         last = rows[-1][0]
-        yield np.array([r[0] for r in rows], dtype=np.int64), as_vectors([r[1] for r in rows])
+        yield (np.array([r[0] for r in rows], dtype=np.int64), as_vectors([r[1] for r in rows]),
+               [bytes(r[2]) for r in rows])
+
+
+def _descriptor_rows(blobs, width):
+    """(n, width) float32 descriptors from their bytes; IndexUnusable when one differs."""
+    sizes = {len(b) for b in blobs}
+    if sizes - {4 * width}:
+        raise IndexUnusable(f"segment descriptors have {sorted(n // 4 for n in sizes)} numbers, "
+                            f"the index {width}; rebuild the library's descriptors")
+    return np.frombuffer(b"".join(blobs), dtype="<f4").reshape(len(blobs), width)
 
 
 def build(project_id):
@@ -182,22 +194,36 @@ def build(project_id):
 
 
 def _build(project_id):
+    """Read the described segments once, by id: profiles into memory (for training),
+    descriptors straight into the payload file (a million are several GB)."""
     fingerprint = _fingerprint(project_id)
-    parts = list(_chunks(described(project_id)))
-    if not parts:
-        manifest_path(project_id).unlink(missing_ok=True)
-        _remove_generations(project_id, keep=None)
-        return None
-    widths = {v.shape[1] for _, v in parts}
-    if len(widths) > 1:
-        raise IndexUnusable(f"project {project_id}: segment profiles have {sorted(widths)} "
-                            "numbers; rebuild the library's descriptors")
-    ids = np.concatenate([k for k, _ in parts])
-    vectors = np.concatenate([v for _, v in parts])
-    del parts
-    generation = time.time_ns()
-    name = f"project_{project_id}.g{generation}"
-    state = vector_index.build(index_dir() / name, ids, vectors, seed=project_id)
+    index_dir().mkdir(parents=True, exist_ok=True)
+    payload = index_dir() / f"project_{project_id}.payload.tmp"
+    id_parts, vector_parts, width = [], [], None
+    try:
+        with open(payload, "wb") as out:
+            for ids, vectors, blobs in _chunks(described(project_id)):
+                width = width or len(blobs[0]) // 4
+                if id_parts and vectors.shape[1] != vector_parts[0].shape[1]:
+                    raise IndexUnusable(f"project {project_id}: segment profiles have "
+                                        f"{sorted({vector_parts[0].shape[1], vectors.shape[1]})} "
+                                        "numbers; rebuild the library's descriptors")
+                out.write(_descriptor_rows(blobs, width).tobytes())
+                id_parts.append(ids)
+                vector_parts.append(vectors)
+        if not id_parts:
+            manifest_path(project_id).unlink(missing_ok=True)
+            _remove_generations(project_id, keep=None)
+            return None
+        ids = np.concatenate(id_parts)
+        vectors = np.concatenate(vector_parts)
+        del id_parts, vector_parts
+        generation = time.time_ns()
+        name = f"project_{project_id}.g{generation}"
+        state = vector_index.build(index_dir() / name, ids, vectors, seed=project_id,
+                                   payload=payload, payload_width=width)
+    finally:
+        payload.unlink(missing_ok=True)
     lists = state.pop("lists")
     manifest = _publish(project_id, {
         "format": FORMAT, "file": name, "generation": generation, "state": state,
@@ -239,17 +265,22 @@ def update(project_id):
         appended = state["delta"] + state["removed"] + len(added) + len(removed)
         if appended > max(COMPACT_MIN, COMPACT_SHARE * state["base"]):
             return _build(project_id)
-        add_ids, add_vectors = [], []
+        add_ids, add_vectors, add_blobs = [], [], []
         for first in range(0, len(added), READ_CHUNK):
             part = [int(i) for i in added[first:first + READ_CHUNK]]
-            rows = dict(LibrarySegment.objects.filter(pk__in=part).values_list("id", "profile"))
+            rows = {pk: (profile, descriptor) for pk, profile, descriptor in LibrarySegment.objects
+                    .filter(pk__in=part).values_list("id", "profile", "descriptor")}
             part = [pk for pk in part if pk in rows]  # deleted meanwhile
             add_ids += part
-            add_vectors += [rows[pk] for pk in part]
+            add_vectors += [rows[pk][0] for pk in part]
+            add_blobs += [bytes(rows[pk][1]) for pk in part]
         vectors = as_vectors(add_vectors, index.ndim // similarity.PROFILE_ROWS)
-        if len(vectors) and vectors.shape[1] != index.ndim:
+        if len(vectors) and (vectors.shape[1] != index.ndim
+                             or {len(b) for b in add_blobs} != {4 * state["payload"]}):
             return _build(project_id)
-        state = vector_index.append(folder_of(manifest), state, add_ids, vectors, removed)
+        payload = _descriptor_rows(add_blobs, state["payload"]) if add_blobs else None
+        state = vector_index.append(folder_of(manifest), state, add_ids, vectors, removed,
+                                    add_payload=payload)
         max_id = max(int(ids.max()) if len(ids) else 0, manifest["max_id"])
         return _publish(project_id, {**manifest, "state": state, "max_id": max_id,
                                      "count": len(keys) - len(removed) + len(add_ids),
@@ -266,8 +297,9 @@ def schedule_update(project_id):
 
 def _candidates_or_newer(pool, ids, project_id, after):
     """``pool``'s rows that are among ``ids`` or newer than the index file (the delta), in
-    one query: [(id, capture, start, stop, descriptor bytes)]. The descriptors come with
-    the candidates, so that ranking the shortlist needs no query of its own.
+    one query: [(id, capture, start, stop, descriptor bytes or None)]. Only the newer rows
+    carry their descriptor: the index holds the others' (a stored descriptor is read from
+    the database's out-of-line storage, the dearest part of a search's queries).
 
     The delta is found by row comparisons on (project, id), so that the database walks
     the ``libseg_described`` index from ``(project, after)`` to the project's end: with a
@@ -285,8 +317,10 @@ def _candidates_or_newer(pool, ids, project_id, after):
         where = f'"{table}"."id" = ANY(ARRAY[{marks}]::bigint[] || ARRAY({newer}))'
     else:
         where = f'("{table}"."id" IN ({marks or "NULL"}) OR "{table}"."id" IN ({newer}))'
+    fresh = Case(When(id__gt=after, then=F("descriptor")), default=None,
+                 output_field=BinaryField())
     return list(pool.extra(where=[where], params=[*ids, project_id, after, project_id + 1])
-                .values_list("id", "capture_id", "start", "stop", "descriptor"))
+                .annotate(fresh=fresh).values_list("id", "capture_id", "start", "stop", "fresh"))
 
 
 @dataclass
@@ -317,6 +351,15 @@ class OpenIndex:
     @property
     def size(self):
         return self.manifest["count"]
+
+    def with_descriptors(self, rows):
+        """``rows`` (id, capture, start, stop, descriptor bytes or None) with the index's
+        descriptor where the row has none; a row the index lacks too is left out."""
+        wanted = [r[0] for r in rows if r[4] is None]
+        found, payload = self.index.payload(wanted)
+        stored = {pk: payload[i] for i, pk in enumerate(wanted) if found[i]}
+        return [r if r[4] is not None else (*r[:4], stored[r[0]]) for r in rows
+                if r[4] is not None or r[0] in stored]
 
 
 _open = {}
@@ -352,6 +395,8 @@ def _open_checked(project_id, previous=None):
         state = manifest["state"]
         if previous is not None and previous.manifest["file"] == manifest["file"]:
             return OpenIndex(project_id, manifest, previous.index.at(state))
+        if not state.get("payload"):
+            raise IndexUnusable(f"{manifest['file']}: holds no descriptors")
         index = vector_index.VectorIndex.open(folder_of(manifest), state)
         if state["base"] + state["delta"] - state["removed"] != manifest["count"]:
             raise IndexUnusable(f"{manifest['file']}: holds {state['base']} + {state['delta']}"
@@ -399,7 +444,7 @@ def shortlist(index, query, pool, n):
         candidates = index.nearest(vector, count)
         rows = _candidates_or_newer(pool, [int(c) for c in candidates], index.project_id, after)
         index.note_delta(sum(r[0] > after for r in rows))
-        found = nearest_unique(rows, query, n)
+        found = nearest_unique(index.with_descriptors(rows), query, n)
         exhausted = len(candidates) < count and count >= index.size
         if len(found) >= n or exhausted:
             return found
@@ -409,7 +454,8 @@ def shortlist(index, query, pool, n):
 
 
 def nearest_unique(rows, query, n):
-    """The exact scan's order over ``rows`` (id, capture, start, stop, descriptor bytes):
+    """The exact scan's order over ``rows`` (id, capture, start, stop, descriptor as bytes
+    or float32 array):
     the ``n`` nearest by profile distance, one row per span (its newest), as
     ``[(id, descriptor)]``. Invalid when the stored descriptors are not of the query's
     shape (a library described by another version)."""
@@ -421,7 +467,8 @@ def nearest_unique(rows, query, n):
         if (capture_id, start, stop) not in seen:
             seen.add((capture_id, start, stop))
             unique.append((pk, blob))
-    flat = np.stack([np.frombuffer(bytes(b), dtype="<f4") for _, b in unique])
+    flat = np.stack([b if isinstance(b, np.ndarray) else np.frombuffer(bytes(b), dtype="<f4")
+                     for _, b in unique])
     if flat.shape[1] != query.size:
         raise Invalid(f"library descriptors have {flat.shape[1]} numbers, the query's "
                       f"{query.shape[0]} x {query.shape[1]}; rebuild the library")

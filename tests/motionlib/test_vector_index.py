@@ -104,3 +104,18 @@ def test_it_names_a_file_shorter_than_its_state(tmp_path):
 def test_it_refuses_more_lists_than_vectors(tmp_path):
     with pytest.raises(InputError, match="n_lists"):
         vector_index.build(tmp_path / "i", np.arange(5), clustered(n=5), n_lists=6)
+
+
+def test_it_returns_the_payload_of_base_and_appended_keys(tmp_path):
+    x = clustered(n=300)
+    rows = np.arange(300 * 4, dtype="<f4").reshape(300, 4)
+    (tmp_path / "payload").write_bytes(rows.tobytes())
+    ids = np.arange(0, 600, 2)
+    state = vector_index.build(tmp_path / "index", ids, x, n_lists=3,
+                               payload=tmp_path / "payload", payload_width=4)
+    state.pop("lists")
+    state = vector_index.append(tmp_path / "index", state, [1001], clustered(n=1, seed=6),
+                                add_payload=[[7, 7, 7, 7]])
+    found, got = VectorIndex.open(tmp_path / "index", state).payload([4, 1001, 5, 9999])
+    assert found.tolist() == [True, True, False, False]
+    assert got.tolist() == [rows[2].tolist(), [7] * 4, [0] * 4, [0] * 4]
