@@ -174,6 +174,10 @@ def _chunks(queryset):
         if not rows:
             return
         last = rows[-1][0]
+        missing = [r[0] for r in rows if r[2] is None]
+        if missing:
+            raise IndexUnusable(f"segments {missing[:5]}: a profile without a descriptor; "
+                                "rebuild the library's descriptors")
         yield (np.array([r[0] for r in rows], dtype=np.int64), as_vectors([r[1] for r in rows]),
                [bytes(r[2]) for r in rows])
 
