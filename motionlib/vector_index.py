@@ -216,8 +216,9 @@ class VectorIndex:
         inside = at < len(self.base_ids)
         hit = inside.copy()
         hit[inside] = np.asarray(self.base_ids[at[inside]]) == keys[inside]
-        for i in np.flatnonzero(hit):
-            rows[i] = self._payload[at[i]]
+        if hit.any():
+            # One gather in key order, so the mapped file is read front to back.
+            rows[hit] = self._payload[at[hit]]
         if len(self.delta_ids):
             if self._delta_rows is None:
                 self._delta_rows = {int(k): r for r, k in enumerate(self.delta_ids)}

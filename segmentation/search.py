@@ -1,12 +1,13 @@
 """Similar clips: the library segments that move most like a given one."""
 
 import numpy as np
+from django.contrib.auth import get_user_model
 
 from motionlib import similarity
 from segmentation import similar_index
 from segmentation.descriptors import load_descriptors, profile_pool
 from segmentation.errors import Invalid
-from segmentation.models import LibrarySegment
+from segmentation.models import Capture, Label, LibrarySegment
 
 # Similar clips and suggestions search at most this many of a project's recent segments.
 SIMILAR_POOL = 20000
@@ -36,17 +37,39 @@ def similar(segment, visible, k=10):
     short = similar_index.shortlist(index, query, pool, n) if index else None
     if short is None:
         ids = exact_shortlist(query, pool, n)
-        short = list(zip(ids, load_descriptors(ids), strict=True)) if ids else []
+        short = list(zip(ids, load_descriptors(ids), [None] * len(ids), strict=True))
     if not short:
         return []
     order, distances = similarity.rank_similar(
-        query, np.stack([d for _, d in short]), k=k, shortlist=len(short))
-    winners = [short[i][0] for i in order]
-    # What the caller shows of the winners, in one query (their descriptors are not needed).
+        query, np.stack([d for _, d, _ in short]), k=k, shortlist=len(short))
+    winners = [short[i] for i in order]
+    if all(row is not None for _, _, row in winners):
+        return [(shown(row), float(d)) for (_, _, row), d in zip(winners, distances, strict=True)]
+    # The exact scan read no display columns: the winners' rows in one query.
     rows = (LibrarySegment.objects.select_related("capture", "annotator", "label")
-            .defer("descriptor", "profile", "capture__skeleton").in_bulk(winners))
+            .defer("descriptor", "profile", "capture__skeleton").in_bulk([pk for pk, _, _ in winners]))
     # A row deleted since it was shortlisted is left out.
-    return [(rows[pk], float(d)) for pk, d in zip(winners, distances, strict=True) if pk in rows]
+    return [(rows[pk], float(d)) for (pk, _, _), d in zip(winners, distances, strict=True)
+            if pk in rows]
+
+
+def shown(row):
+    """A LibrarySegment (unsaved, with its capture, annotator and label) from a candidate
+    row of ``similar_index`` (id, capture, start, stop, descriptor, *SHOWN), holding what a
+    result shows: building it costs no query."""
+    pk, capture_id, start, stop, _ = row[:5]
+    f = dict(zip(similar_index.SHOWN, row[5:], strict=True))
+    segment = LibrarySegment(
+        id=pk, project_id=f["project_id"], review_id=f["review_id"], is_gold=f["is_gold"],
+        superseded=f["superseded"], start=start, stop=stop, duration=f["duration"],
+        agreement=f["agreement"])
+    segment.capture = Capture(id=capture_id, project_id=f["project_id"], name=f["capture__name"],
+                              fps=f["capture__fps"], format=f["capture__format"])
+    segment.label = Label(id=f["label_id"], project_id=f["project_id"], name=f["label__name"],
+                          color=f["label__color"])
+    segment.annotator = (get_user_model()(id=f["annotator_id"], username=f["annotator__username"])
+                         if f["annotator_id"] is not None else None)
+    return segment
 
 
 def exact_shortlist(query, pool, n):

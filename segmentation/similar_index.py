@@ -301,9 +301,10 @@ def schedule_update(project_id):
 
 def _candidates_or_newer(pool, ids, project_id, after):
     """``pool``'s rows that are among ``ids`` or newer than the index file (the delta), in
-    one query: [(id, capture, start, stop, descriptor bytes or None)]. Only the newer rows
-    carry their descriptor: the index holds the others' (a stored descriptor is read from
-    the database's out-of-line storage, the dearest part of a search's queries).
+    one query: [(id, capture, start, stop, descriptor bytes or None, *SHOWN)]. Only the
+    newer rows carry their descriptor: the index holds the others' (a stored descriptor is
+    read from the database's out-of-line storage, the dearest part of a search's queries).
+    ``SHOWN`` is what a result shows of a segment, so the winners need no query of their own.
 
     The delta is found by row comparisons on (project, id), so that the database walks
     the ``libseg_described`` index from ``(project, after)`` to the project's end: with a
@@ -324,7 +325,15 @@ def _candidates_or_newer(pool, ids, project_id, after):
     fresh = Case(When(id__gt=after, then=F("descriptor")), default=None,
                  output_field=BinaryField())
     return list(pool.extra(where=[where], params=[*ids, project_id, after, project_id + 1])
-                .annotate(fresh=fresh).values_list("id", "capture_id", "start", "stop", "fresh"))
+                .annotate(fresh=fresh).values_list("id", "capture_id", "start", "stop", "fresh",
+                                                   *SHOWN))
+
+
+# The columns of a segment and its capture, annotator and label that a search result shows
+# (``search.shown`` makes the rows the serializer reads from them).
+SHOWN = ("project_id", "review_id", "annotator_id", "is_gold", "superseded", "label_id",
+         "duration", "agreement", "capture__name", "capture__fps", "capture__format",
+         "annotator__username", "label__name", "label__color")
 
 
 @dataclass
@@ -357,12 +366,12 @@ class OpenIndex:
         return self.manifest["count"]
 
     def with_descriptors(self, rows):
-        """``rows`` (id, capture, start, stop, descriptor bytes or None) with the index's
-        descriptor where the row has none; a row the index lacks too is left out."""
+        """``rows`` (id, capture, start, stop, descriptor bytes or None, ...) with the
+        index's descriptor where the row has none; a row the index lacks too is left out."""
         wanted = [r[0] for r in rows if r[4] is None]
         found, payload = self.index.payload(wanted)
         stored = {pk: payload[i] for i, pk in enumerate(wanted) if found[i]}
-        return [r if r[4] is not None else (*r[:4], stored[r[0]]) for r in rows
+        return [r if r[4] is not None else (*r[:4], stored[r[0]], *r[5:]) for r in rows
                 if r[4] is not None or r[0] in stored]
 
 
@@ -434,7 +443,7 @@ MAX_CANDIDATES = 4096
 def shortlist(index, query, pool, n):
     """The ``n`` segments of ``pool`` whose profiles are nearest to ``query``'s, nearest
     first, as the exact scan orders them (ties: newest first; one span once), as
-    ``[(id, descriptor)]``.
+    ``[(id, descriptor, row)]``, ``row`` the candidate's columns (``_candidates_or_newer``).
 
     ``pool`` is the caller's visible, filtered queryset; the index proposes candidates
     and ``pool`` decides which exist and may be shown. Returns None when even
@@ -459,26 +468,25 @@ def shortlist(index, query, pool, n):
 
 def nearest_unique(rows, query, n):
     """The exact scan's order over ``rows`` (id, capture, start, stop, descriptor as bytes
-    or float32 array):
-    the ``n`` nearest by profile distance, one row per span (its newest), as
-    ``[(id, descriptor)]``. Invalid when the stored descriptors are not of the query's
+    or float32 array, ...): the ``n`` nearest by profile distance, one row per span (its
+    newest), as ``[(id, descriptor, row)]``. Invalid when the stored descriptors are not of the query's
     shape (a library described by another version)."""
     if not rows:
         return []
     rows.sort(key=lambda r: -r[0])
     seen, unique = set(), []
-    for pk, capture_id, start, stop, blob in rows:
-        if (capture_id, start, stop) not in seen:
-            seen.add((capture_id, start, stop))
-            unique.append((pk, blob))
-    flat = np.stack([b if isinstance(b, np.ndarray) else np.frombuffer(bytes(b), dtype="<f4")
-                     for _, b in unique])
+    for row in rows:
+        if row[1:4] not in seen:
+            seen.add(row[1:4])
+            unique.append(row)
+    flat = np.stack([r[4] if isinstance(r[4], np.ndarray) else np.frombuffer(bytes(r[4]), dtype="<f4")
+                     for r in unique])
     if flat.shape[1] != query.size:
         raise Invalid(f"library descriptors have {flat.shape[1]} numbers, the query's "
                       f"{query.shape[0]} x {query.shape[1]}; rebuild the library")
     descs = flat.reshape(len(unique), *query.shape)
     order = similarity.shortlist_by_profile(query, descs, n)
-    return [(unique[i][0], descs[i]) for i in order]
+    return [(unique[i][0], descs[i], unique[i]) for i in order]
 
 
 def forget():
