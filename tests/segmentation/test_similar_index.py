@@ -97,6 +97,21 @@ class SameResultsTest(SimilarIndexTestCase):
         assert {s.pk for s, _ in found} <= {r.pk for r in bob_rows}
 
 
+class ShownTest(SimilarIndexTestCase):
+    def test_it_shows_each_result_as_the_exact_scan_does(self):
+        rows = self.add_segments(self.spans[:60], self.descs[:60])
+        self.add_segments(self.spans[60:90], self.descs[60:90], annotator=self.alice)
+        LibrarySegment.objects.filter(pk=rows[5].pk).update(agreement=0.5, is_gold=True,
+                                                            annotator=None)
+        self.login(self.rachel)
+        url = f"/api/segments/{rows[0].pk}/similar/?k=30"
+        exact = self.client.get(url).json()
+        similar_index.build(self.project.pk)
+        assert similar_index.open_index(self.project.pk) is not None
+        assert self.client.get(url).json() == exact
+        assert len(exact["results"]) == 30
+
+
 class QueryCountTest(SimilarIndexTestCase):
     def test_it_answers_with_the_same_number_of_queries_whatever_k(self):
         rows = self.add_segments(self.spans[:100], self.descs[:100])
