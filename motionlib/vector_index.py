@@ -237,9 +237,9 @@ class VectorIndex:
     def __len__(self):
         return len(self.keys())
 
-    def search(self, query: np.ndarray, count: int, *, nprobe: int = NPROBE):
-        """The ``count`` live keys nearest to ``query`` among the ``nprobe`` nearest lists
-        and the added vectors.
+    def search(self, query: np.ndarray, count: int, *, nprobe: int | None = None):
+        """The ``count`` live keys nearest to ``query`` among the ``nprobe`` (default
+        ``NPROBE``) nearest lists and the added vectors.
 
         Returns
         -------
@@ -252,7 +252,7 @@ class VectorIndex:
         # Removed keys still sit in the files: ask for more, to drop them (a caller that
         # finds too few asks again for more).
         want = count + min(len(self.removed), count)
-        params = faiss.SearchParametersIVF(nprobe=min(nprobe, self.base.nlist))
+        params = faiss.SearchParametersIVF(nprobe=min(nprobe or NPROBE, self.base.nlist))
         dist, keys = self.base.search(q, min(want, self.base.ntotal), params=params)
         keys, dist = keys[0], dist[0]
         found = keys >= 0

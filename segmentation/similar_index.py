@@ -301,9 +301,10 @@ def schedule_update(project_id):
 
 def _candidates_or_newer(pool, ids, project_id, after):
     """``pool``'s rows that are among ``ids`` or newer than the index file (the delta), in
-    one query: [(id, capture, start, stop, descriptor bytes or None, *SHOWN)]. Only the
-    newer rows carry their descriptor: the index holds the others' (a stored descriptor is
-    read from the database's out-of-line storage, the dearest part of a search's queries).
+    one query: [(id, capture, start, stop, profile bytes or None, *SHOWN)]. Only the newer
+    rows carry their profile: the index holds the others' descriptors. No descriptor is
+    read here (it lives in the database's out-of-line storage, the dearest part of a
+    search's queries, and thousands of newer rows may wait for an update).
     ``SHOWN`` is what a result shows of a segment, so the winners need no query of their own.
 
     The delta is found by row comparisons on (project, id), so that the database walks
@@ -322,7 +323,7 @@ def _candidates_or_newer(pool, ids, project_id, after):
         where = f'"{table}"."id" = ANY(ARRAY[{marks}]::bigint[] || ARRAY({newer}))'
     else:
         where = f'("{table}"."id" IN ({marks or "NULL"}) OR "{table}"."id" IN ({newer}))'
-    fresh = Case(When(id__gt=after, then=F("descriptor")), default=None,
+    fresh = Case(When(id__gt=after, then=F("profile")), default=None,
                  output_field=BinaryField())
     return list(pool.extra(where=[where], params=[*ids, project_id, after, project_id + 1])
                 .annotate(fresh=fresh).values_list("id", "capture_id", "start", "stop", "fresh",
@@ -366,8 +367,8 @@ class OpenIndex:
         return self.manifest["count"]
 
     def with_descriptors(self, rows):
-        """``rows`` (id, capture, start, stop, descriptor bytes or None, ...) with the
-        index's descriptor where the row has none; a row the index lacks too is left out."""
+        """``rows`` (id, capture, start, stop, profile bytes or None, ...) with the index's
+        descriptor where the row has no profile; a row the index lacks too is left out."""
         wanted = [r[0] for r in rows if r[4] is None]
         found, payload = self.index.payload(wanted)
         stored = {pk: payload[i] for i, pk in enumerate(wanted) if found[i]}
@@ -467,10 +468,11 @@ def shortlist(index, query, pool, n):
 
 
 def nearest_unique(rows, query, n):
-    """The exact scan's order over ``rows`` (id, capture, start, stop, descriptor as bytes
-    or float32 array, ...): the ``n`` nearest by profile distance, one row per span (its
-    newest), as ``[(id, descriptor, row)]``. Invalid when the stored descriptors are not of the query's
-    shape (a library described by another version)."""
+    """The exact scan's order over ``rows`` (id, capture, start, stop, descriptor as a
+    float32 array or profile as bytes, ...): the ``n`` nearest by profile distance, one row
+    per span (its newest), as ``[(id, descriptor, row)]``. The descriptors of shortlisted
+    rows that came with a profile only are read in one query. Invalid when a stored
+    descriptor is not of the query's shape (a library described by another version)."""
     if not rows:
         return []
     rows.sort(key=lambda r: -r[0])
@@ -479,14 +481,28 @@ def nearest_unique(rows, query, n):
         if row[1:4] not in seen:
             seen.add(row[1:4])
             unique.append(row)
-    flat = np.stack([r[4] if isinstance(r[4], np.ndarray) else np.frombuffer(bytes(r[4]), dtype="<f4")
-                     for r in unique])
-    if flat.shape[1] != query.size:
-        raise Invalid(f"library descriptors have {flat.shape[1]} numbers, the query's "
-                      f"{query.shape[0]} x {query.shape[1]}; rebuild the library")
-    descs = flat.reshape(len(unique), *query.shape)
-    order = similarity.shortlist_by_profile(query, descs, n)
-    return [(unique[i][0], descs[i], unique[i]) for i in order]
+    width = similarity.PROFILE_ROWS * query.shape[1]
+    profiles = np.stack([r[4].ravel()[:width] if isinstance(r[4], np.ndarray)
+                         else np.frombuffer(bytes(r[4]), dtype="<f4") for r in unique])
+    if profiles.shape[1] != width:
+        raise Invalid(f"library profiles have {profiles.shape[1]} numbers, the query's "
+                      f"{width}; rebuild the library")
+    order = similarity.shortlist_by_profile(
+        query, profiles.reshape(len(unique), similarity.PROFILE_ROWS, -1), n)
+    chosen = [unique[i] for i in order]
+    missing = [r[0] for r in chosen if not isinstance(r[4], np.ndarray)]
+    read = {pk: np.frombuffer(bytes(blob), dtype="<f4") for pk, blob in LibrarySegment.objects
+            .filter(pk__in=missing).values_list("id", "descriptor")} if missing else {}
+    out = []
+    for r in chosen:
+        descriptor = r[4] if isinstance(r[4], np.ndarray) else read.get(r[0])
+        if descriptor is None:
+            continue  # deleted since the candidates were read
+        if descriptor.size != query.size:
+            raise Invalid(f"library descriptors have {descriptor.size} numbers, the query's "
+                          f"{query.shape[0]} x {query.shape[1]}; rebuild the library")
+        out.append((r[0], descriptor.reshape(query.shape), r))
+    return out
 
 
 def forget():
