@@ -41,7 +41,7 @@ PAYLOAD, DELTA_PAYLOAD = "payload.f32", "delta_payload.f32"
 # Vectors per list the index aims for (n_lists = n / LIST_SIZE, at least 1).
 LIST_SIZE = 1024
 # Lists a search scans: the nearest centres first.
-NPROBE = 24
+NPROBE = 16
 # Searches run on the calling thread: a web process answers one request per thread, and
 # OpenMP's team would fight the other processes of a small machine for its cores.
 faiss.omp_set_num_threads(1)
