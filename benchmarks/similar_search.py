@@ -26,7 +26,8 @@ and the indexes brought back in step.
 
 ``--busy N`` adds N processes that spin on a core for the length of the run (stopped at
 the end), to measure under load; the load average is printed before and after the
-queries. ``CPU`` is this process's CPU time per request (the web side; PostgreSQL's share
+queries. The paths run in turn for each query (oracle, before, now), with one BLAS thread.
+``CPU`` is this process's CPU time per request (the web side; PostgreSQL's share
 is not in it): on a shared machine it is the steadier figure.
 
     .venv/bin/python benchmarks/similar_search.py [--queries 200] [--busy 0] [--seed 15]
@@ -195,6 +196,16 @@ def table(rows, recall, cpu):
 
 
 def main():
+    # One BLAS thread: the oracle's large products would otherwise leave OpenBLAS threads
+    # spinning on both cores while the next request is timed (a web process makes no such
+    # products).
+    from threadpoolctl import threadpool_limits
+
+    with threadpool_limits(limits=1):
+        run()
+
+
+def run():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--segments", type=int, default=1_000_000)
     parser.add_argument("--seed", type=int, default=15)
@@ -239,7 +250,7 @@ def main():
               f"reviewer, through SimilarView\n", flush=True)
         similar_index.forget()
         user = ctx["reviewer"]
-        paths = {"now": None, f"before ({old.rev})": old.api_similar.SimilarView}
+        paths = {f"before ({old.rev})": old.api_similar.SimilarView, "now": None}
         folders = {"now": dirs["now"], f"before ({old.rev})": dirs["before"]}
         rows = {"exact (oracle, numpy)": [], **{p: [] for p in paths}, "no index (20,000 recent)": []}
         recall = {p: [] for p in rows if p != "exact (oracle, numpy)"}

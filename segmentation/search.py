@@ -1,13 +1,14 @@
 """Similar clips: the library segments that move most like a given one."""
 
+from types import SimpleNamespace
+
 import numpy as np
-from django.contrib.auth import get_user_model
 
 from motionlib import similarity
-from segmentation import similar_index
+from segmentation import exports, similar_index
 from segmentation.descriptors import load_descriptors, profile_pool
 from segmentation.errors import Invalid
-from segmentation.models import Capture, Label, LibrarySegment
+from segmentation.models import LibrarySegment
 
 # Similar clips and suggestions search at most this many of a project's recent segments.
 SIMILAR_POOL = 20000
@@ -24,7 +25,9 @@ def similar(segment, visible, k=10):
     shortlist comes from the project's vector index (``similar_index``), with the
     shortlisted descriptors read in the same query as the candidates, when it has a
     usable one, else from the profiles of up to ``SIMILAR_POOL`` recent segments.
-    Returns ``[(segment, distance)]``, most similar first.
+    Returns ``[(segment, distance)]``, most similar first; a segment found through the
+    index is a ``Shown`` (its id and its API fields), one from the exact scan a
+    LibrarySegment.
     """
     query = segment.descriptor_array()
     if query is None:
@@ -53,23 +56,32 @@ def similar(segment, visible, k=10):
             if pk in rows]
 
 
+class Shown:
+    """A result read from the candidates' columns: its id and what the API shows of it
+    (``SegmentSerializer``'s fields, made without model instances: a search shows ten, and
+    building a segment, capture, label and user for each cost more than the ranking)."""
+
+    __slots__ = ("pk", "data")
+
+    def __init__(self, pk, data):
+        self.pk, self.data = pk, data
+
+
 def shown(row):
-    """A LibrarySegment (unsaved, with its capture, annotator and label) from a candidate
-    row of ``similar_index`` (id, capture, start, stop, descriptor, *SHOWN), holding what a
-    result shows: building it costs no query."""
+    """``Shown`` from a candidate row of ``similar_index`` (id, capture, start, stop,
+    descriptor, *SHOWN)."""
     pk, capture_id, start, stop, _ = row[:5]
     f = dict(zip(similar_index.SHOWN, row[5:], strict=True))
-    segment = LibrarySegment(
-        id=pk, project_id=f["project_id"], review_id=f["review_id"], is_gold=f["is_gold"],
-        superseded=f["superseded"], start=start, stop=stop, duration=f["duration"],
-        agreement=f["agreement"])
-    segment.capture = Capture(id=capture_id, project_id=f["project_id"], name=f["capture__name"],
-                              fps=f["capture__fps"], format=f["capture__format"])
-    segment.label = Label(id=f["label_id"], project_id=f["project_id"], name=f["label__name"],
-                          color=f["label__color"])
-    segment.annotator = (get_user_model()(id=f["annotator_id"], username=f["annotator__username"])
-                         if f["annotator_id"] is not None else None)
-    return segment
+    return Shown(pk, {
+        "id": pk, "project": f["project_id"],
+        "capture": {"id": capture_id, "name": f["capture__name"]}, "review": f["review_id"],
+        "annotator": ({"id": f["annotator_id"], "username": f["annotator__username"]}
+                      if f["annotator_id"] else None),
+        "gold": f["is_gold"], "superseded": f["superseded"], "label": f["label__name"],
+        "color": f["label__color"] if f["label_id"] else "#888888", "start": start,
+        "stop": stop, "fps": float(f["capture__fps"]), "duration": float(f["duration"]),
+        "agreement": None if f["agreement"] is None else float(f["agreement"]),
+        "export_formats": exports.formats_for(SimpleNamespace(format=f["capture__format"]))})
 
 
 def exact_shortlist(query, pool, n):
