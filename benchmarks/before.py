@@ -31,6 +31,11 @@ def _module(name, source, **names):
     return module
 
 
+def vector_index(rev=BEFORE):
+    """Only ``rev``'s ``motionlib.vector_index`` (needs no Django)."""
+    return _module("before_vector_index", _source(rev, "motionlib/vector_index.py"))
+
+
 def load(rev=BEFORE):
     similarity = _module("before_similarity", _source(rev, "motionlib/similarity.py"))
     vector_index = _module("before_vector_index", _source(rev, "motionlib/vector_index.py"))

@@ -123,7 +123,7 @@ def main():
         print(f"{name:<26} {build_s:>8.1f} {n / build_s:>9,.0f} {p50:>7.2f} {p95:>7.2f} "
               f"{recall:>10.3f} {mb:>8.0f}  {shared}", flush=True)
 
-    old = before.load().vector_index
+    old = before.vector_index()
     started = time.perf_counter()
     ivf = old.IvfIndex.build(ids, x)
     built = time.perf_counter() - started
