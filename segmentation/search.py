@@ -22,9 +22,9 @@ def similar(segment, visible, k=10):
     Segments overlapping it in the same capture are left out (other annotators' versions
     of the same motion), and so are duplicates of one span. Two stages: the profiles
     nearest to the query's pick a shortlist, whose full descriptors are ranked. The
-    shortlist comes from the project's vector index (``similar_index``), with the
-    shortlisted descriptors read in the same query as the candidates, when it has a
-    usable one, else from the profiles of up to ``SIMILAR_POOL`` recent segments.
+    shortlist comes from the project's vector index (``similar_index``, which keeps the
+    descriptors too) when it has a usable one, else from the profiles of up to
+    ``SIMILAR_POOL`` recent segments.
     Returns ``[(segment, distance)]``, most similar first; a segment found through the
     index is a ``Shown`` (its id and its API fields), one from the exact scan a
     LibrarySegment.
