@@ -352,8 +352,9 @@ class OpenIndex:
 
     def nearest(self, vector, count):
         """Up to ``count`` segment ids of the index nearest to a profile vector, nearest
-        first. Ids may include segments deleted since the last update."""
-        return self.index.search(vector, count)[0]
+        first, and their squared distances (float32). Ids may include segments deleted
+        since the last update."""
+        return self.index.search(vector, count)
 
     def note_delta(self, newer):
         """Queue an update (once per manifest) when ``newer`` segments outnumber
@@ -366,14 +367,10 @@ class OpenIndex:
     def size(self):
         return self.manifest["count"]
 
-    def with_descriptors(self, rows):
-        """``rows`` (id, capture, start, stop, profile bytes or None, ...) with the index's
-        descriptor where the row has no profile; a row the index lacks too is left out."""
-        wanted = [r[0] for r in rows if r[4] is None]
-        found, payload = self.index.payload(wanted)
-        stored = {pk: payload[i] for i, pk in enumerate(wanted) if found[i]}
-        return [r if r[4] is not None else (*r[:4], stored[r[0]], *r[5:]) for r in rows
-                if r[4] is not None or r[0] in stored]
+    def descriptors(self, ids):
+        """{id: descriptor (float32, flat)} of those of ``ids`` the index holds."""
+        found, payload = self.index.payload(ids)
+        return {pk: payload[i] for i, pk in enumerate(ids) if found[i]}
 
 
 _open = {}
@@ -455,10 +452,11 @@ def shortlist(index, query, pool, n):
     count = max(CANDIDATES * n, MIN_CANDIDATES)
     after = index.manifest["max_id"]
     while True:
-        candidates = index.nearest(vector, count)
+        candidates, distances = index.nearest(vector, count)
         rows = _candidates_or_newer(pool, [int(c) for c in candidates], index.project_id, after)
         index.note_delta(sum(r[0] > after for r in rows))
-        found = nearest_unique(index.with_descriptors(rows), query, n)
+        measured = dict(zip(candidates.tolist(), distances.tolist(), strict=True))
+        found = nearest_unique(rows, query, n, measured, index.descriptors)
         exhausted = len(candidates) < count and count >= index.size
         if len(found) >= n or exhausted:
             return found
@@ -467,12 +465,17 @@ def shortlist(index, query, pool, n):
         count *= GROW
 
 
-def nearest_unique(rows, query, n):
-    """The exact scan's order over ``rows`` (id, capture, start, stop, descriptor as a
-    float32 array or profile as bytes, ...): the ``n`` nearest by profile distance, one row
-    per span (its newest), as ``[(id, descriptor, row)]``. The descriptors of shortlisted
-    rows that came with a profile only are read in one query. Invalid when a stored
+def nearest_unique(rows, query, n, measured, stored):
+    """The exact scan's order over ``rows`` (id, capture, start, stop, profile bytes or
+    None, ...): the ``n`` nearest by profile distance, one row per span (its newest), as
+    ``[(id, descriptor, row)]``.
+
+    A row without a profile is the index's: its distance is ``measured[id]`` (what the
+    index computed, in float32) and its descriptor comes from ``stored(ids)``; the newer
+    rows are measured here and their descriptors read in one query, for the shortlisted
+    ones only (a descriptor is 4.9 kB; a profile 420 bytes). Invalid when a stored
     descriptor is not of the query's shape (a library described by another version)."""
+    rows = [r for r in rows if r[4] is not None or r[0] in measured]
     if not rows:
         return []
     rows.sort(key=lambda r: -r[0])
@@ -482,20 +485,26 @@ def nearest_unique(rows, query, n):
             seen.add(row[1:4])
             unique.append(row)
     width = similarity.PROFILE_ROWS * query.shape[1]
-    profiles = np.stack([r[4].ravel()[:width] if isinstance(r[4], np.ndarray)
-                         else np.frombuffer(bytes(r[4]), dtype="<f4") for r in unique])
-    if profiles.shape[1] != width:
-        raise Invalid(f"library profiles have {profiles.shape[1]} numbers, the query's "
-                      f"{width}; rebuild the library")
-    order = similarity.shortlist_by_profile(
-        query, profiles.reshape(len(unique), similarity.PROFILE_ROWS, -1), n)
-    chosen = [unique[i] for i in order]
-    missing = [r[0] for r in chosen if not isinstance(r[4], np.ndarray)]
-    read = {pk: np.frombuffer(bytes(blob), dtype="<f4") for pk, blob in LibrarySegment.objects
-            .filter(pk__in=missing).values_list("id", "descriptor")} if missing else {}
+    q = np.asarray(query[:similarity.PROFILE_ROWS], dtype=float).ravel()
+    d = np.empty(len(unique))
+    for i, r in enumerate(unique):
+        if r[4] is None:
+            d[i] = measured[r[0]]
+            continue
+        profile = np.frombuffer(bytes(r[4]), dtype="<f4")
+        if profile.size != width:
+            raise Invalid(f"library profiles have {profile.size} numbers, the query's "
+                          f"{width}; rebuild the library")
+        d[i] = float(((profile - q) ** 2).sum())
+    chosen = [unique[i] for i in np.argsort(d, kind="stable")[:n]]
+    read = stored([r[0] for r in chosen if r[4] is None])
+    newer = [r[0] for r in chosen if r[4] is not None]
+    if newer:
+        read.update((pk, np.frombuffer(bytes(blob), dtype="<f4")) for pk, blob in
+                    LibrarySegment.objects.filter(pk__in=newer).values_list("id", "descriptor"))
     out = []
     for r in chosen:
-        descriptor = r[4] if isinstance(r[4], np.ndarray) else read.get(r[0])
+        descriptor = read.get(r[0])
         if descriptor is None:
             continue  # deleted since the candidates were read
         if descriptor.size != query.size:
