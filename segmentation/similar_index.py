@@ -486,16 +486,15 @@ def nearest_unique(rows, query, n, measured, stored):
             unique.append(row)
     width = similarity.PROFILE_ROWS * query.shape[1]
     q = np.asarray(query[:similarity.PROFILE_ROWS], dtype=float).ravel()
-    d = np.empty(len(unique))
-    for i, r in enumerate(unique):
-        if r[4] is None:
-            d[i] = measured[r[0]]
-            continue
-        profile = np.frombuffer(bytes(r[4]), dtype="<f4")
-        if profile.size != width:
-            raise Invalid(f"library profiles have {profile.size} numbers, the query's "
-                          f"{width}; rebuild the library")
-        d[i] = float(((profile - q) ** 2).sum())
+    d = np.array([measured.get(r[0], np.nan) for r in unique])
+    fresh = [i for i, r in enumerate(unique) if r[4] is not None]
+    if fresh:
+        blobs = [bytes(unique[i][4]) for i in fresh]
+        if {len(b) for b in blobs} != {4 * width}:
+            raise Invalid(f"library profiles have {sorted({len(b) // 4 for b in blobs})} "
+                          f"numbers, the query's {width}; rebuild the library")
+        diff = np.frombuffer(b"".join(blobs), dtype="<f4").reshape(len(fresh), width) - q
+        d[fresh] = np.einsum("ij,ij->i", diff, diff)
     chosen = [unique[i] for i in np.argsort(d, kind="stable")[:n]]
     read = stored([r[0] for r in chosen if r[4] is None])
     newer = [r[0] for r in chosen if r[4] is not None]
