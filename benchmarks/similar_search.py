@@ -306,13 +306,14 @@ def run():
             for title, module in (("now", similar_index), (f"before ({old.rev})", old.similar_index)):
                 size = folder_bytes(folders[title])
                 with index_dir(folders[title]):
+                    first = module.read_manifest(project)["file"]
                     started = time.perf_counter()
                     after = module.update(project)
                     took = time.perf_counter() - started
-                written = (folder_bytes(folders[title]) - size if title == "now"
-                           else after["bytes"])
+                appended = after["file"] == first
+                written = folder_bytes(folders[title]) - size if appended else after["bytes"]
                 print(f"  {title:<28} {took:6.1f} s, wrote {written / 1e6:8.1f} MB "
-                      f"({'appended' if title == 'now' else 'a new generation of the whole index'})")
+                      f"({'appended' if appended else 'a new generation of the whole index'})")
         finally:
             LibrarySegment.objects.filter(pk__in=[s.pk for s in added]).delete()
             capture.delete()
