@@ -18,7 +18,7 @@ test: install bpy frontend browser lint vitest pytest
 
 install: $(STAMP)
 
-$(STAMP): pyproject.toml setup.py motionlib/io/_parse.c motionlib/_kinematics.c
+$(STAMP): pyproject.toml setup.py motionlib/io/_parse.c motionlib/_kinematics.c motionlib/_dtw.c
 	test -x $(PY) || python3 -m venv .venv
 	$(PIP) install -q --upgrade pip
 	$(PIP) install -q -e ".[dev,bench,plot]"

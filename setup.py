@@ -1,5 +1,5 @@
 """The compiled parts of motionlib (everything else about the package is in pyproject.toml):
-its number reader and its forward kinematics, C with only the buffer protocol, so building
+its number reader, its forward kinematics and its DTW, C with only the buffer protocol, so building
 needs a C compiler and Python's headers and nothing else."""
 
 from setuptools import Extension, setup
@@ -10,4 +10,5 @@ setup(ext_modules=[
     # body_frame() must round as numpy's separate multiplies and adds do.
     Extension("motionlib._kinematics", ["motionlib/_kinematics.c"],
               extra_compile_args=["-ffp-contract=off"]),
+    Extension("motionlib._dtw", ["motionlib/_dtw.c"]),
 ])

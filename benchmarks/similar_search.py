@@ -1,38 +1,50 @@
-"""Similar-clip search over a million described segments: the vector index beside the
-exact scan.
+"""Similar-clip search over a million described segments: the service now, the service
+before (loaded from git), and the exact answer, in the same run and under the same load.
 
 Uses the seeded million-segment database of ``million.py`` (built on first use, then
-kept). The project "Archive" holds 1,000,000 described segments. Its similar-clip index
-(``segmentation.similar_index``) is built into ``benchmarks/out/`` once (the build time is
-printed; later runs bring the cached file in step with ``update``).
+kept). The project "Archive" holds 1,000,000 described segments. Each service's index is
+built into ``benchmarks/out/`` once (build times printed; later runs bring it in step with
+``update``).
 
-For ``--queries`` seeded random segments of the archive, as a reviewer through the real
-view (``GET /api/segments/{id}/similar/?k=10``):
+For ``--queries`` seeded random segments of the archive, as a reviewer through the view
+(``GET /api/segments/{id}/similar/?k=10``, the whole request: the membership lookup, the
+index, the database reads, the ranking and the JSON), one path after the other per query:
 
 - ``exact``: the oracle. Profile distances to all 1,000,000 segments in memory (numpy),
   the same exclusions (superseded rows, the query's own overlapping spans, one row per
   span), the 20 nearest re-ranked by DTW exactly as the service does.
-- ``index``: the service with its index (what a studio gets).
-- ``old``: the service without an index (its scan of the ``SIMILAR_POOL`` = 20,000 most
-  recent segments, what it did before; it never sees the other 980,000, hence its
-  recall). Timed on the first ``--old-queries`` queries only.
+- ``now``: the service (faiss inverted file with the descriptors beside it, C DTW).
+- ``before``: the service as commit ``--before`` shipped it (numpy inverted file, the
+  candidates' profiles and the shortlist's descriptors read from the database, numpy DTW).
+- ``no index``: the service's fallback (exact scan of the ``SIMILAR_POOL`` most recent
+  segments; it never sees the rest, hence its recall), on the first ``--old-queries``.
 
-Prints latency (median, p95), recall@10 against ``exact``, and the index's memory: file
-size (the most the page cache ever holds for all web processes together, since they map
-the same file read-only) and what this process has resident of the mapping after the
-queries (``/proc/self/smaps``). ``CPU`` is this process's CPU time per request (the web
-side; PostgreSQL's share is not in it): on a shared machine it is the steadier figure.
+Then ``--added`` new segments are stored (copies of existing descriptors in a new
+capture): searches while they wait for the index (read from the database with every
+search), then each service's ``update``, with the bytes it wrote; then they are deleted
+and the indexes brought back in step.
 
-    .venv/bin/python benchmarks/similar_search.py [--queries 200] [--old-queries 20]
+``--busy N`` adds N processes that spin on a core for the length of the run (stopped at
+the end), to measure under load; the load average is printed before and after the
+queries. The paths run in turn for each query (oracle, before, now), with one BLAS thread.
+``CPU`` is this process's CPU time per request (the web side; PostgreSQL's share
+is not in it): on a shared machine it is the steadier figure.
+
+    .venv/bin/python benchmarks/similar_search.py [--queries 200] [--busy 0] [--seed 15]
 """
 
 import argparse
 import os
 import platform
 import statistics
+import subprocess
+import sys
 import time
+from contextlib import contextmanager
+from pathlib import Path
 from unittest import mock
 
+import before
 import million
 import numpy as np
 
@@ -99,7 +111,7 @@ class Profiles:
 CPU = []
 
 
-def call_view(user, pk):
+def call_view(user, pk, view=None):
     from rest_framework.test import APIRequestFactory, force_authenticate
 
     from segmentation.api.similar import SimilarView
@@ -107,12 +119,35 @@ def call_view(user, pk):
     request = APIRequestFactory().get(f"/api/segments/{pk}/similar/?k=10")
     force_authenticate(request, user=user)
     started, cpu = time.perf_counter(), time.process_time()
-    response = SimilarView.as_view()(request, pk=pk)
+    response = (view or SimilarView).as_view()(request, pk=pk)
     response.render()
     elapsed = (time.perf_counter() - started) * 1000
     CPU.append((time.process_time() - cpu) * 1000)
     assert response.status_code == 200, response.content[:300]
     return [r["id"] for r in response.data["results"]], elapsed
+
+
+@contextmanager
+def index_dir(path):
+    """Point the services at ``path`` for their index files."""
+    from django.conf import settings
+
+    previous = settings.SIMILAR_INDEX_DIR
+    settings.SIMILAR_INDEX_DIR = path
+    try:
+        yield
+    finally:
+        settings.SIMILAR_INDEX_DIR = previous
+
+
+def busy(n, seconds):
+    """``n`` processes spinning on a core, each ending by itself after ``seconds``."""
+    spin = f"import time\nend = time.time() + {seconds}\nwhile time.time() < end: pass"
+    return [subprocess.Popen([sys.executable, "-c", spin]) for _ in range(n)]
+
+
+def folder_bytes(path):
+    return sum(p.stat().st_size for p in Path(path).rglob("*") if p.is_file())
 
 
 def mapped_rss(name):
@@ -134,77 +169,164 @@ def p95(times):
     return statistics.quantiles(times, n=20)[-1] if len(times) > 1 else times[0]
 
 
+def load():
+    return ", ".join(f"{x:.1f}" for x in os.getloadavg())
+
+
+def ensure(module, project, folder):
+    """Build (or bring in step) ``module``'s index of ``project`` in ``folder``; returns
+    (manifest, seconds, what was done)."""
+    with index_dir(folder):
+        started = time.perf_counter()
+        fresh = not module.manifest_path(project).exists()
+        manifest = module.build(project) if fresh else module.update(project)
+        return manifest, time.perf_counter() - started, "built" if fresh else "brought in step"
+
+
+def table(rows, recall, cpu):
+    header = (f"{'path':<30} {'queries':>7} {'median ms':>10} {'p95 ms':>8} {'CPU med ms':>11} "
+              f"{'recall@10':>10}")
+    print(header)
+    print("-" * len(header))
+    for title, times in rows.items():
+        r, c = recall.get(title), cpu.get(title)
+        print(f"{title:<30} {len(times):>7} {statistics.median(times):>10.1f} {p95(times):>8.1f} "
+              f"{statistics.median(c) if c else float('nan'):>11.1f} "
+              f"{np.mean(r) if r else 1.0:>10.3f}")
+
+
 def main():
+    # One BLAS thread: the oracle's large products would otherwise leave OpenBLAS threads
+    # spinning on both cores while the next request is timed (a web process makes no such
+    # products).
+    from threadpoolctl import threadpool_limits
+
+    with threadpool_limits(limits=1):
+        run()
+
+
+def run():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--segments", type=int, default=1_000_000)
     parser.add_argument("--seed", type=int, default=15)
     parser.add_argument("--queries", type=int, default=200)
-    parser.add_argument("--old-queries", type=int, default=20)
+    parser.add_argument("--old-queries", type=int, default=10)
+    parser.add_argument("--added", type=int, default=5000)
+    parser.add_argument("--busy", type=int, default=0)
+    parser.add_argument("--before", default=before.BEFORE)
+    parser.add_argument("--nprobe", type=int, help="lists a search scans (default: the service's)")
     parser.add_argument("--admin-url", default=million.default_admin_url())
     args = parser.parse_args()
     name, out = million.connect(args.admin_url, args.segments, args.seed)
-    from django.conf import settings
-
     from segmentation import similar_index
-    from segmentation.models import LibrarySegment
+    from segmentation.models import Capture, LibrarySegment
 
-    settings.SIMILAR_INDEX_DIR = out / "similar"
+    old = before.load(args.before)
+    if args.nprobe:
+        similar_index.vector_index.NPROBE = args.nprobe
     ctx = million.personas()
     project = ctx["project"].pk
-    started = time.perf_counter()
-    fresh = not similar_index.manifest_path(project).exists()
-    manifest = similar_index.build(project) if fresh else similar_index.update(project)
-    built = time.perf_counter() - started
+    dirs = {"now": out / "similar-now", "before": out / "similar-before"}
+    manifest, built, how = ensure(similar_index, project, dirs["now"])
+    old_manifest, old_built, old_how = ensure(old.similar_index, project, dirs["before"])
     ids, profiles, spans = oracle_arrays(out)
     rng = np.random.default_rng(args.seed)
     picks = [int(i) for i in rng.choice(ids[spans[:, 4] == 0], size=args.queries, replace=False)]
     segments = LibrarySegment.objects.in_bulk(picks)
     print(f"database {name}: {len(ids):,} described segments in project Archive "
           f"(descriptor 35 x 35 float32, profile 105 numbers)")
-    print(f"index: inverted file (motionlib.vector_index), {manifest['lists']:,} k-means lists, "
-          f"float16, scans >= {similar_index.PROBE_SHARE:.1%} per search; "
-          f"{manifest['count']:,} vectors, {manifest['bytes'] / 1e6:.0f} MB of files; "
-          f"{'built' if fresh else 'brought in step (cached)'} in {built:.1f} s")
-    print(f"machine: {platform.machine()}, {os.cpu_count()} cores shared with other work, load "
-          f"{', '.join(f'{x:.1f}' for x in os.getloadavg())}; {args.queries} queries "
-          f"(old path: first {args.old_queries}), k=10, reviewer, through SimilarView\n")
-    similar_index.forget()
-    rss_before = mapped_rss("vectors.npy")
-    rows = {"exact (oracle, numpy in memory)": [], "index": [], "old (20,000 recent)": []}
-    recall = {"index": [], "old (20,000 recent)": []}
-    cpu = {"index": [], "old (20,000 recent)": []}
-    user = ctx["reviewer"]
-    for n, pk in enumerate(picks):
-        started = time.perf_counter()
-        truth = exact_top(segments[pk], ids, profiles, spans)
-        rows["exact (oracle, numpy in memory)"].append((time.perf_counter() - started) * 1000)
-        found, ms = call_view(user, pk)
-        rows["index"].append(ms)
-        cpu["index"].append(CPU[-1])
-        recall["index"].append(len(set(found) & set(truth)) / len(truth))
-        if n % 20 == 19:
-            print(f"  {n + 1} queries done", flush=True)
-        if n < args.old_queries:
-            with mock.patch.object(similar_index, "open_index", lambda project_id: None):
-                found, ms = call_view(user, pk)
-            rows["old (20,000 recent)"].append(ms)
-            cpu["old (20,000 recent)"].append(CPU[-1])
-            recall["old (20,000 recent)"].append(len(set(found) & set(truth)) / len(truth))
-    rss, pss = mapped_rss("vectors.npy")
-    header = (f"{'path':<34} {'queries':>7} {'median ms':>10} {'p95 ms':>8} {'CPU med ms':>11} "
-              f"{'recall@10':>10}")
-    print(header)
-    print("-" * len(header))
-    for title, times in rows.items():
-        r, c = recall.get(title), cpu.get(title)
-        print(f"{title:<34} {len(times):>7} {statistics.median(times):>10.1f} {p95(times):>8.1f} "
-              f"{statistics.median(c) if c else float('nan'):>11.1f} {np.mean(r) if r else 1.0:>10.3f}")
-    print(f"\nindex memory: files {manifest['bytes'] / 1e6:.0f} MB (ids + vectors mapped read-only, "
-          f"shared by every process); vectors.npy "
-          f"resident in this process before the queries {rss_before[0] / 1e3:.0f} MB, after "
-          f"{rss / 1e3:.0f} MB (Pss {pss / 1e3:.0f} MB)")
-    print(f"worst: index p95 {p95(rows['index']):.1f} ms (target 50), recall@10 "
-          f"{np.mean(recall['index']):.3f} (target 0.95), min per query {min(recall['index']):.1f}")
+    print(f"now: faiss IVF, {manifest['lists']:,} lists, nprobe {similar_index.vector_index.NPROBE}, "
+          f"float32, descriptors beside it; {manifest['count']:,} vectors, "
+          f"{manifest['bytes'] / 1e6:,.0f} MB of files; {how} in {built:.1f} s")
+    print(f"before ({old.rev}): numpy IVF, {old_manifest['lists']:,} lists, float16, scans "
+          f">= {old.similar_index.PROBE_SHARE:.1%}; {old_manifest['bytes'] / 1e6:,.0f} MB; "
+          f"{old_how} in {old_built:.1f} s")
+    spinning = busy(args.busy, 3600)
+    try:
+        time.sleep(30 if args.busy else 0)  # let the load average rise
+        print(f"machine: {platform.machine()}, {os.cpu_count()} cores shared with other work, "
+              f"{args.busy} busy processes added; load {load()} before the queries; "
+              f"{args.queries} queries (no-index path: first {args.old_queries}), k=10, "
+              f"reviewer, through SimilarView\n", flush=True)
+        similar_index.forget()
+        user = ctx["reviewer"]
+        paths = {f"before ({old.rev})": old.api_similar.SimilarView, "now": None}
+        folders = {"now": dirs["now"], f"before ({old.rev})": dirs["before"]}
+        rows = {"exact (oracle, numpy)": [], **{p: [] for p in paths}, "no index (20,000 recent)": []}
+        recall = {p: [] for p in rows if p != "exact (oracle, numpy)"}
+        cpu = {p: [] for p in recall}
+        for n, pk in enumerate(picks):
+            started = time.perf_counter()
+            truth = exact_top(segments[pk], ids, profiles, spans)
+            rows["exact (oracle, numpy)"].append((time.perf_counter() - started) * 1000)
+            for title, view in paths.items():
+                with index_dir(folders[title]):
+                    found, ms = call_view(user, pk, view)
+                rows[title].append(ms)
+                cpu[title].append(CPU[-1])
+                recall[title].append(len(set(found) & set(truth)) / len(truth))
+            if n < args.old_queries:
+                with index_dir(out / "none"), mock.patch.object(similar_index, "open_index",
+                                                               lambda project_id: None):
+                    found, ms = call_view(user, pk)
+                rows["no index (20,000 recent)"].append(ms)
+                cpu["no index (20,000 recent)"].append(CPU[-1])
+                recall["no index (20,000 recent)"].append(len(set(found) & set(truth)) / len(truth))
+            if n % 50 == 49:
+                print(f"  {n + 1} queries done (load {load()})", flush=True)
+        print(f"load {load()} after the queries\n")
+        table(rows, recall, cpu)
+        rss, pss = mapped_rss(".faiss")
+        print(f"\nnow: the faiss base resident in this process {rss / 1e3:.0f} MB (Pss {pss / 1e3:.0f} MB)")
+
+        # Segments waiting for the index, then each service's update.
+        capture = Capture.objects.create(project_id=project, name="bench_added.bvh",
+                                         checksum="bench_added", format="bvh", status="ready",
+                                         fps=120.0, n_frames=200_000, original="captures/added.bvh")
+        source = LibrarySegment.objects.filter(
+            pk__in=[int(i) for i in rng.choice(ids, args.added, replace=False)])
+        added = LibrarySegment.objects.bulk_create(
+            LibrarySegment(project_id=project, capture=capture, annotator_id=s.annotator_id,
+                           label_id=s.label_id, start=i, stop=i + 100, duration=100 / 120,
+                           descriptor=s.descriptor, descriptor_shape=s.descriptor_shape,
+                           profile=s.profile) for i, s in enumerate(source))
+        try:
+            waiting = {p: [] for p in paths}
+            with mock.patch.object(similar_index, "schedule_update", lambda project_id: None), \
+                    mock.patch.object(old.similar_index, "schedule_update", lambda project_id: None):
+                for pk in picks[:40]:
+                    for title, view in paths.items():
+                        with index_dir(folders[title]):
+                            waiting[title].append(call_view(user, pk, view)[1])
+            print(f"\n{len(added):,} new segments waiting for the index (read with every search), "
+                  f"load {load()}:")
+            for title, times in waiting.items():
+                print(f"  {title:<28} median {statistics.median(times):6.1f} ms, p95 {p95(times):6.1f} ms")
+            print("updates that take them in:")
+            for title, module in (("now", similar_index), (f"before ({old.rev})", old.similar_index)):
+                size = folder_bytes(folders[title])
+                with index_dir(folders[title]):
+                    first = module.read_manifest(project)["file"]
+                    started = time.perf_counter()
+                    after = module.update(project)
+                    took = time.perf_counter() - started
+                appended = after["file"] == first
+                written = folder_bytes(folders[title]) - size if appended else after["bytes"]
+                print(f"  {title:<28} {took:6.1f} s, wrote {written / 1e6:8.1f} MB "
+                      f"({'appended' if appended else 'a new generation of the whole index'})")
+        finally:
+            LibrarySegment.objects.filter(pk__in=[s.pk for s in added]).delete()
+            capture.delete()
+            for title, module in (("now", similar_index), (f"before ({old.rev})", old.similar_index)):
+                with index_dir(folders[title]):
+                    module.update(project)
+    finally:
+        for proc in spinning:
+            proc.kill()
+            proc.wait()
+    print(f"\nworst: now p95 {p95(rows['now']):.1f} ms (target 10 on a quiet machine, 20 at "
+          f"load 4), recall@10 {np.mean(recall['now']):.3f} (target 0.99), min per query "
+          f"{min(recall['now']):.1f}")
 
 
 if __name__ == "__main__":

@@ -29,10 +29,9 @@ service compares a descriptor only with those of its own kind (docs/points.md).
 
 from __future__ import annotations
 
-from functools import lru_cache
-
 import numpy as np
 
+from motionlib import _dtw
 from motionlib.errors import InputError
 from motionlib.features import body_frame_positions, bone_angles
 from motionlib.gaps import filled
@@ -282,7 +281,8 @@ def dtw_distance(a: np.ndarray, b: np.ndarray, *, band: float = 0.25) -> float:
 
 
 def dtw_distances(a: np.ndarray, bs: np.ndarray, *, band: float = 0.25) -> np.ndarray:
-    """``dtw_distance(a, b)`` for every ``b`` in ``bs`` at once (the same numbers).
+    """``dtw_distance(a, b)`` for every ``b`` in ``bs`` at once (the same numbers, summed in
+    another order, so equal up to rounding).
 
     Parameters
     ----------
@@ -291,32 +291,20 @@ def dtw_distances(a: np.ndarray, bs: np.ndarray, *, band: float = 0.25) -> np.nd
 
     Returns
     -------
-    (n_items,) distances. The band's cells are filled one anti-diagonal at a time (a cell
-    depends only on the two diagonals before it), every item together, so ranking a
-    shortlist costs ``n + m`` array steps instead of ``n_items`` Python double loops.
+    (n_items,) distances, computed by ``motionlib._dtw`` (C): a search ranks its whole
+    shortlist this way on every request, and the recursion has no array form that
+    numpy runs in less than milliseconds.
     """
-    a, bs = np.asarray(a, dtype=float), np.asarray(bs, dtype=float)
+    a = np.ascontiguousarray(a, dtype=np.float64)
+    bs = np.ascontiguousarray(bs, dtype=np.float64)
     n, m = len(a), bs.shape[1]
-    cost = np.sqrt(((a[None, :, None, :] - bs[:, None, :, :]) ** 2).sum(axis=-1))
-    acc = np.full((n + 1, m + 1, len(bs)), np.inf)
-    acc[0, 0] = 0.0
-    cost = np.moveaxis(cost, 0, -1)
-    for i, j in _band_diagonals(n, m, band):
-        best = np.minimum(np.minimum(acc[i - 1, j - 1], acc[i - 1, j]), acc[i, j - 1])
-        acc[i, j] = cost[i - 1, j - 1] + best
-    return acc[n, m] / (n + m)
-
-
-@lru_cache(maxsize=16)
-def _band_diagonals(n: int, m: int, band: float) -> list[tuple[np.ndarray, np.ndarray]]:
-    """The cells (i, j) of ``dtw_distance``'s band grouped by anti-diagonal i + j."""
+    if a.ndim != 2 or bs.ndim != 3 or bs.shape[2] != a.shape[1] or not n or not m:
+        raise InputError(f"dtw: expected (n, f) and (items, m, f) descriptors, got shapes "
+                         f"{a.shape} and {bs.shape}")
     width = max(int(np.ceil(band * max(n, m))), abs(n - m))
-    cells = [(i, j) for i in range(1, n + 1)
-             for j in range(max(1, int(i * m / n) - width), min(m, int(i * m / n) + width) + 1)]
-    by_sum = {}
-    for i, j in cells:
-        by_sum.setdefault(i + j, []).append((i, j))
-    return [tuple(np.array(c).T) for _, c in sorted(by_sum.items())]
+    out = np.empty(len(bs))
+    _dtw.distances(a, bs, n, m, a.shape[1], len(bs), width, out)
+    return out
 
 
 def descriptor_distance(a: np.ndarray, b: np.ndarray) -> float:

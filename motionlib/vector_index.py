@@ -1,215 +1,291 @@
-"""An inverted-file (IVF) index for nearest neighbours under the Euclidean distance.
+"""A nearest-neighbour index under the Euclidean distance that grows by appending.
 
-The vectors are split into ``n_lists`` clusters by k-means; each cluster's vectors are
-stored together, so a search compares the query with the cluster centres, then scans
-only the nearest clusters until it has looked at ``probe_share`` of all vectors. Stored as
-four ``.npy`` files in one folder (centres, list offsets, ids and float16 vectors, both
-sorted by cluster); ``open(..., mmap=True)`` maps ids and vectors read-only, so every
-process that opens the same folder shares one copy in the page cache.
+One index is a folder holding:
 
-Why not a graph index (HNSW): on the 2-core machines this project runs on, inserting a
-million 105-dimensional vectors into an HNSW graph takes tens of minutes, while k-means
-on a sample plus one assignment pass takes about a minute; the scan of 1 % of a million
-float16 vectors costs a few milliseconds, well within a search's budget.
+- ``base.faiss``: a faiss inverted-file index (``IndexIVFFlat``: k-means centres, float32
+  vectors grouped by nearest centre, with their int64 keys), and ``base_ids.npy``, the same
+  keys in one array. Written once, when the folder is made.
+- ``delta_ids.i64`` / ``delta_vectors.f32``: keys and vectors added since, appended as raw
+  records.
+- ``removed.i64``: keys removed since, appended.
+- ``payload.f32`` / ``delta_payload.f32`` (optional): a fixed-width float32 row per base
+  key (in ``base_ids`` order, which is ascending) and per added key, for what a caller
+  needs of a result besides its key (the similar-clip search keeps the full motion
+  descriptors there, so ranking reads no database row).
+
+How many records of each file count is the caller's *state* (``{"ndim", "base", "delta",
+"removed", "payload"}``, the last the payload's width), kept in a manifest that the caller replaces atomically after an append. A
+reader opens a folder at a state and sees exactly those records: bytes appended later, or
+left by a writer that crashed, lie past its counts, and the next append overwrites them.
+So an update writes only what changed, and every process sees a consistent index.
+
+``open`` reads ``base.faiss`` memory-mapped (``IO_FLAG_MMAP | IO_FLAG_READ_ONLY``) and maps
+the delta files, so the processes of a machine share one copy in the page cache. A search
+asks the base's ``nprobe`` nearest lists and compares the query with every delta vector
+(the caller rebuilds the folder, retraining the centres, before the delta grows large).
 """
 
 from __future__ import annotations
 
-import json
+import os
 from pathlib import Path
 
+import faiss
 import numpy as np
 
 from motionlib.errors import InputError
 
-FILES = ("centroids", "offsets", "ids", "vectors")
-# Share of the vectors a search scans at least (nearest clusters first).
-PROBE_SHARE = 0.01
-# Lists a search scans at least.
-MIN_LISTS = 8
-# Vectors per cluster the index aims for (n_lists = n / LIST_SIZE, at least 1).
+BASE, BASE_IDS = "base.faiss", "base_ids.npy"
+DELTA_IDS, DELTA_VECTORS, REMOVED = "delta_ids.i64", "delta_vectors.f32", "removed.i64"
+PAYLOAD, DELTA_PAYLOAD = "payload.f32", "delta_payload.f32"
+# Vectors per list the index aims for (n_lists = n / LIST_SIZE, at least 1).
 LIST_SIZE = 1024
-TRAIN_SAMPLE = 65536
+# Lists a search scans: the nearest centres first.
+NPROBE = 16
+TRAIN_PER_LIST = 64
 TRAIN_ITERATIONS = 10
+# Searches run on the calling thread: a web process answers one request per thread, and
+# OpenMP's team would fight the other processes of a small machine for its cores.
+faiss.omp_set_num_threads(1)
 
 
-def _sq_distances(x: np.ndarray, centres: np.ndarray, centre_norms: np.ndarray) -> np.ndarray:
-    """(n, k) squared Euclidean distances, as |x|^2 - 2 x.c + |c|^2 (float32)."""
-    x = np.asarray(x, dtype=np.float32)
-    return (np.einsum("ij,ij->i", x, x)[:, None] - 2.0 * x @ centres.T) + centre_norms[None, :]
+def empty_state(ndim: int, base: int, payload: int = 0) -> dict:
+    return {"ndim": int(ndim), "base": int(base), "delta": 0, "removed": 0,
+            "payload": int(payload)}
 
 
-def train_centroids(vectors: np.ndarray, n_lists: int, *, seed: int = 0,
-                    iterations: int = TRAIN_ITERATIONS, sample: int = TRAIN_SAMPLE) -> np.ndarray:
-    """k-means (Lloyd) centres of a random sample of ``vectors``.
+def build(folder: Path, ids: np.ndarray, vectors: np.ndarray, *, n_lists: int | None = None,
+          seed: int = 0, threads: int | None = None, payload: Path | None = None,
+          payload_width: int = 0) -> dict:
+    """Train centres on ``vectors`` (n, d), write the index of ``ids`` (n,, ascending) into
+    the new ``folder`` (fsynced) and return its state.
 
-    Parameters
-    ----------
-    vectors : (n, d) float
-    n_lists : number of centres, 1 <= n_lists <= n.
-
-    Returns
-    -------
-    (n_lists, d) float32 centres. An emptied cluster is re-seeded with the sample point
-    farthest from its centre, so every centre owns points.
-    """
-    n = len(vectors)
+    ``payload``: a file of ``payload_width`` float32 per key, in ``ids`` order, moved into
+    the folder. ``threads``: cores for training and grouping (default: all; searches use
+    one)."""
+    ids = np.ascontiguousarray(ids, dtype=np.int64)
+    if len(ids) > 1 and not np.all(np.diff(ids) > 0):
+        raise InputError("ids: must be ascending and unique")
+    if payload is not None and payload.stat().st_size != len(ids) * payload_width * 4:
+        raise InputError(f"{payload}: {payload.stat().st_size} bytes, expected {len(ids)} rows "
+                         f"of {payload_width} float32")
+    vectors = np.ascontiguousarray(vectors, dtype=np.float32)
+    if vectors.ndim != 2 or len(vectors) != len(ids) or not len(ids):
+        raise InputError(f"vectors: expected ({len(ids)}, d) with at least one row, got "
+                         f"shape {vectors.shape}")
+    n, d = vectors.shape
+    n_lists = n_lists or max(1, n // LIST_SIZE)
     if not 1 <= n_lists <= n:
         raise InputError(f"n_lists: must be between 1 and the {n} vectors, got {n_lists}")
-    rng = np.random.default_rng(seed)
-    pick = np.sort(rng.choice(n, size=min(n, max(sample, n_lists)), replace=False))
-    x = np.asarray(vectors[pick], dtype=np.float32)
-    centres = x[rng.choice(len(x), size=n_lists, replace=False)].copy()
-    for _ in range(iterations):
-        d = _sq_distances(x, centres, np.einsum("ij,ij->i", centres, centres))
-        labels = d.argmin(axis=1)
-        counts = np.bincount(labels, minlength=n_lists)
-        sums = np.zeros_like(centres)
-        np.add.at(sums, labels, x)
-        filled = counts > 0
-        centres[filled] = sums[filled] / counts[filled, None]
-        empty = np.flatnonzero(~filled)
-        if len(empty):
-            far = np.argsort(d[np.arange(len(x)), labels])[::-1][:len(empty)]
-            centres[empty[:len(far)]] = x[far]
-    return centres
+    index = _trained(vectors, n_lists, seed, threads)
+    _add_keyed(index, ids, vectors, threads)
+    folder.mkdir(parents=True)
+    faiss.write_index(index, str(folder / BASE))
+    np.save(folder / BASE_IDS, ids)
+    if payload is not None:
+        os.replace(payload, folder / PAYLOAD)
+    for name in (DELTA_IDS, DELTA_VECTORS, REMOVED, DELTA_PAYLOAD) + (() if payload else (PAYLOAD,)):
+        (folder / name).touch()
+    for path in folder.iterdir():
+        _fsync(path)
+    _fsync(folder)
+    return empty_state(d, n, payload_width if payload is not None else 0) | {"lists": n_lists}
 
 
-def assign(vectors: np.ndarray, centres: np.ndarray, chunk: int = 65536) -> np.ndarray:
-    """(n,) index of the nearest centre of each vector."""
-    norms = np.einsum("ij,ij->i", centres, centres)
-    out = np.empty(len(vectors), dtype=np.int32)
-    for first in range(0, len(vectors), chunk):
-        part = np.asarray(vectors[first:first + chunk], dtype=np.float32)
-        out[first:first + chunk] = _sq_distances(part, centres, norms).argmin(axis=1)
-    return out
+def _trained(vectors, n_lists, seed, threads):
+    """An IndexIVFFlat of ``vectors`` keyed by row (keys are added by the caller)."""
+    previous = faiss.omp_get_max_threads()
+    faiss.omp_set_num_threads(threads or os.cpu_count() or 1)
+    try:
+        d = vectors.shape[1]
+        index = faiss.IndexIVFFlat(faiss.IndexFlatL2(d), d, n_lists)
+        index.cp.seed = seed
+        # k-means on a sample of TRAIN_PER_LIST points per list, TRAIN_ITERATIONS rounds:
+        # faiss's defaults (256 per list, 25 rounds) cost ten times as much for centres
+        # that only decide which lists a search scans.
+        index.cp.niter = TRAIN_ITERATIONS
+        index.cp.max_points_per_centroid = TRAIN_PER_LIST
+        # faiss warns below 39 training points per list; small libraries have fewer.
+        index.cp.min_points_per_centroid = 1
+        index.verbose = False
+        index.train(vectors)
+        return index
+    finally:
+        faiss.omp_set_num_threads(previous)
 
 
-class IvfIndex:
-    """Vectors grouped by nearest centre: list ``i`` is rows ``offsets[i]:offsets[i+1]``.
+def _add_keyed(index, ids, vectors, threads):
+    previous = faiss.omp_get_max_threads()
+    faiss.omp_set_num_threads(threads or os.cpu_count() or 1)
+    try:
+        index.add_with_ids(vectors, ids)
+    finally:
+        faiss.omp_set_num_threads(previous)
 
-    Parameters
-    ----------
-    centroids : (n_lists, d) float32
-    offsets : (n_lists + 1,) int64, increasing, from 0 to n.
-    ids : (n,) int64 keys, sorted by list.
-    vectors : (n, d) float16, in the order of ``ids``.
-    """
 
-    def __init__(self, centroids, offsets, ids, vectors):
-        self.centroids = np.asarray(centroids, dtype=np.float32)
-        self.offsets = np.asarray(offsets, dtype=np.int64)
-        self.ids, self.vectors = ids, vectors
-        self._norms = np.einsum("ij,ij->i", self.centroids, self.centroids)
+def append(folder: Path, state: dict, add_ids=(), add_vectors=None, remove_ids=(),
+           add_payload=None) -> dict:
+    """Append added keys, vectors and payload rows, and removed keys, after ``state``'s
+    records (bytes past them are overwritten); fsync and return the new state. The caller
+    serialises writers and publishes the state."""
+    d, w = state["ndim"], state.get("payload", 0)
+    add_ids = np.ascontiguousarray(add_ids, dtype="<i8")
+    add_vectors = np.ascontiguousarray(
+        np.zeros((0, d)) if add_vectors is None else add_vectors, dtype="<f4").reshape(-1, d)
+    remove_ids = np.ascontiguousarray(remove_ids, dtype="<i8")
+    add_payload = (np.ascontiguousarray(add_payload, dtype="<f4").reshape(-1, w)
+                   if w and add_payload is not None else np.zeros((0, w), dtype="<f4"))
+    if len(add_vectors) != len(add_ids) or (w and len(add_payload) != len(add_ids)):
+        raise InputError(f"add_vectors, add_payload: expected ({len(add_ids)}, {d}) and "
+                         f"({len(add_ids)}, {w}), got {add_vectors.shape}, {add_payload.shape}")
+    for name, at, data in ((DELTA_IDS, state["delta"] * 8, add_ids),
+                           (DELTA_VECTORS, state["delta"] * 4 * d, add_vectors),
+                           (DELTA_PAYLOAD, state["delta"] * 4 * w, add_payload),
+                           (REMOVED, state["removed"] * 8, remove_ids)):
+        with open(folder / name, "r+b") as fh:
+            fh.truncate(at)
+            fh.seek(at)
+            fh.write(data.tobytes())
+            fh.flush()
+            os.fsync(fh.fileno())
+    return {**state, "delta": state["delta"] + len(add_ids),
+            "removed": state["removed"] + len(remove_ids)}
 
-    def __len__(self):
-        return len(self.ids)
+
+def check(folder: Path, state: dict) -> None:
+    """InputError naming a file of ``folder`` that is missing or shorter than ``state``."""
+    d, w = state["ndim"], state.get("payload", 0)
+    need = {BASE: 1, BASE_IDS: 1, DELTA_IDS: state["delta"] * 8,
+            DELTA_VECTORS: state["delta"] * 4 * d, REMOVED: state["removed"] * 8,
+            PAYLOAD: state["base"] * 4 * w, DELTA_PAYLOAD: state["delta"] * 4 * w}
+    for name, size in need.items():
+        try:
+            found = (folder / name).stat().st_size
+        except OSError as exc:
+            raise InputError(f"{folder / name}: cannot be read ({exc.strerror})") from exc
+        if found < size:
+            raise InputError(f"{folder / name}: {found} bytes, its state needs {size}")
+
+
+class VectorIndex:
+    """A folder opened at a state. ``search`` finds the nearest live keys; ``keys`` lists
+    them."""
+
+    def __init__(self, folder: Path, state: dict, base=None, base_ids=None):
+        check(folder, state)
+        self.folder, self.state = folder, dict(state)
+        d = state["ndim"]
+        if base is None:
+            try:
+                base = faiss.read_index(str(folder / BASE), faiss.IO_FLAG_MMAP | faiss.IO_FLAG_READ_ONLY)
+                base_ids = np.load(folder / BASE_IDS, mmap_mode="r")
+            except (RuntimeError, OSError, ValueError) as exc:
+                raise InputError(f"{folder}: its base index cannot be read ({exc})") from exc
+            if base.ntotal != state["base"] or base.d != d or len(base_ids) != base.ntotal:
+                raise InputError(f"{folder}: holds {base.ntotal} vectors of {base.d} numbers "
+                                 f"and {len(base_ids)} keys, its state says {state['base']} of {d}")
+        self.base, self.base_ids = base, base_ids
+        self.delta_ids = _mapped(folder / DELTA_IDS, "<i8", (state["delta"],))
+        self.delta_vectors = _mapped(folder / DELTA_VECTORS, "<f4", (state["delta"], d))
+        self._delta_norms = np.einsum("ij,ij->i", self.delta_vectors, self.delta_vectors)
+        self.removed = np.unique(_mapped(folder / REMOVED, "<i8", (state["removed"],)))
+        w = state.get("payload", 0)
+        self._payload = _mapped(folder / PAYLOAD, "<f4", (state["base"] if w else 0, w))
+        self._delta_payload = _mapped(folder / DELTA_PAYLOAD, "<f4", (state["delta"] if w else 0, w))
+        self._delta_rows = None
+
+    @classmethod
+    def open(cls, folder: Path, state: dict) -> VectorIndex:
+        return cls(folder, state)
+
+    def at(self, state: dict) -> VectorIndex:
+        """The same folder at a later state: the mapped base is kept, the delta re-read."""
+        return VectorIndex(self.folder, state, self.base, self.base_ids)
 
     @property
     def ndim(self):
-        return self.centroids.shape[1]
+        return self.state["ndim"]
 
-    @classmethod
-    def build(cls, ids: np.ndarray, vectors: np.ndarray, *, n_lists: int | None = None,
-              seed: int = 0) -> IvfIndex:
-        """Train centres on ``vectors`` (n, d) and group them; ``ids`` (n,) int keys."""
-        ids = np.asarray(ids, dtype=np.int64)
-        if vectors.ndim != 2 or len(vectors) != len(ids) or not len(ids):
-            raise InputError(f"vectors: expected ({len(ids)}, d) with at least one row, got "
-                             f"shape {vectors.shape}")
-        n_lists = n_lists or max(1, len(ids) // LIST_SIZE)
-        centres = train_centroids(vectors, n_lists, seed=seed)
-        return cls._grouped(centres, ids, vectors, assign(vectors, centres))
+    @property
+    def n_lists(self):
+        return self.base.nlist
 
-    @classmethod
-    def _grouped(cls, centres, ids, vectors, labels):
-        order = np.argsort(labels, kind="stable")
-        offsets = np.concatenate([[0], np.cumsum(np.bincount(labels, minlength=len(centres)))])
-        return cls(centres, offsets, ids[order], np.asarray(vectors, dtype=np.float16)[order])
+    def payload(self, keys) -> tuple[np.ndarray, np.ndarray]:
+        """(found, rows): which of ``keys`` the index holds (base or added, removed or
+        not), and their payload rows (len(keys), width) float32, zeros where not found."""
+        keys = np.asarray(keys, dtype=np.int64)
+        w = self.state.get("payload", 0)
+        rows = np.zeros((len(keys), w), dtype=np.float32)
+        found = np.zeros(len(keys), dtype=bool)
+        if not w or not len(keys):
+            return found, rows
+        at = np.searchsorted(self.base_ids, keys)
+        inside = at < len(self.base_ids)
+        hit = inside.copy()
+        hit[inside] = np.asarray(self.base_ids[at[inside]]) == keys[inside]
+        if hit.any():
+            # One gather in key order, so the mapped file is read front to back.
+            rows[hit] = self._payload[at[hit]]
+        if len(self.delta_ids):
+            if self._delta_rows is None:
+                self._delta_rows = {int(k): r for r, k in enumerate(self.delta_ids)}
+            for i in np.flatnonzero(~hit):
+                r = self._delta_rows.get(int(keys[i]))
+                if r is not None:
+                    rows[i], hit[i] = self._delta_payload[r], True
+        found[:] = hit
+        return found, rows
 
-    def changed(self, remove: np.ndarray, add_ids: np.ndarray, add_vectors: np.ndarray) -> IvfIndex:
-        """A new index without the ``remove`` keys and with the added vectors, grouped by
-        the same centres (no retraining)."""
-        keep = ~np.isin(self.ids, remove)
-        lists = np.repeat(np.arange(len(self.centroids), dtype=np.int32), np.diff(self.offsets))
-        ids = np.concatenate([np.asarray(self.ids)[keep], np.asarray(add_ids, dtype=np.int64)])
-        vectors = np.concatenate([np.asarray(self.vectors)[keep],
-                                  np.asarray(add_vectors, dtype=np.float16).reshape(-1, self.ndim)])
-        labels = np.concatenate([lists[keep], assign(add_vectors, self.centroids)
-                                 if len(add_ids) else np.zeros(0, dtype=np.int32)])
-        return self._grouped(self.centroids, ids, vectors, labels)
+    def keys(self) -> np.ndarray:
+        """The live keys (base and added, less removed), sorted."""
+        keys = np.union1d(np.asarray(self.base_ids), np.asarray(self.delta_ids))
+        return np.setdiff1d(keys, self.removed, assume_unique=True)
 
-    def search(self, query: np.ndarray, count: int, *, probe_share: float = PROBE_SHARE,
-               min_lists: int = MIN_LISTS):
-        """The ``count`` stored vectors nearest to ``query`` among the scanned lists.
+    def __len__(self):
+        return len(self.keys())
 
-        Lists are scanned nearest centre first until ``probe_share`` of all vectors (and
-        at least ``count``) have been compared, and at least ``min_lists`` lists (a
-        query near the border of its cluster has neighbours in the next ones).
+    def search(self, query: np.ndarray, count: int, *, nprobe: int | None = None):
+        """The ``count`` live keys nearest to ``query`` among the ``nprobe`` (default
+        ``NPROBE``) nearest lists and the added vectors.
 
         Returns
         -------
-        ids : (<= count,) int64 keys, nearest first.
-        distances : their squared Euclidean distances (from the float16 copies).
+        keys : (<= count,) int64, nearest first.
+        distances : their squared Euclidean distances (float32).
         """
-        q = np.asarray(query, dtype=np.float32).reshape(1, -1)
+        q = np.ascontiguousarray(query, dtype=np.float32).reshape(1, -1)
         if q.shape[1] != self.ndim:
             raise InputError(f"query: expected {self.ndim} numbers, got {q.shape[1]}")
-        sizes = np.diff(self.offsets)
-        order = np.argsort(_sq_distances(q, self.centroids, self._norms)[0], kind="stable")
-        need = max(count, int(np.ceil(probe_share * len(self))))
-        scanned = np.cumsum(sizes[order])
-        lists = order[:max(int(np.searchsorted(scanned, need)) + 1, min_lists)]
-        spans = [(self.offsets[i], self.offsets[i + 1]) for i in np.sort(lists) if sizes[i]]
-        if not spans:
-            return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.float32)
-        rows = np.concatenate([np.arange(a, b) for a, b in _merged(spans)])
-        block = np.concatenate([self.vectors[a:b] for a, b in _merged(spans)]).astype(np.float32)
-        diff = block - q
-        d = np.einsum("ij,ij->i", diff, diff)
-        top = np.argpartition(d, count - 1)[:count] if len(d) > count else np.arange(len(d))
-        top = top[np.argsort(d[top], kind="stable")]
-        return np.asarray(self.ids[rows[top]], dtype=np.int64), d[top]
-
-    def save(self, folder: Path) -> dict:
-        """Write the four arrays into ``folder``; returns {file name: bytes}."""
-        folder.mkdir(parents=True, exist_ok=True)
-        sizes = {}
-        for name in FILES:
-            path = folder / f"{name}.npy"
-            np.save(path, np.asarray(getattr(self, name)))
-            sizes[path.name] = path.stat().st_size
-        (folder / "sizes.json").write_text(json.dumps(sizes))
-        return sizes
-
-    @classmethod
-    def open(cls, folder: Path, *, mmap: bool = True) -> IvfIndex:
-        """Read an index written by ``save``; ids and vectors memory-mapped when ``mmap``.
-
-        ValueError names the file that is missing, truncated or inconsistent."""
-        arrays = {}
-        for name in FILES:
-            path = folder / f"{name}.npy"
-            try:
-                arrays[name] = np.load(path, mmap_mode="r" if mmap and name in ("ids", "vectors")
-                                       else None)
-            except (OSError, ValueError, EOFError) as exc:
-                raise InputError(f"{path}: cannot be read ({exc})") from exc
-        centroids, offsets = arrays["centroids"], arrays["offsets"]
-        if (offsets.shape != (len(centroids) + 1,) or offsets[-1] != len(arrays["ids"])
-                or arrays["vectors"].shape != (len(arrays["ids"]), centroids.shape[1])):
-            raise InputError(f"{folder}: its arrays disagree (centroids {centroids.shape}, "
-                             f"offsets {offsets.shape}, ids {arrays['ids'].shape}, vectors "
-                             f"{arrays['vectors'].shape})")
-        return cls(**arrays)
+        # Removed keys still sit in the files: ask for more, to drop them (a caller that
+        # finds too few asks again for more).
+        want = count + min(len(self.removed), count)
+        params = faiss.SearchParametersIVF(nprobe=min(nprobe or NPROBE, self.base.nlist))
+        dist, keys = self.base.search(q, min(want, self.base.ntotal), params=params)
+        keys, dist = keys[0], dist[0]
+        found = keys >= 0
+        keys, dist = keys[found], dist[found]
+        if len(self.delta_ids):
+            dd = self._delta_norms - 2.0 * (self.delta_vectors @ q[0]) + float(q[0] @ q[0])
+            near = np.argsort(dd, kind="stable")[:want] if len(dd) <= want else \
+                np.argpartition(dd, want - 1)[:want]
+            keys = np.concatenate([keys, np.asarray(self.delta_ids[near], dtype=np.int64)])
+            dist = np.concatenate([dist, np.maximum(dd[near], 0).astype(np.float32)])
+        if len(self.removed):
+            live = ~np.isin(keys, self.removed)
+            keys, dist = keys[live], dist[live]
+        order = np.argsort(dist, kind="stable")[:count]
+        return keys[order].astype(np.int64), dist[order]
 
 
-def _merged(spans):
-    """Adjacent (start, stop) row ranges joined, so neighbouring lists read as one."""
-    out = [list(spans[0])]
-    for a, b in spans[1:]:
-        if a == out[-1][1]:
-            out[-1][1] = b
-        else:
-            out.append([a, b])
-    return out
+def _mapped(path, dtype, shape):
+    if not shape[0]:
+        return np.zeros(shape, dtype=dtype)
+    return np.memmap(path, dtype=dtype, mode="r", shape=shape)
+
+
+def _fsync(path):
+    fd = os.open(path, os.O_RDONLY)
+    try:
+        os.fsync(fd)
+    finally:
+        os.close(fd)

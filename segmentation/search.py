@@ -1,10 +1,12 @@
 """Similar clips: the library segments that move most like a given one."""
 
+from types import SimpleNamespace
+
 import numpy as np
 
 from motionlib import similarity
-from segmentation import similar_index
-from segmentation.descriptors import profile_pool, same_kind
+from segmentation import exports, similar_index
+from segmentation.descriptors import load_descriptors, profile_pool, same_kind
 from segmentation.errors import Invalid
 from segmentation.models import LibrarySegment
 
@@ -19,11 +21,15 @@ def similar(segment, visible, k=10):
 
     Only segments described as it is are compared (``descriptors.same_kind``: a body or
     bare points). Segments overlapping it in the same capture are left out (other
-    annotators' versions of the same motion), and so are duplicates of one span. Two stages: the profiles
+    annotators' versions of the same motion), and so are duplicates of one span. Two
+    stages: the profiles
     nearest to the query's pick a shortlist, whose full descriptors are ranked. The
-    shortlist comes from the project's vector index (``similar_index``) when it has a
-    usable one, else from the profiles of up to ``SIMILAR_POOL`` recent segments.
-    Returns ``[(segment, distance)]``, most similar first.
+    shortlist comes from the project's vector index (``similar_index``, which keeps the
+    descriptors too) when it has a usable one, else from the profiles of up to
+    ``SIMILAR_POOL`` recent segments.
+    Returns ``[(segment, distance)]``, most similar first; a segment found through the
+    index is a ``Shown`` (its id and its API fields), one from the exact scan a
+    LibrarySegment.
     """
     query = segment.descriptor_array()
     if query is None:
@@ -36,18 +42,49 @@ def similar(segment, visible, k=10):
     index = similar_index.open_index(segment.project_id)
     short = similar_index.shortlist(index, query, pool, n) if index else None
     if short is None:
-        short = exact_shortlist(query, pool, n)
-    if not short:
-        return []
-    # The shortlist's rows, with what the caller shows of them, in one query.
-    rows = (LibrarySegment.objects.select_related("capture", "annotator", "label")
-            .defer("profile", "capture__skeleton").in_bulk(short))
-    short = [pk for pk in short if pk in rows]  # a capture's rows rebuilt meanwhile
+        ids = exact_shortlist(query, pool, n)
+        short = list(zip(ids, load_descriptors(ids), [None] * len(ids), strict=True))
     if not short:
         return []
     order, distances = similarity.rank_similar(
-        query, np.stack([rows[pk].descriptor_array() for pk in short]), k=k, shortlist=len(short))
-    return [(rows[short[i]], float(d)) for i, d in zip(order, distances, strict=True)]
+        query, np.stack([d for _, d, _ in short]), k=k, shortlist=len(short))
+    winners = [short[i] for i in order]
+    if all(row is not None for _, _, row in winners):
+        return [(shown(row), float(d)) for (_, _, row), d in zip(winners, distances, strict=True)]
+    # The exact scan read no display columns: the winners' rows in one query.
+    rows = (LibrarySegment.objects.select_related("capture", "annotator", "label")
+            .defer("descriptor", "profile", "capture__skeleton").in_bulk([pk for pk, _, _ in winners]))
+    # A row deleted since it was shortlisted is left out.
+    return [(rows[pk], float(d)) for (pk, _, _), d in zip(winners, distances, strict=True)
+            if pk in rows]
+
+
+class Shown:
+    """A result read from the candidates' columns: its id and what the API shows of it
+    (``SegmentSerializer``'s fields, made without model instances: a search shows ten, and
+    building a segment, capture, label and user for each cost more than the ranking)."""
+
+    __slots__ = ("pk", "data")
+
+    def __init__(self, pk, data):
+        self.pk, self.data = pk, data
+
+
+def shown(row):
+    """``Shown`` from a candidate row of ``similar_index`` (id, capture, start, stop,
+    descriptor, *SHOWN)."""
+    pk, capture_id, start, stop, _ = row[:5]
+    f = dict(zip(similar_index.SHOWN, row[5:], strict=True))
+    return Shown(pk, {
+        "id": pk, "project": f["project_id"],
+        "capture": {"id": capture_id, "name": f["capture__name"]}, "review": f["review_id"],
+        "annotator": ({"id": f["annotator_id"], "username": f["annotator__username"]}
+                      if f["annotator_id"] else None),
+        "gold": f["is_gold"], "superseded": f["superseded"], "label": f["label__name"],
+        "color": f["label__color"] if f["label_id"] else "#888888", "start": start,
+        "stop": stop, "fps": float(f["capture__fps"]), "duration": float(f["duration"]),
+        "agreement": None if f["agreement"] is None else float(f["agreement"]),
+        "export_formats": exports.formats_for(SimpleNamespace(format=f["capture__format"]))})
 
 
 def exact_shortlist(query, pool, n):

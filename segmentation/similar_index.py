@@ -1,40 +1,40 @@
-"""The approximate nearest-neighbour index behind "find similar": one file per project.
+"""The approximate nearest-neighbour index behind "find similar": one folder per project.
 
 What it indexes: each described library segment's *profile* (the first
 ``similarity.PROFILE_ROWS`` rows of its descriptor, flattened: 3 x 35 = 105 numbers),
 under the squared Euclidean distance, which is the first stage of the exact search
-(``similarity.shortlist_by_profile``). The index only proposes candidates; their exact
-profile distances and the DTW re-ranking are computed from the database rows, so an
-index can make a search slower or (rarely) miss a neighbour, never return a segment the
-database no longer has or one the caller may not see.
+(``similarity.shortlist_by_profile``). The index only proposes candidates; the database
+says which of them exist and the caller may see, so an index can make a search slower or
+(rarely) miss a neighbour, never return a segment the database no longer has or one the
+caller may not see.
 
 Files, in ``settings.SIMILAR_INDEX_DIR`` (``$CUTROOM_SIMILAR_INDEX_DIR``, default
 ``var/similar``):
 
-- ``project_<id>.g<generation>/``: an inverted-file index (``motionlib.vector_index``:
-  k-means centres, and the float16 vectors with their segment ids grouped by centre).
-  Web processes map ids and vectors read-only, so all of them on a machine share one
-  copy in the page cache (a million segments: about 220 MB).
-- ``project_<id>.json``: the manifest, replaced atomically last: format version, vector
-  width, the index file's name and size, how many vectors it holds and the highest
-  segment id it has seen. A crash while writing leaves the previous manifest and file in
-  force (a new generation is written beside the old one and only then named; the old
-  one is deleted after, and processes that still map it keep reading it until they see
-  the new manifest).
+- ``project_<id>.g<generation>/``: a ``motionlib.vector_index`` folder: a faiss
+  inverted-file index written when the generation was built, and the keys and vectors
+  added and the keys removed since, appended. Web processes map it read-only, so all of
+  them on a machine share one copy in the page cache.
+- ``project_<id>.json``: the manifest, replaced atomically after every write: format
+  version, the generation's folder, how many base, added and removed records count (the
+  folder's *state*), how many vectors it holds and the highest segment id it has seen. A
+  reader sees exactly the records its manifest counts, so a crash while appending leaves
+  the previous state in force, and an update is visible to every process at once.
 
 Staying in step with the database (which is the truth):
 
 - Segments newer than the manifest's ``max_id`` (the *delta*) are read with each
   search's candidates, in the same query, and measured exactly, so a search never waits
   for the index.
-- Deleted segments left in the file are dropped when candidates are read back.
 - ``update`` (a Celery task queued when library rows change, and run by
-  ``manage.py similar_index``) compares the index's keys with the database's ids, removes
-  and adds the difference (added vectors join their nearest existing centre) and writes a
-  new generation; ``build`` trains new centres and writes one from scratch, which
-  ``update`` does itself when much was removed or the library has doubled.
-- ``open_index`` checks a manifest the first time a process sees it: a missing or
-  unreadable file, another format or width, or a vector count that disagrees with the
+  ``manage.py similar_index``) compares the index's keys with the database's ids and
+  appends the difference: it writes the added vectors and removed keys, not the index.
+  When the appended records outgrow ``COMPACT_SHARE`` of the base, or there is no usable
+  index, it *compacts*: ``build`` trains new centres over the whole library and writes a
+  new generation beside the old one before naming it (processes that still map the old
+  one keep reading it until they see the new manifest).
+- ``open_index`` checks a manifest the first time a process sees a generation: a missing
+  or short file, another format or width, or a vector count that disagrees with the
   database all mean "not usable": the search falls back to the exact scan and a rebuild
   is queued.
 """
@@ -53,23 +53,24 @@ from pathlib import Path
 import numpy as np
 from django.conf import settings
 from django.db import connections, transaction
+from django.db.models import BinaryField, Case, F, When
 
-from motionlib import similarity
-from motionlib.vector_index import IvfIndex
+from motionlib import similarity, vector_index
+from motionlib.errors import InputError
 from segmentation import workers
+from segmentation.errors import Invalid
 from segmentation.models import LibrarySegment
 
 log = logging.getLogger(__name__)
 
-FORMAT = 1
-# A search scans at least this share of the index (nearest clusters first): chosen on the
-# million-segment benchmark for recall@10 >= 0.95 against the exact scan.
-PROBE_SHARE = 0.005
-# An update that would remove more than this share of the vectors, or grow the index past
-# GROWTH times the size its centres were trained on, retrains instead (clusters drift).
-REBUILD_SHARE = 0.25
-GROWTH = 2.0
-# When the delta (segments newer than the file) grows past this, an update is queued.
+FORMAT = 2
+# An update compacts (retrains and rewrites the generation) once the added and removed
+# records outnumber this share of the base: a search compares the query with every added
+# vector, and clusters drift as the library changes.
+COMPACT_SHARE = 0.05
+# ... and never for fewer records than this (a small library would compact at each update).
+COMPACT_MIN = 2000
+# When the delta (segments newer than the index) grows past this, an update is queued.
 DELTA_LIMIT = 5000
 READ_CHUNK = 20000
 
@@ -121,15 +122,17 @@ def read_manifest(project_id):
     if not isinstance(manifest, dict) or manifest.get("format") != FORMAT:
         raise IndexUnusable(f"{path}: format {manifest.get('format') if isinstance(manifest, dict) else '?'}"
                             f", this version reads format {FORMAT}")
-    folder = index_dir() / str(manifest.get("file"))
     try:
-        sizes = {p.name: p.stat().st_size for p in folder.glob("*.npy")}
-    except OSError as exc:
-        raise IndexUnusable(f"{folder}: unreadable ({exc.strerror})") from exc
-    if sizes != manifest.get("bytes_per_file"):
-        raise IndexUnusable(f"{folder}: files {sizes or 'missing'}, the manifest says "
-                            f"{manifest.get('bytes_per_file')}")
+        vector_index.check(folder_of(manifest), manifest["state"])
+    except (KeyError, TypeError) as exc:
+        raise IndexUnusable(f"{path}: no {exc} in it") from exc
+    except InputError as exc:
+        raise IndexUnusable(str(exc)) from exc
     return manifest
+
+
+def folder_of(manifest) -> Path:
+    return index_dir() / str(manifest["file"])
 
 
 def _fingerprint(project_id):
@@ -141,31 +144,15 @@ def _fingerprint(project_id):
     return [found["n"], found["top"] or 0, int(found["total"] or 0)]
 
 
-def _write_generation(project_id, index, max_id, fingerprint, trained_on):
-    """Save ``index`` as a new generation and name it in the manifest (atomically).
-
-    ``fingerprint`` is the database's, read before the index was."""
-    generation = time.time_ns()
-    name = f"project_{project_id}.g{generation}"
-    folder = index_dir() / name
-    sizes = index.save(folder)
-    for path in folder.iterdir():
-        _fsync(path)
-    _fsync(folder)
-    manifest = {"format": FORMAT, "ndim": index.ndim, "file": name, "bytes": sum(sizes.values()),
-                "bytes_per_file": sizes, "count": len(index), "lists": len(index.centroids),
-                "trained_on": trained_on, "max_id": int(max_id), "generation": generation,
-                "fingerprint": fingerprint,
-                "built_at": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())}
+def _publish(project_id, manifest):
+    """Replace the project's manifest atomically (written, fsynced, renamed)."""
+    manifest = {**manifest, "updated_at": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
+                "bytes": sum(p.stat().st_size for p in folder_of(manifest).iterdir())}
     tmp = manifest_path(project_id).with_suffix(".json.tmp")
     tmp.write_text(json.dumps(manifest, indent=1))
     _fsync(tmp)
     os.replace(tmp, manifest_path(project_id))
     _fsync(index_dir())
-    for old in index_dir().glob(f"project_{project_id}.g*"):
-        if old.name != name:
-            # Processes that map the old files keep them (unlinked inodes live on).
-            shutil.rmtree(old, ignore_errors=True)
     return manifest
 
 
@@ -178,15 +165,30 @@ def _fsync(path):
 
 
 def _chunks(queryset):
-    """(ids, vectors) of a queryset of described segments, READ_CHUNK rows at a time."""
+    """(ids, profile vectors, descriptor bytes) of a queryset of described segments,
+    READ_CHUNK rows at a time, by id."""
     last = 0
     while True:
         rows = list(queryset.filter(id__gt=last).order_by("id")
-                    .values_list("id", "profile")[:READ_CHUNK])
+                    .values_list("id", "profile", "descriptor")[:READ_CHUNK])
         if not rows:
             return
         last = rows[-1][0]
-        yield np.array([r[0] for r in rows], dtype=np.int64), as_vectors([r[1] for r in rows])
+        missing = [r[0] for r in rows if r[2] is None]
+        if missing:
+            raise IndexUnusable(f"segments {missing[:5]}: a profile without a descriptor; "
+                                "rebuild the library's descriptors")
+        yield (np.array([r[0] for r in rows], dtype=np.int64), as_vectors([r[1] for r in rows]),
+               [bytes(r[2]) for r in rows])
+
+
+def _descriptor_rows(blobs, width):
+    """(n, width) float32 descriptors from their bytes; IndexUnusable when one differs."""
+    sizes = {len(b) for b in blobs}
+    if sizes - {4 * width}:
+        raise IndexUnusable(f"segment descriptors have {sorted(n // 4 for n in sizes)} numbers, "
+                            f"the index {width}; rebuild the library's descriptors")
+    return np.frombuffer(b"".join(blobs), dtype="<f4").reshape(len(blobs), width)
 
 
 def build(project_id):
@@ -196,61 +198,97 @@ def build(project_id):
 
 
 def _build(project_id):
+    """Read the described segments once, by id: profiles into memory (for training),
+    descriptors straight into the payload file (a million are several GB)."""
     fingerprint = _fingerprint(project_id)
-    parts = list(_chunks(described(project_id)))
-    if not parts:
-        manifest_path(project_id).unlink(missing_ok=True)
-        return None
-    widths = {v.shape[1] for _, v in parts}
-    if len(widths) > 1:
-        raise IndexUnusable(f"project {project_id}: segment profiles have {sorted(widths)} "
-                            "numbers; rebuild the library's descriptors")
-    ids = np.concatenate([k for k, _ in parts])
-    vectors = np.concatenate([v for _, v in parts])
-    del parts
-    index = IvfIndex.build(ids, vectors, seed=project_id)
-    manifest = _write_generation(project_id, index, int(ids[-1]), fingerprint, len(ids))
+    index_dir().mkdir(parents=True, exist_ok=True)
+    payload = index_dir() / f"project_{project_id}.payload.tmp"
+    id_parts, vector_parts, width = [], [], None
+    try:
+        with open(payload, "wb") as out:
+            for ids, vectors, blobs in _chunks(described(project_id)):
+                width = width or len(blobs[0]) // 4
+                if id_parts and vectors.shape[1] != vector_parts[0].shape[1]:
+                    raise IndexUnusable(f"project {project_id}: segment profiles have "
+                                        f"{sorted({vector_parts[0].shape[1], vectors.shape[1]})} "
+                                        "numbers; rebuild the library's descriptors")
+                out.write(_descriptor_rows(blobs, width).tobytes())
+                id_parts.append(ids)
+                vector_parts.append(vectors)
+        if not id_parts:
+            manifest_path(project_id).unlink(missing_ok=True)
+            _remove_generations(project_id, keep=None)
+            return None
+        ids = np.concatenate(id_parts)
+        vectors = np.concatenate(vector_parts)
+        del id_parts, vector_parts
+        generation = time.time_ns()
+        name = f"project_{project_id}.g{generation}"
+        state = vector_index.build(index_dir() / name, ids, vectors, seed=project_id,
+                                   payload=payload, payload_width=width)
+    finally:
+        payload.unlink(missing_ok=True)
+    lists = state.pop("lists")
+    manifest = _publish(project_id, {
+        "format": FORMAT, "file": name, "generation": generation, "state": state,
+        "count": len(ids), "lists": lists, "max_id": int(ids[-1]), "fingerprint": fingerprint,
+        "built_at": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())})
+    _remove_generations(project_id, keep=name)
     log.info("similar index of project %s built: %s vectors", project_id, manifest["count"])
     return manifest
 
 
+def _remove_generations(project_id, keep):
+    for old in index_dir().glob(f"project_{project_id}.g*"):
+        if old.name != keep:
+            # Processes that map the old files keep them (unlinked inodes live on).
+            shutil.rmtree(old, ignore_errors=True)
+
+
 def update(project_id):
-    """Bring a project's index in step with the database: remove the vectors of deleted
-    segments, add the missing ones, write a new generation. Builds when there is no usable
-    index, too much would be removed, or the library outgrew the index's centres.
+    """Bring a project's index in step with the database: append the vectors of segments
+    it lacks and the keys of deleted ones. Compacts (``build``) when there is no usable
+    index, or the appended records would outgrow ``COMPACT_SHARE`` of the base.
     Returns the manifest (unchanged when in step)."""
     with _locked(project_id):
         try:
             manifest = read_manifest(project_id)
-            index = IvfIndex.open(index_dir() / manifest["file"], mmap=False)
-        except (IndexUnusable, ValueError) as exc:
+            index = vector_index.VectorIndex.open(folder_of(manifest), manifest["state"])
+        except (IndexUnusable, InputError) as exc:
             log.info("similar index of project %s rebuilt: %s", project_id, exc)
             return _build(project_id)
         fingerprint = _fingerprint(project_id)
         if fingerprint == manifest.get("fingerprint"):
             return manifest
-        keys = np.asarray(index.ids, dtype=np.int64)
+        keys = index.keys()
         ids = np.fromiter(described(project_id).values_list("id", flat=True).iterator(chunk_size=20000),
                           dtype=np.int64)
         removed = np.setdiff1d(keys, ids, assume_unique=True)
         added = np.setdiff1d(ids, keys, assume_unique=True)
-        if (len(removed) > REBUILD_SHARE * max(len(keys), 1)
-                or len(ids) > GROWTH * manifest.get("trained_on", len(keys))):
+        state = manifest["state"]
+        appended = state["delta"] + state["removed"] + len(added) + len(removed)
+        if appended > max(COMPACT_MIN, COMPACT_SHARE * state["base"]):
             return _build(project_id)
-        add_ids, add_vectors = [], []
+        add_ids, add_vectors, add_blobs = [], [], []
         for first in range(0, len(added), READ_CHUNK):
             part = [int(i) for i in added[first:first + READ_CHUNK]]
-            rows = dict(LibrarySegment.objects.filter(pk__in=part).values_list("id", "profile"))
+            rows = {pk: (profile, descriptor) for pk, profile, descriptor in LibrarySegment.objects
+                    .filter(pk__in=part).values_list("id", "profile", "descriptor")}
             part = [pk for pk in part if pk in rows]  # deleted meanwhile
             add_ids += part
-            add_vectors += [rows[pk] for pk in part]
+            add_vectors += [rows[pk][0] for pk in part]
+            add_blobs += [bytes(rows[pk][1]) for pk in part]
         vectors = as_vectors(add_vectors, index.ndim // similarity.PROFILE_ROWS)
-        if len(vectors) and vectors.shape[1] != index.ndim:
+        if len(vectors) and (vectors.shape[1] != index.ndim
+                             or {len(b) for b in add_blobs} != {4 * state["payload"]}):
             return _build(project_id)
-        index = index.changed(removed, np.array(add_ids, dtype=np.int64), vectors)
+        payload = _descriptor_rows(add_blobs, state["payload"]) if add_blobs else None
+        state = vector_index.append(folder_of(manifest), state, add_ids, vectors, removed,
+                                    add_payload=payload)
         max_id = max(int(ids.max()) if len(ids) else 0, manifest["max_id"])
-        return _write_generation(project_id, index, max_id, fingerprint,
-                                 manifest.get("trained_on", len(keys)))
+        return _publish(project_id, {**manifest, "state": state, "max_id": max_id,
+                                     "count": len(keys) - len(removed) + len(add_ids),
+                                     "fingerprint": fingerprint})
 
 
 def schedule_update(project_id):
@@ -263,7 +301,11 @@ def schedule_update(project_id):
 
 def _candidates_or_newer(pool, ids, project_id, after):
     """``pool``'s rows that are among ``ids`` or newer than the index file (the delta), in
-    one query: [(id, capture, start, stop, profile)].
+    one query: [(id, capture, start, stop, profile bytes or None, *SHOWN)]. Only the newer
+    rows carry their profile: the index holds the others' descriptors. No descriptor is
+    read here (it lives in the database's out-of-line storage, the dearest part of a
+    search's queries, and thousands of newer rows may wait for an update).
+    ``SHOWN`` is what a result shows of a segment, so the winners need no query of their own.
 
     The delta is found by row comparisons on (project, id), so that the database walks
     the ``libseg_described`` index from ``(project, after)`` to the project's end: with a
@@ -281,15 +323,25 @@ def _candidates_or_newer(pool, ids, project_id, after):
         where = f'"{table}"."id" = ANY(ARRAY[{marks}]::bigint[] || ARRAY({newer}))'
     else:
         where = f'("{table}"."id" IN ({marks or "NULL"}) OR "{table}"."id" IN ({newer}))'
+    fresh = Case(When(id__gt=after, then=F("profile")), default=None,
+                 output_field=BinaryField())
     return list(pool.extra(where=[where], params=[*ids, project_id, after, project_id + 1])
-                .values_list("id", "capture_id", "start", "stop", "profile"))
+                .annotate(fresh=fresh).values_list("id", "capture_id", "start", "stop", "fresh",
+                                                   *SHOWN))
+
+
+# The columns of a segment and its capture, annotator and label that a search result shows
+# (``search.shown`` makes the rows the serializer reads from them).
+SHOWN = ("project_id", "review_id", "annotator_id", "is_gold", "superseded", "label_id",
+         "duration", "agreement", "capture__name", "capture__fps", "capture__format",
+         "annotator__username", "label__name", "label__color")
 
 
 @dataclass
 class OpenIndex:
-    """A project's index as this process sees it: its manifest and the mapped file.
+    """A project's index as this process sees it: its manifest and the mapped folder.
 
-    Segments newer than the file (the *delta*) are not cached here: every search reads
+    Segments newer than the index (the *delta*) are not cached here: every search reads
     them from the database in the same query as its candidates (``shortlist``), filtered
     by what the caller may see, so a search costs no query of its own for freshness."""
 
@@ -299,12 +351,13 @@ class OpenIndex:
     update_queued: bool = False
 
     def nearest(self, vector, count):
-        """Up to ``count`` segment ids of the file nearest to a profile vector, nearest
-        first. Ids may include deleted segments."""
-        return self.index.search(vector, count, probe_share=PROBE_SHARE)[0]
+        """Up to ``count`` segment ids of the index nearest to a profile vector, nearest
+        first, and their squared distances (float32). Ids may include segments deleted
+        since the last update."""
+        return self.index.search(vector, count)
 
     def note_delta(self, newer):
-        """Queue an update (once per generation) when ``newer`` segments outnumber
+        """Queue an update (once per manifest) when ``newer`` segments outnumber
         ``DELTA_LIMIT``: every search reads them."""
         if newer > DELTA_LIMIT and not self.update_queued:
             self.update_queued = True
@@ -312,7 +365,12 @@ class OpenIndex:
 
     @property
     def size(self):
-        return len(self.index)
+        return self.manifest["count"]
+
+    def descriptors(self, ids):
+        """{id: descriptor (float32, flat)} of those of ``ids`` the index holds."""
+        found, payload = self.index.payload(ids)
+        return {pk: payload[i] for i, pk in enumerate(ids) if found[i]}
 
 
 _open = {}
@@ -322,12 +380,14 @@ _open_lock = threading.Lock()
 def open_index(project_id):
     """The project's usable index for this process, or None (the caller scans exactly).
 
-    The manifest is re-read when its file changes, so a new generation is picked up at
-    the next search. The first time a process sees a generation it checks it against the
-    database; an index that cannot be used queues a rebuild.
+    The manifest is re-read when it is replaced, so an update is seen at the next search
+    (the mapped base is kept while the generation is the same). The first time a process
+    sees a generation it checks it against the database; an index that cannot be used
+    queues a rebuild.
     """
     try:
-        stamp = manifest_path(project_id).stat().st_mtime_ns
+        found = manifest_path(project_id).stat()
+        stamp = (found.st_ino, found.st_mtime_ns, found.st_size)
     except OSError:
         stamp = None
     with _open_lock:
@@ -335,26 +395,32 @@ def open_index(project_id):
         if current is not None and current[0] == stamp:
             opened = current[1]
         else:
-            opened = _open_checked(project_id)
+            opened = _open_checked(project_id, current[1] if current else None)
             _open[project_id] = (stamp, opened)
     return opened
 
 
-def _open_checked(project_id):
+def _open_checked(project_id, previous=None):
     try:
         manifest = read_manifest(project_id)
-        index = IvfIndex.open(index_dir() / manifest["file"])
-        if len(index) != manifest["count"]:
-            raise IndexUnusable(f"{manifest['file']}: holds {len(index)} vectors, the "
-                                f"manifest says {manifest['count']}")
+        state = manifest["state"]
+        if previous is not None and previous.manifest["file"] == manifest["file"]:
+            return OpenIndex(project_id, manifest, previous.index.at(state))
+        if not state.get("payload"):
+            raise IndexUnusable(f"{manifest['file']}: holds no descriptors")
+        index = vector_index.VectorIndex.open(folder_of(manifest), state)
+        if state["base"] + state["delta"] - state["removed"] != manifest["count"]:
+            raise IndexUnusable(f"{manifest['file']}: holds {state['base']} + {state['delta']}"
+                                f" - {state['removed']} vectors, the manifest says "
+                                f"{manifest['count']}")
         in_db = described(project_id).filter(id__lte=manifest["max_id"]).count()
         if in_db != manifest["count"]:
-            # Rows changed since the file was written (a crash before the update, or
+            # Rows changed since the index was written (a crash before the update, or
             # transactions that committed out of id order): usable, but queue an update.
             log.info("similar index of project %s: %s vectors, %s segments in the database; "
                      "updating", project_id, manifest["count"], in_db)
             schedule_update(project_id)
-    except (IndexUnusable, ValueError) as exc:
+    except (IndexUnusable, InputError, KeyError, TypeError) as exc:
         if described(project_id).exists():
             log.warning("similar index of project %s not used: %s; rebuilding", project_id, exc)
             schedule_update(project_id)
@@ -362,15 +428,20 @@ def _open_checked(project_id):
     return OpenIndex(project_id, manifest, index)
 
 
-# The first look at the index asks for this many candidates per shortlisted segment; a
-# look that finds too few visible ones asks for four times as many, up to MAX_CANDIDATES.
-OVERSAMPLE = 4
+# The first look at the index asks for CANDIDATES x the shortlist (at least
+# MIN_CANDIDATES): the index ranks by the exact profile distance, so only rows the caller
+# may not see, or spans seen twice, need the margin. A look that finds too few visible
+# ones asks for GROW times as many, up to MAX_CANDIDATES.
+CANDIDATES = 2
+MIN_CANDIDATES = 48
+GROW = 4
 MAX_CANDIDATES = 4096
 
 
 def shortlist(index, query, pool, n):
-    """Ids of the ``n`` segments of ``pool`` whose profiles are nearest to ``query``'s,
-    nearest first, as the exact scan orders them (ties: newest first; one span once).
+    """The ``n`` segments of ``pool`` whose profiles are nearest to ``query``'s, nearest
+    first, as the exact scan orders them (ties: newest first; one span once), as
+    ``[(id, descriptor, row)]``, ``row`` the candidate's columns (``_candidates_or_newer``).
 
     ``pool`` is the caller's visible, filtered queryset; the index proposes candidates
     and ``pool`` decides which exist and may be shown. Returns None when even
@@ -378,34 +449,68 @@ def shortlist(index, query, pool, n):
     caller then scans exactly.
     """
     vector = np.asarray(query[:similarity.PROFILE_ROWS], dtype=np.float32).ravel()
-    count = max(OVERSAMPLE * n, 64)
+    count = max(CANDIDATES * n, MIN_CANDIDATES)
     after = index.manifest["max_id"]
     while True:
-        candidates = index.nearest(vector, count)
+        candidates, distances = index.nearest(vector, count)
         rows = _candidates_or_newer(pool, [int(c) for c in candidates], index.project_id, after)
         index.note_delta(sum(r[0] > after for r in rows))
-        found = _nearest_unique(rows, query, n)
-        exhausted = len(candidates) < count
+        measured = dict(zip(candidates.tolist(), distances.tolist(), strict=True))
+        found = nearest_unique(rows, query, n, measured, index.descriptors)
+        exhausted = len(candidates) < count and count >= index.size
         if len(found) >= n or exhausted:
             return found
         if count >= MAX_CANDIDATES:
             return None
-        count *= OVERSAMPLE
+        count *= GROW
 
 
-def _nearest_unique(rows, query, n):
-    """The exact scan's order over ``rows`` (id, capture, start, stop, profile)."""
+def nearest_unique(rows, query, n, measured, stored):
+    """The exact scan's order over ``rows`` (id, capture, start, stop, profile bytes or
+    None, ...): the ``n`` nearest by profile distance, one row per span (its newest), as
+    ``[(id, descriptor, row)]``.
+
+    A row without a profile is the index's: its distance is ``measured[id]`` (what the
+    index computed, in float32) and its descriptor comes from ``stored(ids)``; the newer
+    rows are measured here and their descriptors read in one query, for the shortlisted
+    ones only (a descriptor is 4.9 kB; a profile 420 bytes). Invalid when a stored
+    descriptor is not of the query's shape (a library described by another version)."""
+    rows = [r for r in rows if r[4] is not None or r[0] in measured]
     if not rows:
         return []
     rows.sort(key=lambda r: -r[0])
     seen, unique = set(), []
-    for pk, capture_id, start, stop, blob in rows:
-        if (capture_id, start, stop) not in seen:
-            seen.add((capture_id, start, stop))
-            unique.append((pk, blob))
-    profiles = as_vectors([b for _, b in unique]).reshape(len(unique), similarity.PROFILE_ROWS, -1)
-    order = similarity.shortlist_by_profile(query, profiles, n)
-    return [unique[i][0] for i in order]
+    for row in rows:
+        if row[1:4] not in seen:
+            seen.add(row[1:4])
+            unique.append(row)
+    width = similarity.PROFILE_ROWS * query.shape[1]
+    q = np.asarray(query[:similarity.PROFILE_ROWS], dtype=float).ravel()
+    d = np.array([measured.get(r[0], np.nan) for r in unique])
+    fresh = [i for i, r in enumerate(unique) if r[4] is not None]
+    if fresh:
+        blobs = [bytes(unique[i][4]) for i in fresh]
+        if {len(b) for b in blobs} != {4 * width}:
+            raise Invalid(f"library profiles have {sorted({len(b) // 4 for b in blobs})} "
+                          f"numbers, the query's {width}; rebuild the library")
+        diff = np.frombuffer(b"".join(blobs), dtype="<f4").reshape(len(fresh), width) - q
+        d[fresh] = np.einsum("ij,ij->i", diff, diff)
+    chosen = [unique[i] for i in np.argsort(d, kind="stable")[:n]]
+    read = stored([r[0] for r in chosen if r[4] is None])
+    newer = [r[0] for r in chosen if r[4] is not None]
+    if newer:
+        read.update((pk, np.frombuffer(bytes(blob), dtype="<f4")) for pk, blob in
+                    LibrarySegment.objects.filter(pk__in=newer).values_list("id", "descriptor"))
+    out = []
+    for r in chosen:
+        descriptor = read.get(r[0])
+        if descriptor is None:
+            continue  # deleted since the candidates were read
+        if descriptor.size != query.size:
+            raise Invalid(f"library descriptors have {descriptor.size} numbers, the query's "
+                          f"{query.shape[0]} x {query.shape[1]}; rebuild the library")
+        out.append((r[0], descriptor.reshape(query.shape), r))
+    return out
 
 
 def forget():

@@ -34,10 +34,14 @@ class SimilarView(APIView):
         segment = visible.select_related("capture", "annotator", "label").filter(pk=pk).first()
         if segment is None:
             raise NotFound("No such segment.")
-        found = search.similar(segment, visible.preferred(), k=k)
-        for s, d in found:
-            s.distance = round(d, 4)
-        return Response(SimilarSerializer({"segment": segment.pk, "results": [s for s, _ in found]}).data)
+        results = []
+        for s, d in search.similar(segment, visible.preferred(), k=k):
+            if isinstance(s, search.Shown):
+                results.append({**s.data, "distance": round(d, 4)})
+            else:
+                s.distance = round(d, 4)
+                results.append(SimilarSegmentSerializer(s).data)
+        return Response({"segment": segment.pk, "results": results})
 
 
 urlpatterns = [

@@ -11,6 +11,7 @@ import pytest
 from numpy.testing import assert_allclose
 
 import motionlib
+from motionlib.errors import InputError
 from motionlib.similarity import (
     N_POINT_FEATURES,
     PROFILE_ROWS,
@@ -87,11 +88,16 @@ def test_it_computes_dtw_like_the_textbook_recursion_when_the_band_is_wide():
 
 
 @pytest.mark.parametrize("n, m, band", [(32, 32, 0.25), (12, 9, 0.25), (9, 12, 1.0), (5, 20, 0.1)])
-def test_it_computes_a_batch_of_dtw_distances_exactly_as_one_at_a_time(n, m, band):
+def test_it_computes_a_batch_of_dtw_distances_as_one_at_a_time(n, m, band):
     rng = np.random.default_rng(n + m)
     a, bs = rng.normal(size=(n, 4)), rng.normal(size=(6, m, 4))
     expected = [dtw_distance(a, b, band=band) for b in bs]
-    assert dtw_distances(a, bs, band=band).tolist() == expected
+    assert dtw_distances(a, bs, band=band).tolist() == pytest.approx(expected, rel=1e-12)
+
+
+def test_it_names_descriptors_of_different_widths():
+    with pytest.raises(InputError, match="dtw: expected"):
+        dtw_distances(np.zeros((4, 3)), np.zeros((2, 4, 5)))
 
 
 def test_it_warps_away_a_change_of_tempo():

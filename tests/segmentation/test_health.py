@@ -11,7 +11,7 @@ from django.utils import timezone
 
 from cutroom.celery import app
 from motionlib import similarity
-from segmentation import similar_index
+from segmentation import descriptors, similar_index
 from segmentation.models import Capture, DetectionRun, LibrarySegment, WorkerHeartbeat
 from segmentation.services import health
 from tests.segmentation.base import BaseTestCase
@@ -155,13 +155,14 @@ class HealthEndpointTestCase(BaseTestCase):
     def test_it_names_a_similar_index_that_lags_behind_the_library(self):
         self.workers_beating()
         capture = self.ready_capture()
-        profile = np.arange(similarity.PROFILE_ROWS * 4, dtype="<f4")
+        descriptor = np.arange((similarity.PROFILE_ROWS + 2) * 4, dtype="<f4").reshape(-1, 4)
         walk, _ = self.project.labels.get_or_create(name="walk", defaults={"color": "#2a9d8f"})
         for start in (0, 100, 200):
-            LibrarySegment.objects.create(
-                project=self.project, capture=capture, label=walk, start=start,
-                stop=start + 100, duration=100 / 120, profile=(profile + start).tobytes(),
-                created_at=ago(1000))
+            segment = LibrarySegment(project=self.project, capture=capture, label=walk,
+                                     start=start, stop=start + 100, duration=100 / 120,
+                                     created_at=ago(1000))
+            descriptors.store_descriptor(segment, descriptor + start)
+            segment.save()
         body = self.health(503)
         self.assertEqual(body["failing"], ["similar_index"])
         self.assertIn(f"the similar-clip index of project(s) {self.project.pk} lacks segments "

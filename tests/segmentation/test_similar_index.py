@@ -11,7 +11,7 @@ from django.test.utils import CaptureQueriesContext
 
 import motionlib
 from motionlib import similarity, synth, vector_index
-from motionlib.vector_index import IvfIndex
+from motionlib.vector_index import VectorIndex
 from segmentation import descriptors, search, services, similar_index, tasks
 from segmentation.models import LibrarySegment
 from tests.segmentation.base import BaseTestCase
@@ -97,6 +97,21 @@ class SameResultsTest(SimilarIndexTestCase):
         assert {s.pk for s, _ in found} <= {r.pk for r in bob_rows}
 
 
+class ShownTest(SimilarIndexTestCase):
+    def test_it_shows_each_result_as_the_exact_scan_does(self):
+        rows = self.add_segments(self.spans[:60], self.descs[:60])
+        self.add_segments(self.spans[60:90], self.descs[60:90], annotator=self.alice)
+        LibrarySegment.objects.filter(pk__in=[r.pk for r in rows[1::2]]).update(
+            agreement=0.5, is_gold=True, annotator=None)
+        self.login(self.rachel)
+        url = f"/api/segments/{rows[0].pk}/similar/?k=30"
+        exact = self.client.get(url).json()
+        similar_index.build(self.project.pk)
+        assert similar_index.open_index(self.project.pk) is not None
+        assert self.client.get(url).json() == exact
+        assert len(exact["results"]) == 30
+
+
 class QueryCountTest(SimilarIndexTestCase):
     def test_it_answers_with_the_same_number_of_queries_whatever_k(self):
         rows = self.add_segments(self.spans[:100], self.descs[:100])
@@ -163,18 +178,49 @@ class IncrementalTest(SimilarIndexTestCase):
         LibrarySegment.objects.filter(pk__in=gone).delete()
         tasks.update_similar_index(self.project.pk)  # what the worker runs
         manifest = similar_index.read_manifest(self.project.pk)
-        index = IvfIndex.open(similar_index.index_dir() / manifest["file"])
+        index = VectorIndex.open(similar_index.folder_of(manifest), manifest["state"])
         ids = set(similar_index.described(self.project.pk).values_list("id", flat=True))
-        assert set(index.ids.tolist()) == ids
+        assert set(index.keys().tolist()) == ids
         assert manifest["count"] == len(ids) == self.N - 5
 
-    def test_it_retrains_when_the_library_has_doubled(self):
+    def test_an_update_appends_and_leaves_the_base_file_alone(self):
+        rows = self.add_segments(self.spans[:200], self.descs[:200])
+        first = similar_index.build(self.project.pk)
+        base = similar_index.folder_of(first) / vector_index.BASE
+        before = (base.stat().st_ino, base.read_bytes())
+        added = self.add_segments(self.spans[:10], self.descs[:10])  # twins, in another capture
+        LibrarySegment.objects.filter(pk=added[0].pk).delete()
+        manifest = similar_index.update(self.project.pk)
+        assert manifest["file"] == first["file"]
+        assert (base.stat().st_ino, base.read_bytes()) == before
+        assert (manifest["state"]["delta"], manifest["state"]["removed"]) == (9, 0)
+        assert manifest["max_id"] == added[-1].pk  # found in the index, not as newer rows
+        assert self.indexed(rows[1], k=1)[0] == (added[1].pk, 0.0)
+
+    def test_it_compacts_when_the_appended_records_outgrow_their_share(self):
         self.add_segments(self.spans[:100], self.descs[:100])
         first = similar_index.build(self.project.pk)
         self.add_segments(self.spans[100:], self.descs[100:])
-        manifest = similar_index.update(self.project.pk)
+        with mock.patch.object(similar_index, "COMPACT_MIN", 50):
+            manifest = similar_index.update(self.project.pk)
+        assert manifest["file"] != first["file"]
+        assert manifest["state"] == {**first["state"], "base": self.N}
+        assert (first["state"]["delta"], first["state"]["removed"]) == (0, 0)
         assert (first["lists"], manifest["lists"]) == (6, 18)
-        assert manifest["count"] == manifest["trained_on"] == self.N
+        assert not similar_index.folder_of(first).exists()
+
+    def test_an_update_that_dies_before_publishing_leaves_the_last_state_in_force(self):
+        rows = self.add_segments(self.spans[:100], self.descs[:100])
+        first = similar_index.build(self.project.pk)
+        twin = self.add_segments([self.spans[0]], [self.descs[0]])[0]
+        with mock.patch.object(similar_index, "_publish", side_effect=OSError("disk full")):
+            with self.assertRaises(OSError):
+                similar_index.update(self.project.pk)
+        assert similar_index.read_manifest(self.project.pk) == first
+        similar_index.forget()
+        assert self.indexed(rows[0], k=1)[0] == (twin.pk, 0.0)  # read from the database
+        manifest = similar_index.update(self.project.pk)
+        assert manifest["state"]["delta"] == 1 and manifest["max_id"] == twin.pk
 
     def test_it_leaves_an_index_in_step_unchanged(self):
         self.add_segments(self.spans[:50], self.descs[:50])
@@ -187,7 +233,7 @@ class RebuildTest(SimilarIndexTestCase):
         rows = self.add_segments(self.spans, self.descs)
         expected = self.exact(rows[7])
         manifest = similar_index.build(self.project.pk)
-        (similar_index.index_dir() / manifest["file"] / "vectors.npy").unlink()
+        (similar_index.folder_of(manifest) / vector_index.BASE).unlink()
         similar_index.forget()
         with self.captureOnCommitCallbacks() as callbacks:
             assert similar_index.open_index(self.project.pk) is None
@@ -201,7 +247,7 @@ class RebuildTest(SimilarIndexTestCase):
         self.add_segments(self.spans[:50], self.descs[:50])
         similar_index.build(self.project.pk)
         path = similar_index.manifest_path(self.project.pk)
-        path.write_text(path.read_text().replace('"format": 1', '"format": 0'))
+        path.write_text(path.read_text().replace('"format": 2', '"format": 1'))
         similar_index.forget()
         assert similar_index.open_index(self.project.pk) is None
 

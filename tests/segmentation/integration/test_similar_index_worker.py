@@ -1,9 +1,9 @@
-"""A submitted review reaches the similar-clip index through a real worker."""
+"""A submitted review reaches the similar-clip index through a real worker, and this
+process, which had the index open, sees the worker's appended update."""
 
 import pytest
 from django.contrib.auth import get_user_model
 
-from motionlib.vector_index import IvfIndex
 from segmentation import search, services, similar_index
 from segmentation.models import LibrarySegment
 from tests.segmentation.base import synthetic_bvh
@@ -31,11 +31,9 @@ def people(transactional_db, settings, shared_media):
 
 
 def indexed_ids(project):
-    try:
-        manifest = similar_index.read_manifest(project.pk)
-    except similar_index.IndexUnusable:
-        return None
-    return set(IvfIndex.open(similar_index.index_dir() / manifest["file"]).ids.tolist())
+    """The keys of the project's index as this process sees it (kept open between calls)."""
+    opened = similar_index.open_index(project.pk)
+    return None if opened is None else set(opened.index.keys().tolist())
 
 
 def test_it_indexes_the_segments_of_a_submitted_review_on_a_worker(running_workers, people):
@@ -48,11 +46,15 @@ def test_it_indexes_the_segments_of_a_submitted_review_on_a_worker(running_worke
     first = set(LibrarySegment.objects.values_list("id", flat=True))
     assert len(first) == 3
     wait_for(lambda: indexed_ids(project) == first, what="the index of the first review")
+    built = similar_index.read_manifest(project.pk)
 
     # A second take's review: the worker adds its segments to the same index.
     submit_review(captures[1], bob, [400], ["squat", "walk"])
     every = set(LibrarySegment.objects.values_list("id", flat=True))
     wait_for(lambda: indexed_ids(project) == every, what="the index of both reviews")
+    appended = similar_index.read_manifest(project.pk)
+    assert appended["file"] == built["file"], "the update appended to the same generation"
+    assert appended["state"]["delta"] == len(every - first)
     query = LibrarySegment.objects.get(capture=captures[1], start=0)
     visible = LibrarySegment.objects.visible_to(bob).preferred()
     assert similar_index.open_index(project.pk) is not None
