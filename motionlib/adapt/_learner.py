@@ -247,18 +247,32 @@ def placed(model: CutModel, one: dict) -> np.ndarray:
 # ---- learning ------------------------------------------------------------------------------
 
 def fit(studies: list[dict], cuts: list[np.ndarray], *, tolerance_s: float,
-        zero_min_segment_s: float) -> CutModel:
-    """Learn a :class:`CutModel` from example studies and their human cuts (take frames)."""
+        zero_min_segment_s: float, choice: tuple | None = None):
+    """Learn a :class:`CutModel` from example studies and their human cuts (take frames).
+
+    Returns (model, choice). ``choice`` is what the fit chose from all its examples
+    together: the examples' weights, the prior's precision and whether the count is
+    calibrated. Given back (the weights of the examples kept, in order), a refit on fewer
+    of the same examples takes it instead of choosing again: those choices are most of
+    a fit's cost, and a refit without one example, as the gate's leave-one-out makes, is
+    then a single regression. Below CV_TAKES examples a refit chooses anew (cheaply).
+    """
     prior = CutModel.zero_shot(tolerance_s)
     placement, offset = _placement(studies, cuts, tolerance_s)
     fine = _min_segment([(c, float(s["fps"])) for c, s in zip(cuts, studies, strict=True)],
                         zero_min_segment_s)
     base = replace(prior, placement=placement, offset_s=offset, min_segment_s=fine)
     data = [_labelled(base, one, c) for one, c in zip(studies, cuts, strict=True)]
-    weights = _take_weights(base, studies, cuts, data)
+    if choice is None or len(studies) < CV_TAKES:
+        weights = _take_weights(base, studies, cuts, data)
+    else:
+        weights = np.asarray(choice[0], dtype=float)
     if len(studies) < CV_TAKES:  # one or two takes do not show how finely a studio cuts
         base = replace(base, min_segment_s=0.0)
-    precision, calibrate = _choose(base, studies, cuts, data, weights)
+    if choice is None or len(studies) < CV_TAKES:
+        precision, calibrate = _choose(base, studies, cuts, data, weights)
+    else:
+        precision, calibrate = choice[1], choice[2]
     model = replace(base, weights=tuple(float(v) for v in _map_fit(data, weights, precision)),
                     n_takes=len(studies), n_cuts=int(sum(len(c) for c in cuts)),
                     down_weighted=int(np.sum(weights < 0.5)), precision=precision)
@@ -267,7 +281,7 @@ def fit(studies: list[dict], cuts: list[np.ndarray], *, tolerance_s: float,
         model = replace(model, threshold=_calibrated(
             model, [s for s, t in zip(studies, trusted, strict=True) if t],
             [c for c, t in zip(cuts, trusted, strict=True) if t]))
-    return model
+    return model, (weights, precision, calibrate)
 
 
 def _calibrated(model: CutModel, studies, cuts) -> float:

@@ -152,14 +152,20 @@ def _train(job):
     stored = takecache.StoredStudies(Capture._meta.get_field("original").storage)
     # The full fit first, with the stored studies: they stay those of the examples as they
     # are, which the next training reads (the gate's refits keep theirs in memory).
-    model = fit_examples(examples, stored)
+    candidate = fit_examples(examples, stored, refits=True)
+    model = candidate.model
     # One training at a time per project: no other version appears before this one ends.
     current = ProjectCutModel.objects.newest(job.project_id)
-    refits = model_gate.FoldStudies(stored)
+    in_memory = model_gate.FoldStudies(stored)
+    learnt = set(current.trained_on) if current is not None else set()
+    own = [e for e in examples if e[0].pk in learnt]
+    # The current model's own examples, refitted only when a take it learnt from is scored.
+    own_refits = functools.cache(lambda: fit_examples(own, in_memory, refits=True))
     verdict = model_gate.judge(
         examples, current, _loaded(current.pk, current.version) if current else None,
-        fit=lambda chosen: fit_examples(chosen, refits) if chosen else None,
-        detect=lambda capture, cut_model: _candidates(capture, cut_model, refits),
+        candidate_without=lambda capture: candidate.without(_position(examples, capture)),
+        current_without=lambda capture: own_refits().without(_position(own, capture)),
+        detect=lambda capture, cut_model: _candidates(capture, cut_model, in_memory),
     )
     with transaction.atomic():
         newest = ProjectCutModel.objects.filter(project_id=job.project_id).aggregate(v=Max("version"))
@@ -178,12 +184,19 @@ def _train(job):
         )
 
 
-def fit_examples(examples, studies):
-    """``motionlib.adapt.fit_cut_model`` over ``[(capture, cuts)]``."""
+def fit_examples(examples, studies, refits=False):
+    """``motionlib.adapt.fit_cut_model`` over ``[(capture, cuts)]``; with ``refits``, the
+    ``motionlib.adapt.Refits`` whose ``model`` that is, to refit without one example."""
     from motionlib import adapt
 
-    return adapt.fit_cut_model([example(capture, cuts) for capture, cuts in examples],
-                               studies=studies)
+    chosen = [example(capture, cuts) for capture, cuts in examples]
+    if refits:
+        return adapt.Refits(chosen, studies=studies)
+    return adapt.fit_cut_model(chosen, studies=studies)
+
+
+def _position(examples, capture):
+    return next(i for i, (c, _cuts) in enumerate(examples) if c.pk == capture.pk)
 
 
 def _candidates(capture, cut_model, studies):

@@ -1,10 +1,10 @@
 """The gate a newly trained cut model passes before it replaces the project's current one.
 
 Both models are scored out of sample on the same reviewed takes: the candidate on each
-scored take by a model fitted on the project's other examples (leave-one-take-out); the
-current model on a take it did not learn from as it is, and on a take it learnt from by
-a model fitted on its own examples without that take (zero-shot, the model of a project
-without one, learnt from nothing). The scored takes fall in two groups, those the
+scored take by a model refitted on the project's other examples (leave-one-take-out,
+``motionlib.adapt.Refits``); the current model on a take it did not learn from as it is,
+and on a take it learnt from by a refit of its own examples without that take (zero-shot,
+the model of a project without one, learnt from nothing). The scored takes fall in two groups, those the
 current model learnt from and the others, and the candidate must be not worse in each:
 an annotator whose new reviews cut differently from everyone before makes a candidate
 that wins on their own takes and loses on the others', and such a model is refused.
@@ -110,7 +110,7 @@ def scored_takes(examples, learnt):
     return new[:n_new] + old[:FOLDS - n_new]
 
 
-def judge(examples, current, current_model, *, fit, detect):
+def judge(examples, current, current_model, *, candidate_without, current_without, detect):
     """Score the candidate fitted on ``examples`` against the project's current model.
 
     Parameters
@@ -118,7 +118,10 @@ def judge(examples, current, current_model, *, fit, detect):
     examples : [(capture, cuts)], the examples the candidate learnt from.
     current : the project's current ProjectCutModel row, or None (zero-shot).
     current_model : its loaded CutModel, or None (zero-shot, or unreadable).
-    fit : [(capture, cuts)] -> CutModel, or None for an empty list (zero-shot).
+    candidate_without : capture -> the candidate refitted without that example (None:
+        zero-shot, when it was the only one).
+    current_without : capture -> the current model refitted on its own examples without
+        that one (None: zero-shot); asked only for takes the current model learnt from.
     detect : (capture, CutModel or None) -> candidate cut frames in its take.
 
     Returns
@@ -129,10 +132,9 @@ def judge(examples, current, current_model, *, fit, detect):
     figure = Figure()
     groups = {True: (Figure(), Figure()), False: (Figure(), Figure())}  # learnt: (new, current)
     for capture, cuts in scored_takes(examples, learnt):
-        others = [e for e in examples if e[0].pk != capture.pk]
-        candidate = fit(others)
+        candidate = candidate_without(capture)
         was_learnt = capture.pk in learnt
-        rival = fit([e for e in others if e[0].pk in learnt]) if was_learnt else current_model
+        rival = current_without(capture) if was_learnt else current_model
         found = detect(capture, candidate)
         rival_found = found if rival == candidate else detect(capture, rival)
         figure.add(found, cuts, capture.fps)

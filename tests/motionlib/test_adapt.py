@@ -11,6 +11,7 @@ from motionlib.adapt import (
     Example,
     ExampleError,
     MemoryStudies,
+    Refits,
     ThresholdModel,
     cuts_in,
     detect,
@@ -181,6 +182,18 @@ def test_an_examples_study_is_read_from_where_the_fit_kept_it():
     assert cuts_in(arrays, model).tolist() == detect(examples[0].read(), model).cuts.tolist()
     zero = cuts_in(arrays, CutModel.zero_shot()).tolist()
     assert zero == detect(examples[0].read()).cuts.tolist()
+
+
+def test_refits_start_from_the_full_fit_and_leave_one_example_out():
+    examples = [_take(seed) for seed in (1, 2, 4, 5)]
+    refits = Refits(examples)
+    assert refits.model == fit_cut_model(examples)
+    without = refits.without(1)
+    assert (without.n_takes, without.n_cuts) == (3, sum(len(c) for i, (_, c) in
+                                                         enumerate(examples) if i != 1))
+    # Below three examples a refit has nothing to keep: it is the fit on the others.
+    assert Refits(examples[:3]).without(0) == fit_cut_model(examples[1:3])
+    assert Refits(examples[:1]).without(0) is None
 
 
 def test_it_scores_a_model_on_a_reviewed_take():
