@@ -87,8 +87,8 @@ def build(folder: Path, ids: np.ndarray, vectors: np.ndarray, *, n_lists: int | 
     for name in (DELTA_IDS, DELTA_VECTORS, REMOVED, DELTA_PAYLOAD) + (() if payload else (PAYLOAD,)):
         (folder / name).touch()
     for path in folder.iterdir():
-        _fsync(path)
-    _fsync(folder)
+        fsync(path)
+    fsync(folder)
     return empty_state(d, n, payload_width if payload is not None else 0) | {"lists": n_lists}
 
 
@@ -283,7 +283,8 @@ def _mapped(path, dtype, shape):
     return np.memmap(path, dtype=dtype, mode="r", shape=shape)
 
 
-def _fsync(path):
+def fsync(path):
+    """Flush a file or a folder (its entries) to disk."""
     fd = os.open(path, os.O_RDONLY)
     try:
         os.fsync(fd)

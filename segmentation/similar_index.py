@@ -150,18 +150,10 @@ def _publish(project_id, manifest):
                 "bytes": sum(p.stat().st_size for p in folder_of(manifest).iterdir())}
     tmp = manifest_path(project_id).with_suffix(".json.tmp")
     tmp.write_text(json.dumps(manifest, indent=1))
-    _fsync(tmp)
+    vector_index.fsync(tmp)
     os.replace(tmp, manifest_path(project_id))
-    _fsync(index_dir())
+    vector_index.fsync(index_dir())
     return manifest
-
-
-def _fsync(path):
-    fd = os.open(path, os.O_RDONLY)
-    try:
-        os.fsync(fd)
-    finally:
-        os.close(fd)
 
 
 def _chunks(queryset):

@@ -110,17 +110,29 @@ def test_a_worker_computes_the_suggestions_the_page_asks_for(running_workers, pe
     second = upload(client_for(alice), project, synthetic_bvh(seed=6, duration=30.0), name="two.bvh")
     wait_for(lambda: settled(first) and settled(second), what="ingest and detection")
     bob_client = client_for(bob)
-    review = bob_client.post(f"/api/captures/{first}/review/").json()
-    for index in range(len(review["segments"])):
-        review = bob_client.patch(f"/api/captures/{first}/review/segments/{index}/",
-                                  {"label": "squat", "version": review["version"]}, format="json").json()
-    bob_client.post(f"/api/captures/{first}/review/submit/", {"version": review["version"]}, format="json")
+    label_all_and_submit(bob_client, first, "squat")
+    assert suggested_labels(bob_client, second) == {"squat"}
 
-    url = f"/api/captures/{second}/review/suggestions/"
-    assert bob_client.get(url).json()["pending"] is True
-    wait_for(lambda: bob_client.get(url).json()["pending"] is False, timeout=120, interval=0.5,
+
+def label_all_and_submit(client, capture, label):
+    """Label every segment of the capture's review ``label`` and submit it."""
+    review = client.post(f"/api/captures/{capture}/review/").json()
+    for index in range(len(review["segments"])):
+        review = client.patch(f"/api/captures/{capture}/review/segments/{index}/",
+                              {"label": label, "version": review["version"]}, format="json").json()
+    client.post(f"/api/captures/{capture}/review/submit/", {"version": review["version"]},
+                format="json")
+
+
+def suggested_labels(client, capture):
+    """The labels a real worker suggests for the capture's review, once it has: one
+    suggestion for each segment of the review."""
+    url = f"/api/captures/{capture}/review/suggestions/"
+    assert client.get(url).json()["pending"] is True
+    wait_for(lambda: client.get(url).json()["pending"] is False, timeout=120, interval=0.5,
              what="suggestions")
-    body = bob_client.get(url).json()
-    segments = bob_client.get(f"/api/captures/{second}/review/").json()["segments"]
-    assert [(s["start"], s["stop"]) for s in body["suggestions"]] == [(s["start"], s["stop"]) for s in segments]
-    assert {s["label"] for s in body["suggestions"]} == {"squat"}
+    body = client.get(url).json()
+    segments = client.get(f"/api/captures/{capture}/review/").json()["segments"]
+    assert [(s["start"], s["stop"]) for s in body["suggestions"]] == \
+        [(s["start"], s["stop"]) for s in segments]
+    return {s["label"] for s in body["suggestions"]}

@@ -9,7 +9,14 @@ from segmentation import services
 from segmentation.models import Capture
 from tests.motionlib.points_data import HDM05, points_file
 from tests.segmentation.integration.conftest import wait_for
-from tests.segmentation.integration.test_pipeline import client_for, people, settled, upload
+from tests.segmentation.integration.test_pipeline import (
+    client_for,
+    label_all_and_submit,
+    people,
+    settled,
+    suggested_labels,
+    upload,
+)
 
 pytestmark = pytest.mark.integration
 __all__ = ["people"]
@@ -45,18 +52,5 @@ def test_a_worker_suggests_labels_for_a_take_of_points_of_no_known_set(running_w
                             name=name) for name in ("subject1_run1.tsv", "subject1_run2.tsv"))
     wait_for(lambda: settled(first) and settled(second), timeout=120, what="ingest and detection")
     bob_client = client_for(bob)
-    review = bob_client.post(f"/api/captures/{first}/review/").json()
-    for index in range(len(review["segments"])):
-        review = bob_client.patch(f"/api/captures/{first}/review/segments/{index}/",
-                                  {"label": "reach", "version": review["version"]}, format="json").json()
-    bob_client.post(f"/api/captures/{first}/review/submit/", {"version": review["version"]}, format="json")
-
-    url = f"/api/captures/{second}/review/suggestions/"
-    assert bob_client.get(url).json()["pending"] is True
-    wait_for(lambda: bob_client.get(url).json()["pending"] is False, timeout=120, interval=0.5,
-             what="suggestions")
-    body = bob_client.get(url).json()
-    segments = bob_client.get(f"/api/captures/{second}/review/").json()["segments"]
-    assert [(s["start"], s["stop"]) for s in body["suggestions"]] == \
-        [(s["start"], s["stop"]) for s in segments]
-    assert {s["label"] for s in body["suggestions"]} == {"reach"}
+    label_all_and_submit(bob_client, first, "reach")
+    assert suggested_labels(bob_client, second) == {"reach"}
