@@ -5,10 +5,9 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from motionlib import metrics, synth
+from motionlib import metrics
 from motionlib.adapt import (
     CutModel,
-    Example,
     ExampleError,
     MemoryStudies,
     Refits,
@@ -20,13 +19,7 @@ from motionlib.adapt import (
     score,
     study,
 )
-
-FPS = 60.0
-
-
-def _take(seed, **kw):
-    take, segments = synth.generate(seed=seed, fps=FPS, duration=kw.pop("duration", 50.0), **kw)
-    return take, np.asarray([start for start, _, _ in segments[1:]], dtype=np.int64)
+from tests.motionlib.adapt_examples import FPS, keyed_examples, take_with_cuts
 
 
 def _f1(cuts, truth, tolerance_s=1.0):
@@ -35,7 +28,7 @@ def _f1(cuts, truth, tolerance_s=1.0):
 
 def test_the_prior_model_detects_exactly_the_zero_shot_cuts():
     for seed in (1, 2, 3):
-        take, _ = _take(seed)
+        take, _ = take_with_cuts(seed)
         assert detect(take, CutModel.zero_shot()).cuts.tolist() == detect(take).cuts.tolist()
 
 
@@ -43,10 +36,10 @@ def test_it_cuts_a_new_take_closer_to_the_convention_it_was_taught():
     # Two studios cut the same activity changes, one at the cross-fade, the other 0.6 s
     # later (at the onset of the next activity).
     late = int(0.6 * FPS)
-    takes = [_take(seed) for seed in (1, 2, 4, 5)]
+    takes = [take_with_cuts(seed) for seed in (1, 2, 4, 5)]
     at_change = fit_cut_model(takes)
     at_onset = fit_cut_model([(take, cuts + late) for take, cuts in takes])
-    take, cuts = _take(3)
+    take, cuts = take_with_cuts(3)
     for model, taught, other in ((at_change, cuts, cuts + late),
                                  (at_onset, cuts + late, cuts)):
         found = detect(take, model).cuts
@@ -54,19 +47,19 @@ def test_it_cuts_a_new_take_closer_to_the_convention_it_was_taught():
 
 
 def test_it_learns_that_a_studio_cuts_nothing_in_such_takes():
-    model = fit_cut_model([(_take(seed)[0], []) for seed in (4, 5, 10)])
-    assert len(detect(_take(6)[0], model).cuts) == 0
+    model = fit_cut_model([(take_with_cuts(seed)[0], []) for seed in (4, 5, 10)])
+    assert len(detect(take_with_cuts(6)[0], model).cuts) == 0
 
 
 def test_it_learns_how_finely_a_studio_segments():
     long = dict(segment_seconds=(8.0, 12.0), duration=60.0)
-    model = fit_cut_model([_take(seed, **long) for seed in (1, 2, 3)])
+    model = fit_cut_model([take_with_cuts(seed, **long) for seed in (1, 2, 3)])
     assert model.min_segment_s > 3.0
 
 
 @pytest.mark.parametrize("mode", ["under", "over"])
 def test_a_minority_of_bad_reviews_barely_moves_the_model(mode):
-    takes = [_take(seed, duration=40.0) for seed in range(20, 30)]
+    takes = [take_with_cuts(seed, duration=40.0) for seed in range(20, 30)]
     rng = np.random.default_rng(0)
 
     def bad(take, cuts):
@@ -80,13 +73,13 @@ def test_a_minority_of_bad_reviews_barely_moves_the_model(mode):
     clean, poisoned = fit_cut_model(takes), fit_cut_model(reviewed)
     assert poisoned.down_weighted >= 2
     for seed in (40, 41):
-        take, cuts = _take(seed)
+        take, cuts = take_with_cuts(seed)
         moved = _f1(detect(take, poisoned).cuts, cuts) - _f1(detect(take, clean).cuts, cuts)
         assert abs(moved) < 0.05
 
 
 def test_it_round_trips_a_model_through_json():
-    model = fit_cut_model([_take(1), _take(2), _take(4)])
+    model = fit_cut_model([take_with_cuts(1), take_with_cuts(2), take_with_cuts(4)])
     text = model.to_json()
     assert '"format": 2' in text
     assert CutModel.from_json(text) == model
@@ -100,7 +93,7 @@ def test_it_reads_a_model_of_the_first_format_and_detects_with_it_as_before():
             '"placement": "split"}')
     model = CutModel.from_json(text)
     assert isinstance(model, ThresholdModel)
-    take, _ = _take(3)
+    take, _ = take_with_cuts(3)
     assert detect(take, model).cuts.tolist() == detect_threshold(take, model).cuts.tolist()
 
 
@@ -126,34 +119,21 @@ def test_it_refuses_an_empty_example_list():
 
 
 def test_it_refuses_a_cut_outside_the_example_take():
-    take, _ = _take(1, duration=20.0)
+    take, _ = take_with_cuts(1, duration=20.0)
     with pytest.raises(ExampleError, match=f"cut {take.n_frames + 5} is outside"):
         fit_cut_model([(take, [100, take.n_frames + 5])])
 
 
 def test_it_names_an_example_take_too_short_to_learn_from():
-    take, _ = _take(1, duration=20.0)
+    take, _ = take_with_cuts(1, duration=20.0)
     with pytest.raises(ExampleError, match=r"synth-1: too short to learn from \(3 frames\)"):
-        fit_cut_model([(_take(2)[0], []), (take.slice(0, 3), [1])])
+        fit_cut_model([(take_with_cuts(2)[0], []), (take.slice(0, 3), [1])])
 
-
-def _examples(seeds, reads):
-    """Keyed examples that record each time their take is read."""
-    out = []
-    for seed in seeds:
-        take, cuts = _take(seed)
-
-        def read(take=take, seed=seed):
-            reads.append(seed)
-            return take
-        out.append(Example(name=f"take {seed}", cuts=cuts, fps=take.fps,
-                           n_frames=take.n_frames, read=read, key=f"take-{seed}"))
-    return out
 
 
 def test_a_refit_reads_only_the_takes_it_has_not_studied():
     studies, reads = MemoryStudies(), []
-    examples = _examples((1, 2, 3), reads)
+    examples = keyed_examples((1, 2, 3), reads)
     first = fit_cut_model(examples, studies=studies)
     reads.clear()
     assert fit_cut_model(examples, studies=studies) == first
@@ -162,19 +142,19 @@ def test_a_refit_reads_only_the_takes_it_has_not_studied():
     changed = fit_cut_model(examples, studies=studies)
     assert changed == fit_cut_model([(e.read(), e.cuts) for e in examples])
     reads.clear()
-    fit_cut_model(examples + _examples((4,), reads), studies=studies)
+    fit_cut_model(examples + keyed_examples((4,), reads), studies=studies)
     assert reads == [4]
 
 
 def test_detection_from_stored_candidates_equals_detection_from_the_take():
-    model = fit_cut_model([_take(1), _take(2), _take(4)])
-    take, _ = _take(3)
+    model = fit_cut_model([take_with_cuts(1), take_with_cuts(2), take_with_cuts(4)])
+    take, _ = take_with_cuts(3)
     assert cuts_in(study(take), model).tolist() == detect(take, model).cuts.tolist()
 
 
 def test_an_examples_study_is_read_from_where_the_fit_kept_it():
     studies, reads = MemoryStudies(), []
-    examples = _examples((1, 2, 3), reads)
+    examples = keyed_examples((1, 2, 3), reads)
     model = fit_cut_model(examples, studies=studies)
     reads.clear()
     arrays = example_study(examples[0], studies=studies)
@@ -185,7 +165,7 @@ def test_an_examples_study_is_read_from_where_the_fit_kept_it():
 
 
 def test_refits_start_from_the_full_fit_and_leave_one_example_out():
-    examples = [_take(seed) for seed in (1, 2, 4, 5)]
+    examples = [take_with_cuts(seed) for seed in (1, 2, 4, 5)]
     refits = Refits(examples)
     assert refits.model == fit_cut_model(examples)
     without = refits.without(1)
@@ -197,7 +177,7 @@ def test_refits_start_from_the_full_fit_and_leave_one_example_out():
 
 
 def test_it_scores_a_model_on_a_reviewed_take():
-    take, cuts = _take(3)
+    take, cuts = take_with_cuts(3)
     found = detect(take).cuts
     figure = score(None, take, cuts, tolerance_s=1.0)
     assert figure["f1"] == pytest.approx(_f1(found, cuts))

@@ -7,13 +7,7 @@ import pytest
 from motionlib import metrics, synth
 from motionlib.adapt import ExampleError, ThresholdModel, detect
 from motionlib.adapt import fit_threshold_model as fit_cut_model
-
-FPS = 60.0
-
-
-def _take(seed, **kw):
-    take, segments = synth.generate(seed=seed, fps=FPS, duration=kw.pop("duration", 50.0), **kw)
-    return take, np.asarray([start for start, _, _ in segments[1:]], dtype=np.int64)
+from tests.motionlib.adapt_examples import FPS, keyed_examples, take_with_cuts
 
 
 def _signed_errors(cuts, truth, fps):
@@ -24,9 +18,9 @@ def _signed_errors(cuts, truth, fps):
 def test_it_moves_placement_to_where_the_annotators_cut():
     # These annotators mark the onset of the next activity, 0.6 s after the cross-fade.
     late = int(0.6 * FPS)
-    examples = [(take, cuts + late) for take, cuts in (_take(1), _take(2))]
+    examples = [(take, cuts + late) for take, cuts in (take_with_cuts(1), take_with_cuts(2))]
     model = fit_cut_model(examples)
-    take, cuts = _take(3)
+    take, cuts = take_with_cuts(3)
     zero_shot = np.median(_signed_errors(detect(take).cuts, cuts + late, FPS))
     adapted = np.median(_signed_errors(detect(take, model).cuts, cuts + late, FPS))
     assert zero_shot > 0.3
@@ -34,29 +28,29 @@ def test_it_moves_placement_to_where_the_annotators_cut():
 
 
 def test_it_learns_that_a_studio_cuts_nothing_in_such_takes():
-    model = fit_cut_model([(_take(4)[0], []), (_take(5)[0], [])])
-    assert len(detect(_take(6)[0], model).cuts) == 0
+    model = fit_cut_model([(take_with_cuts(4)[0], []), (take_with_cuts(5)[0], [])])
+    assert len(detect(take_with_cuts(6)[0], model).cuts) == 0
 
 
 def test_it_learns_the_shortest_activity_from_the_examples():
     short = dict(segment_seconds=(1.5, 2.5), duration=30.0)
-    model = fit_cut_model([_take(7, **short), _take(8, **short)])
+    model = fit_cut_model([take_with_cuts(7, **short), take_with_cuts(8, **short)])
     assert model.min_segment_s < 1.5
     assert model.scale_min_s < 3.0  # windows short enough to see such an activity
-    take, cuts = _take(9, **short)
+    take, cuts = take_with_cuts(9, **short)
     found = metrics.boundary_scores(detect(take, model).cuts, cuts, fps=FPS, tolerance_s=0.5)
     zero_shot = metrics.boundary_scores(detect(take).cuts, cuts, fps=FPS, tolerance_s=0.5)
     assert found["recall"] > zero_shot["recall"]
 
 
 def test_it_keeps_the_zero_shot_windows_without_short_activities():
-    model = fit_cut_model([_take(1), _take(2)])
+    model = fit_cut_model([take_with_cuts(1), take_with_cuts(2)])
     assert (model.scale_min_s, model.scale_max_s) == (3.0, 6.0)
 
 
 def test_it_counts_the_examples_it_learnt_from():
-    model = fit_cut_model([_take(1), _take(2)])
-    assert (model.n_takes, model.n_cuts) == (2, len(_take(1)[1]) + len(_take(2)[1]))
+    model = fit_cut_model([take_with_cuts(1), take_with_cuts(2)])
+    assert (model.n_takes, model.n_cuts) == (2, len(take_with_cuts(1)[1]) + len(take_with_cuts(2)[1]))
 
 
 def test_it_round_trips_a_model_through_json():
@@ -88,15 +82,15 @@ def test_it_reads_a_stored_model_from_before_the_prominence_test_as_it_was():
 
 
 def test_it_refuses_a_cut_outside_the_example_take():
-    take, _ = _take(1, duration=20.0)
+    take, _ = take_with_cuts(1, duration=20.0)
     with pytest.raises(ExampleError, match=f"cut {take.n_frames + 5} is outside"):
         fit_cut_model([(take, [100, take.n_frames + 5])])
 
 
 def test_it_names_an_example_take_too_short_to_learn_from():
-    take, _ = _take(1, duration=20.0)
+    take, _ = take_with_cuts(1, duration=20.0)
     with pytest.raises(ExampleError, match=r"synth-1: too short to learn from \(3 frames\)"):
-        fit_cut_model([(_take(2)[0], []), (take.slice(0, 3), [1])])
+        fit_cut_model([(take_with_cuts(2)[0], []), (take.slice(0, 3), [1])])
 
 
 def test_it_refuses_an_empty_example_list():
@@ -107,7 +101,7 @@ def test_it_refuses_an_empty_example_list():
 def test_it_detects_zero_shot_exactly_as_the_default_segmenter():
     from motionlib.segmenters.default import Default
 
-    take, _ = _take(1, duration=20.0)
+    take, _ = take_with_cuts(1, duration=20.0)
     assert detect(take).cuts.tolist() == Default().fit_predict(take).cuts.tolist()
 
 
@@ -184,24 +178,9 @@ def test_two_examples_keep_the_fixed_prior():
 
 
 def test_a_studio_that_cuts_nothing_teaches_it_with_three_examples():
-    model = fit_cut_model([(_take(seed)[0], []) for seed in (4, 5, 10)])
-    assert len(detect(_take(6)[0], model).cuts) == 0
+    model = fit_cut_model([(take_with_cuts(seed)[0], []) for seed in (4, 5, 10)])
+    assert len(detect(take_with_cuts(6)[0], model).cuts) == 0
 
-
-def _examples(seeds, reads, **kw):
-    """Keyed examples that record each time their take is read."""
-    from motionlib.adapt import Example
-
-    out = []
-    for seed in seeds:
-        take, cuts = _take(seed, **kw)
-
-        def read(take=take, seed=seed):
-            reads.append(seed)
-            return take
-        out.append(Example(name=f"take {seed}", cuts=cuts, fps=take.fps,
-                           n_frames=take.n_frames, read=read, key=f"take-{seed}"))
-    return out
 
 
 def test_a_refit_reads_only_the_examples_whose_study_is_not_stored():
@@ -210,7 +189,7 @@ def test_a_refit_reads_only_the_examples_whose_study_is_not_stored():
     from motionlib.adapt import MemoryStudies
 
     studies, reads = MemoryStudies(), []
-    examples = _examples((1, 2, 3), reads)
+    examples = keyed_examples((1, 2, 3), reads)
     first = fit_cut_model(examples, studies=studies)
     assert reads == [1, 2, 3] and set(studies.items) == {"take-1", "take-2", "take-3"}
     reads.clear()
@@ -227,12 +206,12 @@ def test_a_study_made_with_other_settings_is_not_used():
     from motionlib.adapt import MemoryStudies
 
     studies, reads = MemoryStudies(), []
-    fit_cut_model(_examples((7, 8), reads), studies=studies)
+    fit_cut_model(keyed_examples((7, 8), reads), studies=studies)
     # A third example with a much shorter activity changes the minimum segment, and so
     # what every example's peaks are: all three are analysed again.
-    short = _examples((9,), reads, segment_seconds=(1.5, 2.5), duration=30.0)
+    short = keyed_examples((9,), reads, segment_seconds=(1.5, 2.5), duration=30.0)
     reads.clear()
-    fit_cut_model(_examples((7, 8), reads) + short, studies=studies)
+    fit_cut_model(keyed_examples((7, 8), reads) + short, studies=studies)
     assert sorted(reads) == [7, 8, 9]
 
 
@@ -240,15 +219,15 @@ def test_examples_without_a_key_are_never_stored():
     from motionlib.adapt import MemoryStudies
 
     studies = MemoryStudies()
-    fit_cut_model([_take(1), _take(2)], studies=studies)
+    fit_cut_model([take_with_cuts(1), take_with_cuts(2)], studies=studies)
     assert studies.items == {}
 
 
 def test_it_starts_from_the_settings_it_is_given():
-    model = fit_cut_model([_take(1), _take(2)], base={"threshold": 0.2, "min_segment_s": 1.0})
+    model = fit_cut_model([take_with_cuts(1), take_with_cuts(2)], base={"threshold": 0.2, "min_segment_s": 1.0})
     assert model.threshold == 0.2
     assert model.min_segment_s <= 1.0  # never longer than where it started
-    zero_shot = fit_cut_model([_take(1), _take(2)])
+    zero_shot = fit_cut_model([take_with_cuts(1), take_with_cuts(2)])
     assert (zero_shot.threshold, zero_shot.min_segment_s) == (0.1, 1.5)
 
 
