@@ -46,30 +46,6 @@ def test_it_loads_a_segments_glb_export_with_threejs(live_server, new_page, fbx_
     assert page.errors == []
 
 
-# What of the preview's canvas is not its background (#161a21): how many pixels, and the
-# share of the canvas's height they span.
-DRAWN = """(box) => {
-  const canvas = box.querySelector("canvas");
-  const copy = document.createElement("canvas");
-  copy.width = canvas.width;
-  copy.height = canvas.height;
-  const context = copy.getContext("2d");
-  context.drawImage(canvas, 0, 0);
-  const data = context.getImageData(0, 0, canvas.width, canvas.height).data;
-  let pixels = 0, top = canvas.height, bottom = -1;
-  for (let i = 0; i < data.length; i += 4) {
-    const off = Math.abs(data[i] - 0x16) + Math.abs(data[i + 1] - 0x1a) + Math.abs(data[i + 2] - 0x21);
-    if (off > 60) {
-      pixels++;
-      const y = Math.floor(i / 4 / canvas.width);
-      top = Math.min(top, y);
-      bottom = Math.max(bottom, y);
-    }
-  }
-  return { pixels, span: bottom < 0 ? 0 : (bottom - top + 1) / canvas.height };
-}"""
-
-
 def test_it_shows_the_framed_skeleton_of_a_bvh_clips_glb(live_server, new_page, studio,
                                                        ingested_capture, screenshots):
     """A BVH clip's glTF is an armature without a mesh: the preview draws its skeleton,
@@ -85,9 +61,10 @@ def test_it_shows_the_framed_skeleton_of_a_bvh_clips_glb(live_server, new_page, 
     expect(preview).to_have_attribute("data-playing", f"glb:{segment.pk}", timeout=90_000)
     expect(preview.locator("canvas")).to_be_visible()
     page.wait_for_timeout(500)
-    drawn = preview.evaluate(DRAWN)
+    drawn = preview.evaluate(DRAWN_BOX)
     assert drawn["pixels"] > 500, drawn
-    assert 0.3 < drawn["span"] < 0.95, drawn  # framed: neither a speck nor cut off
+    # Framed: its height neither a speck nor cut off.
+    assert 0.3 < drawn["bottom"] - drawn["top"] < 0.95, drawn
     assert 1.0 < float(preview.get_attribute("data-gltf-height")) < 2.0  # metres
     page.screenshot(path=str(screenshots / "library-gltf-bvh.png"))
     assert page.errors == []
