@@ -155,7 +155,19 @@ COLUMNS = ("project_id", "capture_id", "annotator_id", "is_gold", "superseded", 
 def _copy_rows(connection, rng, project_id, cap_ids, gold, label_ids, annotators, desc):
     from django.utils import timezone
 
-    now = timezone.now()
+    rows = segment_rows(rng, project_id, cap_ids, gold, label_ids, annotators, desc,
+                        timezone.now())
+    with connection.cursor() as cursor:
+        with cursor.cursor.copy(f"COPY segmentation_librarysegment ({', '.join(COLUMNS)}) "
+                                "FROM STDIN") as copy:
+            for row in rows:
+                copy.write_row(row)
+
+
+def segment_rows(rng, project_id, cap_ids, gold, label_ids, annotators, desc, now):
+    """The library rows (``COLUMNS``) of one project's segments, one per descriptor: their
+    capture, label, span, annotator or gold and agreement drawn from ``rng`` (the same
+    draws, in the same order, whichever database they go to)."""
     count = len(desc)
     caps = cap_ids[rng.integers(len(cap_ids), size=count)]
     labs = rng.integers(len(label_ids), size=count)
@@ -165,19 +177,16 @@ def _copy_rows(connection, rng, project_id, cap_ids, gold, label_ids, annotators
     gold_draw = rng.random(count)
     agree = rng.beta(5, 2, size=count)
     has_agree = rng.random(count) < 0.8
-    with connection.cursor() as cursor:
-        with cursor.cursor.copy(f"COPY segmentation_librarysegment ({', '.join(COLUMNS)}) "
-                                "FROM STDIN") as copy:
-            for i in range(count):
-                cap = int(caps[i])
-                is_gold = cap in gold and gold_draw[i] < 0.25
-                label_id, _ = label_ids[labs[i]]
-                copy.write_row((
-                    project_id, cap, None if is_gold else annotators[anns[i]].pk, is_gold,
-                    not is_gold and cap in gold, label_id, int(starts[i]),
-                    int(starts[i] + lengths[i]), float(lengths[i]) / 120.0,
-                    float(agree[i]) if has_agree[i] else None, desc[i].tobytes(), "[35, 35]",
-                    desc[i, :3].tobytes(), now))
+    for i in range(count):
+        cap = int(caps[i])
+        is_gold = bool(cap in gold and gold_draw[i] < 0.25)
+        label_id, _ = label_ids[labs[i]]
+        yield (
+            project_id, cap, None if is_gold else annotators[anns[i]].pk, is_gold,
+            not is_gold and cap in gold, label_id, int(starts[i]),
+            int(starts[i] + lengths[i]), float(lengths[i]) / 120.0,
+            float(agree[i]) if has_agree[i] else None, desc[i].tobytes(), "[35, 35]",
+            desc[i, :3].tobytes(), now)
 
 
 def connect(admin_url, n, seed, rebuild=False):

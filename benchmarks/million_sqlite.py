@@ -95,26 +95,8 @@ def _insert_rows(connection, rng, project_id, cap_ids, gold, label_ids, annotato
     from django.db import transaction
     from django.utils import timezone
 
-    now = timezone.now().isoformat(sep=" ")
-    count = len(desc)
-    caps = cap_ids[rng.integers(len(cap_ids), size=count)]
-    labs = rng.integers(len(label_ids), size=count)
-    starts = rng.integers(0, 190_000, size=count)
-    lengths = rng.integers(30, 1000, size=count)
-    anns = rng.integers(len(annotators), size=count)
-    gold_draw = rng.random(count)
-    agree = rng.beta(5, 2, size=count)
-    has_agree = rng.random(count) < 0.8
-    rows = []
-    for i in range(count):
-        cap = int(caps[i])
-        is_gold = bool(cap in gold and gold_draw[i] < 0.25)
-        rows.append((
-            project_id, cap, None if is_gold else annotators[anns[i]].pk, is_gold,
-            not is_gold and cap in gold, label_ids[labs[i]][0], int(starts[i]),
-            int(starts[i] + lengths[i]), float(lengths[i]) / 120.0,
-            float(agree[i]) if has_agree[i] else None, desc[i].tobytes(), "[35, 35]",
-            desc[i, :3].tobytes(), now))
+    rows = list(million.segment_rows(rng, project_id, cap_ids, gold, label_ids, annotators,
+                                     desc, timezone.now().isoformat(sep=" ")))
     columns = ", ".join(million.COLUMNS)
     marks = ", ".join(["%s"] * len(million.COLUMNS))
     with transaction.atomic(), connection.cursor() as cursor:
