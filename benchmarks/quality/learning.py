@@ -15,8 +15,11 @@ edits per true cut and the median placement error, beside the zero-shot detector
 
 Then convention-following (Krüger's and Baak's labels of the same subject-86 takes:
 a model taught one convention, scored against both, on each take it did not learn
-from), the poisoning case (3 of the reviewed takes under- or over-cut by one
-annotator), and whether the issue's targets are met. Every take's candidates are
+from), the oracle ceiling (``ceiling``: what the best choice among each take's
+candidates scores against its own labels, to tell a candidate set that lacks the cuts
+from a scorer that cannot find them; not a result), the poisoning case (3 of the
+reviewed takes under- or over-cut by one annotator), labellings tried and not shipped
+(``learning_tried``), and whether the issue's targets are met. Every take's candidates are
 computed once (``adapt.study``) and every model detects from them (``adapt.cuts_in``),
 so the whole run takes minutes. The learner's fixed settings were not chosen on any
 figure here (``docs/detector/adaptation.md``).
@@ -33,7 +36,7 @@ from pathlib import Path
 
 import numpy as np
 
-from benchmarks.quality import ceiling, data
+from benchmarks.quality import ceiling, data, learning_tried
 from motionlib import adapt
 
 KS = (0, 1, 3, 5, 10)
@@ -411,6 +414,7 @@ def main(root: Path | None = None, out=None) -> int:
     conv = convention(sets, out)
     print_ceiling(sets, {**curves, **within}, out)
     poison = poisoning(sets, out)
+    learning_tried.print_tried(sets, curves, poison, out)
     targets({**curves, **{f"{k} (within)": v for k, v in within.items()}}, conv, poison, out)
     print(f"\nlearning curve: {time.perf_counter() - started:.0f} s, load average "
           f"{' '.join(f'{x:.2f}' for x in os.getloadavg())}", file=out)
