@@ -15,8 +15,11 @@ edits per true cut and the median placement error, beside the zero-shot detector
 
 Then convention-following (Krüger's and Baak's labels of the same subject-86 takes:
 a model taught one convention, scored against both, on each take it did not learn
-from), the poisoning case (3 of the reviewed takes under- or over-cut by one
-annotator), and whether the issue's targets are met. Every take's candidates are
+from), the oracle ceiling (``ceiling``: what the best choice among each take's
+candidates scores against its own labels, to tell a candidate set that lacks the cuts
+from a scorer that cannot find them; not a result), the poisoning case (3 of the
+reviewed takes under- or over-cut by one annotator), labellings tried and not shipped
+(``learning_tried``), and whether the issue's targets are met. Every take's candidates are
 computed once (``adapt.study``) and every model detects from them (``adapt.cuts_in``),
 so the whole run takes minutes. The learner's fixed settings were not chosen on any
 figure here (``docs/detector/adaptation.md``).
@@ -33,7 +36,7 @@ from pathlib import Path
 
 import numpy as np
 
-from benchmarks.quality import data
+from benchmarks.quality import ceiling, data, learning_tried
 from motionlib import adapt
 
 KS = (0, 1, 3, 5, 10)
@@ -154,9 +157,12 @@ def _pool(label: LabelSet, item: Item) -> list[Item]:
 
 
 def curve(label: LabelSet) -> dict:
-    """k -> (mean [F1, edits, error] over the set's takes, smallest pool, largest pool)."""
+    """k -> (mean [F1, edits, error] over the set's takes, smallest pool, largest pool);
+    and "best count": at k = TARGET_K, the mean over takes of the models' F1 with the
+    count chosen against the take's labels (``ceiling.best_count``, an oracle)."""
     out = {}
     zero = adapt.CutModel.zero_shot(label.tolerance_s)
+    counted = []
     for k in KS:
         per_take, sizes = [], []
         for t, item in enumerate(label.items):
@@ -173,10 +179,19 @@ def curve(label: LabelSet) -> dict:
                 chosen = [pool[i] for i in rng.choice(len(pool), kk, replace=False)]
                 model = fit(chosen, label.tolerance_s)
                 rows.append(scored(item, adapt.cuts_in(item.study, model), label.tolerance_s))
+                if k == TARGET_K:
+                    counted.append((t, ceiling.best_count(
+                        item.study, item.truth, model, fps=item.fps,
+                        tolerance_s=label.tolerance_s)))
             with np.errstate(all="ignore"), warnings.catch_warnings():
                 warnings.simplefilter("ignore", RuntimeWarning)  # no match: NaN error
                 per_take.append(np.nanmean(rows, axis=0))
         out[k] = (np.nanmean(per_take, axis=0), min(sizes), max(sizes))
+    if counted:
+        takes = np.asarray([t for t, _ in counted])
+        values = np.asarray([v for _, v in counted])
+        out["best count"] = float(np.mean([values[takes == t].mean()
+                                           for t in np.unique(takes)]))
     return out
 
 
@@ -258,6 +273,58 @@ def convention(sets: list[LabelSet], out) -> float | None:
     mean = float(np.mean(gains))
     print(f"{'mean':<16}{'':>20}{mean:>+14.2f}", file=out)
     return mean
+
+
+def print_ceiling(sets: list[LabelSet], curves: dict, out) -> None:
+    """The oracle ceiling per set (``benchmarks/quality/ceiling.py``) beside the zero-shot
+    detector's recall and the curve's model at k = TARGET_K."""
+    print("\n## Ceiling — an ORACLE, not a result: the best subset of each take's candidates "
+          "chosen with that take's own labels (benchmarks/quality/ceiling.py)", file=out)
+    print("Per set, mean over takes: candidates and true cuts per take; recall of the "
+          "zero-shot cuts and of all candidates (a true cut with a candidate within the "
+          "set's tolerance); the oracle subset's F1 and review edits per true cut; the "
+          f"curve's k={TARGET_K} models (by subject or within subject, as above): F1, and "
+          "F1 with their own ranking cut at the count the labels make best (best count).",
+          file=out)
+    print(f"{'set':<14}{'split':>8}{'takes':>6}{'tol s':>6}{'cands':>7}{'true':>6}"
+          f"{'rec zs':>8}{'rec cand':>9}{'ceil F1':>9}{'ceil ed':>9}"
+          f"{f'k={TARGET_K} F1':>8}{'best count':>11}", file=out)
+    for label in sorted((s for s in sets if s.items), key=lambda s: not s.by_subject):
+        zero = adapt.CutModel.zero_shot(label.tolerance_s)
+        zs = [adapt.score_cuts(adapt.cuts_in(i.study, zero), i.truth, fps=i.fps,
+                               tolerance_s=label.tolerance_s)["recall"] for i in label.items]
+        top = np.mean([ceiling.take_ceiling(i.study, i.truth, fps=i.fps,
+                                            tolerance_s=label.tolerance_s)
+                       for i in label.items], axis=0)
+        sizes = np.mean([[len(i.study["stages"]) if i.study else 0,
+                          len(i.cuts)] for i in label.items], axis=0)
+        got = curves[label.name][0]
+        learnt = f"{got[TARGET_K][0][0]:>8.2f}{got.get('best count', np.nan):>11.2f}" \
+            if got[TARGET_K][1] > 0 else f"{'-':>8}{'-':>11}"
+        print(f"{label.name:<14}{'subject' if label.by_subject else 'within':>8}"
+              f"{len(label.items):>6}{label.tolerance_s:>6g}{sizes[0]:>7.0f}{sizes[1]:>6.1f}"
+              f"{np.mean(zs):>8.2f}{top[0]:>9.2f}{top[1]:>9.2f}{top[2]:>9.2f}{learnt}",
+              file=out)
+    conv = _convention_ceiling(sets)
+    if conv is not None:
+        print(f"convention-following, oracle: the oracle subset for one convention's labels "
+              f"scored against both, mean F1(taught) - F1(other) {conv:+.2f}", file=out)
+
+
+def _convention_ceiling(sets: list[LabelSet]) -> float | None:
+    named = {s.name: s for s in sets}
+    kr, bk = named.get("cmu86 Krüger"), named.get("cmu86 Baak")
+    if not kr or not bk:
+        return None
+    kr_items, bk_items = {i.name: i for i in kr.items}, {i.name: i for i in bk.items}
+    gains = []
+    for name in sorted(set(kr_items) & set(bk_items)):
+        pair = (kr_items[name], bk_items[name])
+        for taught, other in (pair, pair[::-1]):
+            chosen = ceiling.oracle_cuts(taught.study, taught.truth, fps=taught.fps,
+                                         tolerance_s=1.0)
+            gains.append(scored(taught, chosen, 1.0)[0] - scored(other, chosen, 1.0)[0])
+    return float(np.mean(gains)) if gains else None
 
 
 def _corrupt(cuts: np.ndarray, mode: str, n_frames: int, fps: float, rng) -> np.ndarray:
@@ -345,7 +412,9 @@ def main(root: Path | None = None, out=None) -> int:
     curves = print_curves(sets, True, out)
     within = print_curves(sets, False, out)
     conv = convention(sets, out)
+    print_ceiling(sets, {**curves, **within}, out)
     poison = poisoning(sets, out)
+    learning_tried.print_tried(sets, curves, poison, out)
     targets({**curves, **{f"{k} (within)": v for k, v in within.items()}}, conv, poison, out)
     print(f"\nlearning curve: {time.perf_counter() - started:.0f} s, load average "
           f"{' '.join(f'{x:.2f}' for x in os.getloadavg())}", file=out)
