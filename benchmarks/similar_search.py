@@ -26,11 +26,15 @@ and the indexes brought back in step.
 
 ``--busy N`` adds N processes that spin on a core for the length of the run (stopped at
 the end), to measure under load; the load average is printed before and after the
-queries. The paths run in turn for each query (oracle, before, now), with one BLAS thread.
+queries. ``--busy-nice K`` runs them at nice ``K``: 0 (the default) is load from
+anything else on the machine; 10 is the load of the service's own workers, which ``make
+up`` (``scripts/up.py``) runs at nice 10 so that web requests come first. The paths run in
+turn for each query (oracle, before, now), with one BLAS thread.
 ``CPU`` is this process's CPU time per request (the web side; PostgreSQL's share
 is not in it): on a shared machine it is the steadier figure.
 
-    .venv/bin/python benchmarks/similar_search.py [--queries 200] [--busy 0] [--seed 15]
+    .venv/bin/python benchmarks/similar_search.py [--queries 200] [--busy 0] [--busy-nice 0]
+        [--seed 15]
 """
 
 import argparse
@@ -140,9 +144,11 @@ def index_dir(path):
         settings.SIMILAR_INDEX_DIR = previous
 
 
-def busy(n, seconds):
-    """``n`` processes spinning on a core, each ending by itself after ``seconds``."""
-    spin = f"import time\nend = time.time() + {seconds}\nwhile time.time() < end: pass"
+def busy(n, seconds, nice=0):
+    """``n`` processes spinning on a core at nice ``nice``, each ending by itself after
+    ``seconds``."""
+    spin = (f"import os, time\nos.nice({nice})\nend = time.time() + {seconds}\n"
+            "while time.time() < end: pass")
     return [subprocess.Popen([sys.executable, "-c", spin]) for _ in range(n)]
 
 
@@ -213,6 +219,8 @@ def run():
     parser.add_argument("--old-queries", type=int, default=10)
     parser.add_argument("--added", type=int, default=5000)
     parser.add_argument("--busy", type=int, default=0)
+    parser.add_argument("--busy-nice", type=int, default=0,
+                        help="nice value of the busy processes (10: as the service's workers)")
     parser.add_argument("--before", default=before.BEFORE)
     parser.add_argument("--nprobe", type=int, help="lists a search scans (default: the service's)")
     parser.add_argument("--admin-url", default=million.default_admin_url())
@@ -241,11 +249,11 @@ def run():
     print(f"before ({old.rev}): numpy IVF, {old_manifest['lists']:,} lists, float16, scans "
           f">= {old.similar_index.PROBE_SHARE:.1%}; {old_manifest['bytes'] / 1e6:,.0f} MB; "
           f"{old_how} in {old_built:.1f} s")
-    spinning = busy(args.busy, 3600)
+    spinning = busy(args.busy, 3600, args.busy_nice)
     try:
         time.sleep(30 if args.busy else 0)  # let the load average rise
         print(f"machine: {platform.machine()}, {os.cpu_count()} cores shared with other work, "
-              f"{args.busy} busy processes added; load {load()} before the queries; "
+              f"{args.busy} busy processes added (nice {args.busy_nice}); load {load()} before the queries; "
               f"{args.queries} queries (no-index path: first {args.old_queries}), k=10, "
               f"reviewer, through SimilarView\n", flush=True)
         similar_index.forget()

@@ -14,6 +14,9 @@ from segmentation.models import LibrarySegment
 SIMILAR_POOL = 20000
 # Profile-nearest segments whose full descriptors are compared (DTW) in both searches.
 SHORTLIST = 20
+# What a search reads of the segment it starts from (``similar``).
+QUERY_FIELDS = ("project_id", "capture_id", "start", "stop", "descriptor", "descriptor_shape",
+                "capture__skeleton")
 
 
 def similar(segment, visible, k=10):

@@ -1,5 +1,6 @@
 """``GET /api/segments/{id}/similar/?k=10``: the library's clips nearest to a segment."""
 
+from django.db.models import Q
 from django.urls import path
 from drf_spectacular.utils import OpenApiParameter, extend_schema
 from rest_framework import serializers
@@ -11,6 +12,7 @@ from segmentation import search
 from segmentation.api.params import int_param
 from segmentation.api.segments import SegmentSerializer
 from segmentation.models import LibrarySegment
+from segmentation.models.library import STAFF, own
 
 
 class SimilarSegmentSerializer(SegmentSerializer):
@@ -29,11 +31,15 @@ class SimilarView(APIView):
     @extend_schema(responses=SimilarSerializer, parameters=[OpenApiParameter("k", int)])
     def get(self, request, pk):
         k = int_param(request, "k", 10, 1, 100)
-        # One membership lookup for both the segment and the clips it may be compared with.
-        visible = LibrarySegment.objects.visible_to(request.user)
-        segment = visible.select_related("capture", "annotator", "label").filter(pk=pk).first()
+        user = request.user
+        # One query reads the segment, the user's role in its project and whether that
+        # role shows it; the role then decides which clips it may be compared with.
+        segment = (LibrarySegment.objects.with_role_of(user).select_related("capture")
+                   .only(*search.QUERY_FIELDS).filter(pk=pk)
+                   .filter(Q(role__in=STAFF) | Q(role__isnull=False) & own(user)).first())
         if segment is None:
             raise NotFound("No such segment.")
+        visible = LibrarySegment.objects.visible_in(segment.project_id, user, segment.role)
         results = []
         for s, d in search.similar(segment, visible.preferred(), k=k):
             if isinstance(s, search.Shown):

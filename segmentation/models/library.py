@@ -14,7 +14,7 @@
 import numpy as np
 from django.conf import settings
 from django.db import models
-from django.db.models import Q
+from django.db.models import OuterRef, Q, Subquery
 from django.utils import timezone
 
 from segmentation.models.captures import Capture
@@ -24,6 +24,14 @@ from segmentation.models.reviews import Review
 # A capture whose annotators agree this well needs no adjudication.
 AGREED_BOUNDARY_F1 = 0.8
 AGREED_LABELS = 0.8
+# Roles that see every segment of their project; an annotator sees own and gold ones.
+STAFF = ("reviewer", "admin")
+
+
+def own(user):
+    """Q of an annotator's own segments and the gold ones (``is_gold__in``: see
+    ``segmentation.api.segments.segment_query``)."""
+    return Q(annotator=user) | Q(is_gold__in=[True])
 
 
 class LibrarySegmentQuerySet(models.QuerySet):
@@ -35,10 +43,23 @@ class LibrarySegmentQuerySet(models.QuerySet):
         roles = Membership.objects.filter(user=user).values_list("project_id", "role")
         staff, annotating = [], []
         for project_id, role in roles:
-            (staff if role in ("reviewer", "admin") else annotating).append(project_id)
-        # ``is_gold__in``: see ``segmentation.api.segments.segment_query``.
-        own = Q(annotator=user) | Q(is_gold__in=[True])
-        return self.filter(Q(project_id__in=staff) | Q(project_id__in=annotating) & own)
+            (staff if role in STAFF else annotating).append(project_id)
+        return self.filter(Q(project_id__in=staff) | Q(project_id__in=annotating) & own(user))
+
+    def visible_in(self, project_id, user, role):
+        """``visible_to`` within one project, for a ``role`` the caller has read already
+        (``role_in_project``): None sees nothing."""
+        if role is None or not user.is_authenticated:
+            return self.none()
+        mine = self.filter(project_id=project_id)
+        return mine if role in STAFF else mine.filter(own(user))
+
+    def with_role_of(self, user):
+        """Each segment annotated with ``role``: ``user``'s role in its project, or None.
+        With ``visible_in`` it reads a segment and decides what its project shows the user
+        in one query (``visible_to`` reads the user's memberships first)."""
+        roles = Membership.objects.filter(project_id=OuterRef("project_id"), user_id=user.pk)
+        return self.annotate(role=Subquery(roles.values("role")[:1]))
 
     def preferred(self):
         """The library's default view: gold where a capture has it, else every annotator's."""

@@ -112,6 +112,62 @@ class ShownTest(SimilarIndexTestCase):
         assert len(exact["results"]) == 30
 
 
+class AccessTest(SimilarIndexTestCase):
+    """What the endpoint shows each role, through the index and without it: the segment's
+    project and the role the user has there decide both the query and the results."""
+
+    def setUp(self):
+        super().setUp()
+        self.alices = self.add_segments(self.spans[:40], self.descs[:40], annotator=self.alice)
+        self.bobs = self.add_segments(self.spans[40:80], self.descs[40:80])
+        self.gold = self.add_segments(self.spans[80:100], self.descs[80:100])
+        LibrarySegment.objects.filter(pk__in=[r.pk for r in self.gold]).update(
+            is_gold=True, annotator=None)
+
+    def both_paths(self, check):
+        check()
+        similar_index.build(self.project.pk)
+        similar_index.forget()
+        assert similar_index.open_index(self.project.pk) is not None
+        check()
+
+    def ids(self, segment, user, k=50):
+        self.login(user)
+        response = self.client.get(f"/api/segments/{segment.pk}/similar/?k={k}")
+        assert response.status_code == 200, response.content
+        return {r["id"] for r in response.json()["results"]}
+
+    def status(self, segment, user):
+        if user is None:
+            self.client.force_authenticate(None)
+        else:
+            self.login(user)
+        return self.client.get(f"/api/segments/{segment.pk}/similar/").status_code
+
+    def test_an_annotator_compares_with_own_and_gold_segments_only(self):
+        def check():
+            found = self.ids(self.bobs[0], self.bob)
+            assert found and found <= {r.pk for r in self.bobs + self.gold}
+            assert found & {r.pk for r in self.gold}
+            assert self.ids(self.gold[0], self.bob) <= {r.pk for r in self.bobs + self.gold}
+        self.both_paths(check)
+
+    def test_a_reviewer_compares_with_everyone_s(self):
+        def check():
+            found = self.ids(self.bobs[0], self.rachel, k=100)
+            assert found & {r.pk for r in self.alices} and found & {r.pk for r in self.bobs}
+        self.both_paths(check)
+
+    def test_it_refuses_a_segment_the_user_may_not_see(self):
+        def check():
+            assert self.status(self.alices[0], self.bob) == 404  # another annotator's
+            assert self.status(self.bobs[0], self.charlie) == 404  # not a member
+            assert self.status(self.bobs[0], None) in (401, 403)
+            LibrarySegment.objects.filter(pk=self.bobs[1].pk).delete()
+            assert self.status(self.bobs[1], self.rachel) == 404
+        self.both_paths(check)
+
+
 class QueryCountTest(SimilarIndexTestCase):
     def test_it_answers_with_the_same_number_of_queries_whatever_k(self):
         rows = self.add_segments(self.spans[:100], self.descs[:100])
