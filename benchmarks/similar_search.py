@@ -30,6 +30,7 @@ queries. ``--busy-nice K`` runs them at nice ``K``: 0 (the default) is load from
 anything else on the machine; 10 is the load of the service's own workers, which ``make
 up`` (``scripts/up.py``) runs at nice 10 so that web requests come first. The paths run in
 turn for each query (oracle, before, now), with one BLAS thread.
+The process is set up as the web server's are (``cutroom/wsgi.py``).
 ``CPU`` is this process's CPU time per request (the web side; PostgreSQL's share
 is not in it): on a shared machine it is the steadier figure.
 
@@ -226,6 +227,9 @@ def run():
     parser.add_argument("--admin-url", default=million.default_admin_url())
     args = parser.parse_args()
     name, out = million.connect(args.admin_url, args.segments, args.seed)
+    # Set up as a web server process is (cutroom/wsgi.py: the URLconf loaded, then
+    # gc.freeze()), so no full collection rescans the start-up objects inside a request.
+    import cutroom.wsgi  # noqa: F401
     from segmentation import similar_index
     from segmentation.models import Capture, LibrarySegment
 
