@@ -162,7 +162,8 @@ class ListPagesTest(LibraryTestCase):
             self.skipTest("SQLite only: PostgreSQL's list indexes INCLUDE the filtered columns")
         from importlib import import_module
 
-        wanted = import_module("segmentation.migrations.0020_library_list_sqlite_indexes").INDEXES
+        wanted = {**import_module("segmentation.migrations.0020_library_list_sqlite_indexes").INDEXES,
+                  **import_module("segmentation.migrations.0021_library_list_sqlite_seek_indexes").INDEXES}
         with connection.cursor() as cursor:
             cursor.execute("SELECT name FROM sqlite_master WHERE type = 'index' "
                            "AND tbl_name = 'segmentation_librarysegment'")
