@@ -11,7 +11,8 @@ median CPU time per request in this process (``new CPU``: SQLite runs in it, Pos
 does not; on a shared machine it is the steadier figure), its SQL queries per request, and
 the indexes the database's plan uses for its page query (``+ sort`` when it sorts the
 matches, ``+ table scan`` when it reads the table). The old and new pages are checked to
-hold the same results, byte for byte.
+hold the same results, byte for byte. The process is set up as the web server's are
+(``cutroom/wsgi.py``, which freezes the objects loaded at start out of the collector's way).
 
 ``--busy N`` adds N processes that spin on a core (nice 0) while the queries are timed,
 killed at the end, so that a figure "at load N" comes from one command; the load average
@@ -128,6 +129,10 @@ def main():
     ctx = million.personas()
     from library_list_old import OldSegmentListView
 
+    # cutroom.wsgi sets this process up as a web server process is (the URLconf loaded, then
+    # gc.freeze()); else a full collection rescans every long-lived object inside a timed
+    # request, which the server does not.
+    import cutroom.wsgi  # noqa: F401
     from segmentation.api.segments import SegmentListView
     from segmentation.models import LibrarySegment
 
