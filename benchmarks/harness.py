@@ -1,6 +1,8 @@
 """What the service benchmarks share: a scratch PostgreSQL database, Django started on
-a chosen environment, stopping a child process group, and `make up`'s own script."""
+a chosen environment, stopping a child process group, busy processes for a known load,
+and `make up`'s own script."""
 
+import contextlib
 import importlib.util
 import os
 import shutil
@@ -87,3 +89,27 @@ def stop(proc):
     except subprocess.TimeoutExpired:
         os.killpg(proc.pid, signal.SIGKILL)
         proc.wait(10)
+
+
+@contextlib.contextmanager
+def busy(n):
+    """``n`` processes spinning on a core (``while True: pass``) for the length of the
+    block, killed at its end: a benchmark's times under a load one can state and repeat.
+
+    They run at nice 0 whatever the caller's niceness (when it may lower it), so that they
+    compete with the benchmark as ordinary requests' neighbours would.
+    """
+    spinners = [subprocess.Popen([sys.executable, "-c", "while True: pass"],
+                                 preexec_fn=_nice_zero) for _ in range(n)]
+    try:
+        yield spinners
+    finally:
+        for proc in spinners:
+            proc.kill()
+        for proc in spinners:
+            proc.wait()
+
+
+def _nice_zero():
+    with contextlib.suppress(PermissionError):
+        os.setpriority(os.PRIO_PROCESS, 0, 0)

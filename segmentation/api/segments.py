@@ -13,6 +13,7 @@ import itertools
 import operator
 
 from django.contrib.auth import get_user_model
+from django.db.models import Q
 from django.http import HttpResponse, StreamingHttpResponse
 from django.urls import path
 from drf_spectacular.utils import OpenApiParameter, extend_schema, extend_schema_field
@@ -23,7 +24,7 @@ from rest_framework.response import Response
 from rest_framework.utils.urls import remove_query_param, replace_query_param
 from rest_framework.views import APIView
 
-from segmentation import exports
+from segmentation import exports, search, similar_index
 from segmentation.api.params import bool_param, float_param, int_param
 from segmentation.api.serializers import NamedRefSerializer, UserRefSerializer
 from segmentation.errors import Invalid
@@ -49,6 +50,8 @@ class SegmentPagination(PageNumberPagination):
     ``ordered_parts``): one, or one per label name when ordered by label, so that each is
     read in its order from an index, and a deep page skips whole parts by counting them
     (capped at what is left to skip) instead of sorting every match.
+
+    The page is its segments' API fields (``page_rows``), not model instances.
     """
 
     page_size = 50
@@ -57,7 +60,8 @@ class SegmentPagination(PageNumberPagination):
     count_cap = 10_000
 
     def paginate_queryset(self, queryset, request, view=None, parts=None):
-        """The page's rows of ``queryset``, read as ``parts`` (default: the query whole)."""
+        """The page's rows of ``queryset`` as the API shows them, read as ``parts``
+        (default: the query whole; ``queryset`` is not read when they are given)."""
         self.request = request
         parts = [Part([queryset])] if parts is None else parts
         size = self.get_page_size(request)
@@ -67,8 +71,7 @@ class SegmentPagination(PageNumberPagination):
         # then its rows by id.
         ids = page_ids(parts, offset, size + 1)
         self.has_next = len(ids) > size
-        found = queryset.order_by().in_bulk(ids[:size])
-        rows = [found[pk] for pk in ids[:size] if pk in found]
+        rows = page_rows(ids[:size])
         if rows and not self.has_next:
             self.count, self.capped = offset + len(rows), False
         else:
@@ -121,7 +124,8 @@ class Part:
         """How many rows the part holds, counting no further than ``cap``."""
         total = 0
         for query in self.queries:
-            total += query.order_by()[:cap - total].count()
+            # Ids only: counting a union, Django would select every column of its rows.
+            total += query.order_by().values_list("id")[:cap - total].count()
             if total >= cap:
                 break
         return total
@@ -194,42 +198,68 @@ class SegmentSerializer(serializers.ModelSerializer):
         return s.label.color if s.label_id else "#888888"
 
 
+# What a list row shows of a segment (``SegmentSerializer``'s fields), read as columns:
+# building a segment, capture, label and user instance per row and serializing them field
+# by field cost a page of 50 more CPU than all its queries.
+PAGE_COLUMNS = ("id", "capture_id", "start", "stop", *similar_index.SHOWN)
+
+
+def page_rows(ids):
+    """The API fields of segments ``ids``, in that order (one deleted since its id was
+    read is left out)."""
+    rows = LibrarySegment.objects.filter(pk__in=ids).values_list(*PAGE_COLUMNS)
+    # ``search.shown`` reads a similar-search candidate row: a descriptor fifth, which a
+    # list row has not.
+    found = {row[0]: search.shown(row[:4] + (None,) + row[4:]).data for row in rows}
+    return [found[pk] for pk in ids if pk in found]
+
+
 def segment_query(request):
     """The caller's visible segments filtered by the query string (shared by list and zip)."""
-    segments = LibrarySegment.objects.visible_to(request.user)
+    return (LibrarySegment.objects.visible_to(request.user).filter(*segment_filters(request))
+            .order_by(*ORDERINGS[ordering_of(request)]))
+
+
+def segment_filters(request):
+    """The query string's filters, as ``Q``s."""
     gold = bool_param(request, "gold")
     # ``__in`` rather than ``=``: on SQLite Django writes a boolean filter as ``NOT "column"``,
     # which no index can seek to; ``IN (0)`` is an equality every index here can use.
     if gold is None:
-        segments = segments.filter(superseded__in=[False])  # LibrarySegment.preferred()
+        filters = [Q(superseded__in=[False])]  # LibrarySegment.preferred()
     else:
-        segments = segments.filter(is_gold__in=[gold])
+        filters = [Q(is_gold__in=[gold])]
     for name, field in (("project", "project_id"), ("capture", "capture_id")):
         value = int_param(request, name, None, 1)
         if value is not None:
-            segments = segments.filter(**{field: value})
+            filters.append(Q(**{field: value}))
     annotator = (request.query_params.get("annotator") or "").strip()
     if annotator.isdigit():  # a user id (what the API said)
-        segments = segments.filter(annotator_id=int_param(request, "annotator", None, 1))
+        filters.append(Q(annotator_id=int_param(request, "annotator", None, 1)))
     elif annotator:  # a username (what the page and a person write)
         user_id = get_user_model().objects.filter(username=annotator).values_list("id", flat=True).first()
         if user_id is None:
             raise Invalid(f"annotator: no user named {annotator[:150]!r}")
-        segments = segments.filter(annotator_id=user_id)
+        filters.append(Q(annotator_id=user_id))
     if request.query_params.get("label"):
         # By the ids the name has in the caller's projects, not by joining the label table,
         # so that the filter is a column of the list's indexes.
-        segments = segments.filter(**one_of("label_id", [pk for _, pk, _ in named_labels(request)]))
+        filters.append(Q(**one_of("label_id", [pk for _, pk, _ in named_labels(request)])))
     for name, lookup, high in (("min_duration", "duration__gte", None),
                                ("max_duration", "duration__lte", None),
                                ("min_agreement", "agreement__gte", 1)):
         value = float_param(request, name, 0, high)
         if value is not None:
-            segments = segments.filter(**{lookup: value})
+            filters.append(Q(**{lookup: value}))
+    ordering_of(request)  # a bad ordering is refused with the other bad parameters
+    return filters
+
+
+def ordering_of(request):
     ordering = request.query_params.get("ordering") or "recent"
     if ordering not in ORDERINGS:
         raise Invalid(f"ordering: must be one of {', '.join(ORDERINGS)}, got {ordering!r}")
-    return segments.order_by(*ORDERINGS[ordering])
+    return ordering
 
 
 def one_of(field, values):
@@ -256,26 +286,54 @@ def named_labels(request):
     return request._named_labels
 
 
-def ordered_parts(request, segments):
-    """``segments`` (a ``segment_query``) as ``Part``s whose concatenation is the list.
+def ordered_parts(request, filters):
+    """The caller's visible segments matching ``filters`` (``segment_filters``) as
+    ``Part``s whose concatenation is the list.
 
     Ordered by label, the list is each label name's segments by id, names in the
     database's order: one part per name, read from the label index in id order, rather
-    than the whole library joined to its labels and sorted. Newest first with a label
-    name that several projects use, one part merging each label's segments.
+    than the whole library joined to its labels and sorted. Newest first, the list is
+    ``newest_first`` of the caller's visible runs, split by label when the label filter
+    names a label of several projects (each then read from a label index in id order).
     """
-    ordering = request.query_params.get("ordering") or "recent"
-    labels = visible_labels(request).order_by("name", "id").values_list("name", "id", "project_id")
+    ordering = ordering_of(request)
+    runs = LibrarySegment.objects.visible_runs(request.user, int_param(request, "project", None, 1))
+    if ordering == "recent":
+        labels = named_labels(request) if request.query_params.get("label") else []
+        if len(labels) > 1:
+            # One run per label and visible run, merged by the database when they are few
+            # enough for one compound query.
+            each = [Q(project_id=project, label_id=pk) for _, pk, project in labels]
+            if len(each) * len(runs) > MAX_MERGED_RUNS:
+                return [Part([newest_first(runs, *filters, q) for q in each], descending=True)]
+            runs = [run.filter(q) for q in each for run in runs]
+        return [Part([newest_first(runs, *filters)])]
+    # An annotator's runs are one OR (``visible_to``) in any other order.
+    visible = runs[0] if len(runs) == 1 else LibrarySegment.objects.visible_to(request.user)
+    segments = visible.filter(*filters)
     if ordering == "label":
+        labels = visible_labels(request).order_by("name", "id").values_list("name", "id", "project_id")
         return [Part([segments.filter(project_id=project, label_id=pk).order_by("id")
                       for _, pk, project in group])
                 for _, group in itertools.groupby(labels, key=operator.itemgetter(0))]
-    if ordering == "recent" and request.query_params.get("label"):
-        labels = named_labels(request)
-        if len(labels) > 1:
-            return [Part([segments.filter(project_id=project, label_id=pk)
-                          for _, pk, project in labels], descending=True)]
-    return [Part([segments])]
+    return [Part([segments.order_by(*ORDERINGS[ordering])])]
+
+
+# SQLite reads at most 500 terms of a compound query (SQLITE_MAX_COMPOUND_SELECT).
+MAX_MERGED_RUNS = 100
+
+
+def newest_first(runs, *filters):
+    """The segments of the ``runs`` (``LibrarySegment.objects.visible_runs``) that match
+    ``filters``, newest first: the runs' ``UNION ALL`` when there are several, which the
+    database reads as a merge of the runs, each in id order from an index (an annotator's
+    own segments, and the gold ones), where ``annotator = me OR gold`` is in id order in
+    no index and would be filtered out of every segment of the projects."""
+    queries = [run.filter(*filters).order_by() for run in runs]
+    if len(queries) < 2:
+        query = queries[0] if queries else LibrarySegment.objects.none()
+        return query.order_by(*ORDERINGS["recent"])
+    return queries[0].union(*queries[1:], all=True).order_by(*ORDERINGS["recent"])
 
 
 def segment_for(user, pk):
@@ -291,13 +349,10 @@ class SegmentListView(APIView):
 
     @extend_schema(responses=SegmentSerializer(many=True))
     def get(self, request):
-        segments = segment_query(request)
         paginator = self.pagination_class()
-        page = paginator.paginate_queryset(
-            segments.select_related("capture", "annotator", "label").defer(
-                "descriptor", "profile", "capture__skeleton"),
-            request, view=self, parts=ordered_parts(request, segments))
-        return paginator.get_paginated_response(SegmentSerializer(page, many=True).data)
+        parts = ordered_parts(request, segment_filters(request))
+        page = paginator.paginate_queryset(None, request, view=self, parts=parts)
+        return paginator.get_paginated_response(page)
 
 
 class SegmentView(APIView):

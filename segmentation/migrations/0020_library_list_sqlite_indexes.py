@@ -32,20 +32,29 @@ def columns(leading):
     return leading + [c for c in FILTERED if c not in leading]
 
 
-def create(apps, schema_editor):
+def create_indexes(schema_editor, indexes):
+    """``indexes`` (name -> leading columns) on SQLite; nothing elsewhere."""
     if schema_editor.connection.vendor != "sqlite":
         return
-    for name, leading in INDEXES.items():
+    for name, leading in indexes.items():
         quoted = ", ".join(f'"{c}"' for c in columns(leading))
         schema_editor.execute(
             f'CREATE INDEX IF NOT EXISTS "{name}" ON "segmentation_librarysegment" ({quoted})')
 
 
-def drop(apps, schema_editor):
+def drop_indexes(schema_editor, indexes):
     if schema_editor.connection.vendor != "sqlite":
         return
-    for name in INDEXES:
+    for name in indexes:
         schema_editor.execute(f'DROP INDEX IF EXISTS "{name}"')
+
+
+def create(apps, schema_editor):
+    create_indexes(schema_editor, INDEXES)
+
+
+def drop(apps, schema_editor):
+    drop_indexes(schema_editor, INDEXES)
 
 
 class Migration(migrations.Migration):

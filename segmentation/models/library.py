@@ -30,8 +30,21 @@ STAFF = ("reviewer", "admin")
 
 def own(user):
     """Q of an annotator's own segments and the gold ones (``is_gold__in``: see
-    ``segmentation.api.segments.segment_query``)."""
+    ``segmentation.api.segments.segment_filters``)."""
     return Q(annotator=user) | Q(is_gold__in=[True])
+
+
+def projects_by_role(user):
+    """``(staff, annotating)``: ids of the projects ``user`` reviews or administers, and
+    of those they annotate."""
+    staff, annotating = [], []
+    for project_id, role in Membership.objects.filter(user=user).values_list("project_id", "role"):
+        (staff if role in STAFF else annotating).append(project_id)
+    return staff, annotating
+
+
+def one_project_of(ids):
+    return Q(project_id=ids[0]) if len(ids) == 1 else Q(project_id__in=ids)
 
 
 class LibrarySegmentQuerySet(models.QuerySet):
@@ -40,10 +53,7 @@ class LibrarySegmentQuerySet(models.QuerySet):
         gold segments for annotators, nothing for anybody else."""
         if not user.is_authenticated:
             return self.none()
-        roles = Membership.objects.filter(user=user).values_list("project_id", "role")
-        staff, annotating = [], []
-        for project_id, role in roles:
-            (staff if role in STAFF else annotating).append(project_id)
+        staff, annotating = projects_by_role(user)
         return self.filter(Q(project_id__in=staff) | Q(project_id__in=annotating) & own(user))
 
     def visible_in(self, project_id, user, role):
@@ -60,6 +70,28 @@ class LibrarySegmentQuerySet(models.QuerySet):
         in one query (``visible_to`` reads the user's memberships first)."""
         roles = Membership.objects.filter(project_id=OuterRef("project_id"), user_id=user.pk)
         return self.annotate(role=Subquery(roles.values("role")[:1]))
+
+    def visible_runs(self, user, project=None):
+        """``visible_to(user)`` as querysets that share no row: the projects the user
+        reviews or administers; in those they annotate, their own segments, and the gold
+        ones. Unlike ``visible_to``'s OR, each can be read in id order from an index. No
+        queryset when the user sees nothing. ``project``: in that project only.
+
+        One project is written as an equality: SQLite reads it as an index prefix, where
+        ``project_id IN (…) AND project_id = 7`` can make it pick a worse index.
+        """
+        if not user.is_authenticated:
+            return []
+        staff, annotating = projects_by_role(user)
+        if project is not None:
+            staff, annotating = [p for p in staff if p == project], [p for p in annotating if p == project]
+        runs = [self.filter(one_project_of(staff))] if staff else []
+        if annotating:
+            theirs = self.filter(one_project_of(annotating))
+            # Gold rows have no annotator; ``exclude`` keeps the runs apart whatever the rows say.
+            runs += [theirs.filter(annotator=user),
+                     theirs.filter(is_gold__in=[True]).exclude(annotator=user)]
+        return runs
 
     def preferred(self):
         """The library's default view: gold where a capture has it, else every annotator's."""

@@ -8,7 +8,8 @@ from django.db import connection
 from django.test.utils import CaptureQueriesContext
 
 from segmentation import services
-from segmentation.models import LibrarySegment
+from segmentation.models import Capture, LibrarySegment
+from segmentation.services import gold
 from tests.segmentation.base import BaseTestCase
 
 
@@ -156,6 +157,24 @@ class SegmentListTest(LibraryTestCase):
 
     def test_it_requires_login(self):
         assert self.client.get("/api/segments/").status_code in (401, 403)
+
+    def test_it_lists_each_segment_field_for_field_as_its_detail_shows_it(self):
+        # The list builds its rows from columns, the detail through SegmentSerializer.
+        # Gold rows have no annotator; a take of points has other export formats, and with
+        # one review its segments no agreement.
+        gold.do_save_gold(self.capture, self.rachel, [100, 200, 300],
+                          ["walk", "punch", "walk", "punch"], 0)
+        points = self.ready_capture(name="p.c3d")
+        submit_review(points, self.bob, [200], ["walk", "punch"])
+        Capture.objects.filter(pk=points.pk).update(format="c3d")
+        self.login(self.rachel)
+        rows = self.get("?gold=true")["results"] + self.get("?gold=false")["results"]
+        assert {r["annotator"] is None for r in rows} == {True, False}
+        assert {r["agreement"] is None for r in rows} == {True, False}
+        assert {tuple(r["export_formats"]) for r in rows} == {("bvh", "fbx", "glb"), ("c3d", "csv")}
+        for row in rows:
+            detail = self.client.get(f"/api/segments/{row['id']}/").json()
+            assert list(row.items()) == list(detail.items())
 
 
 class SegmentDetailTest(LibraryTestCase):

@@ -4,10 +4,14 @@ annotators joined by name) in its order: walking the next links, and jumping to 
 Ordering by label reads one label name at a time; it follows renames at once and merges a
 name that several projects share."""
 
+import itertools
+from unittest import mock
+
 import numpy as np
 from django.db import connection
 
 from segmentation import services
+from segmentation.api import segments
 from segmentation.api.segments import ORDERINGS
 from segmentation.models import Capture, LibrarySegment
 from segmentation.services.taxonomy import do_change_label
@@ -112,6 +116,23 @@ class ListPagesTest(LibraryTestCase):
                     assert body["count"] == len(expected) and not body["count_capped"]
                     assert (body["next"] is not None) == (len(expected) > 100)
 
+    def test_newest_first_an_annotator_and_a_member_of_both_kinds_see_the_obvious_pages(self):
+        # Read as a union of runs (everything of the projects one reviews; one's own and the
+        # gold segments of those one annotates): each segment once, counted once.
+        # Beyond MAX_MERGED_RUNS runs, the runs of each label are merged here, not by the
+        # database.
+        services.do_set_member(self.b, "dana", "reviewer")
+        for user, most in itertools.product((self.rachel, self.bob, self.dana), (100, 1)):
+            self.login(user)
+            for template in FILTERS:
+                query = self.query(template, "recent")
+                expected = oracle(user, query)
+                with self.subTest(user=user.username, query=query, most=most), \
+                        mock.patch.object(segments, "MAX_MERGED_RUNS", most):
+                    assert self.pages(query, 7) == expected
+                    body = self.client.get(f"/api/segments/?{query}&page_size=7").json()
+                    assert body["count"] == len(expected)
+
     def test_by_label_it_follows_a_renamed_label_at_once(self):
         self.login(self.rachel)
         query = self.query("project={a}", "label")
@@ -141,7 +162,8 @@ class ListPagesTest(LibraryTestCase):
             self.skipTest("SQLite only: PostgreSQL's list indexes INCLUDE the filtered columns")
         from importlib import import_module
 
-        wanted = import_module("segmentation.migrations.0020_library_list_sqlite_indexes").INDEXES
+        wanted = {**import_module("segmentation.migrations.0020_library_list_sqlite_indexes").INDEXES,
+                  **import_module("segmentation.migrations.0021_library_list_sqlite_seek_indexes").INDEXES}
         with connection.cursor() as cursor:
             cursor.execute("SELECT name FROM sqlite_master WHERE type = 'index' "
                            "AND tbl_name = 'segmentation_librarysegment'")
