@@ -3,6 +3,7 @@ a chosen environment, stopping a child process group, busy processes for a known
 and `make up`'s own script."""
 
 import contextlib
+import functools
 import importlib.util
 import os
 import shutil
@@ -92,15 +93,16 @@ def stop(proc):
 
 
 @contextlib.contextmanager
-def busy(n):
+def busy(n, nice=0):
     """``n`` processes spinning on a core (``while True: pass``) for the length of the
     block, killed at its end: a benchmark's times under a load one can state and repeat.
 
-    They run at nice 0 whatever the caller's niceness (when it may lower it), so that they
-    compete with the benchmark as ordinary requests' neighbours would.
+    They run at nice ``nice`` whatever the caller's niceness (when it may lower it): 0, the
+    default, competes with the benchmark as ordinary requests' neighbours would; 10 is
+    the service's own workers, which ``scripts/up.py`` runs at nice 10.
     """
     spinners = [subprocess.Popen([sys.executable, "-c", "while True: pass"],
-                                 preexec_fn=_nice_zero) for _ in range(n)]
+                                 preexec_fn=functools.partial(_set_nice, nice)) for _ in range(n)]
     try:
         yield spinners
     finally:
@@ -110,6 +112,6 @@ def busy(n):
             proc.wait()
 
 
-def _nice_zero():
+def _set_nice(nice):
     with contextlib.suppress(PermissionError):
-        os.setpriority(os.PRIO_PROCESS, 0, 0)
+        os.setpriority(os.PRIO_PROCESS, 0, nice)

@@ -39,11 +39,10 @@ is not in it): on a shared machine it is the steadier figure.
 """
 
 import argparse
+import contextlib
 import os
 import platform
 import statistics
-import subprocess
-import sys
 import time
 from contextlib import contextmanager
 from pathlib import Path
@@ -52,6 +51,7 @@ from unittest import mock
 import before
 import million
 import numpy as np
+from harness import busy
 
 
 def oracle_arrays(out):
@@ -143,14 +143,6 @@ def index_dir(path):
         yield
     finally:
         settings.SIMILAR_INDEX_DIR = previous
-
-
-def busy(n, seconds, nice=0):
-    """``n`` processes spinning on a core at nice ``nice``, each ending by itself after
-    ``seconds``."""
-    spin = (f"import os, time\nos.nice({nice})\nend = time.time() + {seconds}\n"
-            "while time.time() < end: pass")
-    return [subprocess.Popen([sys.executable, "-c", spin]) for _ in range(n)]
 
 
 def folder_bytes(path):
@@ -253,7 +245,8 @@ def run():
     print(f"before ({old.rev}): numpy IVF, {old_manifest['lists']:,} lists, float16, scans "
           f">= {old.similar_index.PROBE_SHARE:.1%}; {old_manifest['bytes'] / 1e6:,.0f} MB; "
           f"{old_how} in {old_built:.1f} s")
-    spinning = busy(args.busy, 3600, args.busy_nice)
+    spinning = contextlib.ExitStack()
+    spinning.enter_context(busy(args.busy, args.busy_nice))
     try:
         time.sleep(30 if args.busy else 0)  # let the load average rise
         print(f"machine: {platform.machine()}, {os.cpu_count()} cores shared with other work, "
@@ -333,9 +326,7 @@ def run():
                 with index_dir(folders[title]):
                     module.update(project)
     finally:
-        for proc in spinning:
-            proc.kill()
-            proc.wait()
+        spinning.close()
     print(f"\nworst: now p95 {p95(rows['now']):.1f} ms (target 10 on a quiet machine, 20 at "
           f"load 4), recall@10 {np.mean(recall['now']):.3f} (target 0.99), min per query "
           f"{min(recall['now']):.1f}")
