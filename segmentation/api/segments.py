@@ -8,11 +8,13 @@
 Annotators see their own segments and gold segments; reviewers and admins everybody's.
 """
 
+import functools
 import heapq
 import itertools
 import operator
 
 from django.contrib.auth import get_user_model
+from django.db import connections
 from django.db.models import Q
 from django.http import HttpResponse, StreamingHttpResponse
 from django.urls import path
@@ -300,7 +302,7 @@ def ordered_parts(request, filters):
     runs = LibrarySegment.objects.visible_runs(request.user, int_param(request, "project", None, 1))
     if ordering == "recent":
         labels = named_labels(request) if request.query_params.get("label") else []
-        if len(labels) > 1:
+        if len(labels) > 1 and merges_runs(LibrarySegment.objects.db):
             # One run per label and visible run, merged by the database when they are few
             # enough for one compound query.
             each = [Q(project_id=project, label_id=pk) for _, pk, project in labels]
@@ -328,12 +330,26 @@ def newest_first(runs, *filters):
     ``filters``, newest first: the runs' ``UNION ALL`` when there are several, which the
     database reads as a merge of the runs, each in id order from an index (an annotator's
     own segments, and the gold ones), where ``annotator = me OR gold`` is in id order in
-    no index and would be filtered out of every segment of the projects."""
+    no index and would be filtered out of every segment of the projects.
+
+    On PostgreSQL the runs are one OR instead: over several projects its indexes give the
+    gold run in id order in none of them, so it sorts every gold row of the union (~0.1 s
+    at a million segments), where it walks the OR in id order from ``libseg_list_all``;
+    a label name several projects share is likewise one ``label_id IN`` filter there."""
     queries = [run.filter(*filters).order_by() for run in runs]
     if len(queries) < 2:
         query = queries[0] if queries else LibrarySegment.objects.none()
         return query.order_by(*ORDERINGS["recent"])
+    if not merges_runs(queries[0].db):
+        return functools.reduce(operator.or_, queries).order_by(*ORDERINGS["recent"])
     return queries[0].union(*queries[1:], all=True).order_by(*ORDERINGS["recent"])
+
+
+def merges_runs(db):
+    """Whether the list reads an annotator's runs (and a shared label name's) as a merge
+    of runs: on SQLite, whose indexes give each run in id order; not on PostgreSQL
+    (``newest_first``)."""
+    return connections[db].vendor == "sqlite"
 
 
 def segment_for(user, pk):
