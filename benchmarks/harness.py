@@ -115,3 +115,19 @@ def busy(n, nice=0):
 def _set_nice(nice):
     with contextlib.suppress(PermissionError):
         os.setpriority(os.PRIO_PROCESS, 0, nice)
+
+
+def mapped_rss(name):
+    """kB of the memory maps of files whose path ends with ``name`` resident in this
+    process: (Rss, Pss), from ``/proc/self/smaps``."""
+    rss = pss = 0
+    inside = False
+    with open("/proc/self/smaps") as fh:
+        for line in fh:
+            if "-" in line.split(" ", 1)[0]:
+                inside = line.rstrip().endswith(name)
+            elif inside and line.startswith("Rss:"):
+                rss += int(line.split()[1])
+            elif inside and line.startswith("Pss:"):
+                pss += int(line.split()[1])
+    return rss, pss

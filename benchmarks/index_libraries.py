@@ -64,21 +64,14 @@ def timed_search(search, queries, truth, k):
 MAPPED = """
 import faiss, json, sys, time, numpy as np
 path, out = sys.argv[1], sys.argv[2]
+sys.path.insert(0, sys.argv[6])
+from harness import mapped_rss
 index = faiss.read_index(path, faiss.IO_FLAG_MMAP | faiss.IO_FLAG_READ_ONLY)
 index.nprobe = int(sys.argv[3])
 q = np.load(sys.argv[4])
 for row in q:
     index.search(row[None, :], 10)
-rss = pss = 0
-inside = False
-for line in open("/proc/self/smaps"):
-    if "-" in line.split(" ", 1)[0]:
-        inside = line.rstrip().endswith(path)
-    elif inside and line.startswith("Rss:"):
-        rss += int(line.split()[1])
-    elif inside and line.startswith("Pss:"):
-        pss += int(line.split()[1])
-open(out, "w").write(json.dumps([rss, pss]))
+open(out, "w").write(json.dumps(mapped_rss(path)))
 time.sleep(float(sys.argv[5]))
 """
 
@@ -87,7 +80,7 @@ def faiss_sharing(path, nprobe, queries_path):
     """Two processes map the file and search; returns [[rss kB, pss kB]] of each."""
     outs = [tempfile.mktemp(suffix=".json") for _ in range(2)]
     procs = [subprocess.Popen([sys.executable, "-c", MAPPED, str(path), o, str(nprobe),
-                               str(queries_path), "6"]) for o in outs]
+                               str(queries_path), "6", str(REPO / "benchmarks")]) for o in outs]
     time.sleep(0.5)
     for p in procs:
         p.wait(120)

@@ -51,7 +51,7 @@ from unittest import mock
 import before
 import million
 import numpy as np
-from harness import busy
+from harness import busy, mapped_rss
 
 
 def oracle_arrays(out):
@@ -147,21 +147,6 @@ def index_dir(path):
 
 def folder_bytes(path):
     return sum(p.stat().st_size for p in Path(path).rglob("*") if p.is_file())
-
-
-def mapped_rss(name):
-    """kB of ``name``'s memory map resident in this process (Rss, Pss)."""
-    rss = pss = 0
-    inside = False
-    with open("/proc/self/smaps") as fh:
-        for line in fh:
-            if "-" in line.split(" ", 1)[0]:
-                inside = line.rstrip().endswith(name)
-            elif inside and line.startswith("Rss:"):
-                rss += int(line.split()[1])
-            elif inside and line.startswith("Pss:"):
-                pss += int(line.split()[1])
-    return rss, pss
 
 
 def p95(times):
