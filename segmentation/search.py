@@ -77,8 +77,14 @@ def shown(row):
     """``Shown`` from a candidate row of ``similar_index`` (id, capture, start, stop,
     descriptor, *SHOWN)."""
     pk, capture_id, start, stop, _ = row[:5]
-    f = dict(zip(similar_index.SHOWN, row[5:], strict=True))
-    return Shown(pk, {
+    return Shown(pk, api_fields(pk, capture_id, start, stop, row[5:]))
+
+
+def api_fields(pk, capture_id, start, stop, columns):
+    """What the API shows of a segment (``SegmentSerializer``'s fields) from its id,
+    capture, frames and its ``similar_index.SHOWN`` columns."""
+    f = dict(zip(similar_index.SHOWN, columns, strict=True))
+    return {
         "id": pk, "project": f["project_id"],
         "capture": {"id": capture_id, "name": f["capture__name"]}, "review": f["review_id"],
         "annotator": ({"id": f["annotator_id"], "username": f["annotator__username"]}
@@ -87,7 +93,7 @@ def shown(row):
         "color": f["label__color"] if f["label_id"] else "#888888", "start": start,
         "stop": stop, "fps": float(f["capture__fps"]), "duration": float(f["duration"]),
         "agreement": None if f["agreement"] is None else float(f["agreement"]),
-        "export_formats": exports.formats_for(SimpleNamespace(format=f["capture__format"]))})
+        "export_formats": exports.formats_for(SimpleNamespace(format=f["capture__format"]))}
 
 
 def exact_shortlist(query, pool, n):

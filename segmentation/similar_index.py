@@ -322,8 +322,8 @@ def _candidates_or_newer(pool, ids, project_id, after):
                                                    *SHOWN))
 
 
-# The columns of a segment and its capture, annotator and label that a search result shows
-# (``search.shown`` makes the rows the serializer reads from them).
+# The columns of a segment and its capture, annotator and label that a search result and a
+# library list row show (``search.api_fields`` makes the API fields from them).
 SHOWN = ("project_id", "review_id", "annotator_id", "is_gold", "superseded", "label_id",
          "duration", "agreement", "capture__name", "capture__fps", "capture__format",
          "annotator__username", "label__name", "label__color")

@@ -210,9 +210,7 @@ def page_rows(ids):
     """The API fields of segments ``ids``, in that order (one deleted since its id was
     read is left out)."""
     rows = LibrarySegment.objects.filter(pk__in=ids).values_list(*PAGE_COLUMNS)
-    # ``search.shown`` reads a similar-search candidate row: a descriptor fifth, which a
-    # list row has not.
-    found = {row[0]: search.shown(row[:4] + (None,) + row[4:]).data for row in rows}
+    found = {row[0]: search.api_fields(*row[:4], row[4:]) for row in rows}
     return [found[pk] for pk in ids if pk in found]
 
 

@@ -58,7 +58,7 @@ class LibrarySegmentQuerySet(models.QuerySet):
 
     def visible_in(self, project_id, user, role):
         """``visible_to`` within one project, for a ``role`` the caller has read already
-        (``role_in_project``): None sees nothing."""
+        (``with_role_of``): None sees nothing."""
         if role is None or not user.is_authenticated:
             return self.none()
         mine = self.filter(project_id=project_id)
