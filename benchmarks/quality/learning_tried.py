@@ -25,7 +25,7 @@ from contextlib import contextmanager
 import numpy as np
 
 from motionlib import metrics
-from motionlib.adapt import _learner
+from motionlib.adapt import _candidates, _learner
 
 
 def _near(model, one: dict, cuts: np.ndarray):
@@ -35,12 +35,7 @@ def _near(model, one: dict, cuts: np.ndarray):
     tol = int(round(model.tolerance_s * float(one["fps"])))
     matched = np.zeros(len(frames), dtype=bool)
     matched[metrics.match(frames, cuts, tolerance=tol)[0]] = True
-    near = np.zeros(len(frames), dtype=bool)
-    if len(cuts):
-        at = np.clip(np.searchsorted(cuts, frames), 1, len(cuts)) - 1
-        gap = np.minimum(np.abs(frames - cuts[at]),
-                         np.abs(frames - cuts[np.minimum(at + 1, len(cuts) - 1)]))
-        near = gap <= tol
+    near = _candidates._near(frames, cuts, np.ones(len(cuts)), tol) > 0
     return frames, matched, near
 
 
