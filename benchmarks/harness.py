@@ -131,3 +131,8 @@ def mapped_rss(name):
             elif inside and line.startswith("Pss:"):
                 pss += int(line.split()[1])
     return rss, pss
+
+
+def load():
+    """The load average (1, 5, 15 min) as a benchmark prints it: "1.2, 0.8, 0.5"."""
+    return ", ".join(f"{x:.1f}" for x in os.getloadavg())

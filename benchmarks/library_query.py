@@ -33,7 +33,7 @@ import time
 
 import million
 import million_sqlite
-from harness import busy
+from harness import busy, load
 
 
 def queries(ctx):
@@ -178,9 +178,6 @@ def table(ctx, args, old_view, new_view):
                   f"{statistics.median(cpu):>8.1f} {n_sql:>4}  {plan}", flush=True)
     return worst, differ
 
-
-def load():
-    return ", ".join(f"{x:.1f}" for x in os.getloadavg())
 
 if __name__ == "__main__":
     main()

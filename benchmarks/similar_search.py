@@ -51,7 +51,7 @@ from unittest import mock
 import before
 import million
 import numpy as np
-from harness import busy, mapped_rss
+from harness import busy, load, mapped_rss
 
 
 def oracle_arrays(out):
@@ -151,10 +151,6 @@ def folder_bytes(path):
 
 def p95(times):
     return statistics.quantiles(times, n=20)[-1] if len(times) > 1 else times[0]
-
-
-def load():
-    return ", ".join(f"{x:.1f}" for x in os.getloadavg())
 
 
 def ensure(module, project, folder):
