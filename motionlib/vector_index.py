@@ -19,8 +19,10 @@ reader opens a folder at a state and sees exactly those records: bytes appended 
 left by a writer that crashed, lie past its counts, and the next append overwrites them.
 So an update writes only what changed, and every process sees a consistent index.
 
-``open`` reads ``base.faiss`` memory-mapped (``IO_FLAG_MMAP | IO_FLAG_READ_ONLY``) and maps
-the delta files, so the processes of a machine share one copy in the page cache. A search
+``open`` reads ``base.faiss`` memory-mapped (``IO_FLAG_MMAP | IO_FLAG_READ_ONLY``), so the
+processes of a machine share one copy in the page cache, or with ``in_memory`` into the
+process's own memory, where a search scans its lists in under half the time (the mapped
+file's small pages cost that much); it maps the delta and payload files. A search
 asks the base's ``nprobe`` nearest lists and compares the query with every delta vector
 (the caller rebuilds the folder, retraining the centres, before the delta grows large).
 """
@@ -171,13 +173,14 @@ class VectorIndex:
     """A folder opened at a state. ``search`` finds the nearest live keys; ``keys`` lists
     them."""
 
-    def __init__(self, folder: Path, state: dict, base=None, base_ids=None):
+    def __init__(self, folder: Path, state: dict, base=None, base_ids=None, in_memory=False):
         check(folder, state)
         self.folder, self.state = folder, dict(state)
         d = state["ndim"]
         if base is None:
+            flags = 0 if in_memory else faiss.IO_FLAG_MMAP | faiss.IO_FLAG_READ_ONLY
             try:
-                base = faiss.read_index(str(folder / BASE), faiss.IO_FLAG_MMAP | faiss.IO_FLAG_READ_ONLY)
+                base = faiss.read_index(str(folder / BASE), flags)
                 base_ids = np.load(folder / BASE_IDS, mmap_mode="r")
             except (RuntimeError, OSError, ValueError) as exc:
                 raise InputError(f"{folder}: its base index cannot be read ({exc})") from exc
@@ -195,8 +198,9 @@ class VectorIndex:
         self._delta_rows = None
 
     @classmethod
-    def open(cls, folder: Path, state: dict) -> VectorIndex:
-        return cls(folder, state)
+    def open(cls, folder: Path, state: dict, in_memory: bool = False) -> VectorIndex:
+        """``in_memory``: the base read into this process's memory rather than mapped."""
+        return cls(folder, state, in_memory=in_memory)
 
     def at(self, state: dict) -> VectorIndex:
         """The same folder at a later state: the mapped base is kept, the delta re-read."""

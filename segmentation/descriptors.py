@@ -44,7 +44,12 @@ def same_kind(capture):
     point descriptor have the same width but measure different things
     (``motionlib.similarity``), so each is compared only with its own kind.
     """
-    if is_bare_points(capture):
+    return of_kind(is_bare_points(capture))
+
+
+def of_kind(bare_points):
+    """Q of the library segments described by their bare points (True) or as a body."""
+    if bare_points:
         return Q(capture__skeleton__kind="points", capture__skeleton__marker_set=None)
     # Not the negation of the above: a JSON key a skeleton lacks compares as NULL, and NOT
     # NULL keeps no row.

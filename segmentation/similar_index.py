@@ -14,7 +14,8 @@ Files, in ``settings.SIMILAR_INDEX_DIR`` (``$CUTROOM_SIMILAR_INDEX_DIR``, defaul
 - ``project_<id>.g<generation>/``: a ``motionlib.vector_index`` folder: a faiss
   inverted-file index written when the generation was built, and the keys and vectors
   added and the keys removed since, appended. Web processes map it read-only, so all of
-  them on a machine share one copy in the page cache.
+  them on a machine share one copy in the page cache, except the base's profiles, which
+  each reads into its own memory (``settings.SIMILAR_INDEX_IN_MEMORY``).
 - ``project_<id>.json``: the manifest, replaced atomically after every write: format
   version, the generation's folder, how many base, added and removed records count (the
   folder's *state*), how many vectors it holds and the highest segment id it has seen. A
@@ -57,7 +58,7 @@ from django.db.models import BinaryField, Case, F, When
 
 from motionlib import similarity, vector_index
 from motionlib.errors import InputError
-from segmentation import workers
+from segmentation import statements, workers
 from segmentation.errors import Invalid
 from segmentation.models import LibrarySegment
 
@@ -292,34 +293,54 @@ def schedule_update(project_id):
 
 
 def _candidates_or_newer(pool, ids, project_id, after):
-    """``pool``'s rows that are among ``ids`` or newer than the index file (the delta), in
-    one query: [(id, capture, start, stop, profile bytes or None, *SHOWN)]. Only the newer
-    rows carry their profile: the index holds the others' descriptors. No descriptor is
-    read here (it lives in the database's out-of-line storage, the dearest part of a
-    search's queries, and thousands of newer rows may wait for an update).
-    ``SHOWN`` is what a result shows of a segment, so the winners need no query of their own.
+    """``pool``'s rows (a ``search.Pool``) that are among ``ids`` or newer than the index
+    file (the delta), in one query: [(id, capture, start, stop, profile bytes or None,
+    *SHOWN)]. Only the newer rows carry their profile: the index holds the others'
+    descriptors. No descriptor is read here (it lives in the database's out-of-line
+    storage, the dearest part of a search's queries, and thousands of newer rows may wait
+    for an update). ``SHOWN`` is what a result shows of a segment, so the winners need no
+    query of their own.
 
-    The delta is found by row comparisons on (project, id), so that the database walks
+    The delta is found by a row comparison on (project, id), so that the database walks
     the ``libseg_described`` index from ``(project, after)`` to the project's end: with a
     plain ``project_id = p AND id > after`` PostgreSQL estimates the project's share of
     all newer rows and often prefers the primary key, then filters every newer row of
-    every project. On PostgreSQL the delta's ids are an InitPlan joined to the candidates'
+    every project. The end is ``project_id <= p``: a second row comparison,
+    ``< (p + 1, 0)``, is no bound of the scan on PostgreSQL, which then walks every entry
+    before ``(p, after)`` (~1 ms at a million). On PostgreSQL the delta's ids are an InitPlan joined to the candidates'
     as one array, so the rows themselves are one scan of the primary key (an OR of the two
-    lets the planner pick a library-list index and scan the project: ~0.5 s at a million).
+    lets the planner pick a library-list index and scan the project: ~0.5 s at a million),
+    and a ``search.Scope``'s pool is read as a prepared statement (``CANDIDATE_ROWS``).
     """
-    table = LibrarySegment._meta.db_table
-    newer = (f'SELECT u.id FROM "{table}" u WHERE u.profile IS NOT NULL AND '
-             '(u.project_id, u.id) > (%s, %s) AND (u.project_id, u.id) < (%s, 0)')
-    marks = ", ".join(["%s"] * len(ids))
+    values = {"after": after}
     if connections[pool.db].vendor == "postgresql":
-        where = f'"{table}"."id" = ANY(ARRAY[{marks}]::bigint[] || ARRAY({newer}))'
-    else:
-        where = f'("{table}"."id" IN ({marks or "NULL"}) OR "{table}"."id" IN ({newer}))'
-    fresh = Case(When(id__gt=after, then=F("profile")), default=None,
-                 output_field=BinaryField())
-    return list(pool.extra(where=[where], params=[*ids, project_id, after, project_id + 1])
-                .annotate(fresh=fresh).values_list("id", "capture_id", "start", "stop", "fresh",
-                                                   *SHOWN))
+        if pool.scoped:
+            return CANDIDATE_ROWS.rows(pool.db, pool.key, ids=ids, **values, **pool.values)
+        return list(_candidates_query(pool.key, ids=ids, visible=pool.visible, **values,
+                                      **pool.values).using(pool.db))
+    table = LibrarySegment._meta.db_table
+    where = (f'("{table}"."id" IN ({", ".join(["%s"] * len(ids)) or "NULL"}) '
+             f'OR "{table}"."id" IN ({_NEWER}))')
+    return list(pool.queryset().extra(where=[where], params=[*ids, project_id, after, project_id])
+                .annotate(fresh=_fresh(after)).values_list(*CANDIDATE_COLUMNS))
+
+
+_NEWER = (f'SELECT u.id FROM "{LibrarySegment._meta.db_table}" u WHERE u.profile IS NOT NULL AND '
+          '(u.project_id, u.id) > (%s, %s) AND u.project_id <= %s')
+
+
+def _fresh(after):
+    return Case(When(id__gt=after, then=F("profile")), default=None, output_field=BinaryField())
+
+
+def _candidates_query(key, ids, after, visible=None, **pool):
+    """``_candidates_or_newer``'s query on PostgreSQL, ``ids`` one array parameter."""
+    from segmentation.search import pool_queryset
+
+    where = f'"{LibrarySegment._meta.db_table}"."id" = ANY(%s::bigint[] || ARRAY({_NEWER}))'
+    return (pool_queryset(key, visible=visible, **pool)
+            .extra(where=[where], params=[ids, pool["project_id"], after, pool["project_id"]])
+            .annotate(fresh=_fresh(after)).values_list(*CANDIDATE_COLUMNS))
 
 
 # The columns of a segment and its capture, annotator and label that a search result and a
@@ -327,6 +348,8 @@ def _candidates_or_newer(pool, ids, project_id, after):
 SHOWN = ("project_id", "review_id", "annotator_id", "is_gold", "superseded", "label_id",
          "duration", "agreement", "capture__name", "capture__fps", "capture__format",
          "annotator__username", "label__name", "label__color")
+CANDIDATE_COLUMNS = ("id", "capture_id", "start", "stop", "fresh", *SHOWN)
+CANDIDATE_ROWS = statements.Statement(_candidates_query, lists=("ids",))
 
 
 @dataclass
@@ -400,7 +423,8 @@ def _open_checked(project_id, previous=None):
             return OpenIndex(project_id, manifest, previous.index.at(state))
         if not state.get("payload"):
             raise IndexUnusable(f"{manifest['file']}: holds no descriptors")
-        index = vector_index.VectorIndex.open(folder_of(manifest), state)
+        index = vector_index.VectorIndex.open(folder_of(manifest), state,
+                                              in_memory=settings.SIMILAR_INDEX_IN_MEMORY)
         if state["base"] + state["delta"] - state["removed"] != manifest["count"]:
             raise IndexUnusable(f"{manifest['file']}: holds {state['base']} + {state['delta']}"
                                 f" - {state['removed']} vectors, the manifest says "
@@ -435,10 +459,10 @@ def shortlist(index, query, pool, n):
     first, as the exact scan orders them (ties: newest first; one span once), as
     ``[(id, descriptor, row)]``, ``row`` the candidate's columns (``_candidates_or_newer``).
 
-    ``pool`` is the caller's visible, filtered queryset; the index proposes candidates
-    and ``pool`` decides which exist and may be shown. Returns None when even
-    ``MAX_CANDIDATES`` candidates leave fewer than ``n`` (a very selective filter): the
-    caller then scans exactly.
+    ``pool`` (a ``search.Pool``) is what the caller may see of the project; the index
+    proposes candidates and ``pool`` decides which exist and may be shown. Returns None
+    when even ``MAX_CANDIDATES`` candidates leave fewer than ``n`` (a very selective
+    filter): the caller then scans exactly.
     """
     vector = np.asarray(query[:similarity.PROFILE_ROWS], dtype=np.float32).ravel()
     count = max(CANDIDATES * n, MIN_CANDIDATES)

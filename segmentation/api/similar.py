@@ -11,8 +11,9 @@ from rest_framework.views import APIView
 from segmentation import search
 from segmentation.api.params import int_param
 from segmentation.api.segments import SegmentSerializer
-from segmentation.models import LibrarySegment
+from segmentation.models import Capture, LibrarySegment
 from segmentation.models.library import STAFF, own
+from segmentation.statements import Statement
 
 
 class SimilarSegmentSerializer(SegmentSerializer):
@@ -27,27 +28,41 @@ class SimilarSerializer(serializers.Serializer):
     results = SimilarSegmentSerializer(many=True, help_text="Nearest first")
 
 
+def _segment_query(key, pk, user_id):
+    """The segment a search starts from, with the caller's role in its project, if that
+    role shows it to them."""
+    return (LibrarySegment.objects.with_role_of(user_id).filter(pk=pk)
+            .filter(Q(role__in=STAFF) | Q(role__isnull=False) & own(user_id))
+            .values_list("project_id", "capture_id", "start", "stop", "descriptor",
+                         "descriptor_shape", "capture__skeleton", "role"))
+
+
+# One query reads the segment, the user's role in its project and whether that role shows
+# it (a prepared statement on PostgreSQL: ``segmentation.statements``).
+SEGMENT = Statement(_segment_query)
+
+
 class SimilarView(APIView):
     @extend_schema(responses=SimilarSerializer, parameters=[OpenApiParameter("k", int)])
     def get(self, request, pk):
         k = int_param(request, "k", 10, 1, 100)
         user = request.user
-        # One query reads the segment, the user's role in its project and whether that
-        # role shows it; the role then decides which clips it may be compared with.
-        segment = (LibrarySegment.objects.with_role_of(user).select_related("capture")
-                   .only(*search.QUERY_FIELDS).filter(pk=pk)
-                   .filter(Q(role__in=STAFF) | Q(role__isnull=False) & own(user)).first())
-        if segment is None:
+        found = SEGMENT.rows(LibrarySegment.objects.db, None, pk=pk, user_id=user.pk)
+        if not found:
             raise NotFound("No such segment.")
-        visible = LibrarySegment.objects.visible_in(segment.project_id, user, segment.role)
+        project_id, capture_id, start, stop, descriptor, shape, skeleton, role = found[0]
+        segment = LibrarySegment(pk=pk, project_id=project_id, start=start, stop=stop,
+                                 descriptor=descriptor, descriptor_shape=shape)
+        segment.capture = Capture(pk=capture_id, skeleton=skeleton)
+        # The role then decides which clips it may be compared with.
         results = []
-        for s, d in search.similar(segment, visible.preferred(), k=k):
+        for s, d in search.similar(segment, search.Scope(user.pk, role), k=k):
             if isinstance(s, search.Shown):
                 results.append({**s.data, "distance": round(d, 4)})
             else:
                 s.distance = round(d, 4)
                 results.append(SimilarSegmentSerializer(s).data)
-        return Response({"segment": segment.pk, "results": results})
+        return Response({"segment": pk, "results": results})
 
 
 urlpatterns = [

@@ -30,7 +30,7 @@ STAFF = ("reviewer", "admin")
 
 def own(user):
     """Q of an annotator's own segments and the gold ones (``is_gold__in``: see
-    ``segmentation.api.segments.segment_filters``)."""
+    ``segmentation.api.segments.segment_filters``); ``user`` or their id."""
     return Q(annotator=user) | Q(is_gold__in=[True])
 
 
@@ -56,19 +56,19 @@ class LibrarySegmentQuerySet(models.QuerySet):
         staff, annotating = projects_by_role(user)
         return self.filter(Q(project_id__in=staff) | Q(project_id__in=annotating) & own(user))
 
-    def visible_in(self, project_id, user, role):
-        """``visible_to`` within one project, for a ``role`` the caller has read already
-        (``with_role_of``): None sees nothing."""
-        if role is None or not user.is_authenticated:
+    def visible_in(self, project_id, user_id, role):
+        """``visible_to`` within one project, for the ``role`` user ``user_id`` has there,
+        read already (``with_role_of``): None sees nothing."""
+        if role is None:
             return self.none()
         mine = self.filter(project_id=project_id)
-        return mine if role in STAFF else mine.filter(own(user))
+        return mine if role in STAFF else mine.filter(own(user_id))
 
-    def with_role_of(self, user):
-        """Each segment annotated with ``role``: ``user``'s role in its project, or None.
-        With ``visible_in`` it reads a segment and decides what its project shows the user
-        in one query (``visible_to`` reads the user's memberships first)."""
-        roles = Membership.objects.filter(project_id=OuterRef("project_id"), user_id=user.pk)
+    def with_role_of(self, user_id):
+        """Each segment annotated with ``role``: user ``user_id``'s role in its project, or
+        None. With ``visible_in`` it reads a segment and decides what its project shows the
+        user in one query (``visible_to`` reads the user's memberships first)."""
+        roles = Membership.objects.filter(project_id=OuterRef("project_id"), user_id=user_id)
         return self.annotate(role=Subquery(roles.values("role")[:1]))
 
     def visible_runs(self, user, project=None):

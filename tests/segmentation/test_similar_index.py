@@ -5,6 +5,7 @@ its file is lost."""
 from unittest import mock
 
 import numpy as np
+import pytest
 from django.core.management import call_command
 from django.db import connection
 from django.test.utils import CaptureQueriesContext
@@ -13,7 +14,7 @@ import motionlib
 from motionlib import similarity, synth, vector_index
 from motionlib.vector_index import VectorIndex
 from segmentation import descriptors, search, services, similar_index, tasks
-from segmentation.models import LibrarySegment
+from segmentation.models import Capture, LibrarySegment
 from tests.segmentation.base import BaseTestCase
 from tests.segmentation.test_library import submit_review
 
@@ -166,6 +167,64 @@ class AccessTest(SimilarIndexTestCase):
             LibrarySegment.objects.filter(pk=self.bobs[1].pk).delete()
             assert self.status(self.bobs[1], self.rachel) == 404
         self.both_paths(check)
+
+
+def needs_postgres():
+    if connection.vendor != "postgresql":
+        pytest.skip("needs PostgreSQL: DATABASE_URL=postgres://… (make pytest sets it)")
+
+
+@pytest.mark.integration
+class PostgresAccessTest(AccessTest):
+    """The same refusals on PostgreSQL, where the view reads through compiled statements
+    (``segmentation.statements``)."""
+
+    def setUp(self):
+        needs_postgres()
+        super().setUp()
+
+
+@pytest.mark.integration
+class PostgresStatementPathTest(SimilarIndexTestCase):
+    """On PostgreSQL the view reads its segment and the candidates through statements
+    compiled once per role and kind; it finds what the queryset path finds, for each role,
+    with segments newer than the index, and with takes of bare points beside bodies."""
+
+    def setUp(self):
+        needs_postgres()
+        super().setUp()
+
+    def test_the_view_finds_what_the_queryset_path_finds(self):
+        bobs = self.add_segments(self.spans[:120], self.descs[:120])
+        alices = self.add_segments(self.spans[120:240], self.descs[120:240], annotator=self.alice)
+        LibrarySegment.objects.filter(pk__in=[r.pk for r in alices[1::4]]).update(
+            is_gold=True, annotator=None)
+        similar_index.build(self.project.pk)
+        similar_index.forget()
+        newer = self.add_segments(self.spans[240:], self.descs[240:])
+        # The newest take is one of bare points: compared with its own kind only.
+        Capture.objects.filter(pk=newer[0].capture_id).update(
+            skeleton={"kind": "points", "marker_set": None, "points": []})
+        queries = [bobs[0], bobs[50], alices[0], newer[0], newer[30]]
+        seen = 0
+        for user in (self.rachel, self.bob, self.alice):
+            self.login(user)
+            visible = LibrarySegment.objects.visible_to(user).preferred()
+            for query in queries:
+                response = self.client.get(f"/api/segments/{query.pk}/similar/?k=12")
+                if not visible.filter(pk=query.pk).exists():
+                    assert response.status_code == 404
+                    continue
+                query = LibrarySegment.objects.select_related("capture").get(pk=query.pk)
+                expected = [(s.pk, round(d, 4)) for s, d in search.similar(query, visible, k=12)]
+                found = [(r["id"], r["distance"]) for r in response.json()["results"]]
+                assert found == expected, (user.username, query.pk)
+                assert found
+                seen += 1
+                kinds = {query.capture_id == newer[0].capture_id}
+                assert {LibrarySegment.objects.get(pk=pk).capture_id == newer[0].capture_id
+                        for pk, _ in found} == kinds
+        assert seen == 14  # bob may not see alice's segment; the rest are answered
 
 
 class QueryCountTest(SimilarIndexTestCase):

@@ -1,0 +1,77 @@
+"""Statements: a queryset compiled once per shape reads, with new values, what the queryset
+itself reads, and one whose SQL would depend on a value is refused when it is compiled."""
+
+from unittest import mock
+
+import pytest
+from django.db import connection
+
+from segmentation.models import LibrarySegment
+from segmentation.statements import Statement
+from tests.segmentation.base import BaseTestCase
+
+
+def segments(key, project_id, start):
+    """The statement's queryset: ``key`` says whether gold rows only are read."""
+    found = LibrarySegment.objects.filter(project_id=project_id, start__gte=start)
+    if key == "gold":
+        found = found.filter(is_gold__in=[True])
+    return found.order_by("id").values_list("id", "is_gold", "capture__skeleton", "start", "agreement")
+
+
+class StatementTest(BaseTestCase):
+    def setUp(self):
+        super().setUp()
+        capture = self.ready_capture(name="a.bvh", n_frames=2000)
+        self.rows = LibrarySegment.objects.bulk_create(
+            LibrarySegment(project=self.project, capture=capture, label=self.walk, start=start,
+                           stop=start + 50, duration=50 / 120, is_gold=start % 200 == 0,
+                           annotator=None if start % 200 == 0 else self.bob,
+                           agreement=None if start == 100 else 0.5)
+            for start in range(0, 1000, 100))
+
+    def test_it_reads_what_the_queryset_reads(self):
+        statement = Statement(segments)
+        for key in ("all", "gold"):
+            for project_id, start in ((self.project.pk, 0), (self.project.pk, 450),
+                                      (self.other_project.pk, 0), (self.project.pk, 5000)):
+                expected = list(segments(key, project_id, start))
+                found = statement.rows("default", key, project_id=project_id, start=start)
+                assert found == expected, (key, project_id, start)
+        # The columns come as the queryset gives them: booleans, parsed JSON, None.
+        row = statement.rows("default", "all", project_id=self.project.pk, start=0)[1]
+        assert row[1] is False and isinstance(row[2], dict) and row[4] is None
+
+    def test_it_compiles_each_shape_once(self):
+        built = mock.Mock(side_effect=segments)
+        statement = Statement(built)
+        for start in (0, 300, 600):
+            statement.rows("default", "all", project_id=self.project.pk, start=start)
+        assert built.call_count == 2  # twice, with two sets of stand-ins
+        statement.rows("default", "gold", project_id=self.project.pk, start=0)
+        assert built.call_count == 4
+
+    def test_it_refuses_sql_that_changes_with_a_value(self):
+        def inlined(key, project_id, start):
+            return (LibrarySegment.objects.filter(project_id=project_id)
+                    .extra(where=[f"start >= {start}"]).values_list("id"))
+
+        with pytest.raises(ValueError, match="changes with its values"):
+            Statement(inlined).rows("default", None, project_id=self.project.pk, start=0)
+
+    def test_it_refuses_a_value_it_does_not_pass_on(self):
+        def ignores(key, project_id, start):
+            return LibrarySegment.objects.filter(project_id=project_id).values_list("id")
+
+        with pytest.raises(ValueError, match=r"does not use \['start'\]"):
+            Statement(ignores).rows("default", None, project_id=self.project.pk, start=0)
+
+
+@pytest.mark.integration
+class PostgresStatementTest(StatementTest):
+    """The same on PostgreSQL, where Django passes some integers typed and JSON as text."""
+
+    def setUp(self):
+        if connection.vendor != "postgresql":
+            pytest.skip("needs PostgreSQL: DATABASE_URL=postgres://… (make pytest sets it)")
+        super().setUp()
