@@ -156,8 +156,12 @@ def vacuum():
             cursor.execute("VACUUM (INDEX_CLEANUP ON) segmentation_librarysegment")
 
 
-def folder_bytes(path):
-    return sum(p.stat().st_size for p in Path(path).rglob("*") if p.is_file())
+def appended_bytes(old, new):
+    """Bytes an append wrote, from the states before and after it: each added segment's
+    key, vector and descriptor, each removed one's key (the files may hold bytes past
+    the old state's counts, which an append overwrites: their sizes do not tell)."""
+    added, removed = new["delta"] - old["delta"], new["removed"] - old["removed"]
+    return added * (8 + 4 * new["ndim"] + 4 * new["payload"]) + removed * 8
 
 
 def p95(times):
@@ -319,14 +323,13 @@ def run():
                 print(f"  {title:<28} median {statistics.median(times):6.1f} ms, p95 {p95(times):6.1f} ms")
             print("updates that take them in:")
             for title, module in (("now", similar_index), (f"before ({old.rev})", old.similar_index)):
-                size = folder_bytes(folders[title])
                 with index_dir(folders[title]):
-                    first = module.read_manifest(project)["file"]
+                    first = module.read_manifest(project)
                     started = time.perf_counter()
                     after = module.update(project)
                     took = time.perf_counter() - started
-                appended = after["file"] == first
-                written = folder_bytes(folders[title]) - size if appended else after["bytes"]
+                appended = after["file"] == first["file"]
+                written = appended_bytes(first["state"], after["state"]) if appended else after["bytes"]
                 print(f"  {title:<28} {took:6.1f} s, wrote {written / 1e6:8.1f} MB "
                       f"({'appended' if appended else 'a new generation of the whole index'})")
         finally:
