@@ -46,7 +46,6 @@ import platform
 import statistics
 import time
 from contextlib import contextmanager
-from pathlib import Path
 from unittest import mock
 
 import before
