@@ -116,10 +116,9 @@ class Shown:
 
 
 def shown(row):
-    """``Shown`` from a candidate row of ``similar_index`` (id, capture, start, stop,
-    descriptor, *SHOWN)."""
-    pk, capture_id, start, stop, _ = row[:5]
-    return Shown(pk, api_fields(pk, capture_id, start, stop, row[5:]))
+    """``Shown`` from a candidate row of ``similar_index`` (``CANDIDATE_COLUMNS``)."""
+    pk, capture_id, start, stop = row[:4]
+    return Shown(pk, api_fields(pk, capture_id, start, stop, row[6:]))
 
 
 def api_fields(pk, capture_id, start, stop, columns):

@@ -24,9 +24,9 @@ Files, in ``settings.SIMILAR_INDEX_DIR`` (``$CUTROOM_SIMILAR_INDEX_DIR``, defaul
 
 Staying in step with the database (which is the truth):
 
-- Segments newer than the manifest's ``max_id`` (the *delta*) are read with each
-  search's candidates, in the same query, and measured exactly, so a search never waits
-  for the index.
+- Segments newer than the manifest's ``max_id`` (the *delta*) are read by each process
+  once, after a search's candidates query has reported them, and measured exactly with
+  every search (``OpenIndex``), so a search never waits for the index.
 - ``update`` (a Celery task queued when library rows change, and run by
   ``manage.py similar_index``) compares the index's keys with the database's ids and
   appends the difference: it writes the added vectors and removed keys, not the index.
@@ -48,13 +48,14 @@ import shutil
 import threading
 import time
 from contextlib import contextmanager
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 from django.conf import settings
 from django.db import connections, transaction
-from django.db.models import BinaryField, Case, F, When
+from django.db.models import BigIntegerField, BinaryField, Case, F, When
+from django.db.models.expressions import RawSQL
 
 from motionlib import similarity, vector_index
 from motionlib.errors import InputError
@@ -293,24 +294,27 @@ def schedule_update(project_id):
 
 
 def _candidates_or_newer(pool, ids, project_id, after):
-    """``pool``'s rows (a ``search.Pool``) that are among ``ids`` or newer than the index
-    file (the delta), in one query: [(id, capture, start, stop, profile bytes or None,
-    *SHOWN)]. Only the newer rows carry their profile: the index holds the others'
-    descriptors. No descriptor is read here (it lives in the database's out-of-line
-    storage, the dearest part of a search's queries, and thousands of newer rows may wait
-    for an update). ``SHOWN`` is what a result shows of a segment, so the winners need no
-    query of their own.
+    """``pool``'s rows (a ``search.Pool``) that are among ``ids`` or newer than ``after``
+    (the last segment id of the delta this process has read), in one query: [(id,
+    capture, start, stop, profile bytes or None, newest, *SHOWN)]. Only the rows newer
+    than ``after`` carry their profile: the others were measured already. ``newest`` is
+    the id of the project's newest described segment, whatever the caller may see (the
+    next search reads the delta up to it: ``OpenIndex.take_newer``). No descriptor is
+    read here (it lives in the database's out-of-line storage, the dearest part of a
+    search's queries). ``SHOWN`` is what a result shows of a segment, so the winners need
+    no query of their own.
 
-    The delta is found by a row comparison on (project, id), so that the database walks
-    the ``libseg_described`` index from ``(project, after)`` to the project's end: with a
-    plain ``project_id = p AND id > after`` PostgreSQL estimates the project's share of
-    all newer rows and often prefers the primary key, then filters every newer row of
-    every project. The end is ``project_id <= p``: a second row comparison,
-    ``< (p + 1, 0)``, is no bound of the scan on PostgreSQL, which then walks every entry
-    before ``(p, after)`` (~1 ms at a million). On PostgreSQL the delta's ids are an InitPlan joined to the candidates'
-    as one array, so the rows themselves are one scan of the primary key (an OR of the two
-    lets the planner pick a library-list index and scan the project: ~0.5 s at a million),
-    and a ``search.Scope``'s pool is read as a prepared statement (``CANDIDATE_ROWS``).
+    The newer rows are found by a row comparison on (project, id), so that the database
+    walks the ``libseg_described`` index from ``(project, after)`` to the project's end:
+    with a plain ``project_id = p AND id > after`` PostgreSQL estimates the project's
+    share of all newer rows and often prefers the primary key, then filters every newer
+    row of every project. The end is ``project_id <= p``: a second row comparison,
+    ``< (p + 1, 0)``, bounds no scan on PostgreSQL 15, which then reads ~80 index pages
+    to find nothing (~1 ms at a million). On PostgreSQL the newer ids are an InitPlan
+    joined to the candidates' as one array, so the rows themselves are one scan of the
+    primary key (an OR of the two lets the planner pick a library-list index and scan the
+    project: ~0.5 s at a million), and a ``search.Scope``'s pool is read through a
+    statement compiled once (``CANDIDATE_ROWS``).
     """
     values = {"after": after}
     if connections[pool.db].vendor == "postgresql":
@@ -322,7 +326,8 @@ def _candidates_or_newer(pool, ids, project_id, after):
     where = (f'("{table}"."id" IN ({", ".join(["%s"] * len(ids)) or "NULL"}) '
              f'OR "{table}"."id" IN ({_NEWER}))')
     return list(pool.queryset().extra(where=[where], params=[*ids, project_id, after, project_id])
-                .annotate(fresh=_fresh(after)).values_list(*CANDIDATE_COLUMNS))
+                .annotate(fresh=_fresh(after), newest=_newest(project_id))
+                .values_list(*CANDIDATE_COLUMNS))
 
 
 _NEWER = (f'SELECT u.id FROM "{LibrarySegment._meta.db_table}" u WHERE u.profile IS NOT NULL AND '
@@ -333,6 +338,13 @@ def _fresh(after):
     return Case(When(id__gt=after, then=F("profile")), default=None, output_field=BinaryField())
 
 
+def _newest(project_id):
+    """The id of the project's newest described segment, read once per query."""
+    return RawSQL(f'(SELECT u.id FROM "{LibrarySegment._meta.db_table}" u WHERE u.profile IS NOT NULL'
+                  ' AND u.project_id = %s ORDER BY u.project_id DESC, u.id DESC LIMIT 1)',
+                  [project_id], output_field=BigIntegerField())
+
+
 def _candidates_query(key, ids, after, visible=None, **pool):
     """``_candidates_or_newer``'s query on PostgreSQL, ``ids`` one array parameter."""
     from segmentation.search import pool_queryset
@@ -340,7 +352,8 @@ def _candidates_query(key, ids, after, visible=None, **pool):
     where = f'"{LibrarySegment._meta.db_table}"."id" = ANY(%s::bigint[] || ARRAY({_NEWER}))'
     return (pool_queryset(key, visible=visible, **pool)
             .extra(where=[where], params=[ids, pool["project_id"], after, pool["project_id"]])
-            .annotate(fresh=_fresh(after)).values_list(*CANDIDATE_COLUMNS))
+            .annotate(fresh=_fresh(after), newest=_newest(pool["project_id"]))
+            .values_list(*CANDIDATE_COLUMNS))
 
 
 # The columns of a segment and its capture, annotator and label that a search result and a
@@ -348,22 +361,36 @@ def _candidates_query(key, ids, after, visible=None, **pool):
 SHOWN = ("project_id", "review_id", "annotator_id", "is_gold", "superseded", "label_id",
          "duration", "agreement", "capture__name", "capture__fps", "capture__format",
          "annotator__username", "label__name", "label__color")
-CANDIDATE_COLUMNS = ("id", "capture_id", "start", "stop", "fresh", *SHOWN)
+CANDIDATE_COLUMNS = ("id", "capture_id", "start", "stop", "fresh", "newest", *SHOWN)
 CANDIDATE_ROWS = statements.Statement(_candidates_query, lists=("ids",))
 
 
 @dataclass
 class OpenIndex:
-    """A project's index as this process sees it: its manifest and the mapped folder.
+    """A project's index as this process sees it: its manifest and the mapped folder, and
+    the segments newer than the index (the *delta*) that this process has read.
 
-    Segments newer than the index (the *delta*) are not cached here: every search reads
-    them from the database in the same query as its candidates (``shortlist``), filtered
-    by what the caller may see, so a search costs no query of its own for freshness."""
+    The delta's profiles are read once per process (``take_newer``), all of them,
+    whatever a caller may see, and each search compares its query with them as with the
+    index's: the nearest are candidates like the index's, and the database decides which
+    of them exist and may be shown. Each search's candidates query reports the project's
+    newest described segment, and the rows newer than what was read come with their
+    profiles in that query, so a search costs no query of its own for freshness; the
+    next one reads them into the delta. A segment that commits after a newer one was read
+    is missed until the index's next update, which its commit queues."""
 
     project_id: int
     manifest: dict
     index: object
     update_queued: bool = False
+    # (mark, ids, profiles): the delta as read, up to segment id ``mark``.
+    newer: tuple = None
+    _lock: object = field(default_factory=threading.Lock)
+
+    def __post_init__(self):
+        if self.newer is None:
+            self.newer = (self.manifest["max_id"], np.zeros(0, dtype=np.int64),
+                          np.zeros((0, self.index.ndim), dtype=np.float32))
 
     def nearest(self, vector, count):
         """Up to ``count`` segment ids of the index nearest to a profile vector, nearest
@@ -371,9 +398,42 @@ class OpenIndex:
         since the last update."""
         return self.index.search(vector, count)
 
+    def nearest_newer(self, vector, count):
+        """(mark, ids, distances, held): up to ``count`` of the delta's segments nearest to
+        ``vector``, their squared distances in float64 (as the exact scan measures), and
+        how many the delta holds; ``mark`` the last segment id read."""
+        mark, ids, profiles = self.newer
+        if not len(ids):
+            return mark, ids, np.zeros(0), 0
+        diff = profiles.astype(np.float64) - np.asarray(vector, dtype=np.float64)
+        d = np.einsum("ij,ij->i", diff, diff)
+        near = np.argsort(d, kind="stable")[:count] if len(d) <= count else \
+            np.argpartition(d, count - 1)[:count]
+        return mark, ids[near], d[near], len(ids)
+
+    def take_newer(self, db, newest):
+        """Read the profiles of the project's described segments after the mark, up to id
+        ``newest``, into the delta."""
+        with self._lock:
+            mark, ids, profiles = self.newer
+            if newest is None or newest <= mark:
+                return
+            table = LibrarySegment._meta.db_table
+            with connections[db].cursor() as cursor:
+                cursor.execute(f'SELECT u.id, u.profile FROM "{table}" u WHERE u.profile IS NOT NULL'
+                               ' AND (u.project_id, u.id) > (%s, %s) AND u.project_id <= %s'
+                               ' AND u.id <= %s ORDER BY u.id',
+                               [self.project_id, mark, self.project_id, newest])
+                rows = [(pk, bytes(blob)) for pk, blob in cursor.fetchall()]
+            # A profile of another width is left out, as the index leaves it (``update``).
+            rows = [(pk, blob) for pk, blob in rows if len(blob) == 4 * self.index.ndim]
+            added = np.frombuffer(b"".join(blob for _, blob in rows), dtype="<f4")
+            self.newer = (newest, np.concatenate([ids, np.array([pk for pk, _ in rows], dtype=np.int64)]),
+                          np.concatenate([profiles, added.reshape(len(rows), self.index.ndim)]))
+
     def note_delta(self, newer):
         """Queue an update (once per manifest) when ``newer`` segments outnumber
-        ``DELTA_LIMIT``: every search reads them."""
+        ``DELTA_LIMIT``: every search compares its query with them."""
         if newer > DELTA_LIMIT and not self.update_queued:
             self.update_queued = True
             schedule_update(self.project_id)
@@ -466,14 +526,17 @@ def shortlist(index, query, pool, n):
     """
     vector = np.asarray(query[:similarity.PROFILE_ROWS], dtype=np.float32).ravel()
     count = max(CANDIDATES * n, MIN_CANDIDATES)
-    after = index.manifest["max_id"]
     while True:
         candidates, distances = index.nearest(vector, count)
-        rows = _candidates_or_newer(pool, [int(c) for c in candidates], index.project_id, after)
-        index.note_delta(sum(r[0] > after for r in rows))
+        mark, newer, newer_distances, held = index.nearest_newer(vector, count)
+        rows = _candidates_or_newer(pool, [*candidates.tolist(), *newer.tolist()],
+                                    index.project_id, mark)
+        index.take_newer(pool.db, rows[0][5] if rows else newest_id(pool.db, index.project_id))
+        index.note_delta(held + sum(r[0] > mark for r in rows))
         measured = dict(zip(candidates.tolist(), distances.tolist(), strict=True))
+        measured.update(zip(newer.tolist(), newer_distances.tolist(), strict=True))
         found = nearest_unique(rows, query, n, measured, index.descriptors)
-        exhausted = len(candidates) < count and count >= index.size
+        exhausted = (len(candidates) < count and count >= index.size) and len(newer) == held
         if len(found) >= n or exhausted:
             return found
         if count >= MAX_CANDIDATES:
@@ -481,15 +544,22 @@ def shortlist(index, query, pool, n):
         count *= GROW
 
 
+def newest_id(db, project_id):
+    """The id of the project's newest described segment (None: it has none)."""
+    return described(project_id).using(db).order_by("-id").values_list("id", flat=True).first()
+
+
 def nearest_unique(rows, query, n, measured, stored):
     """The exact scan's order over ``rows`` (id, capture, start, stop, profile bytes or
     None, ...): the ``n`` nearest by profile distance, one row per span (its newest), as
     ``[(id, descriptor, row)]``.
 
-    A row without a profile is the index's: its distance is ``measured[id]`` (what the
-    index computed, in float32) and its descriptor comes from ``stored(ids)``; the newer
-    rows are measured here and their descriptors read in one query, for the shortlisted
-    ones only (a descriptor is 4.9 kB; a profile 420 bytes). Invalid when a stored
+    Every distance is measured as the exact scan measures it (float64), so that ties
+    (the same motion in two takes) fall as they do there: a row with a profile from the
+    profile, one the index holds from its stored descriptor (``stored(ids)``: the profile
+    is its first rows), any other from ``measured`` (the delta's, in float64). The
+    descriptors the index does not hold are read in one query, for the shortlisted rows
+    only (a descriptor is 4.9 kB; a profile 420 bytes). Invalid when a profile or a stored
     descriptor is not of the query's shape (a library described by another version)."""
     rows = [r for r in rows if r[4] is not None or r[0] in measured]
     if not rows:
@@ -502,7 +572,16 @@ def nearest_unique(rows, query, n, measured, stored):
             unique.append(row)
     width = similarity.PROFILE_ROWS * query.shape[1]
     q = np.asarray(query[:similarity.PROFILE_ROWS], dtype=float).ravel()
+    read = stored([r[0] for r in unique if r[4] is None])
+    for descriptor in read.values():
+        if descriptor.size != query.size:
+            raise Invalid(f"library descriptors have {descriptor.size} numbers, the query's "
+                          f"{query.shape[0]} x {query.shape[1]}; rebuild the library")
     d = np.array([measured.get(r[0], np.nan) for r in unique])
+    held = [i for i, r in enumerate(unique) if r[4] is None and r[0] in read]
+    if held:
+        diff = np.stack([read[unique[i][0]][:width] for i in held]) - q
+        d[held] = np.einsum("ij,ij->i", diff, diff)
     fresh = [i for i, r in enumerate(unique) if r[4] is not None]
     if fresh:
         blobs = [bytes(unique[i][4]) for i in fresh]
@@ -512,8 +591,7 @@ def nearest_unique(rows, query, n, measured, stored):
         diff = np.frombuffer(b"".join(blobs), dtype="<f4").reshape(len(fresh), width) - q
         d[fresh] = np.einsum("ij,ij->i", diff, diff)
     chosen = [unique[i] for i in np.argsort(d, kind="stable")[:n]]
-    read = stored([r[0] for r in chosen if r[4] is None])
-    newer = [r[0] for r in chosen if r[4] is not None]
+    newer = [r[0] for r in chosen if r[0] not in read]
     if newer:
         read.update((pk, np.frombuffer(bytes(blob), dtype="<f4")) for pk, blob in
                     LibrarySegment.objects.filter(pk__in=newer).values_list("id", "descriptor"))

@@ -253,6 +253,25 @@ class IncrementalTest(SimilarIndexTestCase):
         assert found[0] == (twin.pk, 0.0)
         assert similar_index.read_manifest(self.project.pk)["max_id"] < twin.pk
 
+    def test_a_process_reads_the_newer_segments_once_for_every_caller(self):
+        rows = self.add_segments(self.spans[:200], self.descs[:200])
+        similar_index.build(self.project.pk)
+        # Twins of the first 20, newer than the index, alice's: bob may not see them.
+        twins = self.add_segments(self.spans[:20], self.descs[:20], annotator=self.alice)
+        bobs = LibrarySegment.objects.visible_to(self.bob).preferred()
+        found = search.similar(rows[0], bobs, k=10)
+        assert len(found) == 10 and not {s.pk for s, _ in found} & {r.pk for r in twins}
+        opened = similar_index.open_index(self.project.pk)
+        assert set(opened.newer[1].tolist()) == {r.pk for r in twins}, "read whatever bob may see"
+        # The reviewer's searches find them through what bob's search read, reading no
+        # profiles of their own.
+        with CaptureQueriesContext(connection) as queries:
+            indexed = [self.indexed(q) for q in rows[:20:4]]
+        assert not [q for q in queries if "SELECT u.id, u.profile" in q["sql"]]
+        assert similar_index.open_index(self.project.pk).newer[0] == twins[-1].pk
+        assert [found[0] for found in indexed] == [(twins[i].pk, 0.0) for i in range(0, 20, 4)]
+        assert indexed == [self.exact(q) for q in rows[:20:4]]
+
     def test_it_finds_newer_segments_of_its_own_project_only(self):
         rows = self.add_segments(self.spans[:50], self.descs[:50])
         similar_index.build(self.project.pk)
