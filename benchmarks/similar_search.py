@@ -20,8 +20,8 @@ index, the database reads, the ranking and the JSON), one path after the other p
   segments; it never sees the rest, hence its recall), on the first ``--old-queries``.
 
 Then ``--added`` new segments are stored (copies of existing descriptors in a new
-capture): searches while they wait for the index (read from the database with every
-search), then each service's ``update``, with the bytes it wrote; then they are deleted,
+capture): searches while they wait for the index (before read them from the database
+with every search; now reads them once per process), then each service's ``update``, with the bytes it wrote; then they are deleted,
 the database vacuumed, the index of now put back as it was (its manifest) and the one
 of before brought in step.
 
@@ -316,8 +316,8 @@ def run():
                     for title, view in paths.items():
                         with index_dir(folders[title]):
                             waiting[title].append(call_view(user, pk, view)[1])
-            print(f"\n{len(added):,} new segments waiting for the index (read with every search), "
-                  f"load {load()}:")
+            print(f"\n{len(added):,} new segments waiting for the index (before: read with every "
+                  f"search; now: read once by this process), load {load()}:")
             for title, times in waiting.items():
                 print(f"  {title:<28} median {statistics.median(times):6.1f} ms, p95 {p95(times):6.1f} ms")
             print("updates that take them in:")
