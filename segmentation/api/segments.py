@@ -117,15 +117,24 @@ class Part:
     A filter on several labels (one name in several projects) cannot be read in id order
     from one index; one query per label, each pinned to its label's project, can, and
     merging them costs as many ids per label as the page needs.
+
+    An annotator's part is counted run by run (their own segments, the gold ones: see
+    ``LibrarySegment.objects.visible_runs``), each from an index of its own: on
+    PostgreSQL the part's query is one OR, which counts by filtering every segment of the
+    projects (~19 ms for 10,000 of them at a million), unless a label filter lets the
+    label's index narrow the OR.
     """
 
-    def __init__(self, queries, descending=False):
+    def __init__(self, queries, descending=False, counted=None):
         self.queries, self.descending = queries, descending
+        self.counted = self.queries if counted is None else counted
 
     def count(self, cap):
-        """How many rows the part holds, counting no further than ``cap``."""
+        """How many rows the part holds, counting no further than ``cap``: the rows of
+        ``counted``, querysets that share no row and together hold the part's (default:
+        its queries)."""
         total = 0
-        for query in self.queries:
+        for query in self.counted:
             # Ids only: counting a union, Django would select every column of its rows.
             total += query.order_by().values_list("id")[:cap - total].count()
             if total >= cap:
@@ -305,9 +314,13 @@ def ordered_parts(request, filters):
             # enough for one compound query.
             each = [Q(project_id=project, label_id=pk) for _, pk, project in labels]
             if len(each) * len(runs) > MAX_MERGED_RUNS:
-                return [Part([newest_first(runs, *filters, q) for q in each], descending=True)]
+                return [Part([newest_first(runs, *filters, q) for q in each], descending=True,
+                             counted=[run.filter(*filters, q) for q in each for run in runs])]
             runs = [run.filter(q) for q in each for run in runs]
-        return [Part([newest_first(runs, *filters)])]
+        # Counted run by run, unless a label narrows them: then the label's index does
+        # better for the OR than the runs' indexes do for each run.
+        counted = None if labels else [run.filter(*filters) for run in runs]
+        return [Part([newest_first(runs, *filters)], counted=counted)]
     # An annotator's runs are one OR (``visible_to``) in any other order.
     visible = runs[0] if len(runs) == 1 else LibrarySegment.objects.visible_to(request.user)
     segments = visible.filter(*filters)
