@@ -6,10 +6,10 @@ import numpy as np
 
 from motionlib import similarity
 from segmentation import exports, similar_index
-from segmentation.descriptors import is_bare_points, load_descriptors, of_kind, profile_pool
+from segmentation.descriptors import load_descriptors, profile_pool
 from segmentation.errors import Invalid
 from segmentation.models import LibrarySegment
-from segmentation.models.library import STAFF
+from segmentation.pools import Pool
 
 # Similar clips and suggestions search at most this many of a project's recent segments.
 SIMILAR_POOL = 20000
@@ -20,11 +20,11 @@ SHORTLIST = 20
 def similar(segment, visible, k=10):
     """The ``k`` visible segments of the same project that move most like ``segment``.
 
-    ``visible``: a queryset of the segments the caller may see, or a ``Scope`` (the same,
-    read on PostgreSQL through prepared statements). Only segments described as it is are
-    compared (``descriptors.same_kind``: a body or bare points). Segments overlapping it
-    in the same capture are left out (other annotators' versions of the same motion), and
-    so are duplicates of one span. Two stages: the profiles nearest to the query's pick a
+    ``visible``: a queryset of the segments the caller may see, or a ``pools.Scope``
+    (the same, read on PostgreSQL through statements compiled once: ``statements``).
+    Only segments described as it is are compared (``descriptors.same_kind``: a body or
+    bare points). Segments overlapping it in the same capture are left out (other
+    annotators' versions of the same motion), and so are duplicates of one span. Two stages: the profiles nearest to the query's pick a
     shortlist, whose full descriptors are ranked. The shortlist comes from the project's
     vector index (``similar_index``, which keeps the descriptors too) when it has a usable
     one, else from the profiles of up to ``SIMILAR_POOL`` recent segments.
@@ -56,52 +56,6 @@ def similar(segment, visible, k=10):
     # A row deleted since it was shortlisted is left out.
     return [(rows[pk], float(d)) for (pk, _, _), d in zip(winners, distances, strict=True)
             if pk in rows]
-
-
-class Scope:
-    """Whose search it is: user ``user_id``, whose role in the query's project is
-    ``role`` (``LibrarySegment.objects.with_role_of``). They may see the segments of the
-    project that the role shows them (``visible_in``), the preferred ones."""
-
-    __slots__ = ("user_id", "role")
-
-    def __init__(self, user_id, role):
-        self.user_id, self.role = user_id, role
-
-
-class Pool:
-    """What a search from ``segment`` may return: the segments of ``visible`` (a queryset
-    or a ``Scope``) in its project, described as it is, not overlapping it.
-
-    With a ``Scope`` it is also a statement's shape and values (``key``, ``values``:
-    ``pool_queryset``'s arguments), so that its SQL is compiled once per shape
-    (``segmentation.statements``)."""
-
-    def __init__(self, segment, visible):
-        self.visible = visible
-        self.scoped = isinstance(visible, Scope)
-        self.values = {"project_id": segment.project_id, "capture_id": segment.capture_id,
-                       "start": segment.start, "stop": segment.stop}
-        self.key = (visible.role if self.scoped else None, is_bare_points(segment.capture))
-        if self.scoped and visible.role not in STAFF:
-            self.values["user_id"] = visible.user_id
-
-    @property
-    def db(self):
-        return LibrarySegment.objects.db if self.scoped else self.visible.db
-
-    def queryset(self):
-        return pool_queryset(self.key, visible=None if self.scoped else self.visible, **self.values)
-
-
-def pool_queryset(key, project_id, capture_id, start, stop, user_id=None, visible=None):
-    """``Pool``'s segments: ``key`` is (role, bare points); ``visible``, when given, is
-    the queryset the role would give (the role is then not used)."""
-    role, bare_points = key
-    if visible is None:
-        visible = LibrarySegment.objects.visible_in(project_id, user_id, role).preferred()
-    return (visible.filter(of_kind(bare_points), project_id=project_id, profile__isnull=False)
-            .exclude(capture_id=capture_id, start__lt=stop, stop__gt=start))
 
 
 class Shown:

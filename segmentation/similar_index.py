@@ -62,6 +62,7 @@ from motionlib.errors import InputError
 from segmentation import statements, workers
 from segmentation.errors import Invalid
 from segmentation.models import LibrarySegment
+from segmentation.pools import pool_queryset
 
 log = logging.getLogger(__name__)
 
@@ -294,7 +295,7 @@ def schedule_update(project_id):
 
 
 def _candidates_or_newer(pool, ids, project_id, after):
-    """``pool``'s rows (a ``search.Pool``) that are among ``ids`` or newer than ``after``
+    """``pool``'s rows (a ``pools.Pool``) that are among ``ids`` or newer than ``after``
     (the last segment id of the delta this process has read), in one query: [(id,
     capture, start, stop, profile bytes or None, newest, *SHOWN)]. Only the rows newer
     than ``after`` carry their profile: the others were measured already. ``newest`` is
@@ -313,7 +314,7 @@ def _candidates_or_newer(pool, ids, project_id, after):
     to find nothing (~1 ms at a million). On PostgreSQL the newer ids are an InitPlan
     joined to the candidates' as one array, so the rows themselves are one scan of the
     primary key (an OR of the two lets the planner pick a library-list index and scan the
-    project: ~0.5 s at a million), and a ``search.Scope``'s pool is read through a
+    project: ~0.5 s at a million), and a ``pools.Scope``'s pool is read through a
     statement compiled once (``CANDIDATE_ROWS``).
     """
     values = {"after": after}
@@ -347,8 +348,6 @@ def _newest(project_id):
 
 def _candidates_query(key, ids, after, visible=None, **pool):
     """``_candidates_or_newer``'s query on PostgreSQL, ``ids`` one array parameter."""
-    from segmentation.search import pool_queryset
-
     where = f'"{LibrarySegment._meta.db_table}"."id" = ANY(%s::bigint[] || ARRAY({_NEWER}))'
     return (pool_queryset(key, visible=visible, **pool)
             .extra(where=[where], params=[ids, pool["project_id"], after, pool["project_id"]])
@@ -519,7 +518,7 @@ def shortlist(index, query, pool, n):
     first, as the exact scan orders them (ties: newest first; one span once), as
     ``[(id, descriptor, row)]``, ``row`` the candidate's columns (``_candidates_or_newer``).
 
-    ``pool`` (a ``search.Pool``) is what the caller may see of the project; the index
+    ``pool`` (a ``pools.Pool``) is what the caller may see of the project; the index
     proposes candidates and ``pool`` decides which exist and may be shown. Returns None
     when even ``MAX_CANDIDATES`` candidates leave fewer than ``n`` (a very selective
     filter): the caller then scans exactly.

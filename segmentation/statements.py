@@ -80,24 +80,24 @@ class Statement:
             sql, params = compiler.as_sql()
             columns = compiler.select[:compiler.col_count]
             if [alias for _, _, alias in columns] != list(queryset._fields):
-                raise ValueError("a statement's columns are not in the order of its values_list")
+                raise TypeError("a statement's columns are not in the order of its values_list")
             shapes.append((sql, params, stand_ins))
         # What values_list does to each column (e.g. JSON parsed, 0/1 to a boolean on SQLite).
         converters = compiler.get_converters([expression for expression, _, _ in columns])
         (sql, first, a), (sql_b, second, b) = shapes
         if sql != sql_b or len(first) != len(second):
-            raise ValueError("a statement's SQL changes with its values; pass them as parameters")
+            raise TypeError("a statement's SQL changes with its values; pass them as parameters")
         slots = []
         for p, q in zip(first, second, strict=True):
             name = next((n for n in names if _same(p, a[n]) and _same(q, b[n])), None)
             if name is None and (not _constant(p, q) or any(_same(p, v) for v in a.values())):
-                raise ValueError(f"a statement's parameter {p!r} is neither a value nor a constant")
+                raise TypeError(f"a statement's parameter {p!r} is neither a value nor a constant")
             # Django passes some integers typed (psycopg's Int4, Int8): so are the values.
             wrap = type(p) if name and type(p) not in (int, list) else None
             slots.append((name, None if name else p, wrap))
         missing = set(names) - {name for name, _, _ in slots}
         if missing:
-            raise ValueError(f"a statement does not use {sorted(missing)} as parameters")
+            raise TypeError(f"a statement does not use {sorted(missing)} as parameters")
         return sql, slots, converters
 
 

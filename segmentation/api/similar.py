@@ -13,6 +13,7 @@ from segmentation.api.params import int_param
 from segmentation.api.segments import SegmentSerializer
 from segmentation.models import Capture, LibrarySegment
 from segmentation.models.library import STAFF, own
+from segmentation.pools import Scope
 from segmentation.statements import Statement
 
 
@@ -56,7 +57,7 @@ class SimilarView(APIView):
         segment.capture = Capture(pk=capture_id, skeleton=skeleton)
         # The role then decides which clips it may be compared with.
         results = []
-        for s, d in search.similar(segment, search.Scope(user.pk, role), k=k):
+        for s, d in search.similar(segment, Scope(user.pk, role), k=k):
             if isinstance(s, search.Shown):
                 results.append({**s.data, "distance": round(d, 4)})
             else:

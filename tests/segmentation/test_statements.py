@@ -56,14 +56,14 @@ class StatementTest(BaseTestCase):
             return (LibrarySegment.objects.filter(project_id=project_id)
                     .extra(where=[f"start >= {start}"]).values_list("id"))
 
-        with pytest.raises(ValueError, match="changes with its values"):
+        with pytest.raises(TypeError, match="changes with its values"):
             Statement(inlined).rows("default", None, project_id=self.project.pk, start=0)
 
     def test_it_refuses_a_value_it_does_not_pass_on(self):
         def ignores(key, project_id, start):
             return LibrarySegment.objects.filter(project_id=project_id).values_list("id")
 
-        with pytest.raises(ValueError, match=r"does not use \['start'\]"):
+        with pytest.raises(TypeError, match=r"does not use \['start'\]"):
             Statement(ignores).rows("default", None, project_id=self.project.pk, start=0)
 
 
