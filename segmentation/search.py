@@ -24,8 +24,9 @@ def similar(segment, visible, k=10):
     (the same, read on PostgreSQL through statements compiled once: ``statements``).
     Only segments described as it is are compared (``descriptors.same_kind``: a body or
     bare points). Segments overlapping it in the same capture are left out (other
-    annotators' versions of the same motion), and so are duplicates of one span. Two stages: the profiles nearest to the query's pick a
-    shortlist, whose full descriptors are ranked. The shortlist comes from the project's
+    annotators' versions of the same motion), and so are duplicates of one span. Two
+    stages: the profiles nearest to the query's pick a shortlist, whose full descriptors
+    are ranked. The shortlist comes from the project's
     vector index (``similar_index``, which keeps the descriptors too) when it has a usable
     one, else from the profiles of up to ``SIMILAR_POOL`` recent segments.
     Returns ``[(segment, distance)]``, most similar first; a segment found through the
