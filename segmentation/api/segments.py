@@ -126,8 +126,16 @@ class Part:
     """
 
     def __init__(self, queries, descending=False, counted=None):
-        self.queries, self.descending = queries, descending
-        self.counted = self.queries if counted is None else counted
+        self._queries, self.descending, self._counted = queries, descending, counted
+
+    @functools.cached_property
+    def queries(self):
+        """The part's querysets (``queries`` may be a function that builds them)."""
+        return self._queries() if callable(self._queries) else self._queries
+
+    @property
+    def counted(self):
+        return self.queries if self._counted is None else self._counted
 
     def count(self, cap):
         """How many rows the part holds, counting no further than ``cap``: the rows of
@@ -326,10 +334,16 @@ def ordered_parts(request, filters):
     segments = visible.filter(*filters)
     if ordering == "label":
         labels = visible_labels(request).order_by("name", "id").values_list("name", "id", "project_id")
-        return [Part([segments.filter(project_id=project, label_id=pk).order_by("id")
-                      for _, pk, project in group])
+        # Built when read: a first page reads the first label's part and counts a few.
+        return [Part(functools.partial(label_queries, segments, list(group)))
                 for _, group in itertools.groupby(labels, key=operator.itemgetter(0))]
     return [Part([segments.order_by(*ORDERINGS[ordering])])]
+
+
+def label_queries(segments, labels):
+    """A label name's part of the list ordered by label: one query per label of that
+    name (``(name, id, project)``), each in id order."""
+    return [segments.filter(project_id=project, label_id=pk).order_by("id") for _, pk, project in labels]
 
 
 # SQLite reads at most 500 terms of a compound query (SQLITE_MAX_COMPOUND_SELECT).
