@@ -331,8 +331,10 @@ def _candidates_or_newer(pool, ids, project_id, after):
                 .values_list(*CANDIDATE_COLUMNS))
 
 
-_NEWER = (f'SELECT u.id FROM "{LibrarySegment._meta.db_table}" u WHERE u.profile IS NOT NULL AND '
-          '(u.project_id, u.id) > (%s, %s) AND u.project_id <= %s')
+# The project's described segments after an id (parameters: project, id, project).
+_AFTER = (f'"{LibrarySegment._meta.db_table}" u WHERE u.profile IS NOT NULL'
+          ' AND (u.project_id, u.id) > (%s, %s) AND u.project_id <= %s')
+_NEWER = f"SELECT u.id FROM {_AFTER}"
 
 
 def _fresh(after):
@@ -382,14 +384,15 @@ class OpenIndex:
     manifest: dict
     index: object
     update_queued: bool = False
-    # (mark, ids, profiles): the delta as read, up to segment id ``mark``.
+    # (mark, ids, profiles): the delta as read, up to segment id ``mark``; the profiles in
+    # float64, as every search measures them.
     newer: tuple = None
     _lock: object = field(default_factory=threading.Lock)
 
     def __post_init__(self):
         if self.newer is None:
             self.newer = (self.manifest["max_id"], np.zeros(0, dtype=np.int64),
-                          np.zeros((0, self.index.ndim), dtype=np.float32))
+                          np.zeros((0, self.index.ndim)))
 
     def nearest(self, vector, count):
         """Up to ``count`` segment ids of the index nearest to a profile vector, nearest
@@ -404,7 +407,7 @@ class OpenIndex:
         mark, ids, profiles = self.newer
         if not len(ids):
             return mark, ids, np.zeros(0), 0
-        diff = profiles.astype(np.float64) - np.asarray(vector, dtype=np.float64)
+        diff = profiles - np.asarray(vector, dtype=np.float64)
         d = np.einsum("ij,ij->i", diff, diff)
         near = np.argsort(d, kind="stable")[:count] if len(d) <= count else \
             np.argpartition(d, count - 1)[:count]
@@ -413,20 +416,19 @@ class OpenIndex:
     def take_newer(self, db, newest):
         """Read the profiles of the project's described segments after the mark, up to id
         ``newest``, into the delta."""
+        if newest is None or newest <= self.newer[0]:
+            return  # what every search but the first after new segments finds
         with self._lock:
             mark, ids, profiles = self.newer
-            if newest is None or newest <= mark:
+            if newest <= mark:
                 return
-            table = LibrarySegment._meta.db_table
             with connections[db].cursor() as cursor:
-                cursor.execute(f'SELECT u.id, u.profile FROM "{table}" u WHERE u.profile IS NOT NULL'
-                               ' AND (u.project_id, u.id) > (%s, %s) AND u.project_id <= %s'
-                               ' AND u.id <= %s ORDER BY u.id',
+                cursor.execute(f"SELECT u.id, u.profile FROM {_AFTER} AND u.id <= %s ORDER BY u.id",
                                [self.project_id, mark, self.project_id, newest])
                 rows = [(pk, bytes(blob)) for pk, blob in cursor.fetchall()]
             # A profile of another width is left out, as the index leaves it (``update``).
             rows = [(pk, blob) for pk, blob in rows if len(blob) == 4 * self.index.ndim]
-            added = np.frombuffer(b"".join(blob for _, blob in rows), dtype="<f4")
+            added = np.frombuffer(b"".join(blob for _, blob in rows), dtype="<f4").astype(np.float64)
             self.newer = (newest, np.concatenate([ids, np.array([pk for pk, _ in rows], dtype=np.int64)]),
                           np.concatenate([profiles, added.reshape(len(rows), self.index.ndim)]))
 
@@ -573,9 +575,7 @@ def nearest_unique(rows, query, n, measured, stored):
     q = np.asarray(query[:similarity.PROFILE_ROWS], dtype=float).ravel()
     read = stored([r[0] for r in unique if r[4] is None])
     for descriptor in read.values():
-        if descriptor.size != query.size:
-            raise Invalid(f"library descriptors have {descriptor.size} numbers, the query's "
-                          f"{query.shape[0]} x {query.shape[1]}; rebuild the library")
+        _check_size(descriptor, query)
     d = np.array([measured.get(r[0], np.nan) for r in unique])
     held = [i for i, r in enumerate(unique) if r[4] is None and r[0] in read]
     if held:
@@ -599,11 +599,15 @@ def nearest_unique(rows, query, n, measured, stored):
         descriptor = read.get(r[0])
         if descriptor is None:
             continue  # deleted since the candidates were read
-        if descriptor.size != query.size:
-            raise Invalid(f"library descriptors have {descriptor.size} numbers, the query's "
-                          f"{query.shape[0]} x {query.shape[1]}; rebuild the library")
+        _check_size(descriptor, query)
         out.append((r[0], descriptor.reshape(query.shape), r))
     return out
+
+
+def _check_size(descriptor, query):
+    if descriptor.size != query.size:
+        raise Invalid(f"library descriptors have {descriptor.size} numbers, the query's "
+                      f"{query.shape[0]} x {query.shape[1]}; rebuild the library")
 
 
 def forget():

@@ -39,7 +39,7 @@ def _segment_query(key, pk, user_id):
 
 
 # One query reads the segment, the user's role in its project and whether that role shows
-# it (a prepared statement on PostgreSQL: ``segmentation.statements``).
+# it (compiled once: ``segmentation.statements``).
 SEGMENT = Statement(_segment_query)
 
 
