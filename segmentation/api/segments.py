@@ -322,13 +322,14 @@ def ordered_parts(request, filters):
             # enough for one compound query.
             each = [Q(project_id=project, label_id=pk) for _, pk, project in labels]
             if len(each) * len(runs) > MAX_MERGED_RUNS:
-                return [Part([newest_first(runs, *filters, q) for q in each], descending=True,
-                             counted=[run.filter(*filters, q) for q in each for run in runs])]
+                per_label = [[run.filter(*filters, q) for run in runs] for q in each]
+                return [Part([newest_first(matched) for matched in per_label], descending=True,
+                             counted=[run for matched in per_label for run in matched])]
             runs = [run.filter(q) for q in each for run in runs]
+        matched = [run.filter(*filters) for run in runs]
         # Counted run by run, unless a label narrows them: then the label's index does
         # better for the OR than the runs' indexes do for each run.
-        counted = None if labels else [run.filter(*filters) for run in runs]
-        return [Part([newest_first(runs, *filters)], counted=counted)]
+        return [Part([newest_first(matched)], counted=None if labels else matched)]
     # An annotator's runs are one OR (``visible_to``) in any other order.
     visible = runs[0] if len(runs) == 1 else LibrarySegment.objects.visible_to(request.user)
     segments = visible.filter(*filters)
@@ -350,18 +351,18 @@ def label_queries(segments, labels):
 MAX_MERGED_RUNS = 100
 
 
-def newest_first(runs, *filters):
-    """The segments of the ``runs`` (``LibrarySegment.objects.visible_runs``) that match
-    ``filters``, newest first: the runs' ``UNION ALL`` when there are several, which the
-    database reads as a merge of the runs, each in id order from an index (an annotator's
-    own segments, and the gold ones), where ``annotator = me OR gold`` is in id order in
+def newest_first(runs):
+    """The segments of the ``runs`` (``LibrarySegment.objects.visible_runs``, filtered),
+    newest first: the runs' ``UNION ALL`` when there are several, which the database reads
+    as a merge of the runs, each in id order from an index (an annotator's own segments,
+    and the gold ones), where ``annotator = me OR gold`` is in id order in
     no index and would be filtered out of every segment of the projects.
 
     On PostgreSQL the runs are one OR instead: over several projects its indexes give the
     gold run in id order in none of them, so it sorts every gold row of the union (~0.1 s
     at a million segments), where it walks the OR in id order from ``libseg_list_all``;
     a label name several projects share is likewise one ``label_id IN`` filter there."""
-    queries = [run.filter(*filters).order_by() for run in runs]
+    queries = [run.order_by() for run in runs]
     if len(queries) < 2:
         query = queries[0] if queries else LibrarySegment.objects.none()
         return query.order_by(*ORDERINGS["recent"])
