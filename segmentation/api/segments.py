@@ -26,11 +26,13 @@ from rest_framework.response import Response
 from rest_framework.utils.urls import remove_query_param, replace_query_param
 from rest_framework.views import APIView
 
-from segmentation import exports, search, similar_index
+from segmentation import exports, search, similar_index, statements
 from segmentation.api.params import bool_param, float_param, int_param
 from segmentation.api.serializers import NamedRefSerializer, UserRefSerializer
 from segmentation.errors import Invalid
 from segmentation.models import Label, LibrarySegment, Membership
+from segmentation.models.library import projects_by_role
+from segmentation.statements import Statement
 from segmentation.storage import read_take
 
 ORDERINGS = {
@@ -61,11 +63,9 @@ class SegmentPagination(PageNumberPagination):
     max_page_size = 500
     count_cap = 10_000
 
-    def paginate_queryset(self, queryset, request, view=None, parts=None):
-        """The page's rows of ``queryset`` as the API shows them, read as ``parts``
-        (default: the query whole; ``queryset`` is not read when they are given)."""
+    def paginate_queryset(self, parts, request, view=None):
+        """The page's rows of the list ``parts`` (``ListQuery.parts``) as the API shows them."""
         self.request = request
-        parts = [Part([queryset])] if parts is None else parts
         size = self.get_page_size(request)
         self.number = int_param(request, self.page_query_param, 1, 1, 1_000_000)
         offset = (self.number - 1) * size
@@ -111,50 +111,154 @@ class SegmentPagination(PageNumberPagination):
         return page
 
 
+class ListQuery:
+    """What a list request asks, read from its query string and the caller's memberships.
+
+    ``values``: what its queries pass as parameters (ids, tuples of them, bounds);
+    ``shape``: everything else, decided in Python (the order, the gold filter, which
+    filters are present, how many projects, labels and label names there are), which says
+    what SQL the list runs. The list's queries are built from the two and compiled once
+    per shape (``segmentation.statements``): building and compiling a page's querysets
+    cost more CPU than the database spent answering them.
+    """
+
+    def __init__(self, request):
+        user = request.user
+        self.ordering, self.gold = ordering_of(request), bool_param(request, "gold")
+        v = {"user": user.pk}
+        project = int_param(request, "project", None, 1)
+        for name in ("project", "capture"):
+            value = project if name == "project" else int_param(request, name, None, 1)
+            if value is not None:
+                v[name] = value
+        annotator = (request.query_params.get("annotator") or "").strip()
+        if annotator.isdigit():  # a user id (what the API said)
+            v["annotator"] = int_param(request, "annotator", None, 1)
+        elif annotator:  # a username (what the page and a person write)
+            found = USER_ID.rows(get_user_model().objects.db, None, username=annotator)
+            if not found:
+                raise Invalid(f"annotator: no user named {annotator[:150]!r}")
+            v["annotator"] = found[0][0]
+        for name, high in (("min_duration", None), ("max_duration", None), ("min_agreement", 1)):
+            value = float_param(request, name, 0, high)
+            if value is not None:
+                v[name] = float(value)
+        staff, annotating = projects_by_role(user)
+        if project is not None:
+            staff, annotating = [p for p in staff if p == project], [p for p in annotating if p == project]
+        v["staff"], v["annotating"] = tuple(staff), tuple(annotating)
+        # Nothing matches: no project to see, or no label of the name in them.
+        self.empty = not staff and not annotating
+        if request.query_params.get("label"):
+            # By the ids the name has in the caller's projects, not by joining the label
+            # table, so that the filter is a column of the list's indexes.
+            labels = label_rows(user, project, request.query_params["label"])
+            v["labels"] = tuple(pk for _, pk, _ in labels)
+            v["label_projects"] = tuple(p for _, _, p in labels)
+            self.empty = self.empty or not labels
+        groups = ()
+        if self.ordering == "label":
+            labels = label_rows(user, project)
+            groups = tuple(len(list(group)) for _, group in
+                           itertools.groupby(labels, key=operator.itemgetter(0)))
+            v["group_labels"] = tuple(pk for _, pk, _ in labels)
+            v["group_projects"] = tuple(p for _, _, p in labels)
+        self.values, self.db = v, LibrarySegment.objects.db
+        self.shape = (self.db, self.ordering, self.gold, groups,
+                      tuple(sorted((k, len(x) if isinstance(x, tuple) else None) for k, x in v.items())))
+
+    def parts(self):
+        """The list as ``Part``s whose concatenation is it (none when nothing matches)."""
+        if self.empty:
+            return []
+        return [Part(self, i, *layout) for i, layout in enumerate(_layout(self.shape, self.values))]
+
+    def segments(self):
+        """The matching segments as one queryset (for an export)."""
+        if self.empty:
+            return LibrarySegment.objects.none()
+        return (_visible(self.values).filter(*segment_filters(self.gold, self.values))
+                .order_by(*ORDERINGS[self.ordering]))
+
+
+def _layout(shape, values):
+    """Per part: how many queries it reads, how many it counts, whether it is newest first."""
+    found = _LAYOUTS.get(shape)
+    if found is None:
+        if len(_LAYOUTS) >= statements.MAX_SHAPES:
+            _LAYOUTS.clear()
+        found = _LAYOUTS[shape] = [(len(p.queries), len(p.counted), p.descending)
+                                  for p in ordered_parts(shape, values)]
+    return found
+
+
+_LAYOUTS = {}
+
+
 class Part:
-    """One ordered run of the list: a query, or one query per label merged by id.
+    """One ordered run of the list: a query, or several merged by id.
 
     A filter on several labels (one name in several projects) cannot be read in id order
     from one index; one query per label, each pinned to its label's project, can, and
     merging them costs as many ids per label as the page needs.
 
     An annotator's part is counted run by run (their own segments, the gold ones: see
-    ``LibrarySegment.objects.visible_runs``), each from an index of its own: on
+    ``LibrarySegment.objects.runs_among``), each from an index of its own: on
     PostgreSQL the part's query is one OR, which counts by filtering every segment of the
     projects (~19 ms for 10,000 of them at a million), unless a label filter lets the
     label's index narrow the OR.
     """
 
-    def __init__(self, queries, descending=False, counted=None):
-        self._queries, self.descending, self._counted = queries, descending, counted
-
-    @functools.cached_property
-    def queries(self):
-        """The part's querysets (``queries`` may be a function that builds them)."""
-        return self._queries() if callable(self._queries) else self._queries
-
-    @property
-    def counted(self):
-        return self.queries if self._counted is None else self._counted
+    def __init__(self, query, index, n_queries, n_counted, descending):
+        self.query, self.index = query, index
+        self.n_queries, self.n_counted, self.descending = n_queries, n_counted, descending
 
     def count(self, cap):
-        """How many rows the part holds, counting no further than ``cap``: the rows of
-        ``counted``, querysets that share no row and together hold the part's (default:
-        its queries)."""
+        """How many rows the part holds, counting no further than ``cap``: the rows of its
+        counted queries, which share no row and together hold the part's."""
         total = 0
-        for query in self.counted:
-            # Ids only: counting a union, Django would select every column of its rows.
-            total += query.order_by().values_list("id")[:cap - total].count()
+        for j in range(self.n_counted):
+            total += COUNTED.count(self.query.db, (self.query.shape, self.index, j),
+                                   cap - total, **self.query.values)
             if total >= cap:
                 break
         return total
 
     def ids(self, offset, limit):
-        if len(self.queries) == 1:
-            return list(self.queries[0].values_list("id", flat=True)[offset:offset + limit])
-        runs = [list(q.values_list("id", flat=True)[:offset + limit]) for q in self.queries]
+        def run(j, window):
+            rows = IDS.rows(self.query.db, (self.query.shape, self.index, j), window=window,
+                            **self.query.values)
+            return [pk for pk, in rows]
+
+        if self.n_queries == 1:
+            return run(0, (offset, limit))
+        runs = [run(j, (0, offset + limit)) for j in range(self.n_queries)]
         merged = heapq.merge(*runs, reverse=self.descending)
         return list(itertools.islice(merged, offset, offset + limit))
+
+
+class QueryPart:
+    """A ``Part`` as querysets, which the statements are compiled from: ``queries``, read
+    in order and merged by id; ``counted``, querysets that share no row and together hold
+    the part's (default: its queries)."""
+
+    def __init__(self, queries, descending=False, counted=None):
+        self.queries, self.descending = queries, descending
+        self.counted = queries if counted is None else counted
+
+
+def _part_query(key, **values):
+    shape, index, j = key
+    return ordered_parts(shape, values)[index].queries[j].values_list("id", flat=True)
+
+
+def _counted_query(key, **values):
+    shape, index, j = key
+    return ordered_parts(shape, values)[index].counted[j].order_by().values_list("id")
+
+
+IDS = Statement(_part_query, partial=True)
+COUNTED = Statement(_counted_query, partial=True)
 
 
 def page_ids(parts, offset, limit):
@@ -226,49 +330,39 @@ PAGE_COLUMNS = ("id", "capture_id", "start", "stop", *similar_index.SHOWN)
 def page_rows(ids):
     """The API fields of segments ``ids``, in that order (one deleted since its id was
     read is left out)."""
-    rows = LibrarySegment.objects.filter(pk__in=ids).values_list(*PAGE_COLUMNS)
+    if not ids:
+        return []
+    rows = PAGE.rows(LibrarySegment.objects.db, None, ids=tuple(ids))
     found = {row[0]: search.api_fields(*row[:4], row[4:]) for row in rows}
     return [found[pk] for pk in ids if pk in found]
 
 
+PAGE = Statement(lambda key, ids: LibrarySegment.objects.filter(pk__in=ids).values_list(*PAGE_COLUMNS))
+
+
 def segment_query(request):
     """The caller's visible segments filtered by the query string (shared by list and zip)."""
-    return (LibrarySegment.objects.visible_to(request.user).filter(*segment_filters(request))
-            .order_by(*ORDERINGS[ordering_of(request)]))
+    return ListQuery(request).segments()
 
 
-def segment_filters(request):
-    """The query string's filters, as ``Q``s."""
-    gold = bool_param(request, "gold")
+def segment_filters(gold, values):
+    """The filters of a ``ListQuery``'s ``gold`` and ``values``, as ``Q``s."""
     # ``__in`` rather than ``=``: on SQLite Django writes a boolean filter as ``NOT "column"``,
     # which no index can seek to; ``IN (0)`` is an equality every index here can use.
     if gold is None:
         filters = [Q(superseded__in=[False])]  # LibrarySegment.preferred()
     else:
         filters = [Q(is_gold__in=[gold])]
-    for name, field in (("project", "project_id"), ("capture", "capture_id")):
-        value = int_param(request, name, None, 1)
-        if value is not None:
-            filters.append(Q(**{field: value}))
-    annotator = (request.query_params.get("annotator") or "").strip()
-    if annotator.isdigit():  # a user id (what the API said)
-        filters.append(Q(annotator_id=int_param(request, "annotator", None, 1)))
-    elif annotator:  # a username (what the page and a person write)
-        user_id = get_user_model().objects.filter(username=annotator).values_list("id", flat=True).first()
-        if user_id is None:
-            raise Invalid(f"annotator: no user named {annotator[:150]!r}")
-        filters.append(Q(annotator_id=user_id))
-    if request.query_params.get("label"):
-        # By the ids the name has in the caller's projects, not by joining the label table,
-        # so that the filter is a column of the list's indexes.
-        filters.append(Q(**one_of("label_id", [pk for _, pk, _ in named_labels(request)])))
-    for name, lookup, high in (("min_duration", "duration__gte", None),
-                               ("max_duration", "duration__lte", None),
-                               ("min_agreement", "agreement__gte", 1)):
-        value = float_param(request, name, 0, high)
-        if value is not None:
-            filters.append(Q(**{lookup: value}))
-    ordering_of(request)  # a bad ordering is refused with the other bad parameters
+    for name, field in (("project", "project_id"), ("capture", "capture_id"),
+                        ("annotator", "annotator_id")):
+        if name in values:
+            filters.append(Q(**{field: values[name]}))
+    if "labels" in values:
+        filters.append(Q(**one_of("label_id", list(values["labels"]))))
+    for name, lookup in (("min_duration", "duration__gte"), ("max_duration", "duration__lte"),
+                         ("min_agreement", "agreement__gte")):
+        if name in values:
+            filters.append(Q(**{lookup: values[name]}))
     return filters
 
 
@@ -286,26 +380,42 @@ def one_of(field, values):
     return {field: values[0]} if len(values) == 1 else {f"{field}__in": values}
 
 
-def visible_labels(request):
-    """The labels of the caller's projects, or of the project the query asks for."""
-    labels = Label.objects.filter(
-        project_id__in=Membership.objects.filter(user=request.user).values_list("project_id"))
-    project = int_param(request, "project", None, 1)
-    return labels if project is None else labels.filter(project_id=project)
+def _labels_query(key, user, name=None, project=None):
+    """The labels of the user's projects, or of the project asked for; those of one name
+    (``key`` says which)."""
+    labels = Label.objects.filter(project_id__in=Membership.objects.filter(user_id=user)
+                                  .values_list("project_id"))
+    if project is not None:
+        labels = labels.filter(project_id=project)
+    if name is not None:
+        labels = labels.filter(name=name)
+    return labels.order_by("name", "id").values_list("name", "id", "project_id")
 
 
-def named_labels(request):
-    """``(name, id, project id)`` of the caller's labels the ``label`` filter names (read
-    once per request: the filter and ``ordered_parts`` both need them)."""
-    if not hasattr(request, "_named_labels"):
-        request._named_labels = list(visible_labels(request).filter(
-            name=request.query_params["label"]).values_list("name", "id", "project_id"))
-    return request._named_labels
+LABELS = Statement(_labels_query)
+USER_ID = Statement(lambda key, username: get_user_model().objects.filter(username=username)
+                    .values_list("id"))
 
 
-def ordered_parts(request, filters):
-    """The caller's visible segments matching ``filters`` (``segment_filters``) as
-    ``Part``s whose concatenation is the list.
+def label_rows(user, project, name=None):
+    """``(name, id, project id)`` of the labels of ``user``'s projects (or of ``project``),
+    of the name ``name`` if given, by name and id."""
+    values = {"user": user.pk}
+    if project is not None:
+        values["project"] = project
+    if name is not None:
+        values["name"] = name
+    return LABELS.rows(Label.objects.db, None, **values)
+
+
+def _visible(values):
+    """The segments the caller of a ``ListQuery`` sees (``visible_to``)."""
+    return LibrarySegment.objects.visible_among(values["staff"], values["annotating"], values["user"])
+
+
+def ordered_parts(shape, values):
+    """The caller's visible segments matching a ``ListQuery`` (its ``shape`` and
+    ``values``) as ``QueryPart``s whose concatenation is the list.
 
     Ordered by label, the list is each label name's segments by id, names in the
     database's order: one part per name, read from the label index in id order, rather
@@ -313,38 +423,38 @@ def ordered_parts(request, filters):
     ``newest_first`` of the caller's visible runs, split by label when the label filter
     names a label of several projects (each then read from a label index in id order).
     """
-    ordering = ordering_of(request)
-    runs = LibrarySegment.objects.visible_runs(request.user, int_param(request, "project", None, 1))
+    db, ordering, gold, groups, _ = shape
+    filters = segment_filters(gold, values)
+    runs = LibrarySegment.objects.runs_among(values["staff"], values["annotating"], values["user"])
     if ordering == "recent":
-        labels = named_labels(request) if request.query_params.get("label") else []
-        if len(labels) > 1 and merges_runs(LibrarySegment.objects.db):
+        labels = list(zip(values["labels"], values["label_projects"], strict=True)) if "labels" in values else []
+        if len(labels) > 1 and merges_runs(db):
             # One run per label and visible run, merged by the database when they are few
             # enough for one compound query.
-            each = [Q(project_id=project, label_id=pk) for _, pk, project in labels]
+            each = [Q(project_id=project, label_id=pk) for pk, project in labels]
             if len(each) * len(runs) > MAX_MERGED_RUNS:
                 per_label = [[run.filter(*filters, q) for run in runs] for q in each]
-                return [Part([newest_first(matched) for matched in per_label], descending=True,
-                             counted=[run for matched in per_label for run in matched])]
+                return [QueryPart([newest_first(matched) for matched in per_label], descending=True,
+                                  counted=[run for matched in per_label for run in matched])]
             runs = [run.filter(q) for q in each for run in runs]
         matched = [run.filter(*filters) for run in runs]
         # Counted run by run, unless a label narrows them: then the label's index does
         # better for the OR than the runs' indexes do for each run.
-        return [Part([newest_first(matched)], counted=None if labels else matched)]
+        return [QueryPart([newest_first(matched)], counted=None if labels else matched)]
     # An annotator's runs are one OR (``visible_to``) in any other order.
-    visible = runs[0] if len(runs) == 1 else LibrarySegment.objects.visible_to(request.user)
+    visible = runs[0] if len(runs) == 1 else _visible(values)
     segments = visible.filter(*filters)
     if ordering == "label":
-        labels = visible_labels(request).order_by("name", "id").values_list("name", "id", "project_id")
-        # Built when read: a first page reads the first label's part and counts a few.
-        return [Part(functools.partial(label_queries, segments, list(group)))
-                for _, group in itertools.groupby(labels, key=operator.itemgetter(0))]
-    return [Part([segments.order_by(*ORDERINGS[ordering])])]
+        labels = iter(zip(values["group_labels"], values["group_projects"], strict=True))
+        return [QueryPart(label_queries(segments, list(itertools.islice(labels, size))))
+                for size in groups]
+    return [QueryPart([segments.order_by(*ORDERINGS[ordering])])]
 
 
 def label_queries(segments, labels):
     """A label name's part of the list ordered by label: one query per label of that
-    name (``(name, id, project)``), each in id order."""
-    return [segments.filter(project_id=project, label_id=pk).order_by("id") for _, pk, project in labels]
+    name (``(id, project)``), each in id order."""
+    return [segments.filter(project_id=project, label_id=pk).order_by("id") for pk, project in labels]
 
 
 # SQLite reads at most 500 terms of a compound query (SQLITE_MAX_COMPOUND_SELECT).
@@ -352,7 +462,7 @@ MAX_MERGED_RUNS = 100
 
 
 def newest_first(runs):
-    """The segments of the ``runs`` (``LibrarySegment.objects.visible_runs``, filtered),
+    """The segments of the ``runs`` (``LibrarySegment.objects.runs_among``, filtered),
     newest first: the runs' ``UNION ALL`` when there are several, which the database reads
     as a merge of the runs, each in id order from an index (an annotator's own segments,
     and the gold ones), where ``annotator = me OR gold`` is in id order in
@@ -392,8 +502,7 @@ class SegmentListView(APIView):
     @extend_schema(responses=SegmentSerializer(many=True))
     def get(self, request):
         paginator = self.pagination_class()
-        parts = ordered_parts(request, segment_filters(request))
-        page = paginator.paginate_queryset(None, request, view=self, parts=parts)
+        page = paginator.paginate_queryset(ListQuery(request).parts(), request, view=self)
         return paginator.get_paginated_response(page)
 
 

@@ -20,6 +20,7 @@ from django.utils import timezone
 from segmentation.models.captures import Capture
 from segmentation.models.projects import Label, Membership, Project
 from segmentation.models.reviews import Review
+from segmentation.statements import Statement
 
 # A capture whose annotators agree this well needs no adjudication.
 AGREED_BOUNDARY_F1 = 0.8
@@ -36,11 +37,16 @@ def own(user):
 
 def projects_by_role(user):
     """``(staff, annotating)``: ids of the projects ``user`` reviews or administers, and
-    of those they annotate."""
+    of those they annotate (by id, in a statement compiled once: the list reads it per
+    request)."""
     staff, annotating = [], []
-    for project_id, role in Membership.objects.filter(user=user).values_list("project_id", "role"):
+    for project_id, role in _ROLES.rows(Membership.objects.db, None, user=user.pk):
         (staff if role in STAFF else annotating).append(project_id)
     return staff, annotating
+
+
+_ROLES = Statement(lambda key, user: Membership.objects.filter(user_id=user).order_by("project_id")
+                   .values_list("project_id", "role"))
 
 
 def one_project_of(ids):
@@ -53,7 +59,11 @@ class LibrarySegmentQuerySet(models.QuerySet):
         gold segments for annotators, nothing for anybody else."""
         if not user.is_authenticated:
             return self.none()
-        staff, annotating = projects_by_role(user)
+        return self.visible_among(*projects_by_role(user), user)
+
+    def visible_among(self, staff, annotating, user):
+        """``visible_to`` a ``user`` (or their id) who reviews or administers the projects
+        ``staff`` and annotates ``annotating`` (``projects_by_role``)."""
         return self.filter(Q(project_id__in=staff) | Q(project_id__in=annotating) & own(user))
 
     def visible_in(self, project_id, user_id, role):
@@ -71,20 +81,15 @@ class LibrarySegmentQuerySet(models.QuerySet):
         roles = Membership.objects.filter(project_id=OuterRef("project_id"), user_id=user_id)
         return self.annotate(role=Subquery(roles.values("role")[:1]))
 
-    def visible_runs(self, user, project=None):
-        """``visible_to(user)`` as querysets that share no row: the projects the user
-        reviews or administers; in those they annotate, their own segments, and the gold
-        ones. Unlike ``visible_to``'s OR, each can be read in id order from an index. No
-        queryset when the user sees nothing. ``project``: in that project only.
+    def runs_among(self, staff, annotating, user):
+        """``visible_among(staff, annotating, user)`` as querysets that share no row: the
+        projects ``staff``; in the projects ``annotating``, the user's own segments, and
+        the gold ones. Unlike ``visible_to``'s OR, each can be read in id order from an
+        index. No queryset when the user sees nothing.
 
         One project is written as an equality: SQLite reads it as an index prefix, where
         ``project_id IN (…) AND project_id = 7`` can make it pick a worse index.
         """
-        if not user.is_authenticated:
-            return []
-        staff, annotating = projects_by_role(user)
-        if project is not None:
-            staff, annotating = [p for p in staff if p == project], [p for p in annotating if p == project]
         runs = [self.filter(one_project_of(staff))] if staff else []
         if annotating:
             theirs = self.filter(one_project_of(annotating))

@@ -67,6 +67,35 @@ class StatementTest(BaseTestCase):
             Statement(ignores).rows("default", None, project_id=self.project.pk, start=0)
 
 
+    def test_floats_strings_and_tuples_are_values_and_a_window_or_count_reads_part(self):
+        def built(key, ids, longest, name):
+            return (LibrarySegment.objects.filter(pk__in=ids, duration__lte=longest, label__name=name)
+                    .order_by("-id").values_list("id", flat=True))
+
+        statement = Statement(built)
+        ids = tuple(row.pk for row in self.rows)
+        for chosen, longest, name in ((ids[:3], 1.0, "walk"), (ids[2:5], 1.0, "walk"),
+                                      (ids[:3], 0.1, "walk"), (ids, 1.0, "run"), (ids, 1.0, "walk")):
+            expected = list(built(None, chosen, longest, name))
+            found = [pk for pk, in statement.rows("default", None, ids=chosen, longest=longest, name=name)]
+            assert found == expected, (chosen, longest, name)
+        window = statement.rows("default", None, window=(2, 3), ids=ids, longest=1.0, name="walk")
+        assert [pk for pk, in window] == list(built(None, ids, 1.0, "walk")[2:5])
+        assert statement.count("default", None, 4, ids=ids, longest=1.0, name="walk") == 4
+        assert statement.count("default", None, 100, ids=ids[:6], longest=1.0, name="walk") == 6
+
+    def test_a_partial_statement_may_leave_values_unused(self):
+        def one_of(key, project_id, start):
+            found = LibrarySegment.objects.filter(project_id=project_id)
+            return (found if key == "project" else found.filter(start__gte=start)).values_list("id")
+
+        with pytest.raises(TypeError, match=r"does not use \['start'\]"):
+            Statement(one_of).rows("default", "project", project_id=self.project.pk, start=0)
+        partial = Statement(one_of, partial=True)
+        assert len(partial.rows("default", "project", project_id=self.project.pk, start=500)) == 10
+        assert len(partial.rows("default", "start", project_id=self.project.pk, start=500)) == 5
+
+
 @pytest.mark.integration
 class PostgresStatementTest(StatementTest):
     """The same on PostgreSQL, where Django passes some integers typed and JSON as text."""
