@@ -428,15 +428,21 @@ def ordered_parts(shape, values):
     runs = LibrarySegment.objects.runs_among(values["staff"], values["annotating"], values["user"])
     if ordering == "recent":
         labels = list(zip(values["labels"], values["label_projects"], strict=True)) if "labels" in values else []
-        if len(labels) > 1 and merges_runs(db):
+        # SQLite reads a label of one project from each run's index; PostgreSQL reads one
+        # OR, unless it has an annotator's runs (``0022``).
+        split = len(labels) > 1 if merges_runs(db) else bool(labels) and len(runs) > 1
+        if split:
             # One run per label and visible run, merged by the database when they are few
             # enough for one compound query.
             each = [Q(project_id=project, label_id=pk) for pk, project in labels]
             if len(each) * len(runs) > MAX_MERGED_RUNS:
                 per_label = [[run.filter(*filters, q) for run in runs] for q in each]
-                return [QueryPart([newest_first(matched) for matched in per_label], descending=True,
+                return [QueryPart([newest_first(matched, merge=True) for matched in per_label],
+                                  descending=True,
                                   counted=[run for matched in per_label for run in matched])]
             runs = [run.filter(q) for q in each for run in runs]
+            matched = [run.filter(*filters) for run in runs]
+            return [QueryPart([newest_first(matched, merge=True)])]
         matched = [run.filter(*filters) for run in runs]
         # Counted run by run, unless a label narrows them: then the label's index does
         # better for the OR than the runs' indexes do for each run.
@@ -461,7 +467,7 @@ def label_queries(segments, labels):
 MAX_MERGED_RUNS = 100
 
 
-def newest_first(runs):
+def newest_first(runs, merge=None):
     """The segments of the ``runs`` (``LibrarySegment.objects.runs_among``, filtered),
     newest first: the runs' ``UNION ALL`` when there are several, which the database reads
     as a merge of the runs, each in id order from an index (an annotator's own segments,
@@ -471,12 +477,14 @@ def newest_first(runs):
     On PostgreSQL the runs are one OR instead: over several projects its indexes give the
     gold run in id order in none of them, so it sorts every gold row of the union (~0.1 s
     at a million segments), where it walks the OR in id order from ``libseg_list_all``;
-    a label name several projects share is likewise one ``label_id IN`` filter there."""
+    a label name several projects share is likewise one ``label_id IN`` filter there.
+    ``merge``: a union whatever the database (runs of one label each, which PostgreSQL
+    reads in id order from its indexes too)."""
     queries = [run.order_by() for run in runs]
     if len(queries) < 2:
         query = queries[0] if queries else LibrarySegment.objects.none()
         return query.order_by(*ORDERINGS["recent"])
-    if not merges_runs(queries[0].db):
+    if not (merges_runs(queries[0].db) if merge is None else merge):
         return functools.reduce(operator.or_, queries).order_by(*ORDERINGS["recent"])
     return queries[0].union(*queries[1:], all=True).order_by(*ORDERINGS["recent"])
 

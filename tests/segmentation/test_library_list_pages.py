@@ -8,6 +8,7 @@ import itertools
 from unittest import mock
 
 import numpy as np
+import pytest
 from django.db import connection
 
 from segmentation import services
@@ -167,5 +168,25 @@ class ListPagesTest(LibraryTestCase):
         with connection.cursor() as cursor:
             cursor.execute("SELECT name FROM sqlite_master WHERE type = 'index' "
                            "AND tbl_name = 'segmentation_librarysegment'")
+            present = {row[0] for row in cursor.fetchall()}
+        assert set(wanted) <= present
+
+
+@pytest.mark.integration
+class PostgresListPagesTest(ListPagesTest):
+    """The same pages on PostgreSQL, which reads an annotator's runs as one OR, or, with a
+    label filter, as one run per label and visible run (``0022``)."""
+
+    def setUp(self):
+        if connection.vendor != "postgresql":
+            pytest.skip("needs PostgreSQL: DATABASE_URL=postgres://… (make pytest sets it)")
+        super().setUp()
+
+    def test_on_postgresql_an_annotators_label_runs_have_their_indexes(self):
+        from importlib import import_module
+
+        wanted = import_module("segmentation.migrations.0022_library_list_postgres_label_runs").INDEXES
+        with connection.cursor() as cursor:
+            cursor.execute("SELECT indexname FROM pg_indexes WHERE tablename = 'segmentation_librarysegment'")
             present = {row[0] for row in cursor.fetchall()}
         assert set(wanted) <= present
