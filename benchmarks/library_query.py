@@ -12,7 +12,9 @@ does not; on a shared machine it is the steadier figure), its SQL queries per re
 the indexes the database's plan uses for its page query (``+ sort`` when it sorts the
 matches, ``+ table scan`` when it reads the table). The old and new pages are checked to
 hold the same results, byte for byte. The process is set up as the web server's are
-(``cutroom/wsgi.py``, which freezes the objects loaded at start out of the collector's way).
+(``cutroom/wsgi.py``, which freezes the objects loaded at start out of the collector's way),
+and each series starts with a collection, so that no list is charged for collecting the
+other's garbage.
 
 ``--busy N`` adds N processes that spin on a core (nice 0) while the queries are timed,
 killed at the end, so that a figure "at load N" comes from one command; the load average
@@ -24,6 +26,7 @@ is printed after they have run 30 s and at the end.
 """
 
 import argparse
+import gc
 import json
 import os
 import platform
@@ -82,6 +85,8 @@ def run_query(user, query, repeat, view_class):
     view = view_class.as_view()
     factory = APIRequestFactory()
     times, cpu = [], []
+    # The other list's garbage is not this one's to collect: a server process runs one list.
+    gc.collect()
     for i in range(repeat + 1):
         request = factory.get(f"/api/segments/?{query}")
         force_authenticate(request, user=user)
