@@ -158,6 +158,16 @@ class ListPagesTest(LibraryTestCase):
         body = self.client.get(f"/api/segments/?project={self.a.pk}&label=kick").json()
         assert (body["count"], body["results"], body["next"]) == (0, [], None)
 
+    def test_a_query_of_a_shape_seen_before_is_run_with_its_values_not_built_again(self):
+        self.login(self.bob)
+        with mock.patch.object(segments, "ordered_parts", wraps=segments.ordered_parts) as built:
+            for label, low in (("walk", 1), ("punch", 2), ("walk", 3), ("punch", 1)):
+                query = self.query(f"label={label}&min_duration={low}", "recent")
+                assert self.pages(query, 5) == oracle(self.bob, query)
+                if label == "punch" and low == 2:
+                    seen = built.call_count
+        assert built.call_count == seen
+
     def test_on_sqlite_the_list_has_its_covering_indexes(self):
         if connection.vendor != "sqlite":
             self.skipTest("SQLite only: PostgreSQL's list indexes INCLUDE the filtered columns")
