@@ -127,8 +127,7 @@ class ListQuery:
         self.ordering, self.gold = ordering_of(request), bool_param(request, "gold")
         v = {"user": user.pk}
         project = int_param(request, "project", None, 1)
-        for name in ("project", "capture"):
-            value = project if name == "project" else int_param(request, name, None, 1)
+        for name, value in (("project", project), ("capture", int_param(request, "capture", None, 1))):
             if value is not None:
                 v[name] = value
         annotator = (request.query_params.get("annotator") or "").strip()
