@@ -25,6 +25,10 @@ with every search; now reads them once per process), then each service's ``updat
 the database vacuumed, the index of now put back as it was (its manifest) and the one
 of before brought in step.
 
+``--drop-caches`` empties the machine's page cache (as root) just before the queries, as
+after a restart or a large read of other files: each service starts from disk (now asks
+the kernel to read its index files back, ``vector_index.prewarm``; before did not).
+
 ``--busy N`` adds N processes that spin on a core for the length of the run (stopped at
 the end), to measure under load; the load average is printed before and after the
 queries. ``--busy-nice K`` runs them at nice ``K``: 0 (the default) is load from
@@ -211,6 +215,8 @@ def run():
                         help="nice value of the busy processes (10: as the service's workers)")
     parser.add_argument("--before", default=before.BEFORE)
     parser.add_argument("--nprobe", type=int, help="lists a search scans (default: the service's)")
+    parser.add_argument("--drop-caches", action="store_true",
+                        help="empty the page cache before the queries (root): every file on disk")
     parser.add_argument("--admin-url", default=million.default_admin_url())
     args = parser.parse_args()
     name, out = million.connect(args.admin_url, args.segments, args.seed)
@@ -248,6 +254,15 @@ def run():
               f"{args.busy} busy processes added (nice {args.busy_nice}); load {load()} before the queries; "
               f"{args.queries} queries (no-index path: first {args.old_queries}), k=10, "
               f"reviewer, through SimilarView\n", flush=True)
+        if args.drop_caches:
+            os.sync()
+            try:
+                with open("/proc/sys/vm/drop_caches", "w") as f:
+                    f.write("3\n")
+            except OSError as exc:
+                raise SystemExit(f"--drop-caches: cannot empty the page cache ({exc})") from exc
+            print("page cache emptied before the queries (--drop-caches): the index files, "
+                  "PostgreSQL's files and the oracle's arrays start on disk\n", flush=True)
         similar_index.forget()
         user = ctx["reviewer"]
         paths = {f"before ({old.rev})": old.api_similar.SimilarView, "now": None}
