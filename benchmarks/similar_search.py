@@ -297,6 +297,13 @@ def run():
                 print(f"  {n + 1} queries done (load {load()})", flush=True)
         print(f"load {load()} after the queries\n")
         table(rows, recall, cpu)
+        if args.drop_caches:
+            print("\nfrom disk, by quarter of the queries (median / p95 ms):")
+            quarter = max(1, len(picks) // 4)
+            for title in paths:
+                spans = [rows[title][i:i + quarter] for i in range(0, len(picks), quarter)]
+                print(f"  {title:<28} " + "   ".join(
+                    f"{statistics.median(t):5.1f} / {p95(t):6.1f}" for t in spans if t))
         from django.conf import settings
 
         if settings.SIMILAR_INDEX_IN_MEMORY:
