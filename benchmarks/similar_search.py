@@ -26,8 +26,8 @@ the database vacuumed, the index of now put back as it was (its manifest) and th
 of before brought in step.
 
 ``--drop-caches`` empties the machine's page cache (as root) just before the queries, as
-after a restart or a large read of other files: each service starts from disk (now asks
-the kernel to read its index files back, ``vector_index.prewarm``; before did not).
+after a restart or a large read of other files: each service starts from disk, and the
+latency of each quarter of the queries shows how soon it recovers.
 
 ``--busy N`` adds N processes that spin on a core for the length of the run (stopped at
 the end), to measure under load; the load average is printed before and after the

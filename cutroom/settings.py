@@ -191,9 +191,6 @@ SIMILAR_INDEX_DIR = Path(os.environ.get("CUTROOM_SIMILAR_INDEX_DIR") or VAR_DIR 
 # Each web process reads an index's base (its profiles, 420 bytes a segment) into memory:
 # searching the shared memory-mapped file costs twice the time (docs/operations.md).
 SIMILAR_INDEX_IN_MEMORY = envbool("CUTROOM_SIMILAR_INDEX_IN_MEMORY", True)
-# A process that opens an index asks the kernel to read its files into the page cache
-# (motionlib.vector_index.prewarm): a search that misses it waits for the disk.
-SIMILAR_INDEX_PREWARM = envbool("CUTROOM_SIMILAR_INDEX_PREWARM", True)
 STORAGES = {
     "default": {
         "BACKEND": os.environ.get(

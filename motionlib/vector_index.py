@@ -30,7 +30,6 @@ asks the base's ``nprobe`` nearest lists and compares the query with every delta
 from __future__ import annotations
 
 import os
-import threading
 from pathlib import Path
 
 import faiss
@@ -280,31 +279,6 @@ class VectorIndex:
             keys, dist = keys[live], dist[live]
         order = np.argsort(dist, kind="stable")[:count]
         return keys[order].astype(np.int64), dist[order]
-
-
-def prewarm(folder: Path) -> threading.Thread:
-    """Ask the kernel to read the folder's files into the page cache, in the background.
-
-    A search reads its shortlist's payload rows from the mapped files at random: a row the
-    page cache does not hold waits for the disk, which sets a search's tail latency (at a
-    million keys the files are ~5 GB, and anything else the machine reads may push them
-    out). ``POSIX_FADV_WILLNEED`` starts the reads and returns; they go to the page cache
-    shared by every process, not to this one's memory, and the kernel drops them again
-    when memory is short. Returns the (daemon) thread that asks, for a caller that waits.
-    """
-    def advise():
-        if not hasattr(os, "posix_fadvise"):  # not on every system: a hint only
-            return
-        for path in sorted(Path(folder).iterdir()):
-            try:
-                with open(path, "rb") as f:
-                    os.posix_fadvise(f.fileno(), 0, 0, os.POSIX_FADV_WILLNEED)
-            except OSError:
-                continue  # a file removed meanwhile, or a filesystem that cannot: a hint only
-
-    thread = threading.Thread(target=advise, name=f"prewarm {Path(folder).name}", daemon=True)
-    thread.start()
-    return thread
 
 
 def _mapped(path, dtype, shape):

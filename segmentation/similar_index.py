@@ -486,8 +486,6 @@ def _open_checked(project_id, previous=None):
             raise IndexUnusable(f"{manifest['file']}: holds no descriptors")
         index = vector_index.VectorIndex.open(folder_of(manifest), state,
                                               in_memory=settings.SIMILAR_INDEX_IN_MEMORY)
-        if settings.SIMILAR_INDEX_PREWARM:
-            vector_index.prewarm(folder_of(manifest))
         if state["base"] + state["delta"] - state["removed"] != manifest["count"]:
             raise IndexUnusable(f"{manifest['file']}: holds {state['base']} + {state['delta']}"
                                 f" - {state['removed']} vectors, the manifest says "

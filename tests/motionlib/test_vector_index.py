@@ -2,10 +2,6 @@
 scans a few, sees appended and removed keys at the state that counts them and not before,
 ignores what a crashed writer left, and names a damaged file."""
 
-import os
-import shutil
-import subprocess
-
 import numpy as np
 import pytest
 
@@ -123,29 +119,3 @@ def test_it_returns_the_payload_of_base_and_appended_keys(tmp_path):
     found, got = VectorIndex.open(tmp_path / "index", state).payload([4, 1001, 5, 9999])
     assert found.tolist() == [True, True, False, False]
     assert got.tolist() == [rows[2].tolist(), [7] * 4, [0] * 4, [0] * 4]
-
-
-def resident(path):
-    """Bytes of ``path`` in the page cache (util-linux ``fincore``)."""
-    out = subprocess.run(["fincore", "--bytes", "--noheadings", "-o", "RES", str(path)],
-                         capture_output=True, text=True, check=True).stdout
-    return int(out.strip())
-
-
-def test_prewarm_reads_the_folders_files_into_the_page_cache(tmp_path):
-    if not shutil.which("fincore") or not hasattr(os, "posix_fadvise"):
-        pytest.skip("needs util-linux fincore and posix_fadvise (Linux)")
-    x = clustered(n=3000, d=64)
-    (tmp_path / "payload").write_bytes(np.ones((3000, 256), dtype="<f4").tobytes())
-    vector_index.build(tmp_path / "index", np.arange(3000), x, n_lists=10,
-                       payload=tmp_path / "payload", payload_width=256)
-    files = [p for p in (tmp_path / "index").iterdir() if p.stat().st_size]
-    for path in files:
-        with open(path, "rb") as f:
-            os.fsync(f.fileno())
-            os.posix_fadvise(f.fileno(), 0, 0, os.POSIX_FADV_DONTNEED)
-    if any(resident(p) for p in files):
-        pytest.skip("this filesystem keeps the files' pages whatever it is told")
-    vector_index.prewarm(tmp_path / "index").join(timeout=30)
-    for path in files:
-        assert resident(path) >= path.stat().st_size // 4096 * 4096, path.name
