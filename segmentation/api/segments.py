@@ -141,7 +141,7 @@ class ListQuery:
         for name, high in (("min_duration", None), ("max_duration", None), ("min_agreement", 1)):
             value = float_param(request, name, 0, high)
             if value is not None:
-                v[name] = float(value)
+                v[name] = value
         staff, annotating = projects_by_role(user)
         if project is not None:
             staff, annotating = [p for p in staff if p == project], [p for p in annotating if p == project]
