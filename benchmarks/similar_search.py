@@ -231,7 +231,9 @@ def run():
         similar_index.vector_index.NPROBE = args.nprobe
     ctx = million.personas()
     project = ctx["project"].pk
-    dirs = {"now": out / "similar-now", "before": out / "similar-before"}
+    dirs = {"now": out / "similar-now",
+            "before": out / ("similar-before" if args.before == before.BEFORE else
+                             f"similar-before-{args.before}")}
     manifest, built, how = ensure(similar_index, project, dirs["now"])
     old_manifest, old_built, old_how = ensure(old.similar_index, project, dirs["before"])
     ids, profiles, spans = oracle_arrays(out)
@@ -243,8 +245,10 @@ def run():
     print(f"now: faiss IVF, {manifest['lists']:,} lists, nprobe {similar_index.vector_index.NPROBE}, "
           f"float32, descriptors beside it; {manifest['count']:,} vectors, "
           f"{manifest['bytes'] / 1e6:,.0f} MB of files; {how} in {built:.1f} s")
-    print(f"before ({old.rev}): numpy IVF, {old_manifest['lists']:,} lists, float16, scans "
-          f">= {old.similar_index.PROBE_SHARE:.1%}; {old_manifest['bytes'] / 1e6:,.0f} MB; "
+    kind = (f"numpy IVF, {old_manifest['lists']:,} lists, float16, scans "
+            f">= {old.similar_index.PROBE_SHARE:.1%}" if hasattr(old.similar_index, "PROBE_SHARE")
+            else f"faiss IVF, {old_manifest['lists']:,} lists")
+    print(f"before ({old.rev}): {kind}; {old_manifest['bytes'] / 1e6:,.0f} MB; "
           f"{old_how} in {old_built:.1f} s")
     spinning = contextlib.ExitStack()
     spinning.enter_context(busy(args.busy, args.busy_nice))

@@ -248,7 +248,8 @@ class VectorIndex:
     def __len__(self):
         return len(self.keys())
 
-    def search(self, query: np.ndarray, count: int, *, nprobe: int | None = None):
+    def search(self, query: np.ndarray, count: int, *, nprobe: int | None = None,
+               vectors: bool = False):
         """The ``count`` live keys nearest to ``query`` among the ``nprobe`` (default
         ``NPROBE``) nearest lists and the added vectors.
 
@@ -256,6 +257,9 @@ class VectorIndex:
         -------
         keys : (<= count,) int64, nearest first.
         distances : their squared Euclidean distances (float32).
+        vectors : with ``vectors=True``, their vectors (<= count, ndim) float32, as stored:
+            read from the lists the search scanned, so a caller that measures the
+            candidates again touches no other file.
         """
         q = np.ascontiguousarray(query, dtype=np.float32).reshape(1, -1)
         if q.shape[1] != self.ndim:
@@ -264,20 +268,30 @@ class VectorIndex:
         # finds too few asks again for more).
         want = count + min(len(self.removed), count)
         params = faiss.SearchParametersIVF(nprobe=min(nprobe or NPROBE, self.base.nlist))
-        dist, keys = self.base.search(q, min(want, self.base.ntotal), params=params)
+        k = min(want, self.base.ntotal)
+        if vectors:
+            dist, keys, rows = self.base.search_and_reconstruct(q, k, params=params)
+            rows = rows[0]
+        else:
+            dist, keys = self.base.search(q, k, params=params)
+            rows = np.zeros((len(keys[0]), 0), dtype=np.float32)
         keys, dist = keys[0], dist[0]
         found = keys >= 0
-        keys, dist = keys[found], dist[found]
+        keys, dist, rows = keys[found], dist[found], rows[found]
         if len(self.delta_ids):
             dd = self._delta_norms - 2.0 * (self.delta_vectors @ q[0]) + float(q[0] @ q[0])
             near = np.argsort(dd, kind="stable")[:want] if len(dd) <= want else \
                 np.argpartition(dd, want - 1)[:want]
             keys = np.concatenate([keys, np.asarray(self.delta_ids[near], dtype=np.int64)])
             dist = np.concatenate([dist, np.maximum(dd[near], 0).astype(np.float32)])
+            rows = np.concatenate([rows, self.delta_vectors[near] if vectors else
+                                   np.zeros((len(near), 0), dtype=np.float32)])
         if len(self.removed):
             live = ~np.isin(keys, self.removed)
-            keys, dist = keys[live], dist[live]
+            keys, dist, rows = keys[live], dist[live], rows[live]
         order = np.argsort(dist, kind="stable")[:count]
+        if vectors:
+            return keys[order].astype(np.int64), dist[order], np.asarray(rows[order])
         return keys[order].astype(np.int64), dist[order]
 
 

@@ -396,9 +396,10 @@ class OpenIndex:
 
     def nearest(self, vector, count):
         """Up to ``count`` segment ids of the index nearest to a profile vector, nearest
-        first, and their squared distances (float32). Ids may include segments deleted
-        since the last update."""
-        return self.index.search(vector, count)
+        first, and their profiles ((n, ndim) float32, as stored). Ids may include segments
+        deleted since the last update."""
+        ids, _, profiles = self.index.search(vector, count, vectors=True)
+        return ids, profiles
 
     def nearest_newer(self, vector, count):
         """(mark, ids, distances, held): up to ``count`` of the delta's segments nearest to
@@ -528,13 +529,13 @@ def shortlist(index, query, pool, n):
     vector = np.asarray(query[:similarity.PROFILE_ROWS], dtype=np.float32).ravel()
     count = max(CANDIDATES * n, MIN_CANDIDATES)
     while True:
-        candidates, distances = index.nearest(vector, count)
+        candidates, profiles = index.nearest(vector, count)
         mark, newer, newer_distances, held = index.nearest_newer(vector, count)
         rows = _candidates_or_newer(pool, [*candidates.tolist(), *newer.tolist()],
                                     index.project_id, mark)
         index.take_newer(pool.db, rows[0][5] if rows else newest_id(pool.db, index.project_id))
         index.note_delta(held + sum(r[0] > mark for r in rows))
-        measured = dict(zip(candidates.tolist(), distances.tolist(), strict=True))
+        measured = dict(zip(candidates.tolist(), _squared(profiles, query).tolist(), strict=True))
         measured.update(zip(newer.tolist(), newer_distances.tolist(), strict=True))
         found = nearest_unique(rows, query, n, measured, index.descriptors)
         exhausted = (len(candidates) < count and count >= index.size) and len(newer) == held
@@ -557,10 +558,10 @@ def nearest_unique(rows, query, n, measured, stored):
 
     Every distance is measured as the exact scan measures it (float64), so that ties
     (the same motion in two takes) fall as they do there: a row with a profile from the
-    profile, one the index holds from its stored descriptor (``stored(ids)``: the profile
-    is its first rows), any other from ``measured`` (the delta's, in float64). The
-    descriptors the index does not hold are read in one query, for the shortlisted rows
-    only (a descriptor is 4.9 kB; a profile 420 bytes). Invalid when a profile or a stored
+    profile, any other from ``measured`` (the index's candidates, from the profiles its
+    lists hold, and the delta's). Only the ``n`` chosen rows' descriptors are read: from
+    the index (``stored(ids)``), else in one query (a descriptor is 4.9 kB, so reading
+    every candidate's would be most of a search's reads). Invalid when a profile or a
     descriptor is not of the query's shape (a library described by another version)."""
     rows = [r for r in rows if r[4] is not None or r[0] in measured]
     if not rows:
@@ -572,24 +573,17 @@ def nearest_unique(rows, query, n, measured, stored):
             seen.add(row[1:4])
             unique.append(row)
     width = similarity.PROFILE_ROWS * query.shape[1]
-    q = np.asarray(query[:similarity.PROFILE_ROWS], dtype=float).ravel()
-    read = stored([r[0] for r in unique if r[4] is None])
-    for descriptor in read.values():
-        _check_size(descriptor, query)
     d = np.array([measured.get(r[0], np.nan) for r in unique])
-    held = [i for i, r in enumerate(unique) if r[4] is None and r[0] in read]
-    if held:
-        diff = np.stack([read[unique[i][0]][:width] for i in held]) - q
-        d[held] = np.einsum("ij,ij->i", diff, diff)
     fresh = [i for i, r in enumerate(unique) if r[4] is not None]
     if fresh:
         blobs = [bytes(unique[i][4]) for i in fresh]
         if {len(b) for b in blobs} != {4 * width}:
             raise Invalid(f"library profiles have {sorted({len(b) // 4 for b in blobs})} "
                           f"numbers, the query's {width}; rebuild the library")
-        diff = np.frombuffer(b"".join(blobs), dtype="<f4").reshape(len(fresh), width) - q
-        d[fresh] = np.einsum("ij,ij->i", diff, diff)
+        d[fresh] = _squared(np.frombuffer(b"".join(blobs), dtype="<f4").reshape(len(fresh), width),
+                            query)
     chosen = [unique[i] for i in np.argsort(d, kind="stable")[:n]]
+    read = stored([r[0] for r in chosen if r[4] is None])
     newer = [r[0] for r in chosen if r[0] not in read]
     if newer:
         read.update((pk, np.frombuffer(bytes(blob), dtype="<f4")) for pk, blob in
@@ -602,6 +596,18 @@ def nearest_unique(rows, query, n, measured, stored):
         _check_size(descriptor, query)
         out.append((r[0], descriptor.reshape(query.shape), r))
     return out
+
+
+def _squared(profiles, query):
+    """Squared distances (float64) from each of ``profiles`` (n, width) to ``query``'s
+    profile, with float64 differences, as the exact scan measures them."""
+    width = similarity.PROFILE_ROWS * query.shape[1]
+    if profiles.shape[1] != width:
+        raise Invalid(f"library profiles have {profiles.shape[1]} numbers, the query's "
+                      f"{width}; rebuild the library")
+    diff = np.asarray(profiles, dtype=np.float64) - np.asarray(
+        query[:similarity.PROFILE_ROWS], dtype=np.float64).ravel()
+    return np.einsum("ij,ij->i", diff, diff)
 
 
 def _check_size(descriptor, query):

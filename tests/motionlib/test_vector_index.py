@@ -67,6 +67,24 @@ def test_it_finds_appended_keys_and_drops_removed_ones(tmp_path):
     assert 4 not in index.search(x[4], 5, nprobe=10)[0]
 
 
+def test_it_returns_the_stored_vectors_of_what_it_finds(tmp_path):
+    x = clustered(n=1000)
+    ids = np.arange(100, 1100)
+    folder, state = built(tmp_path, x, ids)
+    extra = clustered(n=20, seed=5)
+    state = vector_index.append(folder, state, np.arange(5000, 5020), extra, [100, 101])
+    stored = dict(zip([*ids.tolist(), *range(5000, 5020)], [*x, *extra], strict=True))
+    index = VectorIndex.open(folder, state)
+    for q, first in ((x[2], 102), (extra[3], 5003)):
+        keys, d, vectors = index.search(q, 30, nprobe=10, vectors=True)
+        plain, plain_d = index.search(q, 30, nprobe=10)
+        assert keys.tolist() == plain.tolist() and np.array_equal(d, plain_d)
+        assert 100 not in keys and 101 not in keys
+        assert vectors.dtype == np.float32 and vectors.shape == (30, x.shape[1])
+        assert all(np.array_equal(v, stored[k]) for k, v in zip(keys.tolist(), vectors, strict=True))
+        assert keys[0] == first and np.array_equal(vectors[0], q)
+
+
 def test_an_append_leaves_the_base_file_as_it_was(tmp_path):
     folder, state = built(tmp_path, clustered(n=1000))
     before = (folder / vector_index.BASE).read_bytes()

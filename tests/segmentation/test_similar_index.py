@@ -242,6 +242,36 @@ class QueryCountTest(SimilarIndexTestCase):
         assert counts[0] == counts[1]
 
 
+class ReadsTest(SimilarIndexTestCase):
+    def test_it_reads_the_descriptors_of_the_shortlist_only(self):
+        rows = self.add_segments(self.spans, self.descs)
+        similar_index.build(self.project.pk)
+        similar_index.forget()
+        expected = self.indexed(rows[7])
+        index = similar_index.open_index(self.project.pk)
+        asked, proposed = [], []
+        read, nearest = index.descriptors, index.nearest
+
+        def spy_read(ids):
+            asked.append(list(ids))
+            return read(ids)
+
+        def spy_nearest(vector, count):
+            found = nearest(vector, count)
+            proposed.append(len(found[0]))
+            return found
+
+        with mock.patch.object(index, "descriptors", spy_read), \
+                mock.patch.object(index, "nearest", spy_nearest), \
+                CaptureQueriesContext(connection) as queries:
+            assert self.indexed(rows[7]) == expected
+        # The index proposed MIN_CANDIDATES, their profiles with them; only the SHORTLIST
+        # nearest were read whole, from the index, and no descriptor from the database.
+        assert proposed == [similar_index.MIN_CANDIDATES]
+        assert [len(ids) for ids in asked] == [search.SHORTLIST]
+        assert not [q for q in queries if '"descriptor"' in q["sql"]]
+
+
 class IncrementalTest(SimilarIndexTestCase):
     def test_it_finds_segments_added_after_the_index_was_written(self):
         rows = self.add_segments(self.spans[:200], self.descs[:200])
