@@ -136,3 +136,25 @@ def mapped_rss(name):
 def load():
     """The load average (1, 5, 15 min) as a benchmark prints it: "1.2, 0.8, 0.5"."""
     return ", ".join(f"{x:.1f}" for x in os.getloadavg())
+
+
+def reclaim():
+    """The kernel's proactive reclaim, as a benchmark prints it: DAMON schemes that page out
+    memory idle for a while take file pages (the index files, PostgreSQL's files) out of
+    the page cache whatever memory is free, so a later read of them goes to the disk."""
+    root = Path("/sys/kernel/mm/damon/admin/kdamonds")
+    found = []
+    for kdamond in sorted(root.glob("[0-9]*")):
+        try:
+            if (kdamond / "state").read_text().strip() != "on":
+                continue
+            for context in sorted((kdamond / "contexts").glob("[0-9]*")):
+                aggr = int((context / "monitoring_attrs/intervals/aggr_us").read_text())
+                for scheme in sorted((context / "schemes").glob("[0-9]*")):
+                    action = (scheme / "action").read_text().strip()
+                    age = int((scheme / "access_pattern/age/min").read_text())
+                    if action == "pageout":
+                        found.append(f"pages idle >= {age * aggr / 1e6:.0f} s paged out")
+        except (OSError, ValueError):
+            continue
+    return f"proactive reclaim (DAMON): {', '.join(found)}" if found else "no proactive reclaim"

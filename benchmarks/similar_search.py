@@ -55,7 +55,7 @@ from unittest import mock
 import before
 import million
 import numpy as np
-from harness import busy, load, mapped_rss
+from harness import busy, load, mapped_rss, reclaim
 
 
 def oracle_arrays(out):
@@ -257,7 +257,7 @@ def run():
         print(f"machine: {platform.machine()}, {os.cpu_count()} cores shared with other work, "
               f"{args.busy} busy processes added (nice {args.busy_nice}); load {load()} before the queries; "
               f"{args.queries} queries (no-index path: first {args.old_queries}), k=10, "
-              f"reviewer, through SimilarView\n", flush=True)
+              f"reviewer, through SimilarView; {reclaim()}\n", flush=True)
         if args.drop_caches:
             os.sync()
             try:
