@@ -137,3 +137,19 @@ def test_it_returns_the_payload_of_base_and_appended_keys(tmp_path):
     found, got = VectorIndex.open(tmp_path / "index", state).payload([4, 1001, 5, 9999])
     assert found.tolist() == [True, True, False, False]
     assert got.tolist() == [rows[2].tolist(), [7] * 4, [0] * 4, [0] * 4]
+
+
+@pytest.mark.parametrize("in_memory", [False, True])
+def test_it_returns_payload_rows_wider_than_a_page_whole(tmp_path, in_memory):
+    # 1,225 numbers (4.9 kB) a row, as the similar-clip search's descriptors: most rows
+    # straddle two pages of the mapped file.
+    x = clustered(n=200)
+    rows = np.random.default_rng(7).normal(size=(200, 1225)).astype("<f4")
+    (tmp_path / "payload").write_bytes(rows.tobytes())
+    state = vector_index.build(tmp_path / "index", np.arange(200), x, n_lists=3,
+                               payload=tmp_path / "payload", payload_width=1225)
+    state.pop("lists")
+    index = VectorIndex.open(tmp_path / "index", state, in_memory=in_memory)
+    keys = [199, 0, 57, 57, 130, 1]
+    found, got = index.payload(keys)
+    assert found.all() and np.array_equal(got, rows[keys])
