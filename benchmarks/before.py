@@ -11,7 +11,7 @@ import subprocess
 import sys
 import types
 
-from harness import REPO
+from benchmarks.harness import REPO
 
 # The last commit with the numpy inverted file, whole-file updates and the ORM re-ranking.
 BEFORE = "45b52fc"

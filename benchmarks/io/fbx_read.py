@@ -23,8 +23,8 @@ import time
 from pathlib import Path
 
 import numpy as np
-from harness import start_django
 
+from benchmarks.harness.service import start_django
 from segmentation.shared_data import data_dir
 
 
@@ -129,6 +129,3 @@ def report(args, rows, startup, same):
     print(f"NEW FBX read / BVH read: {ratio:.2f}x (target <= 10x): "
           f"{'ok' if ratio <= 10 else 'MISSED'}")
 
-
-if __name__ == "__main__":
-    main()

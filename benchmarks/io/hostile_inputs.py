@@ -13,16 +13,13 @@ and the peak memory traced in one more read.
 from __future__ import annotations
 
 import os
-import sys
 import tempfile
 import time
 import tracemalloc
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-
-import motionlib  # noqa: E402
-from motionlib.take import DEFAULT_LIMITS, Limits  # noqa: E402
+import motionlib
+from motionlib.take import DEFAULT_LIMITS, Limits
 
 HEAD = "HIERARCHY\nROOT Hips\n{\n  OFFSET 0 0 0\n  CHANNELS 1 Yposition\n"
 TAIL = "MOTION\nFrames: {n}\nFrame Time: 0.01\n"
@@ -83,6 +80,3 @@ def main() -> None:
             size = f"{path.stat().st_size / 1024:.0f} KB"
             print(f"{name:<34} {size:>9} {wall:>8.1f} {cpu:>8.1f} {peak:>8.1f}  {outcome}")
 
-
-if __name__ == "__main__":
-    main()

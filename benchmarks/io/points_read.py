@@ -21,7 +21,6 @@ Times are the best and the median of ``--repeats`` reads, the readers interleave
 from __future__ import annotations
 
 import argparse
-import os
 import sys
 import tempfile
 import time
@@ -31,14 +30,11 @@ from pathlib import Path
 
 import numpy as np
 
-REPO = Path(__file__).resolve().parents[1]
-if str(REPO) not in sys.path:
-    sys.path.insert(0, str(REPO))
+import motionlib
+from motionlib.io.c3dfile import write_c3d
+from segmentation.shared_data import data_dir
 
-import motionlib  # noqa: E402
-from motionlib.io.c3dfile import write_c3d  # noqa: E402
-
-DEFAULT_DATA = Path(os.environ.get("CUTROOM_BENCH_DATA", REPO / ".." / "shared" / "data"))
+DEFAULT_DATA = data_dir()
 HDM05 = Path("points/hdm05/HDM_bd_05-01_01_120.c3d")
 
 
@@ -150,6 +146,3 @@ def main():
           f"{check_against_ezc3d(take, c3d_path):g} mm")
     print(export)
 
-
-if __name__ == "__main__":
-    main()

@@ -64,8 +64,7 @@ def timed_search(search, queries, truth, k):
 MAPPED = """
 import faiss, json, sys, time, numpy as np
 path, out = sys.argv[1], sys.argv[2]
-sys.path.insert(0, sys.argv[6])
-from harness import mapped_rss
+from benchmarks.harness.machine import mapped_rss
 index = faiss.read_index(path, faiss.IO_FLAG_MMAP | faiss.IO_FLAG_READ_ONLY)
 index.nprobe = int(sys.argv[3])
 q = np.load(sys.argv[4])
@@ -80,7 +79,7 @@ def faiss_sharing(path, nprobe, queries_path):
     """Two processes map the file and search; returns [[rss kB, pss kB]] of each."""
     outs = [tempfile.mktemp(suffix=".json") for _ in range(2)]
     procs = [subprocess.Popen([sys.executable, "-c", MAPPED, str(path), o, str(nprobe),
-                               str(queries_path), "6", str(REPO / "benchmarks")]) for o in outs]
+                               str(queries_path), "6"]) for o in outs]
     time.sleep(0.5)
     for p in procs:
         p.wait(120)
@@ -192,6 +191,3 @@ def main():
         row("hnswlib HNSW f32", built, *r, path.stat().st_size / 1e6,
             "no (load_index reads it into each process)")
 
-
-if __name__ == "__main__":
-    main()

@@ -34,9 +34,8 @@ import re
 import statistics
 import time
 
-import million
-import million_sqlite
-from harness import busy, load
+from benchmarks.harness.machine import busy, load
+from benchmarks.library import million, million_sqlite
 
 
 def queries(ctx):
@@ -183,6 +182,3 @@ def table(ctx, args, old_view, new_view):
                   f"{statistics.median(cpu):>8.1f} {n_sql:>4}  {plan}", flush=True)
     return worst, differ
 
-
-if __name__ == "__main__":
-    main()

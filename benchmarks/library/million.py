@@ -1,8 +1,9 @@
 """A seeded library of a million described segments on PostgreSQL, built once and reused.
 
-Shared by ``library_query.py`` and ``similar_search.py``. The database
+Shared by ``listing`` and ``similar_search``, which build it on first use. The database
 ``cutroom_bench_million_<n>_s<seed>`` is kept after a run (a marker table says it is
-complete), so the slow build happens once per machine; ``--rebuild`` drops it first.
+complete), so the slow build happens once per machine and revision (a revision compared
+against has its own: ``harness.kept_name``); dropping it makes the next run build it anew.
 Next to it, ``benchmarks/out/million_<n>_s<seed>/`` (git-ignored) keeps the segment ids
 and profiles as ``.npy`` for the exact-search oracle.
 
@@ -20,9 +21,10 @@ import os
 import time
 
 import numpy as np
-from harness import REPO, database_url
 
-OUT = REPO / "benchmarks" / "out"
+from benchmarks.harness import OUT, kept_name
+from benchmarks.harness.service import database_url
+
 SMALL_PROJECT = 20_000
 LABELS = ["walk", "run", "jump", "punch", "kick", "squat", "wave", "turn", "sit", "idle"]
 CMU = [("13_29", "13"), ("13_30", "13"), ("86_01", "86"), ("02_07", "02"), ("06_02", "06"),
@@ -30,7 +32,7 @@ CMU = [("13_29", "13"), ("13_30", "13"), ("86_01", "86"), ("02_07", "02"), ("06_
 
 
 def name_of(n, seed):
-    return f"cutroom_bench_million_{n}_s{seed}"
+    return kept_name(f"cutroom_bench_million_{n}_s{seed}")
 
 
 def out_dir(n, seed):
@@ -228,13 +230,3 @@ def personas():
 def default_admin_url():
     return os.environ.get("DATABASE_ADMIN_URL", "postgres://postgres@127.0.0.1:5432/postgres")
 
-
-if __name__ == "__main__":
-    import argparse
-
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--segments", type=int, default=1_000_000)
-    parser.add_argument("--seed", type=int, default=15)
-    parser.add_argument("--rebuild", action="store_true")
-    args = parser.parse_args()
-    print(connect(default_admin_url(), args.segments, args.seed, args.rebuild))

@@ -4,7 +4,7 @@ Same data as the PostgreSQL one (same seed, same distributions: project "Archive
 described segments, three projects of 20,000, 20 annotators, a reviewer, 10 labels, gold on
 one capture in ten, agreement on 80 %), written with plain ``INSERT``s into a database file
 migrated as `make up` migrates it, in ``benchmarks/out/million_<n>_s<seed>_sqlite/``
-(git-ignored). A marker table says the build finished; ``--rebuild`` starts again. No
+(git-ignored). A marker table says the build finished; deleting the folder starts again. No
 ``ANALYZE`` is run: an installation on the embedded default has no planner statistics
 unless the product gathers them itself, so the benchmark reads the file as one would.
 """
@@ -12,11 +12,11 @@ unless the product gathers them itself, so the benchmark reads the file as one w
 import sqlite3
 import time
 
-import million
 import numpy as np
-from harness import REPO, start_django
 
-OUT = REPO / "benchmarks" / "out"
+from benchmarks.harness import OUT
+from benchmarks.harness.service import start_django
+from benchmarks.library import million
 
 
 def path_of(n, seed):
@@ -103,13 +103,3 @@ def _insert_rows(connection, rng, project_id, cap_ids, gold, label_ids, annotato
         cursor.executemany(f"INSERT INTO segmentation_librarysegment ({columns}) "
                            f"VALUES ({marks})", rows)
 
-
-if __name__ == "__main__":
-    import argparse
-
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--segments", type=int, default=1_000_000)
-    parser.add_argument("--seed", type=int, default=15)
-    parser.add_argument("--rebuild", action="store_true")
-    args = parser.parse_args()
-    print(connect(args.segments, args.seed, args.rebuild))

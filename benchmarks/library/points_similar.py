@@ -20,19 +20,15 @@ from __future__ import annotations
 
 import argparse
 import json
-import sys
 import time
 from collections import Counter
 from pathlib import Path
 
 import numpy as np
 
-REPO = Path(__file__).resolve().parents[1]
-if str(REPO) not in sys.path:
-    sys.path.insert(0, str(REPO))
-
-import motionlib  # noqa: E402
-from motionlib import similarity  # noqa: E402
+import motionlib
+from motionlib import similarity
+from segmentation.shared_data import data_dir
 
 NEIGHBOURS = 5
 
@@ -76,7 +72,7 @@ def accuracy(items, held_out, k):
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--data", type=Path, default=REPO.parent / "shared" / "data")
+    parser.add_argument("--data", type=Path, default=data_dir())
     args = parser.parse_args(argv)
     folder = args.data / "points" / "vmci"
     if not folder.is_dir():
@@ -96,6 +92,3 @@ def main(argv=None) -> int:
               f"{accuracy(items, held_out, NEIGHBOURS):>12.2f}{chance:>10.2f}")
     return 0
 
-
-if __name__ == "__main__":
-    raise SystemExit(main())

@@ -20,25 +20,20 @@ other clips, e.g. 13_29's JumpJack has one), and search time per query.
 """
 
 import argparse
-import sys
 import time
 from collections import defaultdict
-from pathlib import Path
 
 import numpy as np
 
-REPO = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(REPO))
-
-import motionlib  # noqa: E402
-from motionlib.similarity import (  # noqa: E402
+import motionlib
+from motionlib.similarity import (
     PROFILE_ROWS,
     body_scale,
     rank_similar,
     segment_descriptor,
 )
-from motionlib.vector_index import IvfIndex  # noqa: E402
-from segmentation.shared_data import data_dir  # noqa: E402
+from motionlib.vector_index import IvfIndex
+from segmentation.shared_data import data_dir
 
 DATA = data_dir()
 
@@ -133,6 +128,3 @@ def main():
         print(f"{title:<38} {'all':<16} {n:>5} {hits / n:>7.0%} {prec / n:>7.0%} "
               f"{seconds / n * 1000:>9.1f}\n")
 
-
-if __name__ == "__main__":
-    main()

@@ -53,9 +53,10 @@ from contextlib import contextmanager
 from unittest import mock
 
 import before
-import million
 import numpy as np
-from harness import busy, load, mapped_rss, reclaim
+
+from benchmarks.harness.machine import busy, load, mapped_rss, reclaim
+from benchmarks.library import million
 
 
 def oracle_arrays(out):
@@ -374,6 +375,3 @@ def run():
           f"load 4), recall@10 {np.mean(recall['now']):.3f} (target 0.99), min per query "
           f"{min(recall['now']):.1f}")
 
-
-if __name__ == "__main__":
-    main()

@@ -33,7 +33,6 @@ from __future__ import annotations
 import argparse
 import csv
 import json
-import os
 import sys
 import time
 from collections.abc import Callable
@@ -42,17 +41,14 @@ from pathlib import Path
 
 import numpy as np
 
-REPO = Path(__file__).resolve().parents[1]
-if str(REPO) not in sys.path:
-    sys.path.insert(0, str(REPO))
+import motionlib
+from motionlib import features, markersets, metrics
+from motionlib.errors import MotionlibError
+from motionlib.points import filled
+from motionlib.segmenters import list_segmenters
+from segmentation.shared_data import data_dir
 
-import motionlib  # noqa: E402
-from motionlib import features, markersets, metrics  # noqa: E402
-from motionlib.errors import MotionlibError  # noqa: E402
-from motionlib.points import filled  # noqa: E402
-from motionlib.segmenters import list_segmenters  # noqa: E402
-
-DEFAULT_DATA = Path(os.environ.get("CUTROOM_BENCH_DATA", REPO / ".." / "shared" / "data"))
+DEFAULT_DATA = data_dir()
 RUPTURES_PENALTY = 3.0
 RUPTURES_RATE_HZ = 10.0
 
@@ -275,6 +271,3 @@ def main(argv=None):
         print_set(point_set, all_scores[name][1])
     print_summary(all_scores)
 
-
-if __name__ == "__main__":
-    main()

@@ -30,7 +30,14 @@ import tempfile
 import time
 from pathlib import Path
 
-from harness import REPO, drop_database, scratch_database, start_django, stop, up_script
+from benchmarks.harness import REPO
+from benchmarks.harness.service import (
+    drop_database,
+    scratch_database,
+    start_django,
+    stop,
+    up_script,
+)
 
 # The workers run as `make up` runs them: one core per pool process, no BLAS threads.
 SINGLE_THREADED = up_script().SINGLE_THREADED
@@ -179,6 +186,3 @@ def main():
         drop_database(args.admin_url, name)
         shutil.rmtree(var, ignore_errors=True)
 
-
-if __name__ == "__main__":
-    main()

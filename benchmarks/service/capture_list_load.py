@@ -28,7 +28,9 @@ import urllib.request
 from pathlib import Path
 
 import numpy as np
-from harness import REPO, drop_database, scratch_database, start_django, stop
+
+from benchmarks.harness import REPO
+from benchmarks.harness.service import drop_database, scratch_database, start_django, stop
 
 TARGET_MS = 100.0
 SCENARIOS = [
@@ -281,6 +283,3 @@ def main():
         drop_database(args.postgres, name)
         shutil.rmtree(var, ignore_errors=True)
 
-
-if __name__ == "__main__":
-    main()

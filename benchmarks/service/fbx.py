@@ -26,8 +26,9 @@ import time
 from pathlib import Path
 
 import numpy as np
-from harness import REPO, start_django, stop
 
+from benchmarks.harness import REPO
+from benchmarks.harness.service import start_django, stop
 from segmentation.shared_data import data_dir
 
 DEFAULT_DATA = data_dir()
@@ -197,6 +198,3 @@ def main():
             stop(worker)
         shutil.rmtree(var, ignore_errors=True)
 
-
-if __name__ == "__main__":
-    main()

@@ -13,7 +13,8 @@ import os
 import time
 
 import numpy as np
-from hour_take import take_file
+
+from benchmarks.service.hour_take import take_file
 
 
 def timed(function):
@@ -51,6 +52,3 @@ def main():
     print(f"\nsame cuts on both paths: {same}; load after "
           f"{', '.join(f'{x:.1f}' for x in os.getloadavg())}")
 
-
-if __name__ == "__main__":
-    main()

@@ -24,8 +24,9 @@ import threading
 import time
 from pathlib import Path
 
-from harness import REPO, stop
-from upload_to_candidates import (
+from benchmarks.harness import REPO
+from benchmarks.harness.service import stop
+from benchmarks.service.upload_to_candidates import (
     client_and_project,
     embedded_environment,
     start_worker,
@@ -164,6 +165,3 @@ def main():
             stop(worker)
         shutil.rmtree(var, ignore_errors=True)
 
-
-if __name__ == "__main__":
-    main()

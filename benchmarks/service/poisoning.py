@@ -34,7 +34,7 @@ import os
 import sys
 import time
 
-from harness import in_scratch_installation
+from benchmarks.harness.service import in_scratch_installation
 
 FPS = 120.0
 # (takes in the project, which of them the poisoner reviews)
@@ -207,6 +207,3 @@ def run(args, var):
           f"old path {worst['old']:.3f}, new path {worst['new']:.3f} "
           f"({'meets' if worst['new'] < TARGET_F1_MOVE else 'MISSES'} it); "
           f"ran in {time.perf_counter() - started:.0f} s")
-
-if __name__ == "__main__":
-    main()

@@ -30,7 +30,7 @@ import statistics
 import sys
 import time
 
-from harness import in_scratch_installation
+from benchmarks.harness.service import in_scratch_installation
 
 TARGET_SECONDS = 10.0
 
@@ -181,6 +181,3 @@ def run(args, var):
           f"{median:.2f} s CPU {verdict} it; {statistics.median(fresh) / median:.1f}x less "
           f"than fitting anew (median {statistics.median(fresh):.2f} s CPU)")
 
-
-if __name__ == "__main__":
-    main()

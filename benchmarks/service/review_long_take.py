@@ -67,7 +67,9 @@ import types
 from pathlib import Path
 
 import numpy as np
-from harness import REPO, start_django, stop, up_script
+
+from benchmarks.harness import REPO
+from benchmarks.harness.service import start_django, stop, up_script
 
 TARGET_MS = 100.0
 TARGET_FIRST_POSE_MS = 1000.0
@@ -500,7 +502,6 @@ def time_in_chromium(port, capture, repeats, password):
     """{path: {"first pose": [ms], "every lane drawn": [ms], "all poses loaded": [ms]}}."""
     from playwright.sync_api import sync_playwright
 
-    sys.path.insert(0, str(REPO))
     from tests.e2e.conftest import CHROMIUM_ARGS
 
     times = {name: {"first pose": [], "every lane drawn": [], "all poses loaded": []} for name in BROWSER_PATHS}
@@ -643,6 +644,3 @@ def main():
             stop(proc)
         shutil.rmtree(var, ignore_errors=True)
 
-
-if __name__ == "__main__":
-    main()

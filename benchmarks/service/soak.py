@@ -40,10 +40,8 @@ import uuid
 from collections import Counter
 from pathlib import Path
 
-from harness import up_script
-
-REPO = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(REPO))
+from benchmarks.harness import REPO
+from benchmarks.harness.service import up_script
 
 
 def parse_args():
@@ -330,6 +328,3 @@ def report(args, var, out, client, captures, uploads, kills, refused, states, dr
         print(f"  uploads refused: {dict(refused)}")
     print(f"  logs: {var / 'log'}, up.py output: {out}")
 
-
-if __name__ == "__main__":
-    main()

@@ -23,7 +23,9 @@ import time
 from pathlib import Path
 
 import numpy as np
-from harness import REPO, start_django, stop
+
+from benchmarks.harness import REPO
+from benchmarks.harness.service import start_django, stop
 
 TARGET_SECONDS = 2.0
 
@@ -170,6 +172,3 @@ def main():
             stop(worker)
         shutil.rmtree(var, ignore_errors=True)
 
-
-if __name__ == "__main__":
-    main()
