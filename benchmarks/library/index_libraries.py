@@ -7,7 +7,9 @@ on this machine and searches it with ``--queries`` of the stored profiles (seede
 answer (numpy, float64 over all vectors).
 
 - ``numpy IVF``: ``motionlib.vector_index.IvfIndex``, the service's index before faiss
-  (float16 lists, scans 0.5 % of the vectors, at least 8 lists).
+  (float16 lists, scans 0.5 % of the vectors, at least 8 lists), in the revisions that
+  have it: ``python -m benchmarks index-libraries --against 45b52fc`` prints its row
+  (from a worktree of that revision) beside this checkout's table.
 - ``faiss IVF``: ``IndexIVFFlat`` (float32 lists) as ``motionlib.vector_index`` builds it,
   at its ``nprobe``; also written, then read back memory-mapped (``IO_FLAG_MMAP |
   IO_FLAG_READ_ONLY``) in two processes, whose resident and proportional (``Pss``)
@@ -15,7 +17,7 @@ answer (numpy, float64 over all vectors).
 - ``usearch HNSW`` and ``hnswlib HNSW``: graph indexes (M 16, ef_construction 128,
   ef 64), built with every core; usearch's file is also viewed memory-mapped.
 
-    .venv/bin/python benchmarks/index_libraries.py [--profiles PATH] [--queries 500]
+    python -m benchmarks index-libraries [-- --profiles PATH --queries 500]
 """
 
 import argparse
@@ -30,14 +32,8 @@ from pathlib import Path
 
 import numpy as np
 
-REPO = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(REPO))
-
-sys.path.insert(0, str(REPO / "benchmarks"))
-
-import before  # noqa: E402
-
-from motionlib import vector_index  # noqa: E402
+from benchmarks.harness import OUT
+from motionlib import vector_index
 
 
 def exact(x, queries, k):
@@ -89,7 +85,7 @@ def faiss_sharing(path, nprobe, queries_path):
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--profiles", type=Path,
-                        default=REPO / "benchmarks" / "out" / "million_1000000_s35" / "profiles.npy")
+                        default=OUT / "million_1000000_s35" / "profiles.npy")
     parser.add_argument("--queries", type=int, default=500)
     parser.add_argument("--seed", type=int, default=1)
     parser.add_argument("--skip-hnsw", action="store_true",
@@ -115,20 +111,21 @@ def main():
         print(f"{name:<26} {build_s:>8.1f} {n / build_s:>9,.0f} {p50:>7.2f} {p95:>7.2f} "
               f"{recall:>10.3f} {mb:>8.0f}  {shared}", flush=True)
 
-    old = before.vector_index()
-    started = time.perf_counter()
-    ivf = old.IvfIndex.build(ids, x)
-    built = time.perf_counter() - started
-    r = timed_search(lambda q: ivf.search(q, k, probe_share=0.005)[0], queries, truth, k)
-    mb = sum(ivf.save(tmp / "numpy").values()) / 1e6
-    row("numpy IVF (before)", built, *r, mb, "yes (np.load mmap_mode='r')")
-    ivf = None  # free its memory before the next library
+    if hasattr(vector_index, "IvfIndex"):  # the product's own index before faiss
+        started = time.perf_counter()
+        ivf = vector_index.IvfIndex.build(ids, x)
+        built = time.perf_counter() - started
+        r = timed_search(lambda q: ivf.search(q, k, probe_share=0.005)[0], queries, truth, k)
+        mb = sum(ivf.save(tmp / "numpy").values()) / 1e6
+        row("numpy IVF", built, *r, mb, "yes (np.load mmap_mode='r')")
+        ivf = None  # free its memory before the next library
 
     try:
         import faiss
     except ImportError:
+        faiss = None
         print("faiss: not installed")
-    else:
+    if faiss is not None and hasattr(vector_index, "build"):  # the product's faiss index
         faiss.omp_set_num_threads(os.cpu_count())
         started = time.perf_counter()
         vector_index.build(tmp / "faiss", ids, x)

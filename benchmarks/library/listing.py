@@ -1,40 +1,43 @@
-"""Library list benchmark: a million segments, first and 100th page, old and new list.
+"""Library list benchmark: a million segments, first and 100th page.
 
-Uses the seeded million-segment library (``million_sqlite.py`` on the embedded default,
-SQLite, by default; ``--postgres`` for ``million.py``'s PostgreSQL one; each built on
-first use, then kept) and times ``GET /api/segments/`` (the real view: role filter,
-query-string filters, one page of 50 with its count) for typical filters and orders, each
-on page 1 and page 100, with the list as it was (``old``: ``library_list_old.py``) and as
-it is (``new``), on the same database. One row per query and page: rows matched
-(``10,000+`` = capped), median and 95th-percentile milliseconds of each, the new one's
-median CPU time per request in this process (``new CPU``: SQLite runs in it, PostgreSQL
-does not; on a shared machine it is the steadier figure), its SQL queries per request, and
-the indexes the database's plan uses for its page query (``+ sort`` when it sorts the
-matches, ``+ table scan`` when it reads the table). The old and new pages are checked to
-hold the same results, byte for byte. The process is set up as the web server's are
-(``cutroom/wsgi.py``, which freezes the objects loaded at start out of the collector's way),
-and each series starts with a collection, so that no list is charged for collecting the
-other's garbage.
+Uses the seeded million-segment library (``million_sqlite`` on the embedded default,
+SQLite, by default; ``--postgres`` for ``million``'s PostgreSQL one; each built on first
+use, then kept) and times ``GET /api/segments/`` (the real view: role filter, query-string
+filters, one page of 50 with its count) for typical filters and orders, each on page 1
+and page 100. One row per query and page: rows matched (``10,000+`` = capped), median and
+95th-percentile milliseconds, the median CPU time per request in this process (``CPU``:
+SQLite runs in it, PostgreSQL does not; on a shared machine it is the steadier figure),
+its SQL queries per request, a digest of the page's JSON (``page``: two runs whose digests
+agree returned the same segments, fields byte for byte), and the indexes the database's
+plan uses for its page query (``+ sort`` when it sorts the matches, ``+ table scan`` when
+it reads the table). The process is set up as the web server's are (``cutroom/wsgi.py``,
+which freezes the objects loaded at start out of the collector's way), and each series
+starts with a collection.
+
+The list as it was before the SQLite work is the product of ``51c396e^``: ``python -m
+benchmarks library-list --against 51c396e^`` times it from a worktree of that revision,
+on a library of its own built by its own migrations, then this checkout's, in one run.
 
 ``--busy N`` adds N processes that spin on a core (nice 0) while the queries are timed,
 killed at the end, so that a figure "at load N" comes from one command; the load average
 is printed after they have run 30 s and at the end.
 
-    .venv/bin/python benchmarks/library_query.py [--segments 1000000] [--repeat 20] [--busy 3]
+    python -m benchmarks library-list [-- --segments 1000000 --repeat 20 --busy 3]
     DATABASE_ADMIN_URL=postgres://postgres@127.0.0.1:5432/postgres \\
-        .venv/bin/python benchmarks/library_query.py --postgres
+        python -m benchmarks library-list-postgres
 """
 
 import argparse
 import gc
+import hashlib
 import json
 import os
 import platform
 import re
-import statistics
 import time
 
 from benchmarks.harness.machine import busy, load
+from benchmarks.harness.timing import Table, median, p95, timed
 from benchmarks.library import million, million_sqlite
 
 
@@ -77,38 +80,34 @@ def plan_of(sql):
 
 
 def run_query(user, query, repeat, view_class):
+    """(matched, ms, CPU ms, SQL queries, page plan, page digest) of ``repeat`` timed
+    requests for ``query`` after one that warms the caches."""
     from django.db import connection
     from django.test.utils import CaptureQueriesContext
     from rest_framework.test import APIRequestFactory, force_authenticate
 
     view = view_class.as_view()
     factory = APIRequestFactory()
-    times, cpu = [], []
-    # The other list's garbage is not this one's to collect: a server process runs one list.
+    # Another series' garbage is not this one's to collect: a server process runs one list.
     gc.collect()
-    for i in range(repeat + 1):
-        request = factory.get(f"/api/segments/?{query}")
-        force_authenticate(request, user=user)
+
+    def request():
+        req = factory.get(f"/api/segments/?{query}")
+        force_authenticate(req, user=user)
         with CaptureQueriesContext(connection) as captured:
-            started, used = time.perf_counter(), time.process_time()
-            response = view(request)
+            response = view(req)
             response.render()
-            elapsed, used = time.perf_counter() - started, time.process_time() - used
-        if response.status_code == 404:
-            return "no page", [float("nan")], [float("nan")], 0, "(fewer than 100 pages)", []
-        if response.status_code != 200:
-            raise SystemExit(f"{query}: HTTP {response.status_code} {response.content[:200]!r}")
-        if i:  # the first run warms caches
-            times.append(elapsed * 1000)
-            cpu.append(used * 1000)
+        return response, captured
+
+    times, cpu, (response, captured) = timed(request, repeat)
+    if response.status_code == 404:
+        return "no page", [float("nan")], [float("nan")], 0, "(fewer than 100 pages)", "-"
+    if response.status_code != 200:
+        raise SystemExit(f"{query}: HTTP {response.status_code} {response.content[:200]!r}")
     pages = [q["sql"] for q in captured if "LIMIT" in q["sql"] and "COUNT" not in q["sql"]]
     count = f"{response.data['count']:,}" + ("+" if response.data.get("count_capped") else "")
-    return (count, times, cpu, len(captured), plan_of(pages[0]) if pages else "-",
-            response.data["results"])
-
-
-def p95(times):
-    return statistics.quantiles(times, n=20)[-1] if len(times) > 1 else times[0]
+    digest = hashlib.sha1(json.dumps(response.data["results"]).encode()).hexdigest()[:8]
+    return count, times, cpu, len(captured), plan_of(pages[0]) if pages else "-", digest
 
 
 def main():
@@ -116,11 +115,8 @@ def main():
     parser.add_argument("--segments", type=int, default=1_000_000)
     parser.add_argument("--seed", type=int, default=15)
     parser.add_argument("--repeat", type=int, default=20)
-    parser.add_argument("--old-repeat", type=int, default=3,
-                        help="timed runs of the old list (seconds each on SQLite)")
     parser.add_argument("--postgres", action="store_true",
-                        help="PostgreSQL (million.py) instead of the embedded default")
-    parser.add_argument("--no-old", action="store_true", help="time the new list only")
+                        help="PostgreSQL (million) instead of the embedded default")
     parser.add_argument("--busy", type=int, default=0,
                         help="processes spinning on a core while the queries are timed")
     parser.add_argument("--admin-url", default=million.default_admin_url())
@@ -131,8 +127,6 @@ def main():
     else:
         where = f"SQLite file {million_sqlite.connect(args.segments, args.seed).name}"
     ctx = million.personas()
-    from library_list_old import OldSegmentListView
-
     # cutroom.wsgi sets this process up as a web server process is (the URLconf loaded, then
     # gc.freeze()); else a full collection rescans every long-lived object inside a timed
     # request, which the server does not.
@@ -148,37 +142,27 @@ def main():
         time.sleep(30 if args.busy else 0)  # let the load average rise
         print(f"machine: {platform.machine()}, {os.cpu_count()} cores shared with other work, "
               f"{args.busy} busy processes added, load {load()} at the start; "
-              f"{args.old_repeat} timed runs of the old list, then {args.repeat} of the new, "
-              "per query; ms\n")
-        worst, differ = table(ctx, args, OldSegmentListView, SegmentListView)
+              f"{args.repeat} timed runs per query; ms\n")
+        worst = table(ctx, args.repeat, SegmentListView)
         print(f"\nload at the end: {load()}")
-    print(f"worst new p95: {worst:.1f} ms (target 50 ms): {'ok' if worst <= 50 else 'MISSED'}")
-    if not args.no_old:
-        print("old and new pages hold the same segments, fields byte for byte: "
-              + ("yes, every query" if not differ else "NO: " + "; ".join(differ)))
+    print(f"worst p95: {worst:.1f} ms (target 50 ms): {'ok' if worst <= 50 else 'MISSED'}")
 
 
-def table(ctx, args, old_view, new_view):
-    """Time every query on pages 1 and 100 and print a row each; returns the worst p95 of
-    the new list and the pages whose results differ between the old list and the new."""
-    header = (f"{'who':<10} {'query':<29} {'page':>4} {'matched':>10} {'old med':>8} {'old p95':>8} "
-              f"{'new med':>8} {'new p95':>8} {'new CPU':>8} {'SQL':>4}  new page plan uses")
-    print(header)
-    print("-" * len(header))
-    worst, differ = 0.0, []
+TABLE = Table([("who", -10, ""), ("query", -29, ""), ("page", 4, ""), ("matched", 10, ""),
+               ("med", 8, ".1f"), ("p95", 8, ".1f"), ("CPU", 8, ".1f"), ("SQL", 4, ""),
+               ("digest", -8, ""), ("page plan uses", 0, "")])
+
+
+def table(ctx, repeat, view):
+    """Time every query on pages 1 and 100 and print a row each; returns the worst p95."""
+    TABLE.print_header()
+    worst = 0.0
     for who, title, query in queries(ctx):
         user = ctx["reviewer"] if who == "reviewer" else ctx["annotator"]
         for page in (1, 100):
             q = f"{query}&page={page}" if query else f"page={page}"
-            old, old_rows = [float("nan")], None
-            if not args.no_old:
-                _, old, _, _, _, old_rows = run_query(user, q, args.old_repeat, old_view)
-            count, times, cpu, n_sql, plan, rows = run_query(user, q, args.repeat, new_view)
-            if old_rows is not None and json.dumps(old_rows) != json.dumps(rows):
-                differ.append(f"{title} page {page}")
+            count, times, cpu, n_sql, plan, digest = run_query(user, q, repeat, view)
             worst = max(worst, p95(times)) if times[0] == times[0] else worst
-            print(f"{who:<10} {title:<29} {page:>4} {count:>10} {statistics.median(old):>8.1f} "
-                  f"{p95(old):>8.1f} {statistics.median(times):>8.1f} {p95(times):>8.1f} "
-                  f"{statistics.median(cpu):>8.1f} {n_sql:>4}  {plan}", flush=True)
-    return worst, differ
-
+            TABLE.row(who, title, page, count, median(times), p95(times), median(cpu), n_sql,
+                      digest, plan)
+    return worst

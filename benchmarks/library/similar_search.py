@@ -1,9 +1,9 @@
-"""Similar-clip search over a million described segments: the service now, the service
-before (loaded from git), and the exact answer, in the same run and under the same load.
+"""Similar-clip search over a million described segments: the service and the exact
+answer, in the same run and under the same load.
 
 Uses the seeded million-segment database of ``million.py`` (built on first use, then
-kept). The project "Archive" holds 1,000,000 described segments. Each service's index is
-built into ``benchmarks/out/`` once (build times printed; later runs bring it in step with
+kept). The project "Archive" holds 1,000,000 described segments. The service's index is
+built into ``benchmarks/out/`` once (build time printed; later runs bring it in step with
 ``update``).
 
 For ``--queries`` seeded random segments of the archive, as a reviewer through the view
@@ -13,17 +13,20 @@ index, the database reads, the ranking and the JSON), one path after the other p
 - ``exact``: the oracle. Profile distances to all 1,000,000 segments in memory (numpy),
   the same exclusions (superseded rows, the query's own overlapping spans, one row per
   span), the 20 nearest re-ranked by DTW exactly as the service does.
-- ``now``: the service (faiss inverted file with the descriptors beside it, C DTW).
-- ``before``: the service as commit ``--before`` shipped it (numpy inverted file, the
-  candidates' profiles and the shortlist's descriptors read from the database, numpy DTW).
+- ``service``: the service's similar view with its index.
 - ``no index``: the service's fallback (exact scan of the ``SIMILAR_POOL`` most recent
   segments; it never sees the rest, hence its recall), on the first ``--old-queries``.
 
 Then ``--added`` new segments are stored (copies of existing descriptors in a new
-capture): searches while they wait for the index (before read them from the database
-with every search; now reads them once per process), then each service's ``update``, with the bytes it wrote; then they are deleted,
-the database vacuumed, the index of now put back as it was (its manifest) and the one
-of before brought in step.
+capture): searches while they wait for the index, then the service's ``update``, with the
+bytes it wrote; then they are deleted, the database vacuumed and the index put back as it
+was (its manifest) or, when the update wrote a new generation, brought in step.
+
+The service as an earlier revision shipped it (``45b52fc``: a numpy inverted file, the
+candidates' profiles and the shortlist's descriptors read from the database, numpy DTW)
+is measured by the same benchmark on that revision's product: ``python -m benchmarks
+similar-search --against 45b52fc`` runs it from a worktree of it (on a library of its own,
+built by its own migrations on first use), then on this checkout, one after the other.
 
 ``--drop-caches`` empties the machine's page cache (as root) just before the queries, as
 after a restart or a large read of other files: each service starts from disk, and the
@@ -34,13 +37,13 @@ the end), to measure under load; the load average is printed before and after th
 queries. ``--busy-nice K`` runs them at nice ``K``: 0 (the default) is load from
 anything else on the machine; 10 is the load of the service's own workers, which ``make
 up`` (``scripts/up.py``) runs at nice 10 so that web requests come first. The oracle
-answers every query first; then the paths run in turn for each query (before, now), with
-one BLAS thread. The process is set up as the web server's are (``cutroom/wsgi.py``).
+answers every query first; then the paths run in turn for each query, with one BLAS
+thread. The process is set up as the web server's are (``cutroom/wsgi.py``).
 ``CPU`` is this process's CPU time per request (the web side; PostgreSQL's share
 is not in it): on a shared machine it is the steadier figure.
 
-    .venv/bin/python benchmarks/similar_search.py [--queries 200] [--busy 0] [--busy-nice 0]
-        [--seed 15]
+    python -m benchmarks similar-search [--against REV] [-- --queries 200 --busy 0
+        --busy-nice 0 --seed 15]
 """
 
 import argparse
@@ -52,10 +55,10 @@ import time
 from contextlib import contextmanager
 from unittest import mock
 
-import before
 import numpy as np
 
 from benchmarks.harness.machine import busy, load, mapped_rss, reclaim
+from benchmarks.harness.timing import p95
 from benchmarks.library import million
 
 
@@ -168,10 +171,6 @@ def appended_bytes(old, new):
     return added * (8 + 4 * new["ndim"] + 4 * new["payload"]) + removed * 8
 
 
-def p95(times):
-    return statistics.quantiles(times, n=20)[-1] if len(times) > 1 else times[0]
-
-
 def ensure(module, project, folder):
     """Build (or bring in step) ``module``'s index of ``project`` in ``folder``; returns
     (manifest, seconds, what was done)."""
@@ -180,6 +179,17 @@ def ensure(module, project, folder):
         fresh = not module.manifest_path(project).exists()
         manifest = module.build(project) if fresh else module.update(project)
         return manifest, time.perf_counter() - started, "built" if fresh else "brought in step"
+
+
+def index_kind(similar_index, manifest):
+    """The service's index as the run's header describes it: faiss (with its probe count)
+    or, in revisions before it, the numpy inverted file (with its probe share)."""
+    if hasattr(similar_index, "PROBE_SHARE"):
+        return (f"numpy IVF, {manifest['lists']:,} lists, float16, scans "
+                f">= {similar_index.PROBE_SHARE:.1%}")
+    return (f"faiss IVF, {manifest['lists']:,} lists, nprobe "
+            f"{similar_index.vector_index.NPROBE}, float32, descriptors beside it; "
+            f"{manifest['count']:,} vectors")
 
 
 def table(rows, recall, cpu):
@@ -214,7 +224,6 @@ def run():
     parser.add_argument("--busy", type=int, default=0)
     parser.add_argument("--busy-nice", type=int, default=0,
                         help="nice value of the busy processes (10: as the service's workers)")
-    parser.add_argument("--before", default=before.BEFORE)
     parser.add_argument("--nprobe", type=int, help="lists a search scans (default: the service's)")
     parser.add_argument("--drop-caches", action="store_true",
                         help="empty the page cache before the queries (root): every file on disk")
@@ -227,30 +236,20 @@ def run():
     from segmentation import similar_index
     from segmentation.models import Capture, LibrarySegment
 
-    old = before.load(args.before)
     if args.nprobe:
         similar_index.vector_index.NPROBE = args.nprobe
     ctx = million.personas()
     project = ctx["project"].pk
-    dirs = {"now": out / "similar-now",
-            "before": out / ("similar-before" if args.before == before.BEFORE else
-                             f"similar-before-{args.before}")}
-    manifest, built, how = ensure(similar_index, project, dirs["now"])
-    old_manifest, old_built, old_how = ensure(old.similar_index, project, dirs["before"])
+    folder = out / "similar-now"
+    manifest, built, how = ensure(similar_index, project, folder)
     ids, profiles, spans = oracle_arrays(out)
     rng = np.random.default_rng(args.seed)
     picks = [int(i) for i in rng.choice(ids[spans[:, 4] == 0], size=args.queries, replace=False)]
     segments = LibrarySegment.objects.in_bulk(picks)
     print(f"database {name}: {len(ids):,} described segments in project Archive "
           f"(descriptor 35 x 35 float32, profile 105 numbers)")
-    print(f"now: faiss IVF, {manifest['lists']:,} lists, nprobe {similar_index.vector_index.NPROBE}, "
-          f"float32, descriptors beside it; {manifest['count']:,} vectors, "
-          f"{manifest['bytes'] / 1e6:,.0f} MB of files; {how} in {built:.1f} s")
-    kind = (f"numpy IVF, {old_manifest['lists']:,} lists, float16, scans "
-            f">= {old.similar_index.PROBE_SHARE:.1%}" if hasattr(old.similar_index, "PROBE_SHARE")
-            else f"faiss IVF, {old_manifest['lists']:,} lists")
-    print(f"before ({old.rev}): {kind}; {old_manifest['bytes'] / 1e6:,.0f} MB; "
-          f"{old_how} in {old_built:.1f} s")
+    print(f"service: {index_kind(similar_index, manifest)}; {manifest['bytes'] / 1e6:,.0f} MB "
+          f"of files; {how} in {built:.1f} s")
     spinning = contextlib.ExitStack()
     spinning.enter_context(busy(args.busy, args.busy_nice))
     try:
@@ -268,10 +267,11 @@ def run():
                 raise SystemExit(f"--drop-caches: cannot empty the page cache ({exc})") from exc
             print("page cache emptied before the queries (--drop-caches): the index files, "
                   "PostgreSQL's files and the oracle's arrays start on disk\n", flush=True)
-        similar_index.forget()
+        if hasattr(similar_index, "forget"):
+            similar_index.forget()
         user = ctx["reviewer"]
-        paths = {f"before ({old.rev})": old.api_similar.SimilarView, "now": None}
-        folders = {"now": dirs["now"], f"before ({old.rev})": dirs["before"]}
+        paths = {"service": None}
+        folders = {"service": folder}
         rows = {"exact (oracle, numpy)": [], **{p: [] for p in paths}, "no index (20,000 recent)": []}
         recall = {p: [] for p in rows if p != "exact (oracle, numpy)"}
         cpu = {p: [] for p in recall}
@@ -311,20 +311,20 @@ def run():
                     f"{statistics.median(t):5.1f} / {p95(t):6.1f}" for t in spans if t))
         from django.conf import settings
 
-        if settings.SIMILAR_INDEX_IN_MEMORY:
-            base = (dirs["now"] / manifest["file"] / similar_index.vector_index.BASE).stat().st_size
-            print(f"\nnow: the faiss base in this process's own memory (SIMILAR_INDEX_IN_MEMORY), "
-                  f"{base / 1e6:.0f} MB")
-        else:
+        if getattr(settings, "SIMILAR_INDEX_IN_MEMORY", False):
+            base = (folder / manifest["file"] / similar_index.vector_index.BASE).stat().st_size
+            print(f"\nservice: the faiss base in this process's own memory "
+                  f"(SIMILAR_INDEX_IN_MEMORY), {base / 1e6:.0f} MB")
+        elif hasattr(similar_index, "vector_index"):
             rss, pss = mapped_rss(".faiss")
-            print(f"\nnow: the faiss base mapped, resident in this process {rss / 1e3:.0f} MB "
-                  f"(Pss {pss / 1e3:.0f} MB)")
+            print(f"\nservice: the faiss base mapped, resident in this process {rss / 1e3:.0f} "
+                  f"MB (Pss {pss / 1e3:.0f} MB)")
 
         # Segments waiting for the index, then each service's update. The index as it is
         # now is put back afterwards (its manifest: a reader sees the records it counts),
         # so that runs do not pile up added-then-removed records in it.
         kept = similar_index.manifest_path(project).name
-        kept = (dirs["now"] / kept).read_bytes()
+        kept = (folder / kept).read_bytes()
         capture = Capture.objects.create(project_id=project, name="bench_added.bvh",
                                          checksum="bench_added", format="bvh", status="ready",
                                          fps=120.0, n_frames=200_000, original="captures/added.bvh")
@@ -337,18 +337,16 @@ def run():
                            profile=s.profile) for i, s in enumerate(source))
         try:
             waiting = {p: [] for p in paths}
-            with mock.patch.object(similar_index, "schedule_update", lambda project_id: None), \
-                    mock.patch.object(old.similar_index, "schedule_update", lambda project_id: None):
+            with mock.patch.object(similar_index, "schedule_update", lambda project_id: None):
                 for pk in picks[:40]:
                     for title, view in paths.items():
                         with index_dir(folders[title]):
                             waiting[title].append(call_view(user, pk, view)[1])
-            print(f"\n{len(added):,} new segments waiting for the index (before: read with every "
-                  f"search; now: read once by this process), load {load()}:")
+            print(f"\n{len(added):,} new segments waiting for the index, load {load()}:")
             for title, times in waiting.items():
                 print(f"  {title:<28} median {statistics.median(times):6.1f} ms, p95 {p95(times):6.1f} ms")
             print("updates that take them in:")
-            for title, module in (("now", similar_index), (f"before ({old.rev})", old.similar_index)):
+            for title, module in (("service", similar_index),):
                 with index_dir(folders[title]):
                     first = module.read_manifest(project)
                     started = time.perf_counter()
@@ -362,16 +360,14 @@ def run():
             LibrarySegment.objects.filter(pk__in=[s.pk for s in added]).delete()
             capture.delete()
             vacuum()
-            with index_dir(folders["now"]):
+            with index_dir(folder):
                 if similar_index.read_manifest(project)["file"] == manifest["file"]:
                     similar_index.manifest_path(project).write_bytes(kept)
                 else:  # compacted: a new generation
                     similar_index.update(project)
-            with index_dir(folders[f"before ({old.rev})"]):
-                old.similar_index.update(project)
     finally:
         spinning.close()
-    print(f"\nworst: now p95 {p95(rows['now']):.1f} ms (target 10 on a quiet machine, 20 at "
-          f"load 4), recall@10 {np.mean(recall['now']):.3f} (target 0.99), min per query "
-          f"{min(recall['now']):.1f}")
+    print(f"\nworst: service p95 {p95(rows['service']):.1f} ms (target 10 on a quiet machine, "
+          f"20 at load 4), recall@10 {np.mean(recall['service']):.3f} (target 0.99), min per "
+          f"query {min(recall['service']):.1f}")
 
