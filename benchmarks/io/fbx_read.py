@@ -10,7 +10,7 @@ the way it was read before the conversion kept its take: by Blender's importer, 
 already running (its start-up is paid once per process and stated apart). The take the
 service reads back is checked equal to Blender's read.
 
-    .venv/bin/python benchmarks/fbx_read.py [--repeats 20] [--blender-repeats 5]
+    .venv/bin/python -m benchmarks fbx-read -- [--repeats 20] [--blender-repeats 5]
 """
 
 import argparse

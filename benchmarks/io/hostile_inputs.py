@@ -1,6 +1,6 @@
 """How long hostile capture files take to read or refuse, and how much memory they cost.
 
-    .venv/bin/python benchmarks/hostile_inputs.py
+    .venv/bin/python -m benchmarks hostile-inputs
 
 The files are generated in a temporary folder: flat and nested hierarchies of 10,000 to
 80,000 joints (read with the joint limit raised, to show the time grows linearly with the

@@ -15,7 +15,7 @@ independent C3D readers on the same file, and a trimmed C3D export opened by ezc
 
 Times are the best and the median of ``--repeats`` reads, the readers interleaved.
 
-    .venv/bin/python -m benchmarks.points_read [--repeats 15] [--data ../shared/data]
+    .venv/bin/python -m benchmarks points-read -- [--repeats 15] [--data ../shared/data]
 """
 
 from __future__ import annotations

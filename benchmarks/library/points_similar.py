@@ -13,7 +13,7 @@ The pool is every segment of the *other* runs (leave one run out) or of the *oth
 (leave one subject out: the settings of one performer never choose another's). ``chance`` is
 the share of the most common label. Nothing here was tuned on these takes.
 
-    .venv/bin/python -m benchmarks.points_similar [--data ../shared/data]
+    .venv/bin/python -m benchmarks points-similar -- [--data ../shared/data]
 """
 
 from __future__ import annotations

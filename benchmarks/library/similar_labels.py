@@ -16,7 +16,7 @@ Columns: clips, share whose nearest clip is the same action (top-1), mean share 
 same action among the 5 nearest (precision@5; capped when an action has fewer than five
 other clips, e.g. 13_29's JumpJack has one), and search time per query.
 
-    .venv/bin/python benchmarks/library_similar.py [--clip-seconds 1.0]
+    .venv/bin/python -m benchmarks similar-labels -- [--clip-seconds 1.0]
 """
 
 import argparse

@@ -1,4 +1,4 @@
-"""How a studio's cut model learns: ``python -m benchmarks.quality learning-curve``.
+"""How a studio's cut model learns: ``python -m benchmarks learning-curve``.
 
 Each labelled set is one convention. For every scored take, ``k`` reviewed takes are
 drawn (``DRAWS`` seeded draws) and a model is fitted on them (``motionlib.adapt``,

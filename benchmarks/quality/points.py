@@ -25,7 +25,7 @@ Columns: precision, recall and F1 within the tolerance (one-to-one matching,
 ``motionlib.metrics.boundary_scores``), review edits per true cut (``edit_cost`` with the
 tolerance as its match distance), candidate cuts, true cuts and seconds.
 
-    .venv/bin/python -m benchmarks.points_quality [--data ../shared/data] [--sets hdm05,vmci]
+    .venv/bin/python -m benchmarks points-quality -- [--data ../shared/data] [--sets hdm05,vmci]
 """
 
 from __future__ import annotations

@@ -16,7 +16,7 @@ Prints per mode and worker count: takes, hours of motion, wall time, hours of mo
 minute (per worker and in total), and the speed-up over one worker.
 
     DATABASE_ADMIN_URL=postgres://postgres@127.0.0.1:5432/postgres \\
-        .venv/bin/python benchmarks/bulk_import.py [--takes 1000] [--minutes 5] [--workers 1 2]
+        .venv/bin/python -m benchmarks bulk-import -- [--takes 1000] [--minutes 5] [--workers 1 2]
         [--checks full header]
 """
 

@@ -7,7 +7,7 @@ else's; gunicorn serves the app on loopback and ``wrk`` (Debian's; a bounded Pyt
 client if it is missing) requests the list with a token for a fixed time per scenario.
 Queries and CPU time per request are measured in-process for the same URLs.
 
-    .venv/bin/python benchmarks/capture_list_load.py [--captures 10000] [--seconds 10]
+    .venv/bin/python -m benchmarks capture-list-load -- [--captures 10000] [--seconds 10]
         [--connections 4] [--workers 4] [--threads 1] [--postgres postgres://postgres@127.0.0.1:5432]
 
 Target: p95 <= 100 ms.

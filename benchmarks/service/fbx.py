@@ -13,7 +13,7 @@ Exports: frames [1200, 2400) of 13_29 (10 s at 120 fps), cut from the original F
 armature), and written from the BVH take as a new armature, as FBX and as glTF binary, by a
 Blender process already started (the web process keeps one, as the convert worker does).
 
-    .venv/bin/python benchmarks/fbx.py [--repeats 3] [--data ../shared/data]
+    .venv/bin/python -m benchmarks fbx -- [--repeats 3] [--data ../shared/data]
 """
 
 import argparse

@@ -5,7 +5,7 @@ The worker's ingest computes forward kinematics to store the positions and then 
 default detection on the same take; before, detection computed them a second time. Uses
 the cached take of ``hour_take.py`` (written when missing).
 
-    .venv/bin/python benchmarks/hour_detect.py [--minutes 60] [--repeats 2]
+    .venv/bin/python -m benchmarks hour-detect -- [--minutes 60] [--repeats 2]
 """
 
 import argparse

@@ -12,7 +12,7 @@ The worker's memory is sampled every 50 ms (resident set of the worker and its p
 process, from ``/proc``); the peak of the pool process (the one that runs the job) and of
 both together are printed, with the kernel's own high-water mark (VmHWM) of each.
 
-    .venv/bin/python benchmarks/hour_take.py [--minutes 60]
+    .venv/bin/python -m benchmarks hour-take -- [--minutes 60]
 """
 
 import argparse

@@ -23,7 +23,7 @@ Both paths in the same run, on the same reviews:
 Each model is scored on held-out takes of other seeds (F1 within 1 s, review edits per
 true cut, pooled); "clean" is the model learnt from honest reviews of the same takes.
 
-    .venv/bin/python benchmarks/poisoning.py [--minutes 1] [--next 5]
+    .venv/bin/python -m benchmarks poisoning -- [--minutes 1] [--next 5]
 
 Target (issue 34): the poisoner moves the F1 on the next takes by < 0.05.
 """

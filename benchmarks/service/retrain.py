@@ -18,7 +18,7 @@ has claimed the row) is timed end to end:
    the parsed takes read from their cache and fitted anew (`fit_cut_model` without
    `studies`), and what the fit alone costs with the studies (a training without the gate).
 
-    .venv/bin/python benchmarks/retrain.py [--takes 50] [--minutes 5] [--repeats 3]
+    .venv/bin/python -m benchmarks retrain -- [--takes 50] [--minutes 5] [--repeats 3]
 
 Target: training <= 10 s on one core (CPU seconds of the job; wall time printed too), for
 the retrainings after a submit (3).

@@ -31,7 +31,7 @@ Measured, over HTTP with a token (wall-clock ms on the client):
    round), against the small capture's requests (review GET, label edit, capture GET)
    made one after another throughout by a process of its own, and alone before.
 
-    .venv/bin/python benchmarks/review_long_take.py [--minutes 60] [--library-minutes 60]
+    .venv/bin/python -m benchmarks review-long-take -- [--minutes 60] [--library-minutes 60]
         [--repeats 40] [--pages 20] [--waves 3] [--old-serving]
 
 ``--browser`` measures instead what a person sees opening the long take in headless Chromium
@@ -43,7 +43,7 @@ path is the previous request order (``?signals=after-poses``: the full signals a
 once every pose has loaded); the new one asks for them once the first pose is on screen.
 No library is built for it.
 
-    .venv/bin/python benchmarks/review_long_take.py --browser [--minutes 60] [--browser-repeats 5]
+    .venv/bin/python -m benchmarks review-long-take -- --browser [--minutes 60] [--browser-repeats 5]
 
 Targets: review GET and edit p95 <= 100 ms; the small capture's p50 and p95 under the
 load <= 2x alone; in Chromium, first pose <= 1 s and every lane drawn <= 2 s.

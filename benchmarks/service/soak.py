@@ -17,7 +17,7 @@ yet neither processed nor waiting), jobs stuck (captures or runs not ready or fa
 after the drain), jobs failed, HTTP 5xx responses and refused connections (the web
 server down), and what up.py did (restarts, stalls found).
 
-    .venv/bin/python benchmarks/soak.py [--minutes 30] [--port 18600]
+    .venv/bin/python -m benchmarks soak -- [--minutes 30] [--port 18600]
 
 Target: lost, stuck and 5xx all 0.
 """

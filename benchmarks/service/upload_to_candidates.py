@@ -7,7 +7,7 @@ client, so no socket time is counted) and polls the database until the default
 detection run is ready. The clock starts before the POST and stops when the run row
 says ready.
 
-    .venv/bin/python benchmarks/upload_to_candidates.py [--repeats 7] [--minutes 5]
+    .venv/bin/python -m benchmarks upload-to-candidates -- [--repeats 7] [--minutes 5]
 
 Target: median and p95 <= 2 s.
 """
