@@ -20,8 +20,11 @@ other clips, e.g. 13_29's JumpJack has one), and search time per query.
 """
 
 import argparse
+import shutil
+import tempfile
 import time
 from collections import defaultdict
+from pathlib import Path
 
 import numpy as np
 
@@ -32,7 +35,7 @@ from motionlib.similarity import (
     rank_similar,
     segment_descriptor,
 )
-from motionlib.vector_index import IvfIndex
+from motionlib.vector_index import VectorIndex, build
 from segmentation.shared_data import data_dir
 
 DATA = data_dir()
@@ -55,20 +58,28 @@ def clips(seq, clip_frames):
     return names, np.stack(descriptors)
 
 
-def indexed_pool(index, query, pool, min_lists):
+def lists(index, count, nprobe):
+    """Lists to scan: at least ``nprobe`` and enough to hold ``count`` vectors (as the
+    service's index before faiss scanned); None, the index's own default."""
+    if nprobe is None:
+        return None
+    return max(nprobe, -(-count * index.n_lists // len(index)))
+
+
+def indexed_pool(index, query, pool, nprobe):
     """The ``pool`` members the vector index proposes for ``query``, as the service asks
     (``segmentation.similar_index.shortlist``: 4 x the shortlist of 20, at least 64)."""
     allowed = set(pool)
     vector = query[:PROFILE_ROWS].astype(np.float32).ravel()
     count = max(4 * 20, 64)
     while True:
-        candidates = [int(i) for i in index.search(vector, count, min_lists=min_lists)[0] if int(i) in allowed]
+        candidates = [int(i) for i in index.search(vector, count, nprobe=lists(index, count, nprobe))[0] if int(i) in allowed]
         if len(candidates) >= 20 or count >= len(allowed) + 1:
             return sorted(candidates)
         count *= 4
 
 
-def evaluate(queries, library, leave_one_out, index=None, min_lists=8):
+def evaluate(queries, library, leave_one_out, index=None, nprobe=None):
     """Per action: [top-1 hits, precision@5 sum, count, seconds]."""
     q_names, q_desc = queries
     l_names, l_desc = library
@@ -77,7 +88,7 @@ def evaluate(queries, library, leave_one_out, index=None, min_lists=8):
         pool = [i for i in range(len(l_names)) if not (leave_one_out and i == q)]
         started = time.perf_counter()
         if index is not None:
-            pool = indexed_pool(index, q_desc[q], pool, min_lists)
+            pool = indexed_pool(index, q_desc[q], pool, nprobe)
         found, _ = rank_similar(q_desc[q], l_desc[pool], k=5, shortlist=20)
         elapsed = time.perf_counter() - started
         labels = [l_names[pool[i]] for i in found]
@@ -108,15 +119,26 @@ def main():
     ids = np.arange(len(lib[1]))
     # The service's index at this size is one list (exact); 4 clips per list, scanning
     # from one list up, makes it probe.
-    product = IvfIndex.build(ids, profiles)
-    small = IvfIndex.build(ids, profiles, n_lists=max(1, len(ids) // 4))
+    folder = Path(tempfile.mkdtemp(prefix="similar-labels-"))
+    try:
+        product = VectorIndex.open(folder / "product", build(folder / "product", ids, profiles))
+        small = VectorIndex.open(folder / "small", build(folder / "small", ids, profiles,
+                                                         n_lists=max(1, len(ids) // 4)))
+        print_results(lib, other, product, small)
+    finally:
+        shutil.rmtree(folder, ignore_errors=True)
+
+
+def print_results(lib, other, product, small):
+    """Score each setting exactly, through the service's index and through the small one,
+    and print a row per action and setting."""
     settings = [("13_29 leave-one-out", lib, True), ("13_30 -> 13_29", other, False)]
     results = []
     for title, queries, loo in settings:
         results += [(f"{title}", evaluate(queries, lib, loo)),
                     (f"{title} [index]", evaluate(queries, lib, loo, product)),
-                    (f"{title} [index {len(small.centroids)} lists]",
-                     evaluate(queries, lib, loo, small, min_lists=1))]
+                    (f"{title} [index {small.n_lists} lists]",
+                     evaluate(queries, lib, loo, small, nprobe=1))]
     for title, stats in results:
         total = [0, 0.0, 0, 0.0]
         for action in sorted(stats):

@@ -40,8 +40,6 @@ def test_every_registered_module_has_a_main():
     import importlib
 
     for name, bench in BENCHMARKS.items():
-        if name == "similar-labels":
-            continue  # needs motionlib.vector_index.IvfIndex, which this tree no longer has
         assert callable(importlib.import_module(bench.module).main), name
 
 
