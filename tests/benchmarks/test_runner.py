@@ -94,25 +94,25 @@ def test_against_imports_the_revisions_product_and_this_checkouts_benchmarks():
     probe = ("import motionlib, motionlib._dtw, benchmarks; from benchmarks.harness import "
              "REPO, REVISION; print(motionlib.__file__, motionlib._dtw.__file__, "
              "benchmarks.__file__, REPO, REVISION)")
-    with against.worktree("HEAD~1") as revision, against.launcher(revision) as (cwd, env):
+    with against.worktree("HEAD") as revision, against.launcher(revision) as (cwd, env):
         done = subprocess.run([sys.executable, "-c", probe], cwd=cwd, env=env,
                               capture_output=True, text=True, check=True)
         product, compiled, bench, tree, rev = done.stdout.split()
         assert product == str(revision.tree / "motionlib" / "__init__.py")
         assert compiled.startswith(str(revision.tree / "motionlib" / "_dtw"))
         assert __import__("pathlib").Path(bench).resolve() == PACKAGE / "__init__.py"
-        assert (tree, rev) == (str(revision.tree), git("rev-parse", "--short", "HEAD~1"))
+        assert (tree, rev) == (str(revision.tree), git("rev-parse", "--short", "HEAD"))
     assert not revision.tree.exists()
     assert str(revision.tree) not in git("worktree", "list")
 
 
 def test_against_records_the_revisions_table_then_this_checkouts(results, capsys):
-    assert runner.main(["speed-adapt", "--against", "HEAD~1", "--record", *SMALL]) == 0
+    assert runner.main(["speed-adapt", "--against", "HEAD", "--record", *SMALL]) == 0
     text = (results / "speed-adapt.md").read_text()
-    old = git("rev-parse", "--short", "HEAD~1")
-    subject = git("log", "-1", "--format=%s", "HEAD~1")
+    old = git("rev-parse", "--short", "HEAD")
+    subject = git("log", "-1", "--format=%s", "HEAD")
     assert f"- against: {old} ({subject}), run from a git worktree of it" in text
-    assert "`python -m benchmarks speed-adapt --against HEAD~1 -- --takes 2" in text
+    assert "`python -m benchmarks speed-adapt --against HEAD -- --takes 2" in text
     first, second = text.index(f"## at {old} ({subject})"), text.index("## at this checkout")
     assert first < second
     assert text.count("format 2, candidate scorer (now)") == 2
