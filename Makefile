@@ -66,22 +66,14 @@ pytest: install
 
 # Each benchmark's output goes to benchmarks/results/<name>.md (generated, committed: every
 # figure quoted has one source, and a change shows as a diff), headed by date, commit and load.
-RECORD := $(PY) benchmarks/record.py
-RESULTS := benchmarks/results
+# `python -m benchmarks` lists every benchmark; these are the ones cheap enough to rerun.
+BENCHES := speed-io quality learning-curve speed-adapt points-read points-similar fbx-read \
+	upload-to-candidates capture-list-load poisoning
 
 bench: install bpy
-	$(RECORD) $(RESULTS)/speed-io.md -- $(PY) -m benchmarks.quality speed io
-	$(RECORD) $(RESULTS)/quality.md -- $(PY) -m benchmarks.quality --loo
-	$(RECORD) $(RESULTS)/learning-curve.md -- $(PY) -m benchmarks.quality learning-curve
-	$(RECORD) $(RESULTS)/speed-adapt.md -- $(PY) -m benchmarks.quality speed adapt
-	$(RECORD) $(RESULTS)/points-read.md -- $(PY) -m benchmarks.points_read
-	$(RECORD) $(RESULTS)/points-similar.md -- $(PY) -m benchmarks.points_similar
-	$(RECORD) $(RESULTS)/fbx-read.md -- $(PY) benchmarks/fbx_read.py
-	$(RECORD) $(RESULTS)/upload-to-candidates.md -- $(PY) benchmarks/upload_to_candidates.py
 	@command -v wrk >/dev/null || { apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq wrk; } \
 		|| echo "wrk not installed: the capture list benchmark uses its Python client"
-	$(RECORD) $(RESULTS)/capture-list-load.md -- $(PY) benchmarks/capture_list_load.py
-	$(RECORD) $(RESULTS)/poisoning.md -- $(PY) benchmarks/poisoning.py
+	@for name in $(BENCHES); do $(PY) -m benchmarks $$name || exit 1; done
 
 # The README's screenshots, taken by the browser tests.
 screenshots: install frontend browser

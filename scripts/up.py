@@ -41,7 +41,7 @@ WORKER_NICE = 10
 WEB_WORKERS, WEB_THREADS = 2, 32
 # The bulk lane's web server (cutroom/lanes.py): requests about long takes, handed to it
 # by the web server over a Unix socket under var/run/, at the workers' lower CPU priority
-# (benchmarks/review_long_take.py, twenty page loads of a one-hour take: nice 10 kept a
+# (benchmarks/service/review_long_take.py, twenty page loads of a one-hour take: nice 10 kept a
 # small capture's requests within 1.4-1.5x of alone at p95, nice 5 within 1.9-2.1x).
 BULK_NICE = 10
 # FBX files Blender converts at once, each in a pool process of the convert worker with a

@@ -1,6 +1,6 @@
 """The segmentation quality benchmark: every method, default parameters, every labelled take.
 
-``python -m benchmarks.quality [--loo]``. Takes are found by ``data.discover`` (every
+``python -m benchmarks quality``. Takes are found by ``data.discover`` (every
 labelled take in the shared data layout; four-channel takes run only the methods that need
 no skeleton). Rows are the registered segmenters plus two peers from the change-point
 literature, run on the same heading-invariant pose stream the default detector uses
@@ -290,7 +290,7 @@ def _ruptures_loo(cache) -> list[dict]:
 
 def _point_sets(folder: Path, out) -> None:
     """The point sets (markers and tracked joints) beside the rotation sets, each at its
-    own tolerance, with ruptures in the same run (``benchmarks.points_quality``)."""
+    own tolerance, with ruptures in the same run (``benchmarks.quality.points``)."""
     from benchmarks import points_quality
 
     print("\n# Point takes: every set per take and mean, at its tolerance", file=out)

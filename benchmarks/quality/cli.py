@@ -1,5 +1,6 @@
-"""Command line of the research apparatus: the quality benchmark by default, ``speed`` for
-motionlib's speed tables. Errors a user can fix print one line on stderr, exit status 2."""
+"""Command line of the research apparatus, which the runner calls (``quality``,
+``learning-curve``, ``speed-io``, ``speed-adapt`` in ``benchmarks/registry.py``): the
+quality benchmark by default, ``speed`` for motionlib's speed tables. Errors a user can fix print one line on stderr, exit status 2."""
 
 from __future__ import annotations
 
@@ -12,7 +13,7 @@ from motionlib.arguments import run
 
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
-        prog="python -m benchmarks.quality",
+        prog="python -m benchmarks quality",
         description="Every segmenter (default parameters) and two change-point peers on "
                     "every labelled take (rotation sets, then the point sets): a table per take and the mean. `speed` measures "
                     "how fast motionlib reads and detects instead.")

@@ -1,4 +1,4 @@
-"""How a studio's cut model learns: ``python -m benchmarks.quality learning-curve``.
+"""How a studio's cut model learns: ``python -m benchmarks learning-curve``.
 
 Each labelled set is one convention. For every scored take, ``k`` reviewed takes are
 drawn (``DRAWS`` seeded draws) and a model is fitted on them (``motionlib.adapt``,
@@ -27,6 +27,7 @@ figure here (``docs/detector/adaptation.md``).
 
 from __future__ import annotations
 
+import io
 import os
 import sys
 import time
@@ -414,8 +415,43 @@ def main(root: Path | None = None, out=None) -> int:
     conv = convention(sets, out)
     print_ceiling(sets, {**curves, **within}, out)
     poison = poisoning(sets, out)
-    learning_tried.print_tried(sets, curves, poison, out)
+    print_tried(sets, curves, poison, out)
     targets({**curves, **{f"{k} (within)": v for k, v in within.items()}}, conv, poison, out)
     print(f"\nlearning curve: {time.perf_counter() - started:.0f} s, load average "
           f"{' '.join(f'{x:.2f}' for x in os.getloadavg())}", file=out)
     return 0
+
+
+def print_tried(sets, curves: dict, poison: dict, out) -> None:
+    """For each labelling: the by-subject curve (F1, edits) beside the shipped one, the
+    best count at k = TARGET_K, the poisoning case, and whether the shipping rule holds."""
+    chosen = [s for s in sets if s.by_subject and s.items]
+    print("\n## Tried, not shipped: other labellings of the candidates the learner learns "
+          "from (benchmarks/quality/learning_tried.py); by subject, out of sample", file=out)
+    print("F1 / review edits per true cut, shipped -> tried; best count at "
+          f"k={TARGET_K} (oracle, as in the ceiling); poisoning mean dF1 under / "
+          "over.", file=out)
+    for name, labelling in learning_tried.LABELLINGS.items():
+        worse = []
+        with learning_tried.labelled_as(labelling):
+            tried = {s.name: curve(s) for s in chosen}
+            tried_poison = poisoning(sets, io.StringIO())
+        for label in chosen:
+            shipped, other = curves[label.name][0], tried[label.name]
+            cells = []
+            for k in KS[1:]:
+                (f0, e0, _), (f1, e1, _) = shipped[k][0], other[k][0]
+                cells.append(f"k={k} {f0:.2f}/{e0:.2f} -> {f1:.2f}/{e1:.2f}")
+                if f1 < f0 - 1e-9 or e1 > e0 + 1e-9:
+                    worse.append(f"{label.name} k={k}")
+            moved = "; ".join(f"{tried_poison[(label.name, m)][0]:+.3f}"
+                              for m in ("under", "over"))
+            print(f"{name:<20}{label.name:<10}" + ", ".join(cells) +
+                  f"; best count {shipped.get('best count', np.nan):.2f} -> "
+                  f"{other.get('best count', np.nan):.2f}; poisoning {moved}", file=out)
+        broken = [f"{n} {m}" for (n, m), (mean, _) in tried_poison.items()
+                  if abs(mean) >= TARGET_POISON > abs(poison[(n, m)][0])]
+        verdict = "shipping rule holds" if not worse and not broken else (
+            "not shipped: " + ", ".join([*(f"worse at {w}" for w in worse),
+                                         *(f"poisoning {b} no longer met" for b in broken)]))
+        print(f"{name:<20}{verdict}", file=out)

@@ -14,12 +14,12 @@ other labellings:
 Each replaces ``_labelled`` for the length of a ``with labelled_as(...)`` block, so that
 the curve, the ceiling's best count and the poisoning case are scored exactly as for the
 shipped learner. A labelling is shipped only when no by-subject row of the curve is
-worse and the poisoning targets still hold; ``docs/learning.md`` records the outcome.
+worse and the poisoning targets still hold (``learning.print_tried`` scores them);
+``docs/learning.md`` records the outcome.
 """
 
 from __future__ import annotations
 
-import io
 from contextlib import contextmanager
 
 import numpy as np
@@ -62,40 +62,3 @@ def labelled_as(labelling):
         yield
     finally:
         _learner._labelled = shipped
-
-
-def print_tried(sets, curves: dict, poison: dict, out) -> None:
-    """For each labelling: the by-subject curve (F1, edits) beside the shipped one, the
-    best count at k = TARGET_K, the poisoning case, and whether the shipping rule holds."""
-    from benchmarks.quality import learning
-
-    chosen = [s for s in sets if s.by_subject and s.items]
-    print("\n## Tried, not shipped: other labellings of the candidates the learner learns "
-          "from (benchmarks/quality/learning_tried.py); by subject, out of sample", file=out)
-    print("F1 / review edits per true cut, shipped -> tried; best count at "
-          f"k={learning.TARGET_K} (oracle, as in the ceiling); poisoning mean dF1 under / "
-          "over.", file=out)
-    for name, labelling in LABELLINGS.items():
-        worse = []
-        with labelled_as(labelling):
-            tried = {s.name: learning.curve(s) for s in chosen}
-            tried_poison = learning.poisoning(sets, io.StringIO())
-        for label in chosen:
-            shipped, other = curves[label.name][0], tried[label.name]
-            cells = []
-            for k in learning.KS[1:]:
-                (f0, e0, _), (f1, e1, _) = shipped[k][0], other[k][0]
-                cells.append(f"k={k} {f0:.2f}/{e0:.2f} -> {f1:.2f}/{e1:.2f}")
-                if f1 < f0 - 1e-9 or e1 > e0 + 1e-9:
-                    worse.append(f"{label.name} k={k}")
-            moved = "; ".join(f"{tried_poison[(label.name, m)][0]:+.3f}"
-                              for m in ("under", "over"))
-            print(f"{name:<20}{label.name:<10}" + ", ".join(cells) +
-                  f"; best count {shipped.get('best count', np.nan):.2f} -> "
-                  f"{other.get('best count', np.nan):.2f}; poisoning {moved}", file=out)
-        broken = [f"{n} {m}" for (n, m), (mean, _) in tried_poison.items()
-                  if abs(mean) >= learning.TARGET_POISON > abs(poison[(n, m)][0])]
-        verdict = "shipping rule holds" if not worse and not broken else (
-            "not shipped: " + ", ".join([*(f"worse at {w}" for w in worse),
-                                         *(f"poisoning {b} no longer met" for b in broken)]))
-        print(f"{name:<20}{verdict}", file=out)

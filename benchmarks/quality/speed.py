@@ -1,6 +1,6 @@
-"""motionlib's speed benchmarks, printing tables: ``python -m benchmarks.quality speed io|adapt``.
+"""motionlib's speed benchmarks, printing tables: ``python -m benchmarks speed-io|speed-adapt``.
 
-How well the segmenters cut is measured by ``python -m benchmarks.quality`` (``bench``);
+How well the segmenters cut is measured by ``python -m benchmarks quality`` (``bench``);
 this module measures only how fast things run.
 
 ``io``: read + forward kinematics of the CMU take 13_29 as BVH and as AMC + ASF, against the
@@ -211,7 +211,7 @@ def _time_learner(fit, examples, target, minutes, args) -> None:
 
 
 def add_speed(subparsers) -> None:
-    """Register ``python -m benchmarks.quality speed io|adapt`` (see ``__main__``)."""
+    """Register ``python -m benchmarks speed-io|speed-adapt`` (see ``cli``)."""
     parser = subparsers.add_parser(
         "speed", help="benchmark read and detection speed (prints tables)",
         description="How fast motionlib reads takes and detects cuts; the segmentation "

@@ -11,7 +11,7 @@ The score of a setting over some takes is the mean F1 at 1 s, ties broken by few
 per true cut (``motionlib.metrics``); :func:`edits_objective` is the other order, scored
 beside it. Options tried and not shipped (:data:`TRIED`) are scored the same way, with the
 choice made from :func:`tried_grid`, so that the record of why they are not shipped can be
-re-run (``python -m benchmarks.quality --loo``). How the objective and the grid were
+re-run (``python -m benchmarks quality``). How the objective and the grid were
 settled is in ``docs/detector/tuning.md``.
 """
 

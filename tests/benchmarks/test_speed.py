@@ -1,4 +1,4 @@
-"""python -m benchmarks.quality speed io prints its table (speed is read from it, never asserted)."""
+"""python -m benchmarks speed-io prints its table (speed is read from it, never asserted)."""
 
 import pytest
 

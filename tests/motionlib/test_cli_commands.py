@@ -1,5 +1,5 @@
 """``python -m motionlib`` is the library's own command line: info, convert and segment,
-nothing of the benchmarks (those are ``python -m benchmarks.quality``)."""
+nothing of the benchmarks (those are ``python -m benchmarks quality``)."""
 
 import re
 import subprocess

@@ -76,7 +76,7 @@ def test_it_changes_pose_statistics_at_each_boundary():
 
 
 def test_it_generates_a_five_minute_take_at_120_fps():
-    # Its speed is reported by `python -m benchmarks.quality speed io`, not asserted here.
+    # Its speed is reported by `python -m benchmarks speed-io`, not asserted here.
     take, segments = synth.generate(seed=0, fps=120.0, duration=300.0)
     assert take.n_frames == 36000 and take.channels.shape == (36000, take.skeleton.n_channels)
     assert len(segments) >= 300 / 8

@@ -36,7 +36,7 @@ def test_it_searches_through_the_trigram_index(owner):
     # At a few thousand rows a scan is as cheap as the index, so the planner may pick
     # either; with other scans priced out, the plan of the bare filter shows whether the
     # SQL Django writes for ``icontains`` matches the index's expression (at 10,000
-    # captures it is chosen unprompted: benchmarks/capture_list_load.py).
+    # captures it is chosen unprompted: benchmarks/service/capture_list_load.py).
     search = Capture.objects.filter(name__icontains="squat_01").order_by()
     sql, params = search.query.sql_with_params()
     with connection.cursor() as cursor:
