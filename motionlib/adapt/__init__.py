@@ -48,7 +48,7 @@ from motionlib.adapt._threshold import (
     fit_threshold_model,
 )
 from motionlib.points import segmenter_input
-from motionlib.segmenters.base import Segmentation, _checked
+from motionlib.segmenters.base import Segmentation
 from motionlib.segmenters.default import Default
 
 __all__ = [
@@ -215,7 +215,7 @@ def detect(take, model: CutModel | ThresholdModel | None = None, **params) -> Se
         arrays, analysis, speed = found
         cuts, prob = select(model, arrays)
         result = analysis.segmentation(cuts - analysis.first, prob, speed)
-        result = _checked(result, int(arrays["n_frames"]))
+        result = result.checked(int(arrays["n_frames"]))
     result.timings["total"] = time.perf_counter() - start
     return result
 

@@ -27,8 +27,6 @@ from scipy.signal import find_peaks
 
 from motionlib.segmenters import default
 from motionlib.segmenters.default import PLACEMENTS
-from motionlib.segmenters.default._peaks import cross_support
-from motionlib.segmenters.default._placement import place_stages
 
 # The short novelty windows (s): activities of a second or two.
 SHORT_WINDOWS = (1.0, 2.0)
@@ -84,9 +82,7 @@ def candidates_of(take, p: dict):
         # The extra candidates are placed among each other and the zero-shot cuts, each
         # step bounded half-way to its neighbours as the detector bounds its own cuts.
         order = np.argsort(samples, kind="stable")
-        extra_stages, _ = place_stages(analysis.x, analysis.peak_frames(samples[order]),
-                                       analysis.fps, analysis.gamma, p, analysis.speeds,
-                                       only=order >= zero)
+        extra_stages = default.place_samples(analysis, samples[order], p, only=order >= zero)
         back = np.empty_like(order)
         back[order] = np.arange(len(order))
         for j, name in enumerate(PLACEMENTS):
@@ -167,7 +163,7 @@ def _features(analysis, short, samples, zero, long, short_peaks) -> np.ndarray:
     """(n, len(FEATURES)) evidence of each candidate (see FEATURES)."""
     reach = max(1, int(round(MERGE_S * analysis.rate)))
     log = lambda v: np.log(np.maximum(v, 0.0) + FLOOR)  # noqa: E731
-    support = cross_support(analysis.blocks, samples, analysis.rate, analysis.gamma)
+    support = default.peak_support(analysis, samples)
     support = np.where(np.isfinite(support), support, 2.0)
     speed = analysis.speeds[0]
     frames = np.clip(analysis.peak_frames(samples), 0, len(speed) - 1)

@@ -59,7 +59,7 @@ from motionlib.adapt._examples import ExampleError
 from motionlib.errors import InputError
 from motionlib.points import segmenter_input
 from motionlib.segmenters import default
-from motionlib.segmenters.base import Segmentation, _checked
+from motionlib.segmenters.base import Segmentation
 from motionlib.segmenters.default import PLACEMENTS, Default, Peaks, shipped_stage
 
 FORMAT = 1
@@ -536,7 +536,7 @@ def _segment(analysis, p: dict, placement: str, offset_s: float) -> Segmentation
     placed = default.place(analysis, found, p)
     cuts = placed.stages[placement] + int(round(offset_s * analysis.fps))
     result = analysis.segmentation(cuts, found.confidence(p), placed.speed)
-    return _checked(result, len(analysis.x) + analysis.first)
+    return result.checked(len(analysis.x) + analysis.first)
 
 
 def detect_threshold(take, model: ThresholdModel | None = None, **params) -> Segmentation:
