@@ -45,6 +45,9 @@ POISONED = 3  # of POISON_K reviewed takes
 POISON_K = 10
 TARGET_F1, TARGET_EDITS, TARGET_K = 0.92, 0.4, 5
 TARGET_CONVENTION, TARGET_POISON = 0.15, 0.05
+# How every fit here labels the candidates (``adapt.fit_cut_model``'s ``labels``): the
+# shipped labelling, unless ``learning_tried.labelled_as`` tries another.
+LABELS = adapt.matched_labels
 
 
 @dataclass
@@ -122,7 +125,8 @@ def fit(items: list[Item], tolerance_s: float, cuts=None) -> adapt.CutModel:
                                       else cuts[i], fps=item.fps,
                                       n_frames=int(item.study["n_frames"]),
                                       read=_unread(item.name), key=key))
-    return adapt.fit_cut_model(examples, studies=studies, tolerance_s=tolerance_s)
+    return adapt.fit_cut_model(examples, studies=studies, tolerance_s=tolerance_s,
+                               labels=LABELS)
 
 
 class Known:
