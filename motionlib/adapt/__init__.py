@@ -30,9 +30,11 @@ Where new work goes: evidence a take alone gives is a row of ``_evidence.EVIDENC
 a column of its ``evidence`` (its prior weight is 0, so the zero-shot model stays the
 zero-shot detector); evidence that needs a model of the other reviewed takes (what
 happens at each frame, say) is fitted in ``_learner.fit`` beside the scorer, from what
-the studies keep of each take. The learner reads the detector through its public steps
-only (``segmenters.default``: ``analyse``, ``peaks``, ``place``, ``peak_support``,
-``place_samples``).
+the studies keep of each take (a study may hold more arrays than the candidates'), is
+carried by the :class:`CutModel`, and joins the stored evidence where fitting and
+selecting read a study (``_model.scorer_inputs``). The learner reads the detector through
+its public steps only (``segmenters.default``: ``analyse``, ``peaks``, ``place``,
+``peak_support``, ``place_samples``).
 
 Pure numpy/scipy, no Django; the service stores ``model.to_json()`` and reads it back
 with :meth:`CutModel.from_json`.

@@ -17,8 +17,9 @@ from motionlib.segmenters import default
 
 # Evidence features, in the order of a study's ``features`` columns, each with its fixed
 # centre (a typical value), so that the intercept means "a typical candidate" and the
-# prior on it is not dodged through a feature's offset. MMD² values are logged (their
-# scale is multiplicative) with a floor (FLOOR) well below the weakest peak listed.
+# prior on it is not dodged through a feature's offset. Every feature but ``zero_shot``
+# is a logarithm: MMD² values with a floor (FLOOR) well below the weakest peak listed,
+# the others with a small offset (``evidence``), since their scales are multiplicative.
 EVIDENCE = (
     ("zero_shot", 0.0),  # 1 for the zero-shot detector's own cuts
     ("long_height", -2.3),  # the zero-shot novelty curve's height near the candidate

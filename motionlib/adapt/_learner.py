@@ -24,7 +24,14 @@ import numpy as np
 from scipy.special import expit
 
 from motionlib import metrics
-from motionlib.adapt._model import CutModel, design, placed, prior_weights, ranked, select
+from motionlib.adapt._model import (
+    CutModel,
+    placed,
+    prior_weights,
+    ranked,
+    scorer_inputs,
+    select,
+)
 from motionlib.segmenters.default import PLACEMENTS, shipped_stage
 
 # Prior precision on every weight, in units of one candidate's worth of evidence: fixed
@@ -56,6 +63,32 @@ MAX_SEGMENT_S = 8.0
 PLACEMENT_MIN_CUTS = 6
 PLACEMENT_MIN_TAKES = 2
 PLACEMENT_GAIN = (0.2, 0.03)
+
+
+# How a study's candidates are labelled for the scorer: ``labels(model, study, cuts)``
+# -> (rows, y), the candidates learnt from (indices into the study's candidates) and
+# whether each is a human cut (0/1), with ``model`` placing the candidates (its placement
+# and offset, already chosen) and ``cuts`` the take's human cuts (take frames).
+Labels = Callable[[CutModel, dict, np.ndarray], tuple[np.ndarray, np.ndarray]]
+
+
+def matched_labels(model: CutModel, one: dict, cuts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The shipped labelling (:data:`Labels`): every candidate is learnt from, and is a
+    cut when, placed as ``model`` places it, it is matched one-to-one to a human cut
+    within the model's tolerance."""
+    frames = placed(model, one)
+    y = np.zeros(len(frames))
+    ci, _ = metrics.match(frames, cuts, tolerance=int(round(model.tolerance_s *
+                                                               float(one["fps"]))))
+    y[ci] = 1.0
+    return np.arange(len(frames)), y
+
+
+def _labelled(labels: Labels, model: CutModel, one: dict,
+              cuts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(design matrix, 0/1 labels) of the candidates ``labels`` learns from."""
+    rows, y = labels(model, one, cuts)
+    return scorer_inputs(model, one)[rows], np.asarray(y, dtype=float)
 
 
 def fit(studies: list[dict], cuts: list[np.ndarray], *, tolerance_s: float,
@@ -122,32 +155,6 @@ def _calibrated(model: CutModel, studies, cuts) -> float:
         else:
             hi = mid
     return round((lo + hi) / 2, 4)
-
-
-# How a study's candidates are labelled for the scorer: ``labels(model, study, cuts)``
-# -> (rows, y), the candidates learnt from (indices into the study's candidates) and
-# whether each is a human cut (0/1), with ``model`` placing the candidates (its placement
-# and offset, already chosen) and ``cuts`` the take's human cuts (take frames).
-Labels = Callable[[CutModel, dict, np.ndarray], tuple[np.ndarray, np.ndarray]]
-
-
-def matched_labels(model: CutModel, one: dict, cuts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The shipped labelling (:data:`Labels`): every candidate is learnt from, and is a
-    cut when, placed as ``model`` places it, it is matched one-to-one to a human cut
-    within the model's tolerance."""
-    frames = placed(model, one)
-    y = np.zeros(len(frames))
-    ci, _ = metrics.match(frames, cuts, tolerance=int(round(model.tolerance_s *
-                                                               float(one["fps"]))))
-    y[ci] = 1.0
-    return np.arange(len(frames)), y
-
-
-def _labelled(labels: Labels, model: CutModel, one: dict,
-              cuts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(design matrix, 0/1 labels) of the candidates ``labels`` learns from."""
-    rows, y = labels(model, one, cuts)
-    return design(one["features"])[rows], np.asarray(y, dtype=float)
 
 
 def _choose(base: CutModel, studies, cuts, data, weights) -> tuple[float, bool]:

@@ -152,6 +152,15 @@ def design(features: np.ndarray) -> np.ndarray:
     return np.hstack([features - CENTRES, np.ones((len(features), 1))])
 
 
+def scorer_inputs(model: CutModel, one: dict) -> np.ndarray:
+    """(n, len(model.features) + 1) what ``model``'s scorer reads of a study's candidates:
+    their evidence (the study's ``features``), centred, and a column of ones. Fitting and
+    selecting both read the candidates through here, so evidence a study does not keep
+    (from a model of the project's other takes, which ``model`` would then carry) joins
+    the scorer in one place."""
+    return design(one["features"])
+
+
 
 def select(model: CutModel, one: dict) -> tuple[np.ndarray, np.ndarray]:
     """The cuts ``model`` keeps among a study's candidates: (frames, probability),
@@ -169,7 +178,7 @@ def ranked(model: CutModel, one: dict):
     candidates ``select`` keeps at a threshold below all of them. A candidate's fate
     depends only on those ranked before it, so at any threshold ``select`` keeps exactly
     the kept ones above it: one pass serves every threshold (``_learner``)."""
-    logit = design(one["features"]) @ np.asarray(model.weights)
+    logit = scorer_inputs(model, one) @ np.asarray(model.weights)
     frames = placed(model, one)
     gap = int(round(model.min_segment_s * float(one["fps"])))
     order = np.argsort(-logit, kind="stable")
