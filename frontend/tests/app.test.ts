@@ -44,8 +44,15 @@ describe("capture list", () => {
     const file = (name: string) => new File(["x"], name);
     expect(pairFiles([file("13_29.amc"), file("notes.txt")]).problems).toEqual([
       "13_29.amc: an .amc needs its skeleton; drop the matching .asf with it.",
-      "notes.txt: not a .bvh, .fbx or .amc file.",
+      "notes.txt: not a take Cutroom reads (.bvh, .fbx, .amc with its .asf, .c3d, .tsv or .csv).",
     ]);
+  });
+
+  it("test_it_uploads_point_takes_alone", () => {
+    const file = (name: string) => new File(["x"], name);
+    const { items, problems } = pairFiles([file("HDM_bd_05-01_01_120.C3D"), file("subject1_run1.tsv"), file("s01_e01.csv")]);
+    expect(items.map((i) => [i.file.name, i.asf])).toEqual([["HDM_bd_05-01_01_120.C3D", null], ["subject1_run1.tsv", null], ["s01_e01.csv", null]]);
+    expect(problems).toEqual([]);
   });
 
   it("test_it_uploads_an_fbx_alone", () => {

@@ -9,7 +9,7 @@ import { accountLinks, appLinks } from "../ui/appnav";
 import { assignmentBar, teamCell } from "./assign";
 import { invitationsBox } from "./invitations";
 import { navigate } from "../router";
-import { pairFiles, upload, type UploadItem } from "./upload";
+import { CHOOSER_ACCEPT, pairFiles, upload, type UploadItem } from "./upload";
 
 const STATUSES = ["", "queued", "processing", "ready", "failed"];
 
@@ -46,7 +46,7 @@ export async function renderCaptureList(root: HTMLElement): Promise<() => void> 
   const rows = h("tbody", { "data-testid": "capture-rows" });
   const pager = h("div", { class: "pager" });
   const uploads = h("div", { class: "uploads", "data-testid": "uploads" });
-  const fileInput = h("input", { type: "file", multiple: true, accept: ".bvh,.fbx,.amc,.asf,.c3d,.tsv,.csv", hidden: true });
+  const fileInput = h("input", { type: "file", multiple: true, accept: CHOOSER_ACCEPT, hidden: true });
   const projectName = new Map(projects.map((p) => [p.id, p.name]));
   const projectRole = new Map(projects.map((p) => [p.id, p.role]));
 
