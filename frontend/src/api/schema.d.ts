@@ -872,7 +872,7 @@ export interface components {
             training: boolean;
             /** @description Why the last training failed. */
             training_error: string | null;
-            /** @description Why the model of the last training was refused (the project keeps its model). */
+            /** @description Why the model of the last training was refused (the project keeps its model; null for an annotator). */
             training_refused: string | null;
         };
         Adjudication: {
