@@ -97,6 +97,9 @@ class MeSerializer(serializers.Serializer):
     projects = MyProjectSerializer(many=True)
     limits = LimitsSerializer()
     can_create_accounts = serializers.BooleanField()
+    can_see_accounts = serializers.BooleanField(
+        help_text="A site admin who may see accounts: inviting a name no account has is refused, "
+        "saying so (to anyone else the answer is the same whether or not the name exists).")
 
 
 class ParamSerializer(serializers.Serializer):
