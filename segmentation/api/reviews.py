@@ -74,7 +74,7 @@ def unstarted_review(capture, user):
         "return_comment": "", "cuts": cuts,
         "segments": [{"index": i, "start": a, "stop": b, "label": None}
                      for i, (a, b) in enumerate(zip(bounds[:-1], bounds[1:], strict=True))],
-        "adaptation": adaptation_summary(run, capture.project_id),
+        "adaptation": adaptation_summary(run, capture.project_id, user),
     }
 
 

@@ -237,12 +237,20 @@ def test_it_shows_what_changed_when_the_review_was_edited_elsewhere(live_server,
     assert page.errors == []
 
 
-@pytest.mark.parametrize("path", ["/captures/999999/"])
-def test_it_explains_a_capture_that_does_not_exist(live_server, new_page, studio, path):
+@pytest.mark.parametrize(("path", "title", "reason"), [
+    ("/captures/999999/", "Not found", "No such capture."),
+    ("/projects/{project}/dashboard/", "Not allowed", "Only the project's reviewers and admins"),
+])
+def test_it_explains_a_capture_that_does_not_exist_or_a_page_not_for_this_role(
+        live_server, new_page, studio, path, title, reason):
+    """A refusal says so, with the server's reason; it is not a failure ("Something went
+    wrong") of the service."""
     page = new_page("ann")
-    page.goto(f"{live_server.url}{path}")
-    expect(page.locator(".loading-page")).to_contain_text("Something went wrong")
-    expect(page.locator(".loading-page .error-text")).not_to_be_empty()
+    page.goto(f"{live_server.url}{path.format(project=studio['project'].pk)}")
+    failure = page.get_by_test_id("page-failure")
+    expect(failure.locator("h1")).to_have_text(title)
+    expect(failure.locator("p")).to_contain_text(reason)
+    expect(failure.locator(".error-text")).to_have_count(0)
 
 
 def test_it_lists_the_shortcuts_and_locks_the_review_once_submitted(live_server, new_page, ingested_capture, studio):

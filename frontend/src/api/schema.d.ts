@@ -872,7 +872,7 @@ export interface components {
             training: boolean;
             /** @description Why the last training failed. */
             training_error: string | null;
-            /** @description Why the model of the last training was refused (the project keeps its model). */
+            /** @description Why the model of the last training was refused (the project keeps its model; null for an annotator). */
             training_refused: string | null;
         };
         Adjudication: {
@@ -1275,6 +1275,8 @@ export interface components {
             projects: components["schemas"]["MyProject"][];
             limits: components["schemas"]["Limits"];
             can_create_accounts: boolean;
+            /** @description A site admin who may see accounts: inviting a name no account has is refused, saying so (to anyone else the answer is the same whether or not the name exists). */
+            can_see_accounts: boolean;
         };
         Member: {
             readonly id: number;

@@ -94,10 +94,11 @@ const takes = (n: number) => `${n} reviewed take${n === 1 ? "" : "s"}`;
 /**
  * Where the candidates came from — "adapted from 12 reviewed takes" or "not adapted yet" —
  * that model's own figure on held-out reviewed takes, then the project's newer model, a
- * training under way, or why the last one failed or its model was refused.
+ * training under way or why its model was refused (news: the server tells reviewers and
+ * admins only), and apart, as a failure, why the last training failed.
  */
-export function adaptationLines(a: Adaptation | undefined): { line: string; figure: string; notes: string[] } {
-  if (!a) return { line: "", figure: "", notes: [] };
+export function adaptationLines(a: Adaptation | undefined): { line: string; figure: string; notes: string[]; failure: string } {
+  if (!a) return { line: "", figure: "", notes: [], failure: "" };
   const adapted = a.model_version !== null && a.n_takes !== null;
   const line = adapted ? `Candidates adapted from ${takes(a.n_takes!)} (model v${a.model_version}).` : "Candidates not adapted yet (zero-shot detector).";
   const figure = adapted && a.held_out ? `Learnt from ${takes(a.n_takes!)}; ${heldOut(a.held_out)}.` : "";
@@ -108,9 +109,9 @@ export function adaptationLines(a: Adaptation | undefined): { line: string; figu
   }
   if (a.training) notes.push("Retraining on the newest reviews…");
   const kept = project ? `model v${project.version}` : "the zero-shot detector";
-  if (a.training_error) notes.push(`Last retraining failed: ${a.training_error} The project keeps ${kept}.`);
   if (a.training_refused) notes.push(`Last retraining ${a.training_refused}. The project keeps ${kept}.`);
-  return { line, figure, notes };
+  const failure = a.training_error ? `Last retraining failed: ${a.training_error} The project keeps ${kept}.` : "";
+  return { line, figure, notes, failure };
 }
 
 /** "on 5 held-out reviewed takes 0.30 edits per cut, F1 0.91" */
@@ -119,11 +120,12 @@ function heldOut(h: HeldOut): string {
 }
 
 export function renderAdaptation(el: HTMLElement, a: Adaptation | undefined): void {
-  const { line, figure, notes } = adaptationLines(a);
+  const { line, figure, notes, failure } = adaptationLines(a);
   clear(
     el,
     line ? h("div", { "data-testid": "adaptation-line" }, line) : null,
     figure ? h("div", { class: "muted small", "data-testid": "adaptation-figure" }, figure) : null,
-    ...notes.map((note) => h("div", { class: note.startsWith("Last retraining") ? "error-text small" : "muted small", "data-testid": "adaptation-note" }, note)),
+    ...notes.map((note) => h("div", { class: "muted small", "data-testid": "adaptation-note" }, note)),
+    failure ? h("div", { class: "error-text small", "data-testid": "adaptation-failure" }, failure) : null,
   );
 }
