@@ -139,7 +139,8 @@ class ReviewPage {
       reveal: (f) => this.timeline.reveal(f),
       zoom: (factor, f) => this.timeline.zoom(factor, f),
       setSpeed: (v) => this.setSpeed(v),
-      notice: (text) => toast(text),
+      notice: (text, error) => toast(text, error ? "error" : "info"),
+      refresh: () => this.refresh(),
     });
     this.suggestions = new Suggestions(capture.id, () => this.renderSide());
     frames.onChunk = () => this.stage.loaded(this.playback.frame);

@@ -6,6 +6,7 @@ import { MAX_JOINTS, SkeletonView, TooManyJoints } from "../player/skeletonView"
 import { h } from "../ui/dom";
 import { FrameStore, loadFrames } from "./frames";
 import type { Elements } from "./layout";
+import { formatTimecode } from "./timecode";
 import { formatTime } from "./timescale";
 
 /** A capture's poses loading in the background, with a hook for each chunk that lands. */
@@ -91,7 +92,9 @@ export class Stage {
   show(frame: number): void {
     const c = this.capture;
     this.el.hudFrame.textContent = `Frame ${frame} / ${c.n_frames - 1}`;
-    this.el.hudTime.textContent = `${formatTime(frame, c.fps)} / ${formatTime(c.n_frames - 1, c.fps)} · ${c.fps} fps`;
+    // Timecode as the studio writes it; the clock time is the read-out's tooltip.
+    this.el.hudTime.textContent = `${formatTimecode(frame, c.fps)} / ${formatTimecode(c.n_frames - 1, c.fps)} · ${c.fps} fps`;
+    this.el.hudTime.title = `${formatTime(frame, c.fps)} / ${formatTime(c.n_frames - 1, c.fps)}`;
     const store = this.feed.store;
     if (frame === this.shownFrame || !this.player) return;
     const shown = store.has(frame) ? frame : store.nearestLoaded(frame);

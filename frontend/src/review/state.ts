@@ -59,6 +59,24 @@ export function neighbourCut(cuts: readonly Cut[], frame: number, direction: -1 
   return [...sorted].reverse().find((c) => c.frame < frame);
 }
 
+/** The nearest pending candidate strictly before (-1) or after (+1) `frame`. */
+export function neighbourPending(cuts: readonly Cut[], frame: number, direction: -1 | 1): Cut | undefined {
+  return neighbourCut(cuts.filter((c) => c.fate === "pending"), frame, direction);
+}
+
+/** The nearest unlabelled segment starting strictly before (-1) or after (+1) `frame`. */
+export function neighbourUnlabelled(segments: readonly Segment[], frame: number, direction: -1 | 1): Segment | undefined {
+  const open = segments.filter((s) => !s.label);
+  if (direction > 0) return open.find((s) => s.start > frame);
+  return [...open].reverse().find((s) => s.start < frame);
+}
+
+/** The deleted candidate nearest `frame` (either side; the earlier one on a tie). */
+export function nearestDeleted(cuts: readonly Cut[], frame: number): Cut | undefined {
+  const deleted = cuts.filter((c) => c.fate === "deleted" && c.origin === "candidate");
+  return deleted.sort((a, b) => Math.abs(a.frame - frame) - Math.abs(b.frame - frame) || a.frame - b.frame)[0];
+}
+
 /**
  * An unstarted review (id null: reading never creates one) with temporary negative ids
  * on its candidate cuts, so they can be selected and edited before the first save
