@@ -3,23 +3,25 @@
 // (session.ts: edits, history, saving, conflicts), playback (player/playback.ts), the
 // stage (stage.ts), the sidebar (sidebar.ts), the key commands (commands.ts) and the
 // timeline (timeline.ts). Every edit is applied on screen at once and saved through the
-// API straight away (saver.ts); undo/redo are edits too, so the audit log is complete.
+// API straight away (saver.ts); undo/redo are restores the server makes from the audit
+// log (history.ts), so they survive a reload and the log stays complete.
 
 import { ApiError, get } from "../api/client";
 import { isReady } from "../api/types";
-import type { Adaptation, Capture, Label, Me, OpenedReview, Project, ReadyCapture, Review, Signal, SignalResponse } from "../api/types";
+import type { Adaptation, Capture, Label, Me, OpenedReview, Project, ReadyCapture, Review, ReviewEvent, Signal, SignalResponse } from "../api/types";
 import { PlaybackController } from "../player/playback";
 import { nextInQueue } from "../queue/api";
 import { navigate } from "../router";
 import { clear, confirmDialog, dialog, h, toast } from "../ui/dom";
 import { icon } from "../ui/icons";
 import { Commands } from "./commands";
+import { eventDetail } from "./events";
 import { decodeFloat32 } from "./frames";
 import { pageCommand } from "./keys";
 import type { Command } from "./keymap";
 import { buildLayout, type Elements } from "./layout";
 import { ReviewSession } from "./session";
-import { listOf, Sidebar } from "./sidebar";
+import { confirmRestore, listOf, Sidebar } from "./sidebar";
 import { FrameFeed, frameFromUrl, maxJoints, signalsAfterPoses, signalsWait, Stage } from "./stage";
 import { segmentAt, withTempIds } from "./state";
 import { Suggestions } from "./suggestions";
@@ -131,7 +133,10 @@ class ReviewPage {
     this.timeline = this.makeTimeline();
     this.sidebar = new Sidebar(this.el, capture, this.labels, adaptation, {
       label: (name) => this.session.labelAt(this.playback.frame, name),
-      show: (other) => this.session.show(other),
+      show: (other) => {
+        this.session.show(other);
+        if (!other) void this.loadEvents();
+      },
     });
     this.commands = new Commands({
       session: this.session, playback: this.playback, labels: this.labels,
@@ -234,8 +239,15 @@ class ReviewPage {
     this.el.saveState.classList.toggle("busy", pending > 0);
   }
 
+  /** The own review's activity log; the undo history is read from it (it survives a reload). */
   private async loadEvents(): Promise<void> {
-    if (!this.session.readOnly) await this.sidebar.loadEvents();
+    if (this.session.readOnly) return;
+    const events = await this.sidebar.loadEvents(this.session.locked() ? undefined : (e) => void this.askRestore(e));
+    if (events) this.session.readHistory(events);
+  }
+
+  private async askRestore(e: ReviewEvent): Promise<void> {
+    if (await confirmRestore(e)) this.session.restore(e.id, `${e.action} ${eventDetail(e)}`.trim());
   }
 
   /**

@@ -58,7 +58,7 @@ export class Saver {
         const request =
           edit.kind === "label"
             ? labelRequest(this.captureId, this.server, edit, this.server.version)
-            : editRequest(this.captureId, edit, this.server.version, this.resolve);
+            : editRequest(this.captureId, edit, this.server.version, this.resolve, this.server.id);
         const next = await this.send<Review>(request.method, request.url, request.body);
         const renamed = new Map<number, number>();
         if (edit.kind === "insert") {

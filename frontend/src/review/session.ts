@@ -3,8 +3,8 @@
 // draws what this holds and forwards gestures and keys to it; unit tests drive it alone.
 
 import { api } from "../api/client";
-import type { Cut, Review } from "../api/types";
-import { changeFor, emptyHistory, record, redo, undo, type Change, type History } from "./history";
+import type { Cut, Review, ReviewEvent } from "../api/types";
+import { editTitle, emptyHistory, historyFromEvents, record, stepped, type History } from "./history";
 import { Saver, type Send } from "./saver";
 import { applyEdit, describeDifferences, EditError, segmentAt, type Edit } from "./state";
 
@@ -88,11 +88,11 @@ export class ReviewSession {
       return false;
     }
     try {
-      const change = changeFor(this.review, edit);
+      const title = editTitle(this.review, edit);
       this.review = applyEdit(this.review, edit, this.nFrames);
-      this.history = record(this.history, change);
+      this.history = record(this.history, title);
       if (edit.kind === "insert") this.selectedCutId = edit.tempId;
-      this.saver.push([edit], change.title);
+      this.saver.push([edit], title);
       return true;
     } catch (err) {
       if (!(err instanceof EditError)) throw err;
@@ -124,29 +124,39 @@ export class ReviewSession {
     this.view.changed();
   }
 
+  /**
+   * Undo or redo the last step. The server makes it from the review's log (so it works
+   * after a reload too) and answers with the review; the screen shows that answer.
+   */
+  step(which: "undo" | "redo"): void {
+    const locked = this.locked();
+    if (locked) return this.view.notice(locked, true);
+    const step = stepped(this.history, which);
+    if (!step) return this.view.notice(`Nothing to ${which}.`);
+    this.history = step.history;
+    this.saver.push([{ kind: which }], `${which} ${step.title}`);
+    this.view.notice(`${which === "undo" ? "Undo" : "Redo"}: ${step.title}`);
+    this.view.changed();
+  }
+
   undo(): void {
-    if (!this.locked()) this.replay(undo(this.history, this.review, this.saver.resolve), "undo");
+    this.step("undo");
   }
 
   redo(): void {
-    if (!this.locked()) this.replay(redo(this.history, this.review, this.saver.resolve), "redo");
+    this.step("redo");
   }
 
-  private replay(step: { history: History; edits: Edit[]; change: Change } | null, verb: string): void {
-    if (!step) {
-      this.view.notice(`Nothing to ${verb}.`);
-      return;
-    }
-    try {
-      let next = this.review;
-      for (const edit of step.edits) next = applyEdit(next, edit, this.nFrames);
-      this.review = next;
-      this.history = step.history;
-      if (step.edits.length) this.saver.push(step.edits, `${verb} ${step.change.title}`);
-      this.view.notice(`${verb[0].toUpperCase()}${verb.slice(1)}: ${step.change.title}`);
-    } catch (err) {
-      this.view.notice(err instanceof Error ? err.message : String(err), true);
-    }
+  /** Restore the review as it was right after its event `event` (an activity log entry). */
+  restore(event: number, title: string): void {
+    this.perform({ kind: "restore", event });
+    this.view.notice(`Restoring ${title}…`);
+  }
+
+  /** The undo/redo stacks as the server's log has them, unless edits are still queued. */
+  readHistory(events: readonly ReviewEvent[]): void {
+    if (this.saver.pending || this.other) return;
+    this.history = historyFromEvents(events);
     this.view.changed();
   }
 

@@ -1,11 +1,12 @@
 // The review page's side: labels of the segment under the playhead, the selection, the
 // review's counts, the activity log and, for reviewers, the other annotators' reviews.
 
-import { get } from "../api/client";
+import { get, post } from "../api/client";
 import type { Adaptation, Label, Me, Project, ReadyCapture, Review, ReviewEvent, Segment } from "../api/types";
 import { returnReview } from "../queue/api";
-import { clear, h, toast } from "../ui/dom";
+import { clear, confirmDialog, h, toast } from "../ui/dom";
 import { promptDialog } from "../ui/prompt";
+import { eventDetail } from "./events";
 import type { Elements } from "./layout";
 import { renderAdaptation, renderEvents, renderLabels, renderSelection, renderStats } from "./panels";
 import type { ReviewSession } from "./session";
@@ -37,12 +38,12 @@ export class Sidebar {
     renderAdaptation(this.el.adaptation, this.adaptation);
   }
 
-  /** The own review's activity log (the log of a review shown read-only is not fetched). */
-  async loadEvents(): Promise<ReviewEvent[] | null> {
+  /** The own review's activity log, each entry offering `restore` when given. */
+  async loadEvents(restore?: (e: ReviewEvent) => void): Promise<ReviewEvent[] | null> {
     const events = await get<ReviewEvent[] | { results: ReviewEvent[] }>(`/api/captures/${this.capture.id}/review/events/`).catch(() => null);
     if (!events) return null;
     const list = listOf(events);
-    renderEvents(this.el.events, list);
+    renderEvents(this.el.events, list, restore);
     return list;
   }
 
@@ -62,12 +63,34 @@ export class Sidebar {
     const giveBack = h("button", { class: "btn", hidden: true, "data-testid": "return-review", title: "Send this submitted review back to its annotator with a comment", onclick: () => void this.giveBack(others, select, project, me) }, "Return…");
     select.addEventListener("change", () => {
       select.blur();
-      this.el.eventsTitle.textContent = select.value ? "Activity (of your own review)" : "Activity";
       const other = others.find((r) => String(r.id) === select.value);
+      this.el.eventsTitle.textContent = other ? `Activity of ${other.annotator.username}'s review` : "Activity";
       giveBack.hidden = other?.status !== "submitted";
       this.actions.show(other ?? null);
+      if (other) void this.loadOthersEvents(other, others);
     });
     clear(this.el.reviewPicker, select, giveBack);
+  }
+
+  /** Another annotator's log; a reviewer may restore their review (not once submitted). */
+  private async loadOthersEvents(review: Review, others: Review[]): Promise<void> {
+    const events = await get<ReviewEvent[] | { results: ReviewEvent[] }>(`/api/captures/${this.capture.id}/reviews/${review.id}/events/`).catch(() => null);
+    if (!events) return;
+    const restore = review.status === "submitted" ? undefined : (e: ReviewEvent) => void this.restoreOthers(review, e, others);
+    renderEvents(this.el.events, listOf(events), restore);
+  }
+
+  private async restoreOthers(review: Review, e: ReviewEvent, others: Review[]): Promise<void> {
+    if (!(await confirmRestore(e, `${review.annotator.username}'s review`))) return;
+    try {
+      const restored = await post<Review>(`/api/captures/${this.capture.id}/reviews/${review.id}/restore/`, { event: e.id, version: review.version });
+      others[others.indexOf(review)] = restored;
+      toast(`Restored ${review.annotator.username}'s review.`);
+      this.actions.show(restored);
+      await this.loadOthersEvents(restored, others);
+    } catch (err) {
+      toast((err as Error).message, "error");
+    }
   }
 
   private async giveBack(others: Review[], select: HTMLSelectElement, project: Project, me: Me): Promise<void> {
@@ -86,6 +109,15 @@ export class Sidebar {
       toast((err as Error).message, "error");
     }
   }
+}
+
+/** Ask before restoring `whose` review as it was right after the log entry `e`. */
+export function confirmRestore(e: ReviewEvent, whose = "The review"): Promise<boolean> {
+  const what = `${e.action} ${eventDetail(e)}`.trim();
+  return confirmDialog("Restore this point of the activity?", [
+    h("p", {}, `${whose} goes back to how it was right after “${what}” (${new Date(e.created_at).toLocaleTimeString()}).`),
+    h("p", { class: "muted" }, "The restore is itself an entry of the activity log: undo (Z) takes it back."),
+  ], "Restore");
 }
 
 export function listOf<T>(value: T[] | { results: T[] }): T[] {
