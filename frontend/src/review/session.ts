@@ -150,7 +150,7 @@ export class ReviewSession {
   /** Restore the review as it was right after its event `event` (an activity log entry). */
   restore(event: number, title: string): void {
     this.perform({ kind: "restore", event });
-    this.view.notice(`Restoring ${title}…`);
+    this.view.notice(`Restoring the review as it was after “${title}”…`);
   }
 
   /** The undo/redo stacks as the server's log has them, unless edits are still queued. */
