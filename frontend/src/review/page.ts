@@ -10,27 +10,22 @@ import { ApiError, get } from "../api/client";
 import { isReady } from "../api/types";
 import type { Adaptation, Capture, Label, Me, OpenedReview, Project, ReadyCapture, Review, ReviewEvent, Signal, SignalResponse } from "../api/types";
 import { PlaybackController } from "../player/playback";
-import { nextInQueue } from "../queue/api";
-import { navigate } from "../router";
-import { clear, confirmDialog, dialog, h, toast } from "../ui/dom";
+import { clear, h, toast } from "../ui/dom";
 import { icon } from "../ui/icons";
 import { Commands } from "./commands";
+import { confirmSubmit, openNext, showConflict } from "./dialogs";
 import { eventDetail } from "./events";
-import { decodeFloat32 } from "./frames";
 import { pageCommand } from "./keys";
 import type { Command } from "./keymap";
 import { buildLayout, type Elements } from "./layout";
 import { ReviewSession } from "./session";
 import { confirmRestore, listOf, Sidebar } from "./sidebar";
-import { FrameFeed, frameFromUrl, maxJoints, signalsAfterPoses, signalsWait, Stage } from "./stage";
+import { FrameFeed, frameFromUrl, fullSignals, maxJoints, signalsAfterPoses, signalsWait, Stage } from "./stage";
 import { segmentAt, withTempIds } from "./state";
 import { Suggestions } from "./suggestions";
 import { Timeline, type TimelineModel } from "./timeline";
 
 export { frameFromUrl };
-
-/** `/signal/?encoding=float32`: each signal's values as base64 little-endian float32. */
-type PackedSignalResponse = Omit<SignalResponse, "signals"> & { signals: (Omit<Signal, "values"> & { data: string })[] };
 
 export async function renderReview(root: HTMLElement, captureId: number): Promise<() => void> {
   clear(root, h("div", { class: "loading-page" }, "Opening capture…"));
@@ -115,7 +110,7 @@ class ReviewPage {
         // An edit makes new segments; their suggestions are asked for once the edits settle.
         this.suggestions.askForNew(r.segments);
       },
-      conflict: (changes, unsaved) => void this.showConflict(changes, unsaved),
+      conflict: (changes, unsaved) => void showConflict(changes, unsaved).then(() => this.loadEvents()),
     });
     this.playback = new PlaybackController(capture.fps, capture.n_frames, frameFromUrl(capture.n_frames), (frame, playing) => this.onPlayFrame(frame, playing));
     const layout = buildLayout(capture, me, {
@@ -250,55 +245,21 @@ class ReviewPage {
     if (await confirmRestore(e)) this.session.restore(e.id, `${e.action} ${eventDetail(e)}`.trim());
   }
 
-  /**
-   * The first paint uses signals decimated to a few thousand points; once the first pose
-   * is on screen (signalsWait), fetch them at full frame resolution so zooming in shows
-   * every frame.
-   */
+  /** Once the first pose is on screen, the lanes at every frame's value (stage.ts). */
   private async loadFullSignals(): Promise<void> {
-    const aborted = () => this.frames.abort.signal.aborted;
-    if (aborted() || !this.signals.some((sig) => sig.step > 1)) return;
-    // Every frame's value as base64 float32: 5.3 bytes a value instead of ~9 of JSON, and no numbers to parse.
-    const full = await get<PackedSignalResponse>(`/api/captures/${this.capture.id}/signal/?max_points=${this.capture.n_frames}&encoding=float32`).catch(() => null);
-    if (!full || aborted()) return;
-    this.signals = full.signals.map(({ data, ...sig }) => ({ ...sig, values: Array.from(decodeFloat32(data)) }));
-    this.el.timeline.dataset.signalStep = String(Math.max(1, ...this.signals.map((sig) => sig.step)));
+    const full = await fullSignals(this.capture, this.signals, this.frames.abort.signal);
+    if (!full) return;
+    this.signals = full;
+    this.el.timeline.dataset.signalStep = String(Math.max(1, ...full.map((sig) => sig.step)));
     this.refresh();
     // The timeline draws on the next animation frame, before this callback (queued after
     // its own): milliseconds from navigation to every lane drawn at full resolution.
     requestAnimationFrame(() => (this.el.timeline.dataset.lanesMs = String(Math.round(performance.now()))));
   }
 
-  // ---- dialogs -------------------------------------------------------------------------
-
-  private async showConflict(changes: string[], unsaved: string[]): Promise<void> {
-    // The server's text is for API clients (it names the review and says to reload); the
-    // page has already loaded the current version, so it says that instead.
-    await dialog("This review changed elsewhere", [
-      h("p", { "data-testid": "conflict-text" }, "Your review was saved from another tab or window first. This page shows that version now."),
-      h("p", {}, "What changed:"),
-      h("ul", { "data-testid": "conflict-changes" }, ...(changes.length ? changes : ["(nothing visible)"]).map((line) => h("li", {}, line))),
-      unsaved.length ? h("p", {}, "Not saved — redo these if you still want them:") : null,
-      unsaved.length ? h("ul", { "data-testid": "conflict-unsaved" }, ...unsaved.map((t) => h("li", {}, t))) : null,
-    ]);
-    void this.loadEvents();
-  }
-
   private async submit(next: boolean): Promise<void> {
     const s = this.session;
-    if (s.locked() || s.saver.pending) return;
-    const pending = s.review.cuts.filter((c) => c.fate === "pending").length;
-    const unlabelled = s.review.segments.filter((seg) => !seg.label).length;
-    // Submitting keeps every cut not deleted, pending candidates included: say so, with the count.
-    const candidates = `${pending} pending candidate${pending === 1 ? "" : "s"}`;
-    const ok = await confirmDialog(next ? "Submit and open the next capture?" : "Submit this review?", [
-      h("p", {}, "A submitted review counts towards agreement and the library, and can no longer be edited."),
-      pending
-        ? h("p", { "data-testid": "submit-pending" }, h("strong", {}, `${candidates} will be kept as cuts.`), ` Accept or delete ${pending === 1 ? "it" : "them"} first to decide each one.`)
-        : null,
-      unlabelled ? h("p", { class: "muted", "data-testid": "submit-unlabelled" }, `${unlabelled} unlabelled segment${unlabelled === 1 ? "" : "s"} will be left out of the library.`) : null,
-    ], pending ? `Submit, keeping ${pending}` : "Submit");
-    if (!ok) return;
+    if (s.locked() || s.saver.pending || !(await confirmSubmit(s.review, next))) return;
     try {
       await s.submit();
       toast("Review submitted.");
@@ -308,17 +269,7 @@ class ReviewPage {
       next = false;
     }
     this.refresh();
-    if (next) await this.openNext();
-  }
-
-  /** The oldest open capture of the caller's queue in this project, or the queue itself. */
-  private async openNext(): Promise<void> {
-    const item = await nextInQueue(this.capture.project, this.capture.id).catch(() => null);
-    if (item) navigate(`/captures/${item.capture.id}/`);
-    else {
-      toast("Your queue has nothing else open.");
-      navigate(`/queue/?project=${this.capture.project}`);
-    }
+    if (next) await openNext(this.capture);
   }
 }
 

@@ -1,10 +1,11 @@
 // The review page's stage: a capture's poses loading in the background, and the 3D player
 // that shows the pose of the frame under the playhead, with its frame read-outs.
 
-import type { Me, ReadyCapture } from "../api/types";
+import { get } from "../api/client";
+import type { Me, ReadyCapture, Signal, SignalResponse } from "../api/types";
 import { MAX_JOINTS, SkeletonView, TooManyJoints } from "../player/skeletonView";
 import { h } from "../ui/dom";
-import { FrameStore, loadFrames } from "./frames";
+import { decodeFloat32, FrameStore, loadFrames } from "./frames";
 import type { Elements } from "./layout";
 import { formatTimecode } from "./timecode";
 import { formatTime } from "./timescale";
@@ -56,6 +57,22 @@ export function signalsAfterPoses(search = location.search): boolean {
  */
 export function signalsWait(frames: FrameFeed): Promise<void> {
   return signalsAfterPoses() ? frames.done : frames.first;
+}
+
+/** `/signal/?encoding=float32`: each signal's values as base64 little-endian float32. */
+type PackedSignalResponse = Omit<SignalResponse, "signals"> & { signals: (Omit<Signal, "values"> & { data: string })[] };
+
+/**
+ * The first paint uses signals decimated to a few thousand points; once the first pose is
+ * on screen (signalsWait), they are fetched at full frame resolution so zooming in shows
+ * every frame. Null when they already are, or the page was left meanwhile.
+ */
+export async function fullSignals(capture: ReadyCapture, shown: Signal[], abort: AbortSignal): Promise<Signal[] | null> {
+  if (abort.aborted || !shown.some((sig) => sig.step > 1)) return null;
+  // Every frame's value as base64 float32: 5.3 bytes a value instead of ~9 of JSON, and no numbers to parse.
+  const full = await get<PackedSignalResponse>(`/api/captures/${capture.id}/signal/?max_points=${capture.n_frames}&encoding=float32`).catch(() => null);
+  if (!full || abort.aborted) return null;
+  return full.signals.map(({ data, ...sig }) => ({ ...sig, values: Array.from(decodeFloat32(data)) }));
 }
 
 export function jointCount(capture: ReadyCapture): number {
