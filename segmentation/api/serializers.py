@@ -457,6 +457,12 @@ class VersionSerializer(serializers.Serializer):
     version = serializers.IntegerField(min_value=1)
 
 
+class RestoreSerializer(VersionSerializer):
+    """Restore the review as it was right after its event ``event`` (an id of its log)."""
+
+    event = serializers.IntegerField(min_value=1)
+
+
 class InsertCutSerializer(VersionSerializer):
     frame = serializers.IntegerField()
 

@@ -167,5 +167,5 @@ def test_it_pairs_a_dropped_cmu_amc_with_its_asf_and_plays_the_real_take(live_se
     page.wait_for_selector("[data-testid=frames-loading][data-done]", state="attached")
     page.keyboard.press("End")
     expect(page.get_by_test_id("hud-frame")).to_have_text("Frame 4591 / 4591")
-    expect(page.get_by_test_id("hud-time")).to_contain_text("0:38.26 / 0:38.26 · 120 fps")
+    expect(page.get_by_test_id("hud-time")).to_contain_text("00:00:38:031 / 00:00:38:031 · 120 fps")
     assert page.errors == []

@@ -120,7 +120,7 @@ def test_it_saves_every_edit_and_restores_the_review_exactly_after_reload(live_s
     segments = {s["start"]: s["label"] for s in screen.review()["segments"]}
     assert segments[0] == "walk" and segments[inserted_at] == "punch"
 
-    # Undo takes the last label off; redo puts it back; both are saved edits too.
+    # Undo takes the last label off; redo puts it back; both are saved on the server too.
     page.keyboard.press("z")
     screen.saved()
     assert screen.review()["segments"][0]["label"] is None
@@ -148,9 +148,10 @@ def test_it_saves_every_edit_and_restores_the_review_exactly_after_reload(live_s
     assert fates[c2["id"]][0] == "deleted"
     assert stored.version == after_reload["version"]
 
-    # The audit log, in the API and on the page, shows each action in order.
+    # The audit log, in the API and on the page, shows each action in order; the undo and
+    # the redo are restores the server made from the log.
     actions = [e["action"] for e in screen.events()]
-    assert actions == ["create", "accept", "move", "delete", "insert", "label", "label", "label", "label"]
+    assert actions == ["create", "accept", "move", "delete", "insert", "label", "label", "restore", "restore"]
     shown = page.locator("[data-testid=events] li").evaluate_all("els => els.map(e => e.dataset.action)")
     assert shown == list(reversed(actions))
 

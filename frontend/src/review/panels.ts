@@ -75,18 +75,38 @@ export function renderStats(el: HTMLElement, review: Review): void {
   );
 }
 
-/** The audit log, newest first. */
-export function renderEvents(el: HTMLElement, events: ReviewEvent[]): void {
+/**
+ * The audit log, newest first. With `restore`, every entry but the newest offers to bring
+ * the review back to how it was right after that entry.
+ */
+export function renderEvents(el: HTMLElement, events: ReviewEvent[], restore?: (e: ReviewEvent) => void): void {
+  const newest = events[events.length - 1];
   const item = (e: ReviewEvent) =>
     h(
       "li",
-      { "data-action": e.action },
-      h("span", { class: "ev-action" }, e.action.replace(/_/g, " ")),
+      { "data-action": e.action, "data-event": String(e.id) },
+      h("span", { class: "ev-action" }, actionText(e)),
       h("span", { class: "ev-detail", title: eventDetail(e) }, eventDetail(e)),
       h("time", { datetime: e.created_at, title: e.created_at }, new Date(e.created_at).toLocaleTimeString()),
+      restore && e !== newest
+        ? h("button", {
+            class: "btn btn-ghost ev-restore", "data-testid": `restore-event-${e.id}`, "aria-label": "Restore",
+            title: "Restore the review as it was right after this entry (the restore is an entry too: undo takes it back)",
+            onclick: (ev: Event) => {
+              (ev.currentTarget as HTMLElement).blur();
+              restore(e);
+            },
+          }, "↺")
+        : null,
     );
   clear(el, ...events.slice().reverse().map(item));
   if (!events.length) el.append(h("li", { class: "muted" }, "No edits yet."));
+}
+
+/** An entry's action in words: a restore the server made for undo or redo says so. */
+function actionText(e: ReviewEvent): string {
+  const intent = e.action === "restore" ? (e.after as { intent?: string | null } | null)?.intent : null;
+  return intent ?? e.action.replace(/_/g, " ");
 }
 
 const takes = (n: number) => `${n} reviewed take${n === 1 ? "" : "s"}`;
