@@ -139,6 +139,25 @@ def max_frames_for(n_joints: int, n_channels: int, file_bytes: int, limits: Limi
                limits.max_joint_frames // max(n_joints, 1), budget // max(n_joints, 1))
 
 
+def check_points(n_points: int, limits: Limits, path=None, line: int | None = None,
+                 what: str = "points") -> None:
+    """Refuse a point take (or an armature) of more than ``limits.max_joints`` points,
+    before anything per point is built.
+
+    Points count as joints: every later step (positions, links, descriptors) costs per
+    point what it costs per joint, so a file of 33,334 markers is as hostile as a BVH of
+    33,334 joints.
+
+    Raises
+    ------
+    CaptureError
+        Naming the count, the limit and (when given) the file and line.
+    """
+    if n_points > limits.max_joints:
+        raise CaptureError(f"{n_points} {what} is more than the limit of {limits.max_joints} "
+                           "joints", path=path, line=line)
+
+
 def check_size(n_frames: int, n_joints: int, n_channels: int, file_bytes: int,
                limits: Limits, path=None, line: int | None = None) -> None:
     """Refuse a take whose arrays would exceed ``limits``, before they are allocated.

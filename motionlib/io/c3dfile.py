@@ -24,7 +24,7 @@ import numpy as np
 
 from motionlib.errors import CaptureError, shorten
 from motionlib.points import PointTake, make_point_take
-from motionlib.take import DEFAULT_LIMITS, Limits, check_size, frame_range
+from motionlib.take import DEFAULT_LIMITS, Limits, check_points, check_size, frame_range
 
 BLOCK = 512
 C3D_KEY = 0x50
@@ -73,6 +73,7 @@ def read_c3d(path: str | os.PathLike, *, limits: Limits = DEFAULT_LIMITS) -> Poi
     reader = _reader(data, path)
     layout = _layout(reader, data, path, limits)
     coordinates = _frames(data, layout, path)
+    _check_lengths(coordinates, layout, limits, path)
     labels = _labels(reader, layout["n_points"])
     units = _string(reader, "POINT:UNITS") or "mm"
     y_screen = (_string(reader, "POINT:Y_SCREEN") or "+Z").upper()
@@ -149,6 +150,7 @@ def _layout(reader, data: bytes, path, limits: Limits) -> dict:
     if n_points < 1:
         raise CaptureError(f"parameter POINT:USED is {n_points}; the file has no 3D points",
                            path=path)
+    check_points(n_points, limits, path=path, what="points (parameter POINT:USED)")
     scale = float(_number(reader, "POINT:SCALE", path, "float"))
     if not np.isfinite(scale) or scale == 0:
         raise CaptureError(f"parameter POINT:SCALE is {scale}; it must be a non-zero number",
@@ -217,6 +219,21 @@ def _frames(data: bytes, layout: dict, path) -> np.ndarray:
     gap = (residual < 0) | ~np.isfinite(xyz[..., 0] + xyz[..., 1] + xyz[..., 2])
     xyz[gap] = np.nan
     return xyz
+
+
+def _check_lengths(xyz: np.ndarray, layout: dict, limits: Limits, path) -> None:
+    """Refuse a coordinate beyond ``limits.max_length`` (int16 words times a POINT:SCALE of
+    1e38 are finite here and infinite as float32 positions), naming frame, point and value."""
+    with np.errstate(invalid="ignore"):
+        beyond = np.abs(xyz) > limits.max_length
+    frames = np.flatnonzero(beyond.any(axis=(1, 2)))
+    if len(frames):
+        frame = int(frames[0])
+        point = int(np.flatnonzero(beyond[frame].any(axis=1))[0])
+        value = float(xyz[frame, point][beyond[frame, point]][0])
+        raise CaptureError(f"data section, frame {layout['first'] + frame}, point {point + 1}: "
+                           f"{value:g} is beyond the largest coordinate a take may hold "
+                           f"(±{limits.max_length:g})", path=path)
 
 
 def _residual_of_float(word: np.ndarray) -> np.ndarray:

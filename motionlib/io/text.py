@@ -6,16 +6,22 @@ import re
 from pathlib import Path
 
 _LONE_CR = re.compile(rb"\r(?!\n)")
+UTF8_BOM = b"\xef\xbb\xbf"
 
 
 def read_lines_bytes(path) -> bytes:
-    """The bytes of ``path``, with classic Mac line ends (a CR alone) turned into LF.
+    """The bytes of ``path`` without a UTF-8 byte-order mark, with classic Mac line ends (a
+    CR alone) turned into LF.
+
+    Spreadsheets on Windows save CSV with the mark; left in, it would become part of the
+    first word ("\ufeffframe"), and a valid file would be refused for a reason no one sees.
 
     Every reader counts lines by LF; a file saved with CR alone would otherwise be one long
     line, and its error messages would point at the wrong place for the wrong reason.
     CRLF is left as it is (the CR is whitespace to the readers).
     """
-    return lone_cr_to_lf(Path(path).read_bytes())
+    data = Path(path).read_bytes()
+    return lone_cr_to_lf(data[len(UTF8_BOM):] if data.startswith(UTF8_BOM) else data)
 
 
 def lone_cr_to_lf(data: bytes) -> bytes:
