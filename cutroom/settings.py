@@ -276,6 +276,10 @@ CUTROOM_DETECT_TIME_LIMIT = envint("CUTROOM_DETECT_TIME_LIMIT", 300)
 CUTROOM_RETRAIN_TIME_LIMIT = envint("CUTROOM_RETRAIN_TIME_LIMIT", 600)
 CUTROOM_SUGGEST_TIME_LIMIT = envint("CUTROOM_SUGGEST_TIME_LIMIT", 900)
 CUTROOM_TIME_LIMIT_GRACE = envint("CUTROOM_TIME_LIMIT_GRACE", 30)
+# Memory (MB) a job may take beyond what its pool process holds when it starts (0 = no
+# limit): past it the job meets a MemoryError and fails with a message, instead of the
+# machine's OOM killer taking the worker down. Not applied to the convert worker (Blender).
+CUTROOM_JOB_MEMORY_MB = envint("CUTROOM_JOB_MEMORY_MB", 0)
 # Quotas (0 = no limit): uploads per user per hour (each animation of an FBX counts),
 # stored MB per project and per user, detection runs queued or running at once per project
 # and started by one person across projects.
