@@ -23,6 +23,7 @@ The UTKinect skeleton files follow it with ``frame_id`` on the Kinect's 30 Hz cl
 
 from __future__ import annotations
 
+import csv
 import io
 import os
 from pathlib import Path
@@ -37,7 +38,7 @@ from motionlib.io.pointtext import (
     on_clock,
     parse_cells,
 )
-from motionlib.io.text import read_lines_bytes
+from motionlib.io.text import read_lines_bytes, spreadsheet_safe, spreadsheet_text
 from motionlib.points import UP_AXES, PointTake, make_point_take
 from motionlib.take import (
     DEFAULT_LIMITS,
@@ -117,7 +118,7 @@ def _header(data: bytes, offset: int, line: int, path, limits: Limits):
     a header of more points than ``limits.max_joints`` is refused before its names are."""
     end = data.find(b"\n", offset)
     end = len(data) if end < 0 else end
-    columns = [c.strip() for c in data[offset:end].decode("utf-8", "replace").split(",")]
+    columns = header_cells(data[offset:end].decode("utf-8", "replace"))
     if not columns or columns[0].lower() not in (*FRAME_COLUMNS, "time"):
         raise CaptureError(f"column 1: {shorten(columns[0] if columns else '')} should be "
                            "frame, frame_id or time", path=path, line=line + 1)
@@ -141,6 +142,13 @@ def _header(data: bytes, offset: int, line: int, path, limits: Limits):
         names.append(point)
         given.add(point)
     return columns, names, end + 1
+
+
+def header_cells(line: str) -> list[str]:
+    """The column names of a header line, as CSV quotes them (a point named ``a,b`` is
+    ``"a,b_x"``) and as :func:`write_points_csv` protects them (``'=x_x`` is ``=x_x``)."""
+    cells = next(csv.reader([line]), [""])
+    return [spreadsheet_text(c.strip()) for c in cells] or [""]
 
 
 def _fps(settings, path) -> float:
@@ -188,12 +196,18 @@ def write_points_csv(take: PointTake, out, *, start: int | None = None,
 
     Each frame in which some point was seen is one row, numbered with the file's frame
     numbers (``frame``); frames with nothing seen have no row, as in a tracker's own files.
-    Numbers are written in the shortest form that reads back to the same float.
+    Numbers are written in the shortest form that reads back to the same float. Point
+    names are quoted as CSV needs (a comma, a quote) and protected from spreadsheets
+    (``spreadsheet_safe``); the reader reads them back as they were.
     """
     start, stop = frame_range(take.n_frames, start, stop)
     xyz = take.channels[start:stop]
-    head = [f"# fps={take.fps:g} unit={take.unit} up={take.up}",
-            ",".join(["frame"] + [f"{p}_{a}" for p in take.point_names for a in "xyz"])]
+    names = io.StringIO()
+    csv.writer(names, lineterminator="").writerow(
+        ["frame"] + [spreadsheet_safe(f"{p}_{a}".replace("\r", " ").replace("\n", " "))
+                     for p in take.point_names for a in "xyz"])
+    unit = take.unit if take.unit.replace(".", "").isalnum() else "unknown"
+    head = [f"# fps={take.fps:g} unit={unit} up={take.up}", names.getvalue()]
     rows = []
     for k in np.flatnonzero(~np.isnan(xyz).all(axis=1)):
         cells = ["" if np.isnan(v) else repr(float(v)) for v in xyz[k]]

@@ -29,3 +29,24 @@ def lone_cr_to_lf(data: bytes) -> bytes:
     if b"\r" in data and data.count(b"\r") != data.count(b"\r\n"):
         data = _LONE_CR.sub(b"\n", data)
     return data
+
+
+# What a spreadsheet reads as the start of a formula in a cell (OWASP, "CSV Injection"):
+# = + - @, a tab or line end, and their full-width forms, which some spreadsheets fold.
+FORMULA_START = ("=", "+", "-", "@", "\t", "\r", "\n", "\uff1d", "\uff0b", "\uff0d", "\uff20")
+
+
+def spreadsheet_safe(cell: str) -> str:
+    """``cell`` with a ``'`` before it when a spreadsheet would take it for a formula.
+
+    Names written into CSV files (capture, label, point names) come from whoever uploaded
+    or typed them: ``=HYPERLINK(...)`` or ``@SUM(...)`` must open as text, not run. The
+    quote is the one spreadsheets themselves use for "text as typed" (OWASP's advice);
+    :func:`spreadsheet_text` takes it off again when such a file is read back.
+    """
+    return "'" + cell if cell.startswith(FORMULA_START) else cell
+
+
+def spreadsheet_text(cell: str) -> str:
+    """The inverse of :func:`spreadsheet_safe`: ``'=x`` -> ``=x``; anything else as it is."""
+    return cell[1:] if cell.startswith("'") and cell[1:].startswith(FORMULA_START) else cell
