@@ -261,6 +261,25 @@ def _labels(reader, n_points: int) -> list[str]:
     return named
 
 
+# A C3D parameter's dimensions are bytes: at most 255 labels per LABELS parameter, of at most
+# 255 characters each. More points go on in LABELS2, LABELS3... (as the reader reads them).
+LABELS_PER_PARAMETER = 255
+
+
+def _set_labels(writer, c3d, names: list[str]) -> None:
+    """POINT:LABELS (then LABELS2...) and POINT:DESCRIPTIONS for any number of points;
+    ``c3d.Writer.set_point_labels`` writes one parameter, which cannot hold 256."""
+    names = [name[:LABELS_PER_PARAMETER] for name in names]
+    for k in range(0, len(names), LABELS_PER_PARAMETER):
+        chunk = names[k:k + LABELS_PER_PARAMETER]
+        text, size = c3d.Writer.pack_labels(chunk)
+        suffix = "" if k == 0 else str(k // LABELS_PER_PARAMETER + 1)
+        writer.point_group.add_str(f"LABELS{suffix}", "Point labels.", text, size, len(chunk))
+    described = min(len(names), LABELS_PER_PARAMETER)
+    writer.point_group.add_str("DESCRIPTIONS", "Channel descriptions.", " " * described, 1,
+                               described)
+
+
 def write_c3d(take: PointTake, out, *, start: int | None = None,
               stop: int | None = None) -> None:
     """Write frames ``[start, stop)`` of a point take as a C3D file (float, Intel).
@@ -276,7 +295,7 @@ def write_c3d(take: PointTake, out, *, start: int | None = None,
     start, stop = frame_range(take.n_frames, start, stop)
     c3d = _c3d()
     writer = c3d.Writer(point_rate=float(take.fps), point_units=f"{take.unit:<4}")
-    writer.set_point_labels(list(take.point_names))
+    _set_labels(writer, c3d, list(take.point_names))
     writer.set_start_frame(int(take.first_number + start))
     xyz = take.channels[start:stop].reshape(stop - start, take.n_points, 3)
     gap = np.isnan(xyz).any(axis=-1)

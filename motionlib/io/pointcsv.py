@@ -43,6 +43,7 @@ from motionlib.points import UP_AXES, PointTake, make_point_take
 from motionlib.take import (
     DEFAULT_LIMITS,
     Limits,
+    check_point_names,
     check_points,
     check_size,
     frame_range,
@@ -141,6 +142,7 @@ def _header(data: bytes, offset: int, line: int, path, limits: Limits):
                                path=path, line=line + 1)
         names.append(point)
         given.add(point)
+    check_point_names(names, limits, path=path, line=line + 1)
     return columns, names, end + 1
 
 

@@ -23,7 +23,14 @@ from motionlib.errors import CaptureError, shorten
 from motionlib.io.pointtext import check_coordinates, frame_numbers, on_clock, parse_cells
 from motionlib.io.text import read_lines_bytes
 from motionlib.points import PointTake, make_point_take
-from motionlib.take import DEFAULT_LIMITS, Limits, check_points, check_size, max_frames_for
+from motionlib.take import (
+    DEFAULT_LIMITS,
+    Limits,
+    check_point_names,
+    check_points,
+    check_size,
+    max_frames_for,
+)
 
 MAX_HEADER_LINES = 100
 
@@ -112,6 +119,7 @@ def _marker_names(header, path, limits: Limits) -> list[str]:
     if not names:
         raise CaptureError("MARKER_NAMES: no marker named", path=path, line=line)
     check_points(len(names), limits, path=path, line=line, what="markers")
+    check_point_names(names, limits, path=path, line=line, what="marker")
     if len(set(names)) != len(names):
         twice = next(n for n, count in Counter(names).items() if count > 1)
         raise CaptureError(f"MARKER_NAMES: {shorten(twice)} is named twice", path=path,

@@ -212,3 +212,28 @@ def test_a_tsv_saved_with_a_byte_order_mark_reads_as_without(tmp_path):
     a, b = motionlib.read(original), motionlib.read(marked)
     assert (a.fps, a.point_names) == (b.fps, b.point_names)
     np.testing.assert_array_equal(a.channels, b.channels)
+
+
+# ---- what is admitted can be written back ---------------------------------------------------
+
+
+def test_a_take_of_600_points_is_written_as_c3d_and_read_back(tmp_path):
+    # A C3D parameter holds at most 255 labels: the rest go in POINT:LABELS2, LABELS3.
+    rng = np.random.default_rng(0)
+    names = [f"marker{k}" for k in range(600)]
+    take = make_point_take(name="many", format="csv", fps=100.0,
+                           coordinates=rng.normal(size=(4, 600, 3)), names=names, unit="mm",
+                           up="z")
+    write_c3d(take, tmp_path / "many.c3d")
+    back = motionlib.read(tmp_path / "many.c3d")
+    assert back.point_names == names
+    np.testing.assert_allclose(back.channels, take.channels, rtol=1e-6)
+
+
+def test_it_refuses_a_point_name_longer_than_the_limit_naming_the_line(tmp_path):
+    path = tmp_path / "long.csv"
+    name = "p" * 201
+    path.write_text(f"frame,{name}_x,{name}_y,{name}_z\n0,1,2,3\n1,1,2,3\n")
+    with pytest.raises(CaptureError, match=r"long\.csv:1: point name 'ppp.*\(201 characters\) "
+                                           r"is longer than the limit of 200 characters"):
+        motionlib.read(path)
