@@ -226,6 +226,10 @@ CUTROOM_HEARTBEAT_STALE = envint("CUTROOM_HEARTBEAT_STALE", 60)
 # The health endpoint calls a similar-clip index stale when a library segment has waited
 # this long to be indexed (searches still find it: they read newer segments from the rows).
 CUTROOM_INDEX_STALE_SECONDS = envint("CUTROOM_INDEX_STALE_SECONDS", 900)
+# A capture of more joint positions (joints or points × frames) than this has the motion
+# descriptors of its library rows computed by a worker after a review submit or gold save,
+# not in the request (which holds the database's write lock on SQLite).
+CUTROOM_DESCRIBE_INLINE = envint("CUTROOM_DESCRIBE_INLINE", 500_000)
 # After this many claims a job that keeps killing its worker is marked failed.
 CUTROOM_MAX_ATTEMPTS = envint("CUTROOM_MAX_ATTEMPTS", 3)
 # FBX uploads are read by Blender on this queue, served by its own worker (`make up`, compose).

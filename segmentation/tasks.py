@@ -23,7 +23,7 @@ from django.conf import settings
 from django.db import connection
 
 from segmentation import similar_index, suggestions, workers
-from segmentation.services import adaptation, captures, health, jobs
+from segmentation.services import adaptation, captures, health, jobs, library
 from segmentation.services.convert import CONVERT
 
 log = logging.getLogger(__name__)
@@ -178,6 +178,13 @@ def suggest(capture_id, annotator_id):
     """Compute and store the label suggestions an annotator's review of a capture lacks
     (idempotent: a second delivery finds them stored)."""
     return suggestions.fill_by_id(capture_id, annotator_id)
+
+
+@shared_task(acks_late=True, reject_on_worker_lost=False, base=ContainedTask)
+def describe_library(capture_id):
+    """Compute the motion descriptors of a long capture's library rows, off the request
+    that made them (idempotent: described rows are left alone)."""
+    return library.describe_library(capture_id)
 
 
 @shared_task(base=ContainedTask)
