@@ -233,6 +233,10 @@ CUTROOM_HEARTBEAT_STALE = envint("CUTROOM_HEARTBEAT_STALE", 60)
 # The health endpoint calls a similar-clip index stale when a library segment has waited
 # this long to be indexed (searches still find it: they read newer segments from the rows).
 CUTROOM_INDEX_STALE_SECONDS = envint("CUTROOM_INDEX_STALE_SECONDS", 900)
+# A capture of more joint positions (joints or points × frames) than this has the motion
+# descriptors of its library rows computed by a worker after a review submit or gold save,
+# not in the request (which holds the database's write lock on SQLite).
+CUTROOM_DESCRIBE_INLINE = envint("CUTROOM_DESCRIBE_INLINE", 500_000)
 # After this many claims a job that keeps killing its worker is marked failed.
 CUTROOM_MAX_ATTEMPTS = envint("CUTROOM_MAX_ATTEMPTS", 3)
 # FBX uploads are read by Blender on this queue, served by its own worker (`make up`, compose).
@@ -283,6 +287,10 @@ CUTROOM_DETECT_TIME_LIMIT = envint("CUTROOM_DETECT_TIME_LIMIT", 300)
 CUTROOM_RETRAIN_TIME_LIMIT = envint("CUTROOM_RETRAIN_TIME_LIMIT", 600)
 CUTROOM_SUGGEST_TIME_LIMIT = envint("CUTROOM_SUGGEST_TIME_LIMIT", 900)
 CUTROOM_TIME_LIMIT_GRACE = envint("CUTROOM_TIME_LIMIT_GRACE", 30)
+# Memory (MB) a job may take beyond what its pool process holds when it starts (0 = no
+# limit): past it the job meets a MemoryError and fails with a message, instead of the
+# machine's OOM killer taking the worker down. Not applied to the convert worker (Blender).
+CUTROOM_JOB_MEMORY_MB = envint("CUTROOM_JOB_MEMORY_MB", 0)
 # Quotas (0 = no limit): uploads per user per hour (each animation of an FBX counts),
 # stored MB per project and per user, detection runs queued or running at once per project
 # and started by one person across projects.

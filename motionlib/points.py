@@ -110,11 +110,19 @@ def make_point_take(*, name: str, format: str, fps: float, coordinates: np.ndarr
                     names: list[str], unit: str, up: str, first_number: int = 0,
                     path=None) -> PointTake:
     """A :class:`PointTake` from coordinates ``(n_frames, n_points, 3)`` in the file's axes;
-    the marker set is identified and its links become the skeleton's parents."""
+    the marker set is identified and its links become the skeleton's parents.
+
+    A take in which no point is ever seen is refused (CaptureError): it has no motion to
+    segment, show or describe, and every step after would fail on it with a worse reason.
+    """
     from motionlib import markersets
+    from motionlib.errors import CaptureError
 
     coordinates = np.asarray(coordinates, dtype=np.float64)
     n_frames = coordinates.shape[0]
+    if n_frames and np.isnan(coordinates).all():
+        raise CaptureError(f"no point is seen in any of the {n_frames} frames (every "
+                           "coordinate is empty or a gap); the take has no motion", path=path)
     marker_set = markersets.identify(names)
     skeleton = point_skeleton(names, markersets.link_parents(names, marker_set))
     positions = world(coordinates, up)

@@ -20,7 +20,8 @@ keeps a shortlist; profile distance + ``DTW_WEIGHT`` x DTW orders it.
 
 Points of no known marker set (``point_descriptor``) have no limbs to measure, so their
 per-frame features are distributions that need no skeleton and no point order: quantiles of
-the distances between every two points, of each point's height above and horizontal
+the distances between every two points (of at most ``PAIR_POINTS`` of them, so the cost stays
+linear in the points: see ``pair_points``), of each point's height above and horizontal
 distance from the points' centroid, and of the points' speeds, all divided by the take's
 point spread (``point_scale``). The profile and trajectory are built from them as above,
 with as many features as a body descriptor, so one project's vectors share one width; the
@@ -157,6 +158,10 @@ PAIR_QUANTILES = np.linspace(0.0, 1.0, 11)
 HEIGHT_QUANTILES = np.linspace(0.0, 1.0, 8)
 REACH_QUANTILES = np.linspace(0.0, 1.0, 8)
 SPEED_QUANTILES = np.linspace(0.0, 1.0, 8)
+# Most points whose every pair is measured: 2,016 pairs, more than the markers of any body
+# marker set have. A take of more points has the pairs of a spread subset of them measured;
+# all of them would cost points² per frame (a 1,000-point take: 500,000 pairs a frame, GBs).
+PAIR_POINTS = 64
 N_POINT_FEATURES = (len(PAIR_QUANTILES) + len(HEIGHT_QUANTILES) + len(REACH_QUANTILES)
                     + len(SPEED_QUANTILES))
 
@@ -206,15 +211,16 @@ def point_frame_features(points: np.ndarray, scale: float, *, fps: float) -> np.
 
     Returns
     -------
-    (n_frames, N_POINT_FEATURES) quantiles of: the distance between every two points, each
-    point's height above the centroid, its horizontal distance from the centroid, and its
-    speed, divided by ``scale``. None depends on where the points stand, which way they
-    face, their unit or their order.
+    (n_frames, N_POINT_FEATURES) quantiles of: the distance between every two points (of
+    ``pair_points``), each point's height above the centroid, its horizontal distance from
+    the centroid, and its speed, divided by ``scale``. None depends on where the points
+    stand, which way they face, their unit or their order. Time and memory are linear in
+    the points.
     """
-    n = points.shape[1]
-    i, j = np.triu_indices(n, 1)
-    pairs = np.linalg.norm(points[:, i] - points[:, j], axis=-1)
     centred = points - points.mean(axis=1, keepdims=True)
+    some = points[:, pair_points(centred)]
+    i, j = np.triu_indices(some.shape[1], 1)
+    pairs = np.linalg.norm(some[:, i] - some[:, j], axis=-1)
     height = centred[..., 1]
     reach = np.hypot(centred[..., 0], centred[..., 2])
     if len(points) > 1:
@@ -225,6 +231,27 @@ def point_frame_features(points: np.ndarray, scale: float, *, fps: float) -> np.
     parts = [(pairs, PAIR_QUANTILES), (height, HEIGHT_QUANTILES), (reach, REACH_QUANTILES),
              (moved, SPEED_QUANTILES)]
     return np.hstack([np.quantile(x, q, axis=1).T for x, q in parts]) / scale
+
+
+def pair_points(centred: np.ndarray) -> np.ndarray:
+    """Indices of the points whose pairwise distances a bare descriptor measures: all of
+    them up to ``PAIR_POINTS``, else ``PAIR_POINTS`` spread evenly over the points ranked
+    by their mean height above the centroid (then their mean horizontal distance from it).
+
+    The ranking depends on nothing a descriptor ignores (placement, heading, unit, point
+    order), so neither does the subset.
+
+    Parameters
+    ----------
+    centred : (n_frames, n_points, 3) points minus their centroid per frame, Y up.
+    """
+    n = centred.shape[1]
+    if n <= PAIR_POINTS:
+        return np.arange(n)
+    height = centred[..., 1].mean(axis=0)
+    reach = np.hypot(centred[..., 0], centred[..., 2]).mean(axis=0)
+    ranked = np.lexsort((reach, height))
+    return ranked[np.linspace(0, n - 1, PAIR_POINTS).round().astype(int)]
 
 
 def point_descriptor(points: np.ndarray, start: int, stop: int, *, fps: float,

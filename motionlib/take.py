@@ -6,7 +6,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from motionlib.errors import CaptureError, InputError
+from motionlib.errors import CaptureError, InputError, shorten
 from motionlib.skeleton import Skeleton
 
 
@@ -137,6 +137,35 @@ def max_frames_for(n_joints: int, n_channels: int, file_bytes: int, limits: Limi
     budget = max(limits.max_expansion * file_bytes, EXPANSION_FLOOR_BYTES) // POSITION_BYTES
     return min(limits.max_frames, limits.max_values // max(n_channels, 1),
                limits.max_joint_frames // max(n_joints, 1), budget // max(n_joints, 1))
+
+
+def check_points(n_points: int, limits: Limits, path=None, line: int | None = None,
+                 what: str = "points") -> None:
+    """Refuse a point take (or an armature) of more than ``limits.max_joints`` points,
+    before anything per point is built.
+
+    Points count as joints: every later step (positions, links, descriptors) costs per
+    point what it costs per joint, so a file of 33,334 markers is as hostile as a BVH of
+    33,334 joints.
+
+    Raises
+    ------
+    CaptureError
+        Naming the count, the limit and (when given) the file and line.
+    """
+    if n_points > limits.max_joints:
+        raise CaptureError(f"{n_points} {what} is more than the limit of {limits.max_joints} "
+                           "joints", path=path, line=line)
+
+
+def check_point_names(names: list[str], limits: Limits, path=None, line: int | None = None,
+                      what: str = "point") -> None:
+    """Refuse a point name longer than ``limits.max_name_length``, as a joint's is (a C3D
+    label holds at most 255 characters, so a longer one could not be exported)."""
+    long = next((name for name in names if len(name) > limits.max_name_length), None)
+    if long is not None:
+        raise CaptureError(f"{what} name {shorten(long)} is longer than the limit of "
+                           f"{limits.max_name_length} characters", path=path, line=line)
 
 
 def check_size(n_frames: int, n_joints: int, n_channels: int, file_bytes: int,

@@ -28,6 +28,7 @@ from django.db.models import Q
 import motionlib
 from motionlib.errors import MotionlibError
 from motionlib.io.export import write_clips
+from motionlib.io.text import spreadsheet_safe
 from motionlib.io.units import length_unit
 from segmentation import storage
 from segmentation.errors import CutroomError, ExportFormatError, internal_error
@@ -256,5 +257,7 @@ def _csv(rows):
               "unit", "label", "gold", "annotator", "agreement"]
     writer = csv.DictWriter(out, fieldnames=fields)
     writer.writeheader()
-    writer.writerows(rows)
+    # Names typed by people (capture, label, annotator) open as text, never as formulas.
+    writer.writerows({k: spreadsheet_safe(v) if isinstance(v, str) else v for k, v in row.items()}
+                     for row in rows)
     return out.getvalue()

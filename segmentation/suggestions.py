@@ -33,6 +33,7 @@ from django.utils import timezone
 from motionlib import similarity
 from segmentation import workers
 from segmentation.descriptors import Describer, load_descriptors, profile_pool, same_kind
+from segmentation.errors import internal_error
 from segmentation.models import Capture, LabelSuggestion, LibrarySegment, Review, SuggestionRequest
 from segmentation.search import SHORTLIST, SIMILAR_POOL
 
@@ -43,6 +44,9 @@ NEIGHBOURS = 5
 BATCH = 100
 # A job that has neither finished nor reported progress for this long is taken as lost.
 ASK_AGAIN_AFTER = timedelta(minutes=2)
+# A job that failed is not sent again for this long: the same input would fail again, and a
+# page asking every few seconds must not turn one failure into a loop.
+RETRY_FAILED_AFTER = timedelta(hours=1)
 # Nice value added to the thread computing suggestions: the worker shares the machine
 # with the web server (the embedded default), and a page request should come first.
 LOW_PRIORITY = 10
@@ -110,7 +114,7 @@ def for_review(capture, annotator):
     found = stored(capture, key, spans) if key else {}
     pending = bool(key) and len(found) < len(spans)
     if pending:
-        ask(capture, annotator)
+        pending = ask(capture, annotator) or not recently_failed(capture, annotator)
     return {
         "pending": pending,
         "suggestions": [{"start": s, "stop": e, "label": label}
@@ -119,10 +123,12 @@ def for_review(capture, annotator):
 
 
 def ask(capture, annotator):
-    """Send the ``suggest`` job unless one is on its way; True if it was sent."""
+    """Send the ``suggest`` job unless one is on its way or the last one failed less than
+    RETRY_FAILED_AFTER ago; True if it was sent."""
     request, _ = SuggestionRequest.objects.get_or_create(capture=capture, annotator=annotator)
     now = timezone.now()
     idle = Q(asked_at__isnull=True) | Q(done_at__gte=F("asked_at")) | Q(asked_at__lt=now - ASK_AGAIN_AFTER)
+    idle &= Q(failed_at__isnull=True) | Q(failed_at__lt=now - RETRY_FAILED_AFTER)
     # One conditional UPDATE claims the ask: 0 rows means a job is on its way.
     claimed = SuggestionRequest.objects.filter(idle, pk=request.pk).update(asked_at=now, done_at=None)
     if claimed:
@@ -174,14 +180,39 @@ def fill(capture, annotator):
 
 
 def fill_by_id(capture_id, annotator_id):
-    """``fill`` for the job (ids in); 0 if either row is gone."""
+    """``fill`` for the job (ids in); 0 if either row is gone.
+
+    Any error (a MemoryError too) fails the job once: logged with a reference, stored on
+    the request's row, and not asked again for RETRY_FAILED_AFTER. It never reaches the
+    worker, whose main process a MemoryError would end, its message going back to the
+    queue to end the next one.
+    """
     from django.contrib.auth import get_user_model
 
     capture = Capture.objects.filter(pk=capture_id).first()
     annotator = get_user_model().objects.filter(pk=annotator_id).first()
     if capture is None or annotator is None:
         return 0  # deleted since the job was sent
-    return fill(capture, annotator)
+    try:
+        return fill(capture, annotator)
+    except Exception:  # a MemoryError is one: the reason for this guard
+        reference = internal_error(f"label suggestions for capture {capture_id}", log)
+        failed(capture_id, annotator_id, f"label suggestions failed (reference {reference})")
+        return 0
+
+
+def failed(capture_id, annotator_id, error):
+    """Store on the request's row that its job failed, and why."""
+    now = timezone.now()
+    SuggestionRequest.objects.filter(capture_id=capture_id, annotator_id=annotator_id).update(
+        done_at=now, failed_at=now, error=error[:2000])
+
+
+def recently_failed(capture, annotator):
+    """True when the last job for this review failed less than RETRY_FAILED_AFTER ago."""
+    return SuggestionRequest.objects.filter(
+        capture=capture, annotator=annotator,
+        failed_at__gte=timezone.now() - RETRY_FAILED_AFTER).exists()
 
 
 def at_low_priority(work, *args):

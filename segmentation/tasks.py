@@ -11,6 +11,7 @@ connects ``segmentation.workers`` to the broker.
 """
 
 import logging
+import resource
 import threading
 import time
 import uuid
@@ -22,7 +23,7 @@ from django.conf import settings
 from django.db import connection
 
 from segmentation import similar_index, suggestions, workers
-from segmentation.services import adaptation, captures, health, jobs
+from segmentation.services import adaptation, captures, health, jobs, library
 from segmentation.services.convert import CONVERT
 
 log = logging.getLogger(__name__)
@@ -43,7 +44,29 @@ def ping():
 workers.connect(send, stopped=SoftTimeLimitExceeded, ping=ping)
 
 
-class JobTask(Task):
+class OutOfMemory(RuntimeError):
+    """A task's MemoryError, raised again as an ordinary error (see ContainedTask)."""
+
+
+class ContainedTask(Task):
+    """A task whose failure, whatever it is, ends that task only.
+
+    Celery hands a MemoryError from a pool process to the worker's main process and raises
+    it there (``celery.worker.request``): the worker dies, its unacknowledged message goes
+    back to the queue and ends the next worker too. Raised again as OutOfMemory (the
+    original dropped, with the frames holding what filled the memory), it is an ordinary
+    failure: logged, the message acknowledged, the worker serving on.
+    """
+
+    def __call__(self, *args, **kwargs):
+        try:
+            return super().__call__(*args, **kwargs)
+        except MemoryError:
+            log.error("%s%s ran out of memory", self.name, args)
+        raise OutOfMemory(f"{self.name}{args} ran out of memory")
+
+
+class JobTask(ContainedTask):
     """A task that runs one job of ``kind`` (``services.jobs.Kind``), the row whose id is
     its first argument.
 
@@ -85,6 +108,20 @@ def convert(self, capture_id):
 
 
 @worker_process_init.connect
+def limit_job_memory(**kwargs):
+    """Give each pool process CUTROOM_JOB_MEMORY_MB of address space beyond what it holds
+    now: a job past it meets a MemoryError (and fails) before the OOM killer picks a
+    process to end, which may be the worker's main one. Not in the convert worker, whose
+    Blender child would inherit the limit."""
+    if not settings.CUTROOM_JOB_MEMORY_MB or settings.CUTROOM_CONVERT_WORKER:
+        return
+    with open("/proc/self/statm") as statm:
+        held = int(statm.read().split()[0]) * resource.getpagesize()
+    limit = held + settings.CUTROOM_JOB_MEMORY_MB * 2**20
+    resource.setrlimit(resource.RLIMIT_AS, (limit, resource.getrlimit(resource.RLIMIT_AS)[1]))
+
+
+@worker_process_init.connect
 def start_blender(**kwargs):
     # The convert worker loads Blender as its pool process starts, not on its first file (in
     # the background: a pool process must report for work within seconds).
@@ -121,20 +158,42 @@ def retrain(self, model_id):
     self.run_job(model_id)
 
 
-@shared_task(acks_late=True, reject_on_worker_lost=True)
+class SuggestTask(ContainedTask):
+    """Label suggestions: a job whose process died (killed for its memory, say) fails once,
+    stored on its request's row; its message is not given back to the queue (the review
+    page asks again later, see ``suggestions.ask``)."""
+
+    def on_failure(self, exc, task_id, args, kwargs, einfo):
+        # In the worker's main process when the pool process is gone.
+        try:
+            suggestions.failed(*args[:2], f"label suggestions failed: {type(exc).__name__}")
+        except Exception:
+            log.exception("could not store the failure of suggestions %s", args)
+        finally:
+            connection.close()
+
+
+@shared_task(acks_late=True, reject_on_worker_lost=False, base=SuggestTask)
 def suggest(capture_id, annotator_id):
     """Compute and store the label suggestions an annotator's review of a capture lacks
     (idempotent: a second delivery finds them stored)."""
     return suggestions.fill_by_id(capture_id, annotator_id)
 
 
-@shared_task
+@shared_task(acks_late=True, reject_on_worker_lost=False, base=ContainedTask)
+def describe_library(capture_id):
+    """Compute the motion descriptors of a long capture's library rows, off the request
+    that made them (idempotent: described rows are left alone)."""
+    return library.describe_library(capture_id)
+
+
+@shared_task(base=ContainedTask)
 def update_similar_index(project_id):
     """Bring a project's similar-clip index in step with its library rows."""
     similar_index.update(project_id)
 
 
-@shared_task
+@shared_task(base=ContainedTask)
 def sweep():
     """Requeue (or fail) jobs whose claim went stale because their worker vanished."""
     return jobs.sweep()

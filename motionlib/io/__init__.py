@@ -64,7 +64,7 @@ def read(path: str | os.PathLike, *, asf: str | os.PathLike | None = None,
     if suffix == ".fbx":
         from motionlib.io.fbx import read_fbx  # starts Blender only when an FBX is read
 
-        return read_fbx(path, animation=animation)
+        return read_fbx(path, animation=animation, limits=limits)
     if asf is None:
         raise CaptureError("an .amc motion needs its .asf skeleton (pass the .asf file too)", path=path)
     return read_amc(path, asf, limits=limits)

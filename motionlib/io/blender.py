@@ -18,6 +18,7 @@ from __future__ import annotations
 import importlib.util
 import json
 import os
+import re
 import select
 import signal
 import subprocess
@@ -117,10 +118,13 @@ class Blender:
                 raise BlenderUnavailable(exc.reason, path=path) from None
             reply = self._exchange(message, timeout, what, path)
         if not reply.get("ok"):
-            raise CaptureError(reply.get("error") or "Blender failed", path=path)
+            raise CaptureError(scrub(reply.get("error") or "Blender failed", path), path=path)
         return reply
 
     def _exchange(self, message, timeout, what, path):
+        # Blender's log holds every file this process read (other projects' too): a death
+        # is told with what it said during this request only.
+        logged = os.fstat(self._log.fileno()).st_size if self._log is not None else 0
         try:
             self.proc.stdin.write(json.dumps(message) + "\n")
             self.proc.stdin.flush()
@@ -139,27 +143,28 @@ class Blender:
                     "MOTIONLIB_BLENDER_TIMEOUT)", path=path)
             chunk = os.read(self._reply.fileno(), 1 << 16)
             if not chunk:
-                raise CaptureError(self._death(what), path=path)
+                raise CaptureError(scrub(self._death(what, logged), path), path=path)
             line += chunk
         return json.loads(line)
 
-    def _death(self, what):
+    def _death(self, what, logged=0):
         try:
             code = self.proc.wait(10)
         except subprocess.TimeoutExpired:
             self.kill()
             code = self.proc.wait()
-        tail = self.log_tail()
+        tail = self.log_tail(since=logged)
         how = (f"was killed by signal {signal.Signals(-code).name}" if code < 0
                else f"exited with code {code}")
         self.stop()
         return (f"Blender {how} while {what}; the file may be damaged (Blender's last words: "
                 f"{tail or 'none'})")
 
-    def log_tail(self, lines=3) -> str:
+    def log_tail(self, lines=3, since=0) -> str:
+        """The last ``lines`` lines Blender logged after byte ``since`` of its log."""
         if self._log is None:
             return ""
-        self._log.seek(0)
+        self._log.seek(since)
         text = self._log.read().decode("utf-8", "replace").strip().splitlines()
         return " | ".join(line.strip() for line in text[-lines:])
 
@@ -188,6 +193,26 @@ class Blender:
             if handle is not None:
                 handle.close()
         self.proc = self._reply = self._log = None
+
+
+# Text in quotes that holds a slash, and any other run of characters with one: paths.
+_QUOTED_PATH = re.compile(r"""(['"])[^'"\n]*/[^'"\n]*\1""")
+_PATH = re.compile(r"""[^\s'"|,;()\[\]<>]*/[^\s'"|,;()\[\]<>]*""")
+
+
+def scrub(text: str, path=None) -> str:
+    """Blender's ``text`` with ``path`` (the file asked about) shown by its name and every
+    other path replaced by ``<path>``.
+
+    What Blender says goes to whoever uploaded the file: it must not show where the service
+    keeps files, nor another upload it read before (``captures/2/.../SECRET.fbx``), nor its
+    own installation (``.venv-bpy/.../bpy/ops.py``).
+    """
+    if path is not None:
+        for form in sorted({os.fspath(path), os.path.abspath(path)}, key=len, reverse=True):
+            text = text.replace(form, os.path.basename(form))
+    text = _QUOTED_PATH.sub(lambda m: f"{m.group(1)}<path>{m.group(1)}", text)
+    return _PATH.sub("<path>", text)
 
 
 _shared = None

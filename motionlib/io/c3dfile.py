@@ -24,7 +24,7 @@ import numpy as np
 
 from motionlib.errors import CaptureError, shorten
 from motionlib.points import PointTake, make_point_take
-from motionlib.take import DEFAULT_LIMITS, Limits, check_size, frame_range
+from motionlib.take import DEFAULT_LIMITS, Limits, check_points, check_size, frame_range
 
 BLOCK = 512
 C3D_KEY = 0x50
@@ -73,6 +73,7 @@ def read_c3d(path: str | os.PathLike, *, limits: Limits = DEFAULT_LIMITS) -> Poi
     reader = _reader(data, path)
     layout = _layout(reader, data, path, limits)
     coordinates = _frames(data, layout, path)
+    _check_lengths(coordinates, layout, limits, path)
     labels = _labels(reader, layout["n_points"])
     units = _string(reader, "POINT:UNITS") or "mm"
     y_screen = (_string(reader, "POINT:Y_SCREEN") or "+Z").upper()
@@ -149,6 +150,7 @@ def _layout(reader, data: bytes, path, limits: Limits) -> dict:
     if n_points < 1:
         raise CaptureError(f"parameter POINT:USED is {n_points}; the file has no 3D points",
                            path=path)
+    check_points(n_points, limits, path=path, what="points (parameter POINT:USED)")
     scale = float(_number(reader, "POINT:SCALE", path, "float"))
     if not np.isfinite(scale) or scale == 0:
         raise CaptureError(f"parameter POINT:SCALE is {scale}; it must be a non-zero number",
@@ -219,6 +221,21 @@ def _frames(data: bytes, layout: dict, path) -> np.ndarray:
     return xyz
 
 
+def _check_lengths(xyz: np.ndarray, layout: dict, limits: Limits, path) -> None:
+    """Refuse a coordinate beyond ``limits.max_length`` (int16 words times a POINT:SCALE of
+    1e38 are finite here and infinite as float32 positions), naming frame, point and value."""
+    with np.errstate(invalid="ignore"):
+        beyond = np.abs(xyz) > limits.max_length
+    frames = np.flatnonzero(beyond.any(axis=(1, 2)))
+    if len(frames):
+        frame = int(frames[0])
+        point = int(np.flatnonzero(beyond[frame].any(axis=1))[0])
+        value = float(xyz[frame, point][beyond[frame, point]][0])
+        raise CaptureError(f"data section, frame {layout['first'] + frame}, point {point + 1}: "
+                           f"{value:g} is beyond the largest coordinate a take may hold "
+                           f"(±{limits.max_length:g})", path=path)
+
+
 def _residual_of_float(word: np.ndarray) -> np.ndarray:
     """The residual word of float data is an integer stored as a float; NaN counts as a gap."""
     with np.errstate(invalid="ignore"):
@@ -244,6 +261,25 @@ def _labels(reader, n_points: int) -> list[str]:
     return named
 
 
+# A C3D parameter's dimensions are bytes: at most 255 labels per LABELS parameter, of at most
+# 255 characters each. More points go on in LABELS2, LABELS3... (as the reader reads them).
+LABELS_PER_PARAMETER = 255
+
+
+def _set_labels(writer, c3d, names: list[str]) -> None:
+    """POINT:LABELS (then LABELS2...) and POINT:DESCRIPTIONS for any number of points;
+    ``c3d.Writer.set_point_labels`` writes one parameter, which cannot hold 256."""
+    names = [name[:LABELS_PER_PARAMETER] for name in names]
+    for k in range(0, len(names), LABELS_PER_PARAMETER):
+        chunk = names[k:k + LABELS_PER_PARAMETER]
+        text, size = c3d.Writer.pack_labels(chunk)
+        suffix = "" if k == 0 else str(k // LABELS_PER_PARAMETER + 1)
+        writer.point_group.add_str(f"LABELS{suffix}", "Point labels.", text, size, len(chunk))
+    described = min(len(names), LABELS_PER_PARAMETER)
+    writer.point_group.add_str("DESCRIPTIONS", "Channel descriptions.", " " * described, 1,
+                               described)
+
+
 def write_c3d(take: PointTake, out, *, start: int | None = None,
               stop: int | None = None) -> None:
     """Write frames ``[start, stop)`` of a point take as a C3D file (float, Intel).
@@ -259,7 +295,7 @@ def write_c3d(take: PointTake, out, *, start: int | None = None,
     start, stop = frame_range(take.n_frames, start, stop)
     c3d = _c3d()
     writer = c3d.Writer(point_rate=float(take.fps), point_units=f"{take.unit:<4}")
-    writer.set_point_labels(list(take.point_names))
+    _set_labels(writer, c3d, list(take.point_names))
     writer.set_start_frame(int(take.first_number + start))
     xyz = take.channels[start:stop].reshape(stop - start, take.n_points, 3)
     gap = np.isnan(xyz).any(axis=-1)

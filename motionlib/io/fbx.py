@@ -24,11 +24,11 @@ from pathlib import Path
 
 import numpy as np
 
-from motionlib.errors import CaptureError
+from motionlib.errors import CaptureError, shorten
 from motionlib.io.bvh import _snap_fps, detect_rest_pose
 from motionlib.kinematics import euler_to_matrix, matrix_to_euler_zyx
 from motionlib.skeleton import Skeleton
-from motionlib.take import Take
+from motionlib.take import DEFAULT_LIMITS, Limits, Take, check_points
 
 BINARY_MAGIC = b"Kaydara FBX Binary  \x00"
 CENTIMETRES_PER_METRE = 100.0
@@ -71,7 +71,8 @@ def read_fbx_raw(path, *, blender=None, timeout=None):
     return reply, arrays
 
 
-def read_fbx_all(path, *, blender=None, timeout=None) -> list[Take]:
+def read_fbx_all(path, *, blender=None, timeout=None,
+                 limits: Limits = DEFAULT_LIMITS) -> list[Take]:
     """Every armature animation of an FBX file, one take each.
 
     Parameters
@@ -81,6 +82,8 @@ def read_fbx_all(path, *, blender=None, timeout=None) -> list[Take]:
         The Blender process to use (default: this process's shared one).
     timeout : float, optional
         Seconds Blender may take before it is stopped (default 300).
+    limits : Limits, optional
+        An armature of more bones than ``limits.max_joints`` is refused, as a BVH is.
 
     Returns
     -------
@@ -97,15 +100,19 @@ def read_fbx_all(path, *, blender=None, timeout=None) -> list[Take]:
     reply, arrays = read_fbx_raw(path, blender=blender, timeout=timeout)
     animations = reply["animations"]
     single = len(animations) == 1
+    for a in animations:  # before any is built: a bone costs what a joint costs
+        check_points(len(a["bones"]), limits, path=path,
+                     what=f"bones in armature {shorten(a['armature'])}")
     return [_take(path, a, a["name"], arrays, reply["fps"], single) for a in animations]
 
 
-def read_fbx(path, *, animation: str | int | None = None, blender=None, timeout=None) -> Take:
+def read_fbx(path, *, animation: str | int | None = None, blender=None, timeout=None,
+             limits: Limits = DEFAULT_LIMITS) -> Take:
     """One animation of an FBX file: the first, or the one named (or numbered) ``animation``.
 
     See :func:`read_fbx_all`; an unknown ``animation`` is a CaptureError listing the ones there.
     """
-    takes = read_fbx_all(path, blender=blender, timeout=timeout)
+    takes = read_fbx_all(path, blender=blender, timeout=timeout, limits=limits)
     return pick_animation(takes, animation, path)
 
 

@@ -23,6 +23,7 @@ The UTKinect skeleton files follow it with ``frame_id`` on the Kinect's 30 Hz cl
 
 from __future__ import annotations
 
+import csv
 import io
 import os
 from pathlib import Path
@@ -30,10 +31,24 @@ from pathlib import Path
 import numpy as np
 
 from motionlib.errors import CaptureError, shorten
-from motionlib.io.pointtext import frame_numbers, on_clock, parse_cells
-from motionlib.io.text import read_lines_bytes
+from motionlib.io.pointtext import (
+    MAX_FRAME_NUMBER,
+    check_coordinates,
+    frame_numbers,
+    on_clock,
+    parse_cells,
+)
+from motionlib.io.text import read_lines_bytes, spreadsheet_safe, spreadsheet_text
 from motionlib.points import UP_AXES, PointTake, make_point_take
-from motionlib.take import DEFAULT_LIMITS, Limits, check_size, frame_range, max_frames_for
+from motionlib.take import (
+    DEFAULT_LIMITS,
+    Limits,
+    check_point_names,
+    check_points,
+    check_size,
+    frame_range,
+    max_frames_for,
+)
 
 DEFAULTS = {"fps": "30", "unit": "m", "up": "y"}
 FRAME_COLUMNS = ("frame", "frame_id")
@@ -56,9 +71,10 @@ def read_points_csv(path: str | os.PathLike, *, limits: Limits = DEFAULT_LIMITS)
     path = os.fspath(path)
     data = read_lines_bytes(path)
     settings, offset, line = _settings(data, path)
-    columns, names, offset = _header(data, offset, line, path)
+    columns, names, offset = _header(data, offset, line, path, limits)
     values, lines = parse_cells(data, offset, len(columns), ",", path, columns)
     check_size(len(values), len(names), 3 * len(names), len(data), limits, path=path)
+    check_coordinates(values, 1, lines, columns, limits.max_length, path)
     rows = values[:, 1:].reshape(len(values), len(names), 3)
     if columns[0] == "time":
         fps, numbers = _time_clock(values[:, 0], lines, settings, path)
@@ -96,10 +112,14 @@ def _settings(data: bytes, path) -> tuple[dict[str, str], int, int]:
     return settings, pos, line
 
 
-def _header(data: bytes, offset: int, line: int, path):
+def _header(data: bytes, offset: int, line: int, path, limits: Limits):
+    """The column names, the point names and the byte after the header line.
+
+    Linear in the line's length (a header of 300,000 columns is read in milliseconds), and
+    a header of more points than ``limits.max_joints`` is refused before its names are."""
     end = data.find(b"\n", offset)
     end = len(data) if end < 0 else end
-    columns = [c.strip() for c in data[offset:end].decode("utf-8", "replace").split(",")]
+    columns = header_cells(data[offset:end].decode("utf-8", "replace"))
     if not columns or columns[0].lower() not in (*FRAME_COLUMNS, "time"):
         raise CaptureError(f"column 1: {shorten(columns[0] if columns else '')} should be "
                            "frame, frame_id or time", path=path, line=line + 1)
@@ -108,18 +128,29 @@ def _header(data: bytes, offset: int, line: int, path):
         raise CaptureError(f"expected the first column and three per point "
                            f"(<point>_x, <point>_y, <point>_z), found {len(columns)} columns",
                            path=path, line=line + 1)
-    names = []
+    check_points((len(columns) - 1) // 3, limits, path=path, line=line + 1)
+    names: list[str] = []
+    given: set[str] = set()  # a set: a list's ``in`` made long headers quadratic
     for k in range(1, len(columns), 3):
         point = columns[k][:-2]
         for i, axis in enumerate("xyz"):
             if columns[k + i].lower() != f"{point}_{axis}".lower() or not point:
                 raise CaptureError(f"column {k + i + 1}: {shorten(columns[k + i])} should be "
                                    f"{point or '<point>'}_{axis}", path=path, line=line + 1)
-        if point in names:
+        if point in given:
             raise CaptureError(f"column {k + 1}: point {shorten(point)} is given twice",
                                path=path, line=line + 1)
         names.append(point)
+        given.add(point)
+    check_point_names(names, limits, path=path, line=line + 1)
     return columns, names, end + 1
+
+
+def header_cells(line: str) -> list[str]:
+    """The column names of a header line, as CSV quotes them (a point named ``a,b`` is
+    ``"a,b_x"``) and as :func:`write_points_csv` protects them (``'=x_x`` is ``=x_x``)."""
+    cells = next(csv.reader([line]), [""])
+    return [spreadsheet_text(c.strip()) for c in cells] or [""]
 
 
 def _fps(settings, path) -> float:
@@ -148,7 +179,17 @@ def _time_clock(times, lines, settings, path) -> tuple[float, np.ndarray]:
         fps = _fps(settings, path)
     else:
         fps = float(np.round(1.0 / np.median(steps), 6))
-    return fps, np.round((times - times[0]) * fps).astype(np.int64)
+        if not 0.1 <= fps <= 10000:  # steps of 1e-300 s would make it 1e300
+            raise CaptureError(f"column 1 (time): steps of {np.median(steps):g} s make "
+                               f"{fps:g} frames per second, outside 0.1 to 10000; give the "
+                               "rate as # fps=...", path=path, line=lines[0])
+    numbers = np.round((times - times[0]) * fps)
+    beyond = np.flatnonzero(numbers > MAX_FRAME_NUMBER)
+    if len(beyond):
+        raise CaptureError(f"column 1 (time): {times[beyond[0]]:g} s is frame "
+                           f"{numbers[beyond[0]]:g}, beyond {MAX_FRAME_NUMBER}", path=path,
+                           line=lines[beyond[0]])
+    return fps, numbers.astype(np.int64)
 
 
 def write_points_csv(take: PointTake, out, *, start: int | None = None,
@@ -157,12 +198,18 @@ def write_points_csv(take: PointTake, out, *, start: int | None = None,
 
     Each frame in which some point was seen is one row, numbered with the file's frame
     numbers (``frame``); frames with nothing seen have no row, as in a tracker's own files.
-    Numbers are written in the shortest form that reads back to the same float.
+    Numbers are written in the shortest form that reads back to the same float. Point
+    names are quoted as CSV needs (a comma, a quote) and protected from spreadsheets
+    (``spreadsheet_safe``); the reader reads them back as they were.
     """
     start, stop = frame_range(take.n_frames, start, stop)
     xyz = take.channels[start:stop]
-    head = [f"# fps={take.fps:g} unit={take.unit} up={take.up}",
-            ",".join(["frame"] + [f"{p}_{a}" for p in take.point_names for a in "xyz"])]
+    names = io.StringIO()
+    csv.writer(names, lineterminator="").writerow(
+        ["frame"] + [spreadsheet_safe(f"{p}_{a}".replace("\r", " ").replace("\n", " "))
+                     for p in take.point_names for a in "xyz"])
+    unit = take.unit if take.unit.replace(".", "").isalnum() else "unknown"
+    head = [f"# fps={take.fps:g} unit={unit} up={take.up}", names.getvalue()]
     rows = []
     for k in np.flatnonzero(~np.isnan(xyz).all(axis=1)):
         cells = ["" if np.isnan(v) else repr(float(v)) for v in xyz[k]]

@@ -87,14 +87,24 @@ def _cell(cell: str, column: str, k: int, path, line: int) -> float:
     return value
 
 
+# Frame numbers are kept as the file gives them and written back (C3D stores the first one
+# as an unsigned 32-bit word); 1e19 would overflow every integer the service holds it in.
+MAX_FRAME_NUMBER = 2**31 - 1
+
+
 def frame_numbers(values: np.ndarray, lines: list[int], column: str, path) -> np.ndarray:
-    """The first column as whole frame numbers, rising or repeating, or a CaptureError at the
-    line of the first that is missing, fractional or going back."""
+    """The first column as whole frame numbers from 0 to MAX_FRAME_NUMBER, rising or
+    repeating, or a CaptureError at the line of the first that is missing, fractional, out
+    of that range or going back."""
     numbers = values[:, 0]
     bad = np.flatnonzero(np.isnan(numbers) | (numbers != np.round(numbers)))
     if len(bad):
         raise CaptureError(f"column 1 ({column}): {numbers[bad[0]]:g} is not a whole frame "
                            "number", path=path, line=lines[bad[0]])
+    bad = np.flatnonzero((numbers < 0) | (numbers > MAX_FRAME_NUMBER))
+    if len(bad):
+        raise CaptureError(f"column 1 ({column}): frame {numbers[bad[0]]:g} is outside 0 to "
+                           f"{MAX_FRAME_NUMBER}", path=path, line=lines[bad[0]])
     back = np.flatnonzero(np.diff(numbers) < 0)
     if len(back):
         k = back[0] + 1
@@ -102,6 +112,25 @@ def frame_numbers(values: np.ndarray, lines: list[int], column: str, path) -> np
                            f"{int(numbers[k - 1])}; rows must be in frame order", path=path,
                            line=lines[k])
     return numbers.astype(np.int64)
+
+
+def check_coordinates(values: np.ndarray, first: int, lines: list[int], columns: list[str],
+                      max_length: float, path) -> None:
+    """Refuse a coordinate (columns ``first`` on of ``values``) beyond ``max_length`` in
+    absolute value, naming its line, column and value.
+
+    Such a value is finite as read (float64) but not as stored (float32 positions), and
+    every later distance, speed or export of the take would turn it into infinities.
+    """
+    with np.errstate(invalid="ignore"):
+        beyond = np.abs(values[:, first:]) > max_length
+    rows = np.flatnonzero(beyond.any(axis=1))
+    if len(rows):
+        row = rows[0]
+        k = first + int(np.flatnonzero(beyond[row])[0])
+        raise CaptureError(f"column {k + 1} ({shorten(columns[k])}): {values[row, k]:g} is "
+                           f"beyond the largest coordinate a take may hold (±{max_length:g})",
+                           path=path, line=lines[row])
 
 
 def on_clock(numbers: np.ndarray, rows: np.ndarray, max_frames: int, path) -> np.ndarray:

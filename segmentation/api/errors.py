@@ -2,7 +2,8 @@
 
 - ``StaleVersion`` -> 409 with the current review, ``StaleGold`` -> 409 with the current
   gold version;
-- ``UploadTooLarge``, ``QuotaExceeded`` -> 413;
+- ``UploadTooLarge``, ``QuotaExceeded`` -> 413, and so is a body over
+  ``DATA_UPLOAD_MAX_MEMORY_SIZE`` (Django's ``RequestDataTooBig``);
 - ``NotAllowed`` (a role refusal on a project the caller sees) -> 403;
 - ``TooManyRequests`` (rate and concurrency limits) -> 429 with ``Retry-After``;
 - any other domain error (motionlib's ``MotionlibError``: ``CaptureError``, ``ParamError``…;
@@ -16,6 +17,8 @@
 import logging
 import re
 
+from django.conf import settings
+from django.core.exceptions import RequestDataTooBig
 from django.http import Http404
 from rest_framework import status
 from rest_framework.exceptions import NotFound
@@ -45,6 +48,8 @@ NO_MATCH = re.compile(r"^No (\w+) matches the given query\.$")
 def exception_handler(exc, context):
     if isinstance(exc, MotionlibError | CutroomError):
         return _domain_response(exc)
+    if isinstance(exc, RequestDataTooBig):
+        return _too_big()
     if isinstance(exc, Http404):
         # Django's "No Cut matches the given query." names a model class, not a thing.
         found = NO_MATCH.match(str(exc))
@@ -59,6 +64,13 @@ def exception_handler(exc, context):
     elif isinstance(response.data, list):
         response.data = {"detail": _summary(response.data), "errors": response.data}
     return response
+
+
+def _too_big():
+    limit = settings.DATA_UPLOAD_MAX_MEMORY_SIZE
+    detail = (f"The request body is larger than {limit} bytes ({limit / 2**20:g} MB), the "
+              "most a request other than a file upload may send.")
+    return Response({"detail": detail}, status=status.HTTP_413_REQUEST_ENTITY_TOO_LARGE)
 
 
 def _domain_response(exc):

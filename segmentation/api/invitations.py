@@ -1,9 +1,11 @@
 """Invitations: the invitee's list, accept and decline; the project admin's pending list."""
 
-from django.shortcuts import get_object_or_404
+from django.http import Http404
 from django.urls import path
+from django.utils import timezone
 from drf_spectacular.utils import extend_schema, extend_schema_field
 from rest_framework import serializers
+from rest_framework.exceptions import APIException
 from rest_framework.response import Response
 from rest_framework.views import APIView
 
@@ -68,11 +70,31 @@ class MyInvitationsView(APIView):
         return Response(MyInvitationSerializer(invitations, many=True).data)
 
 
+class Gone(APIException):
+    status_code = 410
+    default_detail = "This invitation can no longer be answered."
+
+
 class AnswerView(APIView):
     """POST answers one of the caller's invitations; anybody else's is a 404."""
 
     def invitation(self, request, pk):
-        return get_object_or_404(Invitation.objects.for_user(request.user), pk=pk)
+        """The caller's pending invitation ``pk``; one of theirs that was cancelled, has
+        expired or was answered already is a 410 saying which (not a bare refusal)."""
+        invitation = (Invitation.objects.filter(pk=pk, username=request.user.get_username())
+                      .select_related("project").first())
+        if invitation is None:
+            raise Http404("No Invitation matches the given query.")
+        project = invitation.project.name
+        if invitation.status == "cancelled":
+            raise Gone(f"This invitation to {project!r} was cancelled by the project's admins.")
+        if invitation.status != "pending":
+            raise Gone(f"This invitation to {project!r} was {invitation.status} already.")
+        if invitation.expires_at <= timezone.now():
+            raise Gone(f"This invitation to {project!r} has expired "
+                       f"({invitation.expires_at:%Y-%m-%d %H:%M} UTC); ask one of the "
+                       "project's admins to invite you again.")
+        return invitation
 
 
 class AcceptView(AnswerView):

@@ -35,7 +35,7 @@ def convert_capture(capture):
 
 def _convert(capture):
     with storage.local_path(capture.original) as path:
-        takes = read_fbx_all(path)
+        takes = read_fbx_all(path, limits=storage.input_limits())
     several = len(takes) > 1
     first, rest = takes[0], takes[1:]
     _check_rate(capture, len(takes))  # before writing anything for a file that is refused

@@ -21,7 +21,7 @@ from django.db import transaction
 from django.utils import timezone
 
 from segmentation import locks
-from segmentation.errors import Invalid, TooManyRequests
+from segmentation.errors import Invalid, NotAllowed, TooManyRequests
 from segmentation.models import Invitation
 from segmentation.services import quotas
 from segmentation.services.projects import do_set_member
@@ -93,9 +93,15 @@ def _wait(invitations, since):
 
 
 def do_accept_invitation(invitation, user):
-    """Join the project with the invited role; the invitation records who and when."""
+    """Join the project with the invited role; the invitation records who and when.
+
+    The inviter must still be an admin of the project: an invitation carries their
+    authority, and one made by an admin since removed or demoted (or whose account is
+    gone) is refused (NotAllowed), not accepted with the role they could once give.
+    """
     with transaction.atomic():
         invitation = _still_pending(invitation, user)
+        _check_inviter(invitation)
         membership = do_set_member(invitation.project, user.get_username(), invitation.role)
         _answer(invitation, user, "accepted")
     return membership
@@ -124,6 +130,15 @@ def _still_pending(invitation, user):
     if locked is None:
         raise Invalid("status: this invitation was already answered, cancelled or has expired")
     return locked
+
+
+def _check_inviter(invitation):
+    inviter = invitation.invited_by
+    if inviter is not None and invitation.project.role_of(inviter) == "admin":
+        return
+    who = f"{inviter.get_username()}, who is" if inviter is not None else "an account that is"
+    raise NotAllowed(f"this invitation to {invitation.project.name!r} was made by {who} no "
+                     "longer an admin of the project; ask one of its admins to invite you again")
 
 
 def _answer(invitation, user, status):

@@ -3,16 +3,18 @@
 Segments become ``LibrarySegment`` rows when a review is submitted or a gold version is
 saved (``refresh_capture_library`` rebuilds one capture's rows: agreement values change
 whenever another review of the capture comes in). Each row carries its motion descriptor
-(``segmentation.descriptors``), so "find similar" and label suggestions never re-read takes.
+(``segmentation.descriptors``), so "find similar" and label suggestions never re-read takes;
+a long capture's rows get theirs from a worker (``describe_library``), not the request.
 """
 
 import numpy as np
+from django.conf import settings
 from django.db import transaction
 
 from motionlib.agreement import label_codes, segment_support
-from segmentation import agreement, similar_index
+from segmentation import agreement, similar_index, workers
 from segmentation.descriptors import descriptors, store_descriptor
-from segmentation.models import Adjudication, LibrarySegment
+from segmentation.models import Adjudication, Capture, LibrarySegment
 
 
 def refresh_capture_library(capture):
@@ -44,14 +46,53 @@ def refresh_capture_library(capture):
                 superseded=bool(gold) and review is not None, label_id=label_id,
                 start=start, stop=stop, duration=(stop - start) / capture.fps,
                 agreement=agreement.finite(support)))
-    for segment, descriptor in zip(rows, descriptors(capture, [(r.start, r.stop) for r in rows]),
-                                   strict=True):
-        store_descriptor(segment, descriptor)
+    if described_inline(capture):
+        for segment, descriptor in zip(rows, descriptors(capture, [(r.start, r.stop) for r in rows]),
+                                       strict=True):
+            store_descriptor(segment, descriptor)
     with transaction.atomic():
         LibrarySegment.objects.filter(capture=capture).delete()
         LibrarySegment.objects.bulk_create(rows, batch_size=500)
         similar_index.schedule_update(capture.project_id)
+        if rows and not described_inline(capture):
+            transaction.on_commit(lambda: workers.send(
+                "describe_library", capture.pk, then="its segments stay out of similar search"))
     return rows
+
+
+def described_inline(capture):
+    """Whether a capture's library rows get their descriptors with the request that makes
+    them: reading and describing a long take of many points costs seconds and hundreds of
+    MB, held under the database's write lock on SQLite, so past CUTROOM_DESCRIBE_INLINE
+    joint positions a worker does it (``describe_library``)."""
+    return (capture.n_joints or 0) * (capture.n_frames or 0) <= settings.CUTROOM_DESCRIBE_INLINE
+
+
+def describe_library(capture_id):
+    """The worker's half of ``refresh_capture_library`` for a long capture: describe its
+    rows that lack descriptors and put them back described.
+
+    Computed outside any transaction; then, in one, the rows are replaced by described
+    copies (new ids, as every refresh makes, so the similar index's reading of newer rows
+    finds them), unless a newer refresh replaced them meanwhile (it sends its own job).
+    Returns the number of rows described.
+    """
+    capture = Capture.objects.filter(pk=capture_id).first()
+    if capture is None:
+        return 0
+    rows = list(LibrarySegment.objects.filter(capture=capture, descriptor__isnull=True))
+    found = descriptors(capture, [(r.start, r.stop) for r in rows]) if rows else []
+    for segment, descriptor in zip(rows, found, strict=True):
+        store_descriptor(segment, descriptor)
+    with transaction.atomic():
+        ids = [r.pk for r in rows]
+        if LibrarySegment.objects.filter(pk__in=ids).delete()[0] != len(ids):
+            return 0  # replaced meanwhile; the newer refresh's job describes the new rows
+        for row in rows:
+            row.pk = None
+        LibrarySegment.objects.bulk_create(rows, batch_size=500)
+        similar_index.schedule_update(capture.project_id)
+    return len(rows)
 
 
 def _gold_support(codes, n_reviews, start, stop):

@@ -136,7 +136,7 @@ class InvitationsTestCase(BaseTestCase):
         self.assertEqual(self.answer(self.dana, invitation.pk, "decline").status_code, 200)
         self.assertIsNone(self.project.role_of(self.dana))
         self.assertEqual(Invitation.objects.get().status, "declined")
-        self.assertEqual(self.answer(self.dana, invitation.pk, "accept").status_code, 404)
+        self.assertEqual(self.answer(self.dana, invitation.pk, "accept").status_code, 410)
 
     def test_nobody_else_can_accept_someone_elses_invitation(self):
         self.add("dana", "admin")
@@ -150,14 +150,14 @@ class InvitationsTestCase(BaseTestCase):
         self.add("dana")
         Invitation.objects.update(expires_at=timezone.now() - timedelta(seconds=1))
         self.assertEqual(self.invitations_of(self.dana), [])
-        self.assertEqual(self.answer(self.dana, Invitation.objects.get().pk, "accept").status_code, 404)
+        self.assertEqual(self.answer(self.dana, Invitation.objects.get().pk, "accept").status_code, 410)
 
     def test_an_admin_cancels_a_pending_invitation(self):
         self.add("dana")
         invitation = Invitation.objects.get()
         r = self.client.delete(f"/api/projects/{self.project.pk}/invitations/{invitation.pk}/")
         self.assertEqual(r.status_code, 204)
-        self.assertEqual(self.answer(self.dana, invitation.pk, "accept").status_code, 404)
+        self.assertEqual(self.answer(self.dana, invitation.pk, "accept").status_code, 410)
         self.assertEqual(Invitation.objects.get().status, "cancelled")
 
     def test_inviting_a_name_again_replaces_its_pending_invitation(self):
