@@ -6,7 +6,7 @@ from django.db import migrations, models
 class Migration(migrations.Migration):
 
     dependencies = [
-        ('segmentation', '0022_library_list_postgres_label_runs'),
+        ('segmentation', '0023_one_time_passwords'),
     ]
 
     operations = [
