@@ -85,8 +85,9 @@ def _skeleton(take, metres, buffer):
             nodes[parent].setdefault("children", []).append(j)
     roots = [j for j, parent in enumerate(sk.parents) if parent < 0]
     nodes.append({"name": take.name or "Armature", "children": roots})
+    # No "skeleton": the joints' common root is the armature node (a take may have several
+    # root joints), which Blender's exporter leaves out too.
     skin = {"name": take.name or "Armature", "joints": list(range(sk.n_joints)),
-            "skeleton": roots[0],
             "inverseBindMatrices": buffer.add(_inverse_binds(sk, metres), "MAT4")}
     return {"asset": {"version": "2.0", "generator": GENERATOR}, "scene": 0,
             "scenes": [{"name": "Scene", "nodes": [len(nodes) - 1]}], "nodes": nodes,

@@ -1,12 +1,14 @@
 """glTF binary clips of takes without a mesh, written without Blender (motionlib.io.gltf), as
 the Khronos glTF validator and Blender's own glTF importer read them."""
 
+import json
+import struct
+
 import numpy as np
 import pytest
 
 import motionlib
 from motionlib.io.export import write_clip, write_clips
-from motionlib.io.gltf import glb_bytes
 from motionlib.io.units import length_unit
 from tests.fbx.files import shared_bvh_13_29
 from tests.motionlib.test_io_export import glb_json, gltf_positions
@@ -83,7 +85,42 @@ def test_blenders_importer_poses_the_glb_as_motionlibs_kinematics(tmp_path, sour
     assert np.abs(heads - expected).max() < 1e-4 * height
 
 
-def test_its_bytes_are_a_function_of_the_clip():
-    """The same clip gives the same file: a library's archive exports to the same bytes."""
-    take = motionlib.read(shared_bvh_13_29()).slice(0, 50)
-    assert glb_bytes(take, metres=0.05) == glb_bytes(take, metres=0.05)
+def turning_bvh(path, frames=73):
+    """A two-joint BVH whose root turns a full circle about Y, 5 degrees a frame: its
+    rotation crosses 180 degrees, where a quaternion's sign flips unless it is kept."""
+    lines = ["HIERARCHY", "ROOT Hips", "{", "OFFSET 0 0 0",
+             "CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation",
+             "JOINT Chest", "{", "OFFSET 0 10 0", "CHANNELS 3 Zrotation Xrotation Yrotation",
+             "End Site", "{", "OFFSET 0 10 0", "}", "}", "}",
+             "MOTION", f"Frames: {frames}", "Frame Time: 0.0333333"]
+    lines += [f"0 90 0 0 0 {5.0 * f} 0 0 0" for f in range(frames)]
+    path.write_text("\n".join(lines) + "\n")
+    return motionlib.read(path)
+
+
+def rotation_keys(data):
+    """Each rotation channel's keys, (n_frames, 4) as (x, y, z, w), of a .glb's bytes."""
+    length, = struct.unpack_from("<I", data, 12)
+    gltf, binary = json.loads(data[20:20 + length]), data[28 + length:]
+    [animation] = gltf["animations"]
+    for sampler, channel in zip(animation["samplers"], animation["channels"], strict=True):
+        if channel["target"]["path"] == "rotation":
+            accessor = gltf["accessors"][sampler["output"]]
+            offset = gltf["bufferViews"][accessor["bufferView"]]["byteOffset"]
+            keys = np.frombuffer(binary, "<f4", accessor["count"] * 4, offset)
+            yield keys.reshape(-1, 4).astype(np.float64)
+
+
+def test_it_keys_each_joints_rotation_the_short_way_between_frames(tmp_path):
+    """Consecutive quaternions of a joint lie in one hemisphere: a reader's LINEAR (or slerp)
+    interpolation between two frames turns the joint the short way, never back round."""
+    take = turning_bvh(tmp_path / "turn.bvh")
+    write_clip(take, tmp_path / "turn.glb", format="glb", blender=NoBlender())
+    [root, chest] = rotation_keys((tmp_path / "turn.glb").read_bytes())
+    for keys in (root, chest):
+        np.testing.assert_allclose(np.linalg.norm(keys, axis=1), 1.0, atol=1e-6)
+        assert (np.sum(keys[1:] * keys[:-1], axis=1) > 0).all()
+    half = np.radians(2.5 * np.arange(73))  # the root's half angle about Y, every frame
+    np.testing.assert_allclose(np.abs(root[:, [1, 3]]),
+                               np.abs(np.stack([np.sin(half), np.cos(half)], 1)), atol=1e-5)
+    assert validate(tmp_path / "turn.glb")["issues"]["numErrors"] == 0
