@@ -40,6 +40,8 @@ BENCHMARKS = {
     "points-read": Benchmark("benchmarks.io.points_read", "C3D against BVH of as many "
                              "values, and other C3D readers"),
     "fbx-read": Benchmark("benchmarks.io.fbx_read", "an FBX take read against its BVH"),
+    "gltf-export": Benchmark("benchmarks.io.gltf_export", "glTF export of clips without a "
+                             "mesh, Blender's exporter against motionlib's writer"),
     "hostile-inputs": Benchmark("benchmarks.io.hostile_inputs", "time and memory to read "
                                 "or refuse hostile capture files"),
     # service: the running service, end to end

@@ -1,10 +1,11 @@
-"""Library clips as files: BVH (written here), FBX and glTF binary (written by Blender), C3D
-and joint-position CSV for point takes (same points, rate and gaps), and bulk export as a
-zip archive with a manifest.
+"""Library clips as files: BVH (written here), FBX and glTF binary, C3D and joint-position CSV
+for point takes (same points, rate and gaps), and bulk export as a zip archive with a manifest.
 
-FBX and glTF run Blender in a child process of the calling process (``motionlib.io.blender``;
-nothing here imports it). A clip of a capture read from FBX is cut from its stored original, so
-it keeps the original's armature and bone names; any other becomes a new armature. FBX and glTF
+FBX, and glTF cut from an FBX original, run Blender in a child process of the calling process
+(``motionlib.io.blender``; nothing here imports it); glTF of any other take (no mesh) is
+written by ``motionlib.io.gltf`` in this process. A clip of a capture read from FBX is cut from
+its stored original, so it keeps the original's armature and bone names; any other becomes a
+new armature. FBX and glTF
 clips are in metres by :func:`motionlib.io.units.length_unit`; BVH clips keep the take's numbers.
 
 Every clip holds exactly the frames :func:`clip_range` names, in every format, and the manifest

@@ -2,8 +2,9 @@
 as C3D or joint-position CSV (the same points, rate and gaps; :mod:`motionlib.io.c3dfile`,
 :mod:`motionlib.io.pointcsv`).
 
-BVH is written here (:func:`motionlib.io.bvh.write_bvh`); FBX and glTF by Blender's exporters,
-in the Blender process of :mod:`motionlib.io.blender`:
+BVH is written here (:func:`motionlib.io.bvh.write_bvh`); FBX by Blender's exporter, in the
+Blender process of :mod:`motionlib.io.blender`; glTF by Blender only when it is cut from an FBX
+original, and otherwise here, without Blender (:mod:`motionlib.io.gltf`, milliseconds a clip):
 
 - a take read from FBX, given its original file, is cut from that file: the same armature (bone
   names, rest orientations, the meshes it deforms) with the animation's frames [start, stop);
@@ -91,6 +92,9 @@ def write_clips(take: Take, clips, *, format: str, original=None, blender=None,
         for start, stop, out in clips:
             write_bvh(take, out, start=start, stop=stop)
         return
+    if format == "glb" and not (original is not None and take.format == "fbx"):
+        _write_glb_clips(take, clips)
+        return
     from motionlib.io import blender as blender_module
 
     blender = blender or blender_module.shared()
@@ -124,6 +128,16 @@ def check_export_format(take, format: str) -> None:
             "a take of joint rotations"
         raise CaptureError(f"export format {format!r}: {kind} is written as "
                            f"{' or '.join(allowed)}", path=take.path)
+
+
+def _write_glb_clips(take, clips):
+    """glTF of a take that is not cut from an FBX original (no mesh to keep): written here,
+    without Blender (:mod:`motionlib.io.gltf`)."""
+    from motionlib.io.gltf import write_glb  # it builds on this module's local_transforms
+
+    metres = length_unit(take).metres
+    for start, stop, out in clips:
+        write_glb(take.slice(start, stop), out, metres=metres)
 
 
 def _write_new_armature(take, out, format, blender, timeout, metres):

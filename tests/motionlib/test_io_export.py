@@ -1,4 +1,5 @@
-"""Clips written as FBX and glTF binary by Blender, read back with motionlib's FBX reader."""
+"""Clips written as FBX and glTF binary (by Blender; glTF of a take without an FBX original by
+motionlib.io.gltf), read back with motionlib's FBX reader and Blender's glTF importer."""
 
 import json
 import struct
