@@ -28,7 +28,7 @@ from pathlib import Path
 import numpy as np
 from harness import REPO, start_django, stop
 
-from segmentation.shared_data import data_dir
+from motionlib.shared_data import data_dir
 
 DEFAULT_DATA = data_dir()
 

@@ -31,6 +31,7 @@ REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
 import motionlib  # noqa: E402
+from motionlib.shared_data import data_dir  # noqa: E402
 from motionlib.similarity import (  # noqa: E402
     PROFILE_ROWS,
     body_scale,
@@ -38,7 +39,6 @@ from motionlib.similarity import (  # noqa: E402
     segment_descriptor,
 )
 from motionlib.vector_index import IvfIndex  # noqa: E402
-from segmentation.shared_data import data_dir  # noqa: E402
 
 DATA = data_dir()
 
@@ -62,7 +62,7 @@ def clips(seq, clip_frames):
 
 def indexed_pool(index, query, pool, min_lists):
     """The ``pool`` members the vector index proposes for ``query``, as the service asks
-    (``segmentation.similar_index.shortlist``: 4 x the shortlist of 20, at least 64)."""
+    (``segmentation.similar.index.shortlist``: 4 x the shortlist of 20, at least 64)."""
     allowed = set(pool)
     vector = query[:PROFILE_ROWS].astype(np.float32).ravel()
     count = max(4 * 20, 64)

@@ -44,7 +44,7 @@ def base_descriptors(rng, per_take=400):
     synthetic takes."""
     import motionlib
     from motionlib import similarity, synth
-    from segmentation.shared_data import data_dir
+    from motionlib.shared_data import data_dir
 
     takes, data = [], data_dir()
     for seq, subject in CMU:

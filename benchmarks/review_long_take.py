@@ -111,7 +111,7 @@ def synth_capture(project, user, seed, minutes, detect=False):
     import motionlib
     from motionlib import synth
     from motionlib.segmenters import get_segmenter
-    from segmentation import storage
+    from segmentation.files import storage
     from segmentation.models import Capture, DetectionRun
 
     take, truth = synth.generate(seed=seed, fps=120.0, duration=minutes * 60)
@@ -560,7 +560,7 @@ def browser_main(args, var):
 
 
 def storage_signals(capture):
-    from segmentation import storage
+    from segmentation.files import storage
 
     run = capture.latest_finished_run()
     return storage.load_npz(run.signals) if run and run.signals else {}

@@ -82,7 +82,7 @@ def exact_top(segment, ids, profiles, spans, k=10):
     (as |x|^2 - 2 x.q + |q|^2) pick the 2,000 nearest; those are measured again exactly as
     the service measures (float64 differences), far more than the 20 the ranking needs."""
     from motionlib import similarity
-    from segmentation import descriptors, search
+    from segmentation.similar import descriptors, search
 
     query = segment.descriptor_array()
     q = query[:similarity.PROFILE_ROWS].ravel()
@@ -223,8 +223,8 @@ def run():
     # Set up as a web server process is (cutroom/wsgi.py: the URLconf loaded, then
     # gc.freeze()), so no full collection rescans the start-up objects inside a request.
     import cutroom.wsgi  # noqa: F401
-    from segmentation import similar_index
     from segmentation.models import Capture, LibrarySegment
+    from segmentation.similar import index as similar_index
 
     old = before.load(args.before)
     if args.nprobe:

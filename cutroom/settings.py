@@ -186,7 +186,7 @@ SILENCED_SYSTEM_CHECKS = ["staticfiles.W004"]
 
 MEDIA_URL = "/media/"
 MEDIA_ROOT = Path(os.environ.get("CUTROOM_MEDIA_ROOT") or VAR_DIR / "media")
-# The similar-clip vector indexes (segmentation.similar_index); rebuilt from the database.
+# The similar-clip vector indexes (segmentation.similar.index); rebuilt from the database.
 SIMILAR_INDEX_DIR = Path(os.environ.get("CUTROOM_SIMILAR_INDEX_DIR") or VAR_DIR / "similar")
 # Each web process reads an index's base (its profiles, 420 bytes a segment) into memory:
 # searching the shared memory-mapped file costs twice the time (docs/operations.md).

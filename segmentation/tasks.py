@@ -21,9 +21,11 @@ from celery.signals import worker_init, worker_process_init, worker_ready
 from django.conf import settings
 from django.db import connection
 
-from segmentation import similar_index, suggestions, workers
+from segmentation import workers
 from segmentation.services import adaptation, captures, health, jobs
 from segmentation.services.convert import CONVERT
+from segmentation.similar import index as similar_index
+from segmentation.similar import suggestions
 
 log = logging.getLogger(__name__)
 

@@ -8,10 +8,10 @@ from rest_framework.exceptions import PermissionDenied
 from rest_framework.response import Response
 from rest_framework.views import APIView
 
-from segmentation import agreement
 from segmentation.api.captures import capture_for
 from segmentation.api.params import float_param
 from segmentation.api.serializers import UserRefSerializer
+from segmentation.services import agreement
 
 
 class AgreementReviewSerializer(serializers.Serializer):

@@ -14,7 +14,7 @@ from rest_framework.pagination import PageNumberPagination
 from rest_framework.parsers import FormParser, MultiPartParser
 from rest_framework.response import Response
 
-from segmentation import services, storage
+from segmentation import services
 from segmentation.api.heavy import immutable
 from segmentation.api.params import body, int_param
 from segmentation.api.parsers import BoundedJSONParser
@@ -31,6 +31,7 @@ from segmentation.api.serializers import (
     UploadSerializer,
 )
 from segmentation.errors import Invalid, NotReady, UploadTooLarge
+from segmentation.files import storage
 from segmentation.models import Capture, DetectionRun, JSONArrayLength, Review
 
 

@@ -9,7 +9,7 @@ from rest_framework.response import Response
 from rest_framework.views import APIView
 
 from motionlib.segmenters import list_segmenters
-from segmentation import services, storage
+from segmentation import services
 from segmentation.api.invitations import InvitationSerializer, InvitedSerializer, invited_response
 from segmentation.api.params import body
 from segmentation.api.serializers import (
@@ -20,6 +20,7 @@ from segmentation.api.serializers import (
     MethodSerializer,
     ProjectSerializer,
 )
+from segmentation.files import storage
 from segmentation.models import Membership, Project
 from segmentation.services.team import can_create_accounts
 

@@ -7,7 +7,7 @@ from rest_framework.exceptions import PermissionDenied
 from rest_framework.response import Response
 from rest_framework.views import APIView
 
-from segmentation import services, suggestions
+from segmentation import services
 from segmentation.api.captures import capture_for
 from segmentation.api.params import body
 from segmentation.api.serializers import (
@@ -22,6 +22,7 @@ from segmentation.api.serializers import (
 )
 from segmentation.services.adaptation import adaptation_summary
 from segmentation.services.reviews import catch_up, started_review
+from segmentation.similar import suggestions
 
 
 class OwnReviewView(APIView):

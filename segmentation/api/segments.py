@@ -26,14 +26,17 @@ from rest_framework.response import Response
 from rest_framework.utils.urls import remove_query_param, replace_query_param
 from rest_framework.views import APIView
 
-from segmentation import exports, search, similar_index, statements
 from segmentation.api.params import bool_param, float_param, int_param
 from segmentation.api.serializers import NamedRefSerializer, UserRefSerializer
+from segmentation.db import statements
+from segmentation.db.statements import Statement
 from segmentation.errors import Invalid
+from segmentation.files import exports
+from segmentation.files.storage import read_take
 from segmentation.models import Label, LibrarySegment, Membership
 from segmentation.models.library import projects_by_role
-from segmentation.statements import Statement
-from segmentation.storage import read_take
+from segmentation.similar import index as similar_index
+from segmentation.similar import search
 
 ORDERINGS = {
     "recent": ("-id",), "duration": ("duration", "id"), "-duration": ("-duration", "-id"),
@@ -118,7 +121,7 @@ class ListQuery:
     ``shape``: everything else, decided in Python (the order, the gold filter, which
     filters are present, how many projects, labels and label names there are), which says
     what SQL the list runs. The list's queries are built from the two and compiled once
-    per shape (``segmentation.statements``): building and compiling a page's querysets
+    per shape (``segmentation.db.statements``): building and compiling a page's querysets
     cost more CPU than the database spent answering them.
     """
 

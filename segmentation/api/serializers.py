@@ -415,7 +415,7 @@ class ReviewSerializer(serializers.ModelSerializer):
     @extend_schema_field(ReviewSegmentSerializer(many=True))
     def get_segments(self, review):
         # Label suggestions are not part of a review: they are computed by a worker and
-        # read from …/review/suggestions/ (segmentation.suggestions).
+        # read from …/review/suggestions/ (segmentation.similar.suggestions).
         kept = [(cut["id"], cut["frame"]) for cut in self._cuts(review) if cut["fate"] != "deleted"]
         return [{"index": index, "start": start, "stop": stop, "label": label}
                 for index, start, stop, label in review.segments(kept=kept)]

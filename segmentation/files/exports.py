@@ -27,9 +27,9 @@ import motionlib
 from motionlib.errors import MotionlibError
 from motionlib.io.export import write_clips
 from motionlib.io.units import length_unit
-from segmentation import storage
 from segmentation.errors import CutroomError, ExportFormatError, internal_error
-from segmentation.storage import read_take
+from segmentation.files import storage
+from segmentation.files.storage import read_take
 
 log = logging.getLogger(__name__)
 

@@ -1,5 +1,5 @@
 """The project dashboard: where each capture stands, annotators' throughput, agreement per
-label and the library's size (agreement itself is ``segmentation.agreement``)."""
+label and the library's size (agreement itself is ``segmentation.services.agreement``)."""
 
 from statistics import median
 

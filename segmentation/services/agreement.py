@@ -2,7 +2,7 @@
 
 The numbers come from ``motionlib.agreement``; this module feeds it the reviews' kept
 cuts and labelled segments, names the annotators, and keeps a summary row per capture
-(``CaptureAgreement``) so the dashboard (``segmentation.dashboard``) never recomputes
+(``CaptureAgreement``) so the dashboard (``segmentation.queries.dashboard``) never recomputes
 agreement for every capture.
 """
 

@@ -15,10 +15,11 @@ from django.db.models import Max, Min, Q
 from django.db.models.functions import Coalesce
 from django.utils import timezone
 
-from segmentation import similar_index, workers
+from segmentation import workers
 from segmentation.models import Capture, DetectionRun, LibrarySegment, WorkerHeartbeat
 from segmentation.models.jobs import claim_cutoff
 from segmentation.services import jobs
+from segmentation.similar import index as similar_index
 
 log = logging.getLogger(__name__)
 

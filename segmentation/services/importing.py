@@ -15,8 +15,9 @@ from django.core.files import File
 import motionlib
 from motionlib.io import check_bvh
 from motionlib.io.fbx import check_fbx_header
-from segmentation import services, storage
 from segmentation.errors import ImportProblem
+from segmentation.files import storage
+from segmentation.services.captures import do_upload_capture
 
 CAPTURE_SUFFIXES = (".bvh", ".amc", ".fbx", ".c3d", ".tsv", ".csv")
 
@@ -152,7 +153,7 @@ def _upload(project, user, path, asf):
     with open(path, "rb") as handle, _maybe_open(asf) as asf_handle:
         upload = File(handle, name=path.name)
         skeleton = File(asf_handle, name=asf.name) if asf_handle else None
-        return services.do_upload_capture(project, user, upload, skeleton)
+        return do_upload_capture(project, user, upload, skeleton)
 
 
 def _maybe_open(path):

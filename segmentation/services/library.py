@@ -3,16 +3,17 @@
 Segments become ``LibrarySegment`` rows when a review is submitted or a gold version is
 saved (``refresh_capture_library`` rebuilds one capture's rows: agreement values change
 whenever another review of the capture comes in). Each row carries its motion descriptor
-(``segmentation.descriptors``), so "find similar" and label suggestions never re-read takes.
+(``segmentation.similar.descriptors``), so "find similar" and label suggestions never re-read takes.
 """
 
 import numpy as np
 from django.db import transaction
 
 from motionlib.agreement import label_codes, segment_support
-from segmentation import agreement, similar_index
-from segmentation.descriptors import descriptors, store_descriptor
 from segmentation.models import Adjudication, LibrarySegment
+from segmentation.services import agreement
+from segmentation.similar import index as similar_index
+from segmentation.similar.descriptors import descriptors, store_descriptor
 
 
 def refresh_capture_library(capture):

@@ -9,8 +9,8 @@ from django.db.models import Q
 
 import motionlib
 from motionlib import markersets, similarity
-from segmentation import storage
 from segmentation.errors import Invalid
+from segmentation.files import storage
 from segmentation.models import LibrarySegment
 
 log = logging.getLogger(__name__)

@@ -59,10 +59,11 @@ from django.db.models.expressions import RawSQL
 
 from motionlib import similarity, vector_index
 from motionlib.errors import InputError
-from segmentation import statements, workers
+from segmentation import workers
+from segmentation.db import statements
 from segmentation.errors import Invalid
 from segmentation.models import LibrarySegment
-from segmentation.pools import pool_queryset
+from segmentation.similar.pools import pool_queryset
 
 log = logging.getLogger(__name__)
 

@@ -2,9 +2,9 @@
 caller may see, described as the query is, not overlapping it (used by ``search`` and by
 ``similar_index``, which reads its candidates from them)."""
 
-from segmentation.descriptors import is_bare_points, of_kind
 from segmentation.models import LibrarySegment
 from segmentation.models.library import STAFF
+from segmentation.similar.descriptors import is_bare_points, of_kind
 
 
 class Scope:
@@ -24,7 +24,7 @@ class Pool:
 
     With a ``Scope`` it is also a statement's shape and values (``key``, ``values``:
     ``pool_queryset``'s arguments), so that its SQL is compiled once per shape
-    (``segmentation.statements``)."""
+    (``segmentation.db.statements``)."""
 
     def __init__(self, segment, visible):
         self.visible = visible

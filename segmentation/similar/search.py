@@ -5,11 +5,12 @@ from types import SimpleNamespace
 import numpy as np
 
 from motionlib import similarity
-from segmentation import exports, similar_index
-from segmentation.descriptors import load_descriptors, profile_pool
 from segmentation.errors import Invalid
+from segmentation.files import exports
 from segmentation.models import LibrarySegment
-from segmentation.pools import Pool
+from segmentation.similar import index as similar_index
+from segmentation.similar.descriptors import load_descriptors, profile_pool
+from segmentation.similar.pools import Pool
 
 # Similar clips and suggestions search at most this many of a project's recent segments.
 SIMILAR_POOL = 20000

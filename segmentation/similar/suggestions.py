@@ -32,9 +32,9 @@ from django.utils import timezone
 
 from motionlib import similarity
 from segmentation import workers
-from segmentation.descriptors import Describer, load_descriptors, profile_pool, same_kind
 from segmentation.models import Capture, LabelSuggestion, LibrarySegment, Review, SuggestionRequest
-from segmentation.search import SHORTLIST, SIMILAR_POOL
+from segmentation.similar.descriptors import Describer, load_descriptors, profile_pool, same_kind
+from segmentation.similar.search import SHORTLIST, SIMILAR_POOL
 
 log = logging.getLogger(__name__)
 

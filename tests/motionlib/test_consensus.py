@@ -1,9 +1,9 @@
 """The cuts a project learns from when several annotators reviewed a take: a cut at least
-half of them made, at the median of their cuts (segmentation.consensus)."""
+half of them made, at the median of their cuts (motionlib.consensus)."""
 
 from unittest import TestCase
 
-from segmentation.consensus import consensus_cuts
+from motionlib.consensus import consensus_cuts
 
 TOL = 120  # 1 s at 120 fps
 

@@ -31,8 +31,9 @@ def synthetic_bvh(seed):
 
 def populate():
     """Build the installation (in an empty database); returns its project."""
-    from segmentation import services, similar_index
+    from segmentation import services
     from segmentation.services.gold import do_save_gold
+    from segmentation.similar import index as similar_index
 
     users = get_user_model().objects
     alice = users.create_user("alice", password="alice-password", is_staff=True)

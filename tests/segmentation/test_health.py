@@ -11,9 +11,10 @@ from django.utils import timezone
 
 from cutroom.celery import app
 from motionlib import similarity
-from segmentation import descriptors, similar_index
 from segmentation.models import Capture, DetectionRun, LibrarySegment, WorkerHeartbeat
 from segmentation.services import health
+from segmentation.similar import descriptors
+from segmentation.similar import index as similar_index
 from tests.segmentation.base import BaseTestCase
 
 

@@ -13,8 +13,10 @@ from django.test.utils import CaptureQueriesContext
 import motionlib
 from motionlib import similarity, synth, vector_index
 from motionlib.vector_index import VectorIndex
-from segmentation import descriptors, search, services, similar_index, tasks
+from segmentation import services, tasks
 from segmentation.models import Capture, LibrarySegment
+from segmentation.similar import descriptors, search
+from segmentation.similar import index as similar_index
 from tests.segmentation.base import BaseTestCase
 from tests.segmentation.test_library import submit_review
 
@@ -177,7 +179,7 @@ def needs_postgres():
 @pytest.mark.integration
 class PostgresAccessTest(AccessTest):
     """The same refusals on PostgreSQL, where the view reads through compiled statements
-    (``segmentation.statements``)."""
+    (``segmentation.db.statements``)."""
 
     def setUp(self):
         needs_postgres()

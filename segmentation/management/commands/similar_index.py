@@ -1,7 +1,7 @@
 from django.core.management.base import BaseCommand, CommandError
 
-from segmentation import similar_index
 from segmentation.models import Project
+from segmentation.similar import index as similar_index
 
 
 class Command(BaseCommand):

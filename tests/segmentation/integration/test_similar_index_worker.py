@@ -4,8 +4,10 @@ process, which had the index open, sees the worker's appended update."""
 import pytest
 from django.contrib.auth import get_user_model
 
-from segmentation import search, services, similar_index
+from segmentation import services
 from segmentation.models import LibrarySegment
+from segmentation.similar import index as similar_index
+from segmentation.similar import search
 from tests.segmentation.base import synthetic_bvh
 from tests.segmentation.integration.conftest import wait_for
 from tests.segmentation.integration.test_pipeline import client_for, settled, upload
