@@ -50,6 +50,7 @@ import platform
 import statistics
 import time
 from contextlib import contextmanager
+from types import SimpleNamespace
 from unittest import mock
 
 import before
@@ -223,8 +224,14 @@ def run():
     # Set up as a web server process is (cutroom/wsgi.py: the URLconf loaded, then
     # gc.freeze()), so no full collection rescans the start-up objects inside a request.
     import cutroom.wsgi  # noqa: F401
+    from motionlib import vector_index
     from segmentation.models import Capture, LibrarySegment
-    from segmentation.similar import index as similar_index
+    from segmentation.similar import files, index, updates
+
+    # The index's public steps under one name, as the old revision's single module has them.
+    similar_index = SimpleNamespace(
+        build=updates.build, update=updates.update, manifest_path=files.manifest_path,
+        read_manifest=files.read_manifest, forget=index.forget, vector_index=vector_index)
 
     old = before.load(args.before)
     if args.nprobe:
@@ -291,7 +298,7 @@ def run():
                 cpu[title].append(CPU[-1])
                 recall[title].append(len(set(found) & set(truth)) / len(truth))
             if n < args.old_queries:
-                with index_dir(out / "none"), mock.patch.object(similar_index, "open_index",
+                with index_dir(out / "none"), mock.patch.object(index, "open_index",
                                                                lambda project_id: None):
                     found, ms = call_view(user, pk)
                 rows["no index (20,000 recent)"].append(ms)
@@ -336,7 +343,7 @@ def run():
                            profile=s.profile) for i, s in enumerate(source))
         try:
             waiting = {p: [] for p in paths}
-            with mock.patch.object(similar_index, "schedule_update", lambda project_id: None), \
+            with mock.patch.object(index, "schedule_update", lambda project_id: None), \
                     mock.patch.object(old.similar_index, "schedule_update", lambda project_id: None):
                 for pk in picks[:40]:
                     for title, view in paths.items():

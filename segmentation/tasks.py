@@ -24,8 +24,7 @@ from django.db import connection
 from segmentation import workers
 from segmentation.services import adaptation, captures, health, jobs
 from segmentation.services.convert import CONVERT
-from segmentation.similar import index as similar_index
-from segmentation.similar import suggestions
+from segmentation.similar import suggestions, updates
 
 log = logging.getLogger(__name__)
 
@@ -133,7 +132,7 @@ def suggest(capture_id, annotator_id):
 @shared_task
 def update_similar_index(project_id):
     """Bring a project's similar-clip index in step with its library rows."""
-    similar_index.update(project_id)
+    updates.update(project_id)
 
 
 @shared_task

@@ -35,8 +35,7 @@ from segmentation.files import exports
 from segmentation.files.storage import read_take
 from segmentation.models import Label, LibrarySegment, Membership
 from segmentation.models.library import projects_by_role
-from segmentation.similar import index as similar_index
-from segmentation.similar import search
+from segmentation.similar import candidates, search
 
 ORDERINGS = {
     "recent": ("-id",), "duration": ("duration", "id"), "-duration": ("-duration", "-id"),
@@ -326,7 +325,7 @@ class SegmentSerializer(serializers.ModelSerializer):
 # What a list row shows of a segment (``SegmentSerializer``'s fields), read as columns:
 # building a segment, capture, label and user instance per row and serializing them field
 # by field cost a page of 50 more CPU than all its queries.
-PAGE_COLUMNS = ("id", "capture_id", "start", "stop", *similar_index.SHOWN)
+PAGE_COLUMNS = ("id", "capture_id", "start", "stop", *candidates.SHOWN)
 
 
 def page_rows(ids):

@@ -12,7 +12,7 @@ refused when it is compiled (it is compiled twice, with two sets of stand-ins, a
 must agree on everything but the stand-ins).
 
 Nothing is prepared on the server: PostgreSQL plans each run with its values. A generic
-plan of the candidates' statement (``similar_index``) scans ~0.4 s where a custom plan
+plan of the candidates' statement (``similar.candidates``) scans ~0.4 s where a custom plan
 takes 0.5 ms, and a prepared statement may switch to its generic plan after five runs.
 """
 

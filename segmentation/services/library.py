@@ -12,7 +12,7 @@ from django.db import transaction
 from motionlib.agreement import label_codes, segment_support
 from segmentation.models import Adjudication, LibrarySegment
 from segmentation.services import agreement
-from segmentation.similar import index as similar_index
+from segmentation.similar import updates
 from segmentation.similar.descriptors import descriptors, store_descriptor
 
 
@@ -51,7 +51,7 @@ def refresh_capture_library(capture):
     with transaction.atomic():
         LibrarySegment.objects.filter(capture=capture).delete()
         LibrarySegment.objects.bulk_create(rows, batch_size=500)
-        similar_index.schedule_update(capture.project_id)
+        updates.schedule_update(capture.project_id)
     return rows
 
 

@@ -27,344 +27,51 @@ Staying in step with the database (which is the truth):
 - Segments newer than the manifest's ``max_id`` (the *delta*) are read by each process
   once, after a search's candidates query has reported them, and measured exactly with
   every search (``OpenIndex``), so a search never waits for the index.
-- ``update`` (a Celery task queued when library rows change, and run by
+- ``updates.update`` (a Celery task queued when library rows change, and run by
   ``manage.py similar_index``) compares the index's keys with the database's ids and
   appends the difference: it writes the added vectors and removed keys, not the index.
   When the appended records outgrow ``COMPACT_SHARE`` of the base, or there is no usable
-  index, it *compacts*: ``build`` trains new centres over the whole library and writes a
+  index, it *compacts*: ``updates.build`` trains new centres over the whole library and writes a
   new generation beside the old one before naming it (processes that still map the old
   one keep reading it until they see the new manifest).
 - ``open_index`` checks a manifest the first time a process sees a generation: a missing
   or short file, another format or width, or a vector count that disagrees with the
   database all mean "not usable": the search falls back to the exact scan and a rebuild
   is queued.
+
+This module holds the index as a process has it open (``open_index``, ``OpenIndex``);
+``similar.files`` the folder and manifest, ``similar.updates`` ``build`` and ``update``,
+and ``similar.candidates`` the search of candidates through an open index.
 """
 
-import fcntl
-import json
 import logging
-import os
-import shutil
 import threading
-import time
-from contextlib import contextmanager
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 from django.conf import settings
-from django.db import connections, transaction
-from django.db.models import BigIntegerField, BinaryField, Case, F, When
-from django.db.models.expressions import RawSQL
+from django.db import connections
 
-from motionlib import similarity, vector_index
+from motionlib import vector_index
 from motionlib.errors import InputError
-from segmentation import workers
-from segmentation.db import statements
-from segmentation.errors import Invalid
 from segmentation.models import LibrarySegment
-from segmentation.similar.pools import pool_queryset
+from segmentation.similar.files import (
+    IndexUnusable,
+    described,
+    folder_of,
+    manifest_path,
+    read_manifest,
+)
+from segmentation.similar.updates import schedule_update
 
 log = logging.getLogger(__name__)
 
-FORMAT = 2
-# An update compacts (retrains and rewrites the generation) once the added and removed
-# records outnumber this share of the base: a search compares the query with every added
-# vector, and clusters drift as the library changes.
-COMPACT_SHARE = 0.05
-# ... and never for fewer records than this (a small library would compact at each update).
-COMPACT_MIN = 2000
 # When the delta (segments newer than the index) grows past this, an update is queued.
 DELTA_LIMIT = 5000
-READ_CHUNK = 20000
-
-
-class IndexUnusable(Exception):
-    """The index of a project cannot be used; the message says why."""
-
-
-def index_dir() -> Path:
-    return Path(settings.SIMILAR_INDEX_DIR)
-
-
-def manifest_path(project_id) -> Path:
-    return index_dir() / f"project_{project_id}.json"
-
-
-def described(project_id):
-    return LibrarySegment.objects.filter(project_id=project_id, profile__isnull=False)
-
-
-def as_vectors(blobs, n_features=None):
-    """(n, PROFILE_ROWS * n_features) float32 profiles from the stored bytes."""
-    vectors = np.stack([np.frombuffer(bytes(b), dtype="<f4") for b in blobs]) if blobs else (
-        np.zeros((0, similarity.PROFILE_ROWS * (n_features or 0)), dtype=np.float32))
-    return vectors
-
-
-@contextmanager
-def _locked(project_id):
-    """One writer per project and machine (an update and a rebuild never interleave)."""
-    index_dir().mkdir(parents=True, exist_ok=True)
-    with open(index_dir() / f"project_{project_id}.lock", "w") as fh:
-        fcntl.flock(fh, fcntl.LOCK_EX)
-        try:
-            yield
-        finally:
-            fcntl.flock(fh, fcntl.LOCK_UN)
-
-
-def read_manifest(project_id):
-    """The manifest dict, or IndexUnusable naming what is wrong with it."""
-    path = manifest_path(project_id)
-    try:
-        manifest = json.loads(path.read_text())
-    except FileNotFoundError as exc:
-        raise IndexUnusable(f"{path}: no index yet") from exc
-    except (OSError, ValueError) as exc:
-        raise IndexUnusable(f"{path}: unreadable ({exc})") from exc
-    if not isinstance(manifest, dict) or manifest.get("format") != FORMAT:
-        raise IndexUnusable(f"{path}: format {manifest.get('format') if isinstance(manifest, dict) else '?'}"
-                            f", this version reads format {FORMAT}")
-    try:
-        vector_index.check(folder_of(manifest), manifest["state"])
-    except (KeyError, TypeError) as exc:
-        raise IndexUnusable(f"{path}: no {exc} in it") from exc
-    except InputError as exc:
-        raise IndexUnusable(str(exc)) from exc
-    return manifest
-
-
-def folder_of(manifest) -> Path:
-    return index_dir() / str(manifest["file"])
-
-
-def _fingerprint(project_id):
-    """[count, max id, sum of ids] of the described segments: cheap to compare, and
-    changed by any insert or delete."""
-    from django.db.models import Count, Max, Sum
-
-    found = described(project_id).aggregate(n=Count("id"), top=Max("id"), total=Sum("id"))
-    return [found["n"], found["top"] or 0, int(found["total"] or 0)]
-
-
-def _publish(project_id, manifest):
-    """Replace the project's manifest atomically (written, fsynced, renamed)."""
-    manifest = {**manifest, "updated_at": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
-                "bytes": sum(p.stat().st_size for p in folder_of(manifest).iterdir())}
-    tmp = manifest_path(project_id).with_suffix(".json.tmp")
-    tmp.write_text(json.dumps(manifest, indent=1))
-    vector_index.fsync(tmp)
-    os.replace(tmp, manifest_path(project_id))
-    vector_index.fsync(index_dir())
-    return manifest
-
-
-def _chunks(queryset):
-    """(ids, profile vectors, descriptor bytes) of a queryset of described segments,
-    READ_CHUNK rows at a time, by id."""
-    last = 0
-    while True:
-        rows = list(queryset.filter(id__gt=last).order_by("id")
-                    .values_list("id", "profile", "descriptor")[:READ_CHUNK])
-        if not rows:
-            return
-        last = rows[-1][0]
-        missing = [r[0] for r in rows if r[2] is None]
-        if missing:
-            raise IndexUnusable(f"segments {missing[:5]}: a profile without a descriptor; "
-                                "rebuild the library's descriptors")
-        yield (np.array([r[0] for r in rows], dtype=np.int64), as_vectors([r[1] for r in rows]),
-               [bytes(r[2]) for r in rows])
-
-
-def _descriptor_rows(blobs, width):
-    """(n, width) float32 descriptors from their bytes; IndexUnusable when one differs."""
-    sizes = {len(b) for b in blobs}
-    if sizes - {4 * width}:
-        raise IndexUnusable(f"segment descriptors have {sorted(n // 4 for n in sizes)} numbers, "
-                            f"the index {width}; rebuild the library's descriptors")
-    return np.frombuffer(b"".join(blobs), dtype="<f4").reshape(len(blobs), width)
-
-
-def build(project_id):
-    """Write a project's index from scratch; returns the manifest (None: nothing to index)."""
-    with _locked(project_id):
-        return _build(project_id)
-
-
-def _build(project_id):
-    """Read the described segments once, by id: profiles into memory (for training),
-    descriptors straight into the payload file (a million are several GB)."""
-    fingerprint = _fingerprint(project_id)
-    index_dir().mkdir(parents=True, exist_ok=True)
-    payload = index_dir() / f"project_{project_id}.payload.tmp"
-    id_parts, vector_parts, width = [], [], None
-    try:
-        with open(payload, "wb") as out:
-            for ids, vectors, blobs in _chunks(described(project_id)):
-                width = width or len(blobs[0]) // 4
-                if id_parts and vectors.shape[1] != vector_parts[0].shape[1]:
-                    raise IndexUnusable(f"project {project_id}: segment profiles have "
-                                        f"{sorted({vector_parts[0].shape[1], vectors.shape[1]})} "
-                                        "numbers; rebuild the library's descriptors")
-                out.write(_descriptor_rows(blobs, width).tobytes())
-                id_parts.append(ids)
-                vector_parts.append(vectors)
-        if not id_parts:
-            manifest_path(project_id).unlink(missing_ok=True)
-            _remove_generations(project_id, keep=None)
-            return None
-        ids = np.concatenate(id_parts)
-        vectors = np.concatenate(vector_parts)
-        del id_parts, vector_parts
-        generation = time.time_ns()
-        name = f"project_{project_id}.g{generation}"
-        state = vector_index.build(index_dir() / name, ids, vectors, seed=project_id,
-                                   payload=payload, payload_width=width)
-    finally:
-        payload.unlink(missing_ok=True)
-    lists = state.pop("lists")
-    manifest = _publish(project_id, {
-        "format": FORMAT, "file": name, "generation": generation, "state": state,
-        "count": len(ids), "lists": lists, "max_id": int(ids[-1]), "fingerprint": fingerprint,
-        "built_at": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())})
-    _remove_generations(project_id, keep=name)
-    log.info("similar index of project %s built: %s vectors", project_id, manifest["count"])
-    return manifest
-
-
-def _remove_generations(project_id, keep):
-    for old in index_dir().glob(f"project_{project_id}.g*"):
-        if old.name != keep:
-            # Processes that map the old files keep them (unlinked inodes live on).
-            shutil.rmtree(old, ignore_errors=True)
-
-
-def update(project_id):
-    """Bring a project's index in step with the database: append the vectors of segments
-    it lacks and the keys of deleted ones. Compacts (``build``) when there is no usable
-    index, or the appended records would outgrow ``COMPACT_SHARE`` of the base.
-    Returns the manifest (unchanged when in step)."""
-    with _locked(project_id):
-        try:
-            manifest = read_manifest(project_id)
-            index = vector_index.VectorIndex.open(folder_of(manifest), manifest["state"])
-        except (IndexUnusable, InputError) as exc:
-            log.info("similar index of project %s rebuilt: %s", project_id, exc)
-            return _build(project_id)
-        fingerprint = _fingerprint(project_id)
-        if fingerprint == manifest.get("fingerprint"):
-            return manifest
-        keys = index.keys()
-        ids = np.fromiter(described(project_id).values_list("id", flat=True).iterator(chunk_size=20000),
-                          dtype=np.int64)
-        removed = np.setdiff1d(keys, ids, assume_unique=True)
-        added = np.setdiff1d(ids, keys, assume_unique=True)
-        state = manifest["state"]
-        appended = state["delta"] + state["removed"] + len(added) + len(removed)
-        if appended > max(COMPACT_MIN, COMPACT_SHARE * state["base"]):
-            return _build(project_id)
-        add_ids, add_vectors, add_blobs = [], [], []
-        for first in range(0, len(added), READ_CHUNK):
-            part = [int(i) for i in added[first:first + READ_CHUNK]]
-            rows = {pk: (profile, descriptor) for pk, profile, descriptor in LibrarySegment.objects
-                    .filter(pk__in=part).values_list("id", "profile", "descriptor")}
-            part = [pk for pk in part if pk in rows]  # deleted meanwhile
-            add_ids += part
-            add_vectors += [rows[pk][0] for pk in part]
-            add_blobs += [bytes(rows[pk][1]) for pk in part]
-        vectors = as_vectors(add_vectors, index.ndim // similarity.PROFILE_ROWS)
-        if len(vectors) and (vectors.shape[1] != index.ndim
-                             or {len(b) for b in add_blobs} != {4 * state["payload"]}):
-            return _build(project_id)
-        payload = _descriptor_rows(add_blobs, state["payload"]) if add_blobs else None
-        state = vector_index.append(folder_of(manifest), state, add_ids, vectors, removed,
-                                    add_payload=payload)
-        max_id = max(int(ids.max()) if len(ids) else 0, manifest["max_id"])
-        return _publish(project_id, {**manifest, "state": state, "max_id": max_id,
-                                     "count": len(keys) - len(removed) + len(add_ids),
-                                     "fingerprint": fingerprint})
-
-
-def schedule_update(project_id):
-    """Queue ``update`` for when the current transaction commits (a worker must see the
-    rows). A broker that cannot be reached costs freshness of the file only: searches
-    read newer segments from the database."""
-    transaction.on_commit(lambda: workers.send(
-        "update_similar_index", project_id, then="searches read the newer segments from the database"))
-
-
-def _candidates_or_newer(pool, ids, project_id, after):
-    """``pool``'s rows (a ``pools.Pool``) that are among ``ids`` or newer than ``after``
-    (the last segment id of the delta this process has read), in one query: [(id,
-    capture, start, stop, profile bytes or None, newest, *SHOWN)]. Only the rows newer
-    than ``after`` carry their profile: the others were measured already. ``newest`` is
-    the id of the project's newest described segment, whatever the caller may see (the
-    next search reads the delta up to it: ``OpenIndex.take_newer``). No descriptor is
-    read here (it lives in the database's out-of-line storage, the dearest part of a
-    search's queries). ``SHOWN`` is what a result shows of a segment, so the winners need
-    no query of their own.
-
-    The newer rows are found by a row comparison on (project, id), so that the database
-    walks the ``libseg_described`` index from ``(project, after)`` to the project's end:
-    with a plain ``project_id = p AND id > after`` PostgreSQL estimates the project's
-    share of all newer rows and often prefers the primary key, then filters every newer
-    row of every project. The end is ``project_id <= p``: a second row comparison,
-    ``< (p + 1, 0)``, bounds no scan on PostgreSQL 15, which then reads ~80 index pages
-    to find nothing (~1 ms at a million). On PostgreSQL the newer ids are an InitPlan
-    joined to the candidates' as one array, so the rows themselves are one scan of the
-    primary key (an OR of the two lets the planner pick a library-list index and scan the
-    project: ~0.5 s at a million), and a ``pools.Scope``'s pool is read through a
-    statement compiled once (``CANDIDATE_ROWS``).
-    """
-    values = {"after": after}
-    if connections[pool.db].vendor == "postgresql":
-        if pool.scoped:
-            return CANDIDATE_ROWS.rows(pool.db, pool.key, ids=ids, **values, **pool.values)
-        return list(_candidates_query(pool.key, ids=ids, visible=pool.visible, **values,
-                                      **pool.values).using(pool.db))
-    table = LibrarySegment._meta.db_table
-    where = (f'("{table}"."id" IN ({", ".join(["%s"] * len(ids)) or "NULL"}) '
-             f'OR "{table}"."id" IN ({_NEWER}))')
-    return list(pool.queryset().extra(where=[where], params=[*ids, project_id, after, project_id])
-                .annotate(fresh=_fresh(after), newest=_newest(project_id))
-                .values_list(*CANDIDATE_COLUMNS))
-
 
 # The project's described segments after an id (parameters: project, id, project).
-_AFTER = (f'"{LibrarySegment._meta.db_table}" u WHERE u.profile IS NOT NULL'
+AFTER = (f'"{LibrarySegment._meta.db_table}" u WHERE u.profile IS NOT NULL'
           ' AND (u.project_id, u.id) > (%s, %s) AND u.project_id <= %s')
-_NEWER = f"SELECT u.id FROM {_AFTER}"
-
-
-def _fresh(after):
-    return Case(When(id__gt=after, then=F("profile")), default=None, output_field=BinaryField())
-
-
-def _newest(project_id):
-    """The id of the project's newest described segment, read once per query."""
-    return RawSQL(f'(SELECT u.id FROM "{LibrarySegment._meta.db_table}" u WHERE u.profile IS NOT NULL'
-                  ' AND u.project_id = %s ORDER BY u.project_id DESC, u.id DESC LIMIT 1)',
-                  [project_id], output_field=BigIntegerField())
-
-
-def _candidates_query(key, ids, after, visible=None, **pool):
-    """``_candidates_or_newer``'s query on PostgreSQL, ``ids`` one array parameter."""
-    where = f'"{LibrarySegment._meta.db_table}"."id" = ANY(%s::bigint[] || ARRAY({_NEWER}))'
-    return (pool_queryset(key, visible=visible, **pool)
-            .extra(where=[where], params=[ids, pool["project_id"], after, pool["project_id"]])
-            .annotate(fresh=_fresh(after), newest=_newest(pool["project_id"]))
-            .values_list(*CANDIDATE_COLUMNS))
-
-
-# The columns of a segment and its capture, annotator and label that a search result and a
-# library list row show (``search.api_fields`` makes the API fields from them).
-SHOWN = ("project_id", "review_id", "annotator_id", "is_gold", "superseded", "label_id",
-         "duration", "agreement", "capture__name", "capture__fps", "capture__format",
-         "annotator__username", "label__name", "label__color")
-CANDIDATE_COLUMNS = ("id", "capture_id", "start", "stop", "fresh", "newest", *SHOWN)
-CANDIDATE_ROWS = statements.Statement(_candidates_query, lists=("ids",))
 
 
 @dataclass
@@ -425,7 +132,7 @@ class OpenIndex:
             if newest <= mark:
                 return
             with connections[db].cursor() as cursor:
-                cursor.execute(f"SELECT u.id, u.profile FROM {_AFTER} AND u.id <= %s ORDER BY u.id",
+                cursor.execute(f"SELECT u.id, u.profile FROM {AFTER} AND u.id <= %s ORDER BY u.id",
                                [self.project_id, mark, self.project_id, newest])
                 rows = [(pk, bytes(blob)) for pk, blob in cursor.fetchall()]
             # A profile of another width is left out, as the index leaves it (``update``).
@@ -506,115 +213,6 @@ def _open_checked(project_id, previous=None):
         return None
     return OpenIndex(project_id, manifest, index)
 
-
-# The first look at the index asks for CANDIDATES x the shortlist (at least
-# MIN_CANDIDATES): the index ranks by the exact profile distance, so only rows the caller
-# may not see, or spans seen twice, need the margin. A look that finds too few visible
-# ones asks for GROW times as many, up to MAX_CANDIDATES.
-CANDIDATES = 2
-MIN_CANDIDATES = 48
-GROW = 4
-MAX_CANDIDATES = 4096
-
-
-def shortlist(index, query, pool, n):
-    """The ``n`` segments of ``pool`` whose profiles are nearest to ``query``'s, nearest
-    first, as the exact scan orders them (ties: newest first; one span once), as
-    ``[(id, descriptor, row)]``, ``row`` the candidate's columns (``_candidates_or_newer``).
-
-    ``pool`` (a ``pools.Pool``) is what the caller may see of the project; the index
-    proposes candidates and ``pool`` decides which exist and may be shown. Returns None
-    when even ``MAX_CANDIDATES`` candidates leave fewer than ``n`` (a very selective
-    filter): the caller then scans exactly.
-    """
-    vector = np.asarray(query[:similarity.PROFILE_ROWS], dtype=np.float32).ravel()
-    count = max(CANDIDATES * n, MIN_CANDIDATES)
-    while True:
-        candidates, profiles = index.nearest(vector, count)
-        mark, newer, newer_distances, held = index.nearest_newer(vector, count)
-        rows = _candidates_or_newer(pool, [*candidates.tolist(), *newer.tolist()],
-                                    index.project_id, mark)
-        index.take_newer(pool.db, rows[0][5] if rows else newest_id(pool.db, index.project_id))
-        index.note_delta(held + sum(r[0] > mark for r in rows))
-        measured = dict(zip(candidates.tolist(), _squared(profiles, query).tolist(), strict=True))
-        measured.update(zip(newer.tolist(), newer_distances.tolist(), strict=True))
-        found = nearest_unique(rows, query, n, measured, index.descriptors)
-        exhausted = (len(candidates) < count and count >= index.size) and len(newer) == held
-        if len(found) >= n or exhausted:
-            return found
-        if count >= MAX_CANDIDATES:
-            return None
-        count *= GROW
-
-
-def newest_id(db, project_id):
-    """The id of the project's newest described segment (None: it has none)."""
-    return described(project_id).using(db).order_by("-id").values_list("id", flat=True).first()
-
-
-def nearest_unique(rows, query, n, measured, stored):
-    """The exact scan's order over ``rows`` (id, capture, start, stop, profile bytes or
-    None, ...): the ``n`` nearest by profile distance, one row per span (its newest), as
-    ``[(id, descriptor, row)]``.
-
-    Every distance is measured as the exact scan measures it (float64), so that ties
-    (the same motion in two takes) fall as they do there: a row with a profile from the
-    profile, any other from ``measured`` (the index's candidates, from the profiles its
-    lists hold, and the delta's). Only the ``n`` chosen rows' descriptors are read: from
-    the index (``stored(ids)``), else in one query (a descriptor is 4.9 kB, so reading
-    every candidate's would be most of a search's reads). Invalid when a profile or a
-    descriptor is not of the query's shape (a library described by another version)."""
-    rows = [r for r in rows if r[4] is not None or r[0] in measured]
-    if not rows:
-        return []
-    rows.sort(key=lambda r: -r[0])
-    seen, unique = set(), []
-    for row in rows:
-        if row[1:4] not in seen:
-            seen.add(row[1:4])
-            unique.append(row)
-    width = similarity.PROFILE_ROWS * query.shape[1]
-    d = np.array([measured.get(r[0], np.nan) for r in unique])
-    fresh = [i for i, r in enumerate(unique) if r[4] is not None]
-    if fresh:
-        blobs = [bytes(unique[i][4]) for i in fresh]
-        if {len(b) for b in blobs} != {4 * width}:
-            raise Invalid(f"library profiles have {sorted({len(b) // 4 for b in blobs})} "
-                          f"numbers, the query's {width}; rebuild the library")
-        d[fresh] = _squared(np.frombuffer(b"".join(blobs), dtype="<f4").reshape(len(fresh), width),
-                            query)
-    chosen = [unique[i] for i in np.argsort(d, kind="stable")[:n]]
-    read = stored([r[0] for r in chosen if r[4] is None])
-    newer = [r[0] for r in chosen if r[0] not in read]
-    if newer:
-        read.update((pk, np.frombuffer(bytes(blob), dtype="<f4")) for pk, blob in
-                    LibrarySegment.objects.filter(pk__in=newer).values_list("id", "descriptor"))
-    out = []
-    for r in chosen:
-        descriptor = read.get(r[0])
-        if descriptor is None:
-            continue  # deleted since the candidates were read
-        _check_size(descriptor, query)
-        out.append((r[0], descriptor.reshape(query.shape), r))
-    return out
-
-
-def _squared(profiles, query):
-    """Squared distances (float64) from each of ``profiles`` (n, width) to ``query``'s
-    profile, with float64 differences, as the exact scan measures them."""
-    width = similarity.PROFILE_ROWS * query.shape[1]
-    if profiles.shape[1] != width:
-        raise Invalid(f"library profiles have {profiles.shape[1]} numbers, the query's "
-                      f"{width}; rebuild the library")
-    diff = np.asarray(profiles, dtype=np.float64) - np.asarray(
-        query[:similarity.PROFILE_ROWS], dtype=np.float64).ravel()
-    return np.einsum("ij,ij->i", diff, diff)
-
-
-def _check_size(descriptor, query):
-    if descriptor.size != query.size:
-        raise Invalid(f"library descriptors have {descriptor.size} numbers, the query's "
-                      f"{query.shape[0]} x {query.shape[1]}; rebuild the library")
 
 
 def forget():

@@ -1,6 +1,6 @@
 """What a similar-clip search may return: the segments of the query's project that the
 caller may see, described as the query is, not overlapping it (used by ``search`` and by
-``similar_index``, which reads its candidates from them)."""
+``similar.candidates``, which reads its candidates from them)."""
 
 from segmentation.models import LibrarySegment
 from segmentation.models.library import STAFF

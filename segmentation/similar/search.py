@@ -8,7 +8,7 @@ from motionlib import similarity
 from segmentation.errors import Invalid
 from segmentation.files import exports
 from segmentation.models import LibrarySegment
-from segmentation.similar import index as similar_index
+from segmentation.similar import candidates, index
 from segmentation.similar.descriptors import load_descriptors, profile_pool
 from segmentation.similar.pools import Pool
 
@@ -28,7 +28,7 @@ def similar(segment, visible, k=10):
     annotators' versions of the same motion), and so are duplicates of one span. Two
     stages: the profiles nearest to the query's pick a shortlist, whose full descriptors
     are ranked. The shortlist comes from the project's
-    vector index (``similar_index``, which keeps the descriptors too) when it has a usable
+    vector index (``similar.index``, which keeps the descriptors too) when it has a usable
     one, else from the profiles of up to ``SIMILAR_POOL`` recent segments.
     Returns ``[(segment, distance)]``, most similar first; a segment found through the
     index is a ``Shown`` (its id and its API fields), one from the exact scan a
@@ -40,8 +40,8 @@ def similar(segment, visible, k=10):
                       "parts and it is not a take of points, so it has no motion descriptor")
     pool = Pool(segment, visible)
     n = max(SHORTLIST, k)
-    index = similar_index.open_index(segment.project_id)
-    short = similar_index.shortlist(index, query, pool, n) if index else None
+    opened = index.open_index(segment.project_id)
+    short = candidates.shortlist(opened, query, pool, n) if opened else None
     if short is None:
         ids = exact_shortlist(query, pool.queryset(), n)
         short = list(zip(ids, load_descriptors(ids), [None] * len(ids), strict=True))
@@ -72,15 +72,15 @@ class Shown:
 
 
 def shown(row):
-    """``Shown`` from a candidate row of ``similar_index`` (``CANDIDATE_COLUMNS``)."""
+    """``Shown`` from a candidate row of ``similar.candidates`` (``CANDIDATE_COLUMNS``)."""
     pk, capture_id, start, stop = row[:4]
     return Shown(pk, api_fields(pk, capture_id, start, stop, row[6:]))
 
 
 def api_fields(pk, capture_id, start, stop, columns):
     """What the API shows of a segment (``SegmentSerializer``'s fields) from its id,
-    capture, frames and its ``similar_index.SHOWN`` columns."""
-    f = dict(zip(similar_index.SHOWN, columns, strict=True))
+    capture, frames and its ``candidates.SHOWN`` columns."""
+    f = dict(zip(candidates.SHOWN, columns, strict=True))
     return {
         "id": pk, "project": f["project_id"],
         "capture": {"id": capture_id, "name": f["capture__name"]}, "review": f["review_id"],

@@ -29,12 +29,12 @@ def _media_root_on_testcase(request, media_root):
 def similar_index_dir(settings, tmp_path):
     """Each test keeps its similar-clip indexes in its own folder, and no process cache
     of an index outlives the test (ids are reused once a test's rows are rolled back)."""
-    from segmentation.similar import index as similar_index
+    from segmentation.similar import index
 
     settings.SIMILAR_INDEX_DIR = tmp_path / "similar"
-    similar_index.forget()
+    index.forget()
     yield settings.SIMILAR_INDEX_DIR
-    similar_index.forget()
+    index.forget()
 
 
 @pytest.fixture(autouse=True)
