@@ -7,13 +7,13 @@ from django.db.models import Count, Q
 
 from segmentation.models import (
     Adjudication,
+    Assignment,
     Capture,
     CaptureAgreement,
     LibrarySegment,
     Review,
     ReviewEvent,
 )
-from segmentation.services.assignments import assignment_summary
 
 EDIT_ACTIONS = ("accept", "delete", "reset", "move", "insert", "label")
 
@@ -115,3 +115,15 @@ def library_counts(project):
     return segments.aggregate(
         total=Count("id", filter=Q(superseded=False)), gold=Count("id", filter=Q(is_gold=True))
     )
+
+
+def assignment_summary(capture_ids):
+    """Per capture id: who is assigned and each review's state (the dashboard)."""
+    out = {pk: {"assigned": [], "reviews": []} for pk in capture_ids}
+    for a in Assignment.objects.filter(capture_id__in=capture_ids).select_related("annotator"):
+        out[a.capture_id]["assigned"].append(a.annotator.username)
+    reviews = Review.objects.filter(capture_id__in=capture_ids).select_related("annotator")
+    for r in reviews.order_by("id"):
+        out[r.capture_id]["reviews"].append({"id": r.pk, "annotator": r.annotator.username,
+                                             "status": r.status})
+    return out
