@@ -88,6 +88,11 @@ class NotAllowed(CutroomError, PermissionError):
     """The caller's role does not allow the action: a 403 whose text says who may."""
 
 
+class Missing(CutroomError, LookupError):
+    """No such record among those the caller may see: a 404 (never a 403, which would say
+    that it exists)."""
+
+
 def internal_error(what, logger=log):
     """Log the exception being handled with its traceback and a short reference, and
     return the reference: the user quotes it, the administrators find the traceback."""

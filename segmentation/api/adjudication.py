@@ -7,7 +7,7 @@ from rest_framework import serializers
 from rest_framework.response import Response
 from rest_framework.views import APIView
 
-from segmentation.api.agreement import AgreementSerializer, staff_capture
+from segmentation.api.agreement import AgreementSerializer
 from segmentation.api.params import body
 from segmentation.api.serializers import (
     DetailSerializer,
@@ -18,6 +18,7 @@ from segmentation.api.serializers import (
 from segmentation.errors import Invalid
 from segmentation.limits import text_limit
 from segmentation.models import Adjudication, Label, Review
+from segmentation.queries.access import staff_capture
 from segmentation.services import agreement
 from segmentation.services.gold import do_save_gold
 

@@ -4,13 +4,12 @@ agree (reviewers and admins; an annotator is told why not, an outsider gets 404)
 from django.urls import path
 from drf_spectacular.utils import OpenApiParameter, extend_schema
 from rest_framework import serializers
-from rest_framework.exceptions import PermissionDenied
 from rest_framework.response import Response
 from rest_framework.views import APIView
 
-from segmentation.api.captures import capture_for
 from segmentation.api.params import float_param
 from segmentation.api.serializers import UserRefSerializer
+from segmentation.queries.access import staff_capture
 from segmentation.services import agreement
 
 
@@ -59,16 +58,6 @@ class AgreementSerializer(serializers.Serializer):
     labels = LabelMeasureSerializer()
     alpha = serializers.FloatField(allow_null=True)
     per_label = LabelOverlapSerializer(many=True)
-
-
-def staff_capture(user, pk):
-    """A capture whose project the user reviews or administers; 404 for outsiders, 403
-    (saying why) for an annotator, who sees the capture anyway."""
-    capture = capture_for(user, pk)
-    if not capture.project.can_see_all_reviews(user):
-        raise PermissionDenied("Only the project's reviewers and admins see agreement and "
-                               "adjudicate; you annotate in this project.")
-    return capture
 
 
 class AgreementView(APIView):

@@ -9,10 +9,10 @@ from rest_framework.response import Response
 from rest_framework.views import APIView
 
 from segmentation.api.agreement import LabelOverlapSerializer
-from segmentation.api.projects import project_for
 from segmentation.api.serializers import NamedRefSerializer
 from segmentation.models import Review
 from segmentation.queries import dashboard
+from segmentation.queries.access import project_for
 
 # The schema's CaptureStateEnum (settings.SPECTACULAR_SETTINGS).
 CAPTURE_STATES = dashboard.STATES

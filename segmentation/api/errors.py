@@ -4,6 +4,7 @@
   gold version;
 - ``UploadTooLarge``, ``QuotaExceeded`` -> 413;
 - ``NotAllowed`` (a role refusal on a project the caller sees) -> 403;
+- ``Missing`` (no such record among those the caller sees) -> 404;
 - ``TooManyRequests`` (rate and concurrency limits) -> 429 with ``Retry-After``;
 - any other domain error (motionlib's ``MotionlibError``: ``CaptureError``, ``ParamError``…;
   the service's ``Invalid``) -> 400 with its message, which names the field, file, line or
@@ -27,6 +28,7 @@ from segmentation.api.adjudication import StaleGoldSerializer, gold_body
 from segmentation.api.serializers import ReviewSerializer
 from segmentation.errors import (
     CutroomError,
+    Missing,
     NotAllowed,
     QuotaExceeded,
     StaleGold,
@@ -70,6 +72,8 @@ def _domain_response(exc):
         return Response(body, status=status.HTTP_409_CONFLICT)
     if isinstance(exc, NotAllowed):
         return Response({"detail": str(exc)}, status=status.HTTP_403_FORBIDDEN)
+    if isinstance(exc, Missing):
+        return Response({"detail": str(exc)}, status=status.HTTP_404_NOT_FOUND)
     if isinstance(exc, TooManyRequests):
         return Response(_value_error_body(exc), status=429,
                         headers={"Retry-After": str(exc.retry_after)})

@@ -125,8 +125,3 @@ class MethodsView(APIView):
     @extend_schema(responses=MethodSerializer(many=True))
     def get(self, request):
         return Response(MethodSerializer([cls.schema() for cls in list_segmenters()], many=True).data)
-
-
-def project_for(user, pk):
-    """A project the user is a member of, or 404 (never 403, which would leak it)."""
-    return get_object_or_404(Project.objects.for_user(user), pk=pk)

@@ -8,7 +8,6 @@ from rest_framework.response import Response
 from rest_framework.views import APIView
 
 from segmentation import services
-from segmentation.api.captures import capture_for
 from segmentation.api.params import body
 from segmentation.api.serializers import (
     ChangeCutSerializer,
@@ -20,6 +19,7 @@ from segmentation.api.serializers import (
     SuggestionsSerializer,
     VersionSerializer,
 )
+from segmentation.queries.access import capture_for
 from segmentation.services.adaptation import adaptation_summary
 from segmentation.services.reviews import catch_up, started_review
 from segmentation.similar import suggestions

@@ -31,7 +31,7 @@ STAFF = ("reviewer", "admin")
 
 def own(user):
     """Q of an annotator's own segments and the gold ones (``is_gold__in``: see
-    ``segmentation.api.segments.segment_filters``); ``user`` or their id."""
+    ``segmentation.queries.library.segment_filters``); ``user`` or their id."""
     return Q(annotator=user) | Q(is_gold__in=[True])
 
 
