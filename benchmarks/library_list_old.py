@@ -12,7 +12,7 @@ from rest_framework.exceptions import NotFound
 from rest_framework.pagination import PageNumberPagination
 from rest_framework.response import Response
 
-from segmentation.api.params import bool_param, float_param, int_param
+from segmentation.api.common.params import bool_param, float_param, int_param
 from segmentation.api.segments import SegmentListView, SegmentSerializer
 from segmentation.errors import Invalid
 from segmentation.models import LibrarySegment

@@ -219,7 +219,7 @@ def old_library():
 def time_old_path(data, repeats):
     from django.core.cache import cache
 
-    from segmentation.api.serializers import ReviewSerializer
+    from segmentation.api.common.serializers.reviews import ReviewSerializer
     from segmentation.models import Review
 
     old = old_library()

@@ -74,7 +74,7 @@ MIDDLEWARE = [
     "django.middleware.common.CommonMiddleware",
     "django.middleware.csrf.CsrfViewMiddleware",
     "django.contrib.auth.middleware.AuthenticationMiddleware",
-    "segmentation.api.pathids.PathIdMiddleware",
+    "segmentation.api.common.pathids.PathIdMiddleware",
     "django.contrib.messages.middleware.MessageMiddleware",
     "django.middleware.clickjacking.XFrameOptionsMiddleware",
 ]
@@ -247,7 +247,7 @@ CUTROOM_MAX_EXPANSION = envint("CUTROOM_MAX_EXPANSION", None)
 CUTROOM_JOINT_FRAMES_PER_REQUEST = 250_000
 # Frames and signals answers: at most this many built at once per web process (0: no
 # limit), a waiting request gives up after CUTROOM_HEAVY_WAIT s (429); built answers kept
-# per process up to CUTROOM_ANSWER_CACHE_MB (0: none). See segmentation/api/heavy.py.
+# per process up to CUTROOM_ANSWER_CACHE_MB (0: none). See segmentation/api/common/heavy.py.
 CUTROOM_HEAVY_REQUESTS = envint("CUTROOM_HEAVY_REQUESTS", 1)
 CUTROOM_HEAVY_WAIT = envint("CUTROOM_HEAVY_WAIT", 60)
 CUTROOM_ANSWER_CACHE_MB = envint("CUTROOM_ANSWER_CACHE_MB", 64)
@@ -323,14 +323,14 @@ REST_FRAMEWORK = {
         "rest_framework.authentication.SessionAuthentication",
     ],
     "DEFAULT_PERMISSION_CLASSES": ["rest_framework.permissions.IsAuthenticated"],
-    # Bounded nesting and numbers in every JSON body (see segmentation.api.parsers).
+    # Bounded nesting and numbers in every JSON body (see segmentation.api.common.parsers).
     "DEFAULT_PARSER_CLASSES": [
-        "segmentation.api.parsers.BoundedJSONParser",
+        "segmentation.api.common.parsers.BoundedJSONParser",
         "rest_framework.parsers.FormParser",
         "rest_framework.parsers.MultiPartParser",
     ],
     "DEFAULT_SCHEMA_CLASS": "drf_spectacular.openapi.AutoSchema",
-    "EXCEPTION_HANDLER": "segmentation.api.errors.exception_handler",
+    "EXCEPTION_HANDLER": "segmentation.api.common.errors.exception_handler",
     "UNAUTHENTICATED_USER": "django.contrib.auth.models.AnonymousUser",
 }
 SPECTACULAR_SETTINGS = {
@@ -346,13 +346,13 @@ SPECTACULAR_SETTINGS = {
     "COMPONENT_SPLIT_REQUEST": True,
     "POSTPROCESSING_HOOKS": [
         "drf_spectacular.hooks.postprocess_schema_enums",
-        "segmentation.api.schema.answers_have_every_field",
+        "segmentation.api.common.schema.answers_have_every_field",
     ],
     "ENUM_NAME_OVERRIDES": {
         "JobStatusEnum": "segmentation.models.JOB_STATUSES",
         "ReviewStatusEnum": "segmentation.models.Review.STATUSES",
         "RoleEnum": "segmentation.models.ROLES",
-        "ReviewStateEnum": "segmentation.api.serializers.REVIEW_STATES",
+        "ReviewStateEnum": "segmentation.api.common.serializers.reviews.REVIEW_STATES",
         "QueueStateEnum": "segmentation.api.assignments.QUEUE_STATES",
         "CaptureStateEnum": "segmentation.api.dashboard.CAPTURE_STATES",
     },

@@ -7,8 +7,8 @@ from rest_framework import serializers
 from rest_framework.response import Response
 from rest_framework.views import APIView
 
-from segmentation.api.params import float_param
-from segmentation.api.serializers import UserRefSerializer
+from segmentation.api.common.params import float_param
+from segmentation.api.common.serializers.base import UserRefSerializer
 from segmentation.queries.access import staff_capture
 from segmentation.services import agreement
 

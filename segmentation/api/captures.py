@@ -15,10 +15,10 @@ from rest_framework.parsers import FormParser, MultiPartParser
 from rest_framework.response import Response
 
 from segmentation import services
-from segmentation.api.heavy import immutable
-from segmentation.api.params import body, int_param
-from segmentation.api.parsers import BoundedJSONParser
-from segmentation.api.serializers import (
+from segmentation.api.common.heavy import immutable
+from segmentation.api.common.params import body, int_param
+from segmentation.api.common.parsers import BoundedJSONParser
+from segmentation.api.common.serializers.captures import (
     CaptureListSerializer,
     CaptureSerializer,
     FramesSerializer,

@@ -9,7 +9,7 @@ from rest_framework.response import Response
 from rest_framework.views import APIView
 
 from segmentation.api.agreement import LabelOverlapSerializer
-from segmentation.api.serializers import NamedRefSerializer
+from segmentation.api.common.serializers.base import NamedRefSerializer
 from segmentation.models import Review
 from segmentation.queries import dashboard
 from segmentation.queries.access import project_for

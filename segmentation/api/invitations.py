@@ -8,7 +8,8 @@ from rest_framework.response import Response
 from rest_framework.views import APIView
 
 from segmentation import services
-from segmentation.api.serializers import DetailSerializer, MemberSerializer, NamedRefSerializer
+from segmentation.api.common.serializers.base import DetailSerializer, NamedRefSerializer
+from segmentation.api.common.serializers.projects import MemberSerializer
 from segmentation.models import Invitation
 
 # What a project admin is told, whether or not an account has the username.

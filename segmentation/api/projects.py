@@ -10,16 +10,16 @@ from rest_framework.views import APIView
 
 from motionlib.segmenters import list_segmenters
 from segmentation import services
-from segmentation.api.invitations import InvitationSerializer, InvitedSerializer, invited_response
-from segmentation.api.params import body
-from segmentation.api.serializers import (
-    CutModelSerializer,
+from segmentation.api.common.params import body
+from segmentation.api.common.serializers.captures import CutModelSerializer
+from segmentation.api.common.serializers.projects import (
     LabelSerializer,
     MemberSerializer,
     MeSerializer,
     MethodSerializer,
     ProjectSerializer,
 )
+from segmentation.api.invitations import InvitationSerializer, InvitedSerializer, invited_response
 from segmentation.files import storage
 from segmentation.models import Membership, Project
 from segmentation.services.team import can_create_accounts

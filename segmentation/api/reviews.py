@@ -8,8 +8,8 @@ from rest_framework.response import Response
 from rest_framework.views import APIView
 
 from segmentation import services
-from segmentation.api.params import body
-from segmentation.api.serializers import (
+from segmentation.api.common.params import body
+from segmentation.api.common.serializers.reviews import (
     ChangeCutSerializer,
     EventSerializer,
     InsertCutSerializer,

@@ -18,8 +18,8 @@ from rest_framework.response import Response
 from rest_framework.utils.urls import remove_query_param, replace_query_param
 from rest_framework.views import APIView
 
-from segmentation.api.params import bool_param, float_param, int_param
-from segmentation.api.serializers import NamedRefSerializer, UserRefSerializer
+from segmentation.api.common.params import bool_param, float_param, int_param
+from segmentation.api.common.serializers.base import NamedRefSerializer, UserRefSerializer
 from segmentation.errors import Invalid
 from segmentation.files import exports
 from segmentation.files.storage import read_take

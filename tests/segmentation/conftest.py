@@ -41,7 +41,7 @@ def similar_index_dir(settings, tmp_path):
 def answer_cache():
     """No built frames or signals answer outlives its test (ids and file names recur once a
     test's rows and media folder are gone)."""
-    from segmentation.api import heavy
+    from segmentation.api.common import heavy
 
     heavy.answer_cache().clear()
     yield heavy.answer_cache()

@@ -24,8 +24,8 @@ from rest_framework.response import Response
 from rest_framework.views import exception_handler as drf_exception_handler
 
 from motionlib.errors import MotionlibError, ParamError
-from segmentation.api.adjudication import StaleGoldSerializer, gold_body
-from segmentation.api.serializers import ReviewSerializer
+from segmentation.api.common.serializers.gold import StaleGoldSerializer, gold_body
+from segmentation.api.common.serializers.reviews import ReviewSerializer
 from segmentation.errors import (
     CutroomError,
     Missing,

@@ -20,7 +20,7 @@ from django.conf import settings
 from rest_framework.exceptions import ParseError
 from rest_framework.parsers import JSONParser
 
-from segmentation.api.params import INT_RANGE
+from segmentation.api.common.params import INT_RANGE
 from segmentation.errors import Invalid
 
 MAX_DEPTH = 16

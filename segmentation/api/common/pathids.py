@@ -7,7 +7,7 @@ a database driver that cannot hold the number.
 
 from django.http import JsonResponse
 
-from segmentation.api.params import INT_RANGE
+from segmentation.api.common.params import INT_RANGE
 
 
 class PathIdMiddleware:
