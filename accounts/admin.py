@@ -4,8 +4,8 @@ from django.contrib.auth.admin import UserAdmin
 from django.contrib.auth.forms import AdminUserCreationForm, UserChangeForm
 from django.core.exceptions import ValidationError
 
-from cutroom.accounts.models import ApiToken, LoginFailure
-from segmentation import usernames
+from accounts import usernames
+from accounts.models import ApiToken, LoginFailure
 
 
 class CheckedUsername:

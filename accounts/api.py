@@ -12,8 +12,8 @@ from rest_framework.permissions import AllowAny
 from rest_framework.response import Response
 from rest_framework.views import APIView
 
-from cutroom.accounts import passwords, throttle
-from cutroom.accounts.models import ApiToken
+from accounts import passwords, throttle
+from accounts.models import ApiToken
 
 
 class ApiTokenSerializer(serializers.ModelSerializer):

@@ -2,10 +2,10 @@ from django.apps import AppConfig
 
 
 class AccountsConfig(AppConfig):
-    name = "cutroom.accounts"
+    name = "accounts"
     label = "accounts"
     verbose_name = "Accounts"
     default_auto_field = "django.db.models.BigAutoField"
 
     def ready(self):
-        from cutroom.accounts import signals  # noqa: F401  (connects the receivers)
+        from accounts import signals  # noqa: F401  (connects the receivers)

@@ -1,7 +1,7 @@
 from rest_framework.authentication import TokenAuthentication
 from rest_framework.exceptions import AuthenticationFailed
 
-from cutroom.accounts.models import ApiToken
+from accounts.models import ApiToken
 
 
 class ExpiringTokenAuthentication(TokenAuthentication):

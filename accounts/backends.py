@@ -1,7 +1,7 @@
 from django.contrib.auth import get_user_model
 from django.contrib.auth.backends import ModelBackend
 
-from segmentation.usernames import find_user
+from accounts.usernames import find_user
 
 
 class UsernameBackend(ModelBackend):

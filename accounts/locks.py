@@ -13,7 +13,7 @@ from datetime import timedelta
 from django.db import transaction
 from django.utils import timezone
 
-from segmentation.models import ThrottleLock
+from accounts.models import ThrottleLock
 
 # A lock row unused this long is deleted (the next use makes it again).
 IDLE = timedelta(days=1)

@@ -8,9 +8,8 @@ from django.contrib.auth.signals import user_logged_in, user_login_failed
 from django.db.models.signals import post_save, pre_save
 from django.dispatch import receiver
 
-from cutroom.accounts import throttle
-from cutroom.accounts.models import ApiToken
-from segmentation import usernames
+from accounts import throttle, usernames
+from accounts.models import ApiToken
 
 
 @receiver(user_login_failed)

@@ -20,8 +20,8 @@ from django.conf import settings
 from django.db import transaction
 from django.utils import timezone
 
-from cutroom.accounts.models import LoginFailure, digest
-from segmentation import locks, usernames
+from accounts import locks, usernames
+from accounts.models import LoginFailure, digest
 
 # Longer typed usernames are counted by their first this many characters.
 MAX_TYPED = 20 * usernames.MAX_LENGTH

@@ -19,7 +19,7 @@ import unicodedata
 
 from django.contrib.auth import get_user_model
 
-from segmentation.models import UsernameKey
+from accounts.models import UsernameKey
 
 MAX_LENGTH = 150  # Django's own limit on usernames
 

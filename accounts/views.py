@@ -5,7 +5,7 @@ from functools import wraps
 
 from django.shortcuts import render
 
-from cutroom.accounts import throttle
+from accounts import throttle
 
 
 def throttled_sign_in(view):

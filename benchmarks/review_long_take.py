@@ -141,7 +141,7 @@ def synth_capture(project, user, seed, minutes, detect=False):
 def populate(args):
     from django.contrib.auth import get_user_model
 
-    from cutroom.accounts.models import ApiToken
+    from accounts.models import ApiToken
     from motionlib import synth
     from segmentation import services
     from segmentation.models import LibrarySegment

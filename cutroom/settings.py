@@ -61,7 +61,7 @@ INSTALLED_APPS = [
     "rest_framework",
     "drf_spectacular",
     "drf_spectacular_sidecar",  # Swagger UI served from /static/, not a CDN
-    "cutroom.accounts",
+    "accounts",
     "segmentation",
 ]
 
@@ -123,8 +123,13 @@ AUTH_PASSWORD_VALIDATORS = [
     {"NAME": "django.contrib.auth.password_validation.CommonPasswordValidator"},
     {"NAME": "django.contrib.auth.password_validation.NumericPasswordValidator"},
 ]
-# Sign-in finds the account by any spelling of its username (segmentation.usernames).
-AUTHENTICATION_BACKENDS = ["cutroom.accounts.backends.UsernameBackend"]
+# Sign-in finds the account by any spelling of its username (accounts.usernames).
+AUTHENTICATION_BACKENDS = [
+    "accounts.backends.UsernameBackend",
+    # The same backend's path before the accounts app left the project package, which
+    # sessions made then still name (it only finds their user).
+    "cutroom.accounts.backends.UsernameBackend",
+]
 # Behind a TLS-terminating proxy: trust its X-Forwarded-Proto and send cookies over HTTPS only.
 if envbool("BEHIND_TLS_PROXY", False):
     SECURE_PROXY_SSL_HEADER = ("HTTP_X_FORWARDED_PROTO", "https")
@@ -319,7 +324,7 @@ CELERY_BEAT_SCHEDULE = {
 REST_FRAMEWORK = {
     "DEFAULT_AUTHENTICATION_CLASSES": [
         # First, so an anonymous call gets 401 with "WWW-Authenticate: Token", not 403.
-        "cutroom.accounts.authentication.ExpiringTokenAuthentication",
+        "accounts.authentication.ExpiringTokenAuthentication",
         "rest_framework.authentication.SessionAuthentication",
     ],
     "DEFAULT_PERMISSION_CLASSES": ["rest_framework.permissions.IsAuthenticated"],

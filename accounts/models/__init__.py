@@ -1,4 +1,6 @@
-"""API tokens and the record of failed sign-ins.
+"""The accounts' records: API tokens and the record of failed sign-ins (here), the key of
+each account's username (``usernames``) and the named row locks that count attempts
+against a limit (``locks``).
 
 Both live in the database because every web process must see the same state: a token
 revoked through one process is refused by all, and failures counted by one process
@@ -12,6 +14,11 @@ from datetime import timedelta
 from django.conf import settings
 from django.db import models
 from django.utils import timezone
+
+from accounts.models.locks import ThrottleLock
+from accounts.models.usernames import UsernameKey
+
+__all__ = ["ApiToken", "LoginFailure", "ThrottleLock", "UsernameKey", "digest"]
 
 # A script that asks for a token on every run must not grow the table without bound.
 MAX_TOKENS_PER_USER = 20

@@ -1,4 +1,4 @@
-"""Named row locks: one row per key that counting against a limit locks (``segmentation.locks``)."""
+"""Named row locks: one row per key that counting against a limit locks (``accounts.locks``)."""
 
 from django.db import models
 from django.utils import timezone
@@ -15,6 +15,9 @@ class ThrottleLock(models.Model):
 
     key = models.CharField(max_length=64, unique=True)
     used_at = models.DateTimeField(default=timezone.now, db_index=True)
+
+    class Meta:
+        db_table = "segmentation_throttlelock"  # made when it was a model of that app
 
     def __str__(self):
         return f"{self.key[:8]}… used {self.used_at:%Y-%m-%d %H:%M:%S}"

@@ -1,4 +1,4 @@
-"""The key of each account's username (``segmentation.usernames``), stored and unique."""
+"""The key of each account's username (``accounts.usernames``), stored and unique."""
 
 from django.conf import settings
 from django.db import models
@@ -23,6 +23,9 @@ class UsernameKey(models.Model):
                                 primary_key=True, related_name="username_key")
     # NULL, not "": many accounts may have no key, and unique counts NULLs as distinct.
     digest = models.CharField(max_length=64, unique=True, null=True)  # noqa: DJ001
+
+    class Meta:
+        db_table = "segmentation_usernamekey"  # made when it was a model of that app
 
     def __str__(self):
         return f"{self.user_id}: {(self.digest or '-')[:8]}…"

@@ -10,7 +10,7 @@ import secrets
 from django.contrib.auth import get_user_model
 from django.db import IntegrityError, transaction
 
-from segmentation import usernames
+from accounts import usernames
 from segmentation.errors import Invalid, NotAllowed
 from segmentation.models import Membership, Project
 

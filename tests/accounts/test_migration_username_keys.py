@@ -17,7 +17,7 @@ class UsernameKeyMigrationTest(MigrationTestCase):
         self.apps = self.migrate(AFTER)
 
     def test_every_account_gets_a_row_and_the_oldest_of_a_key_holds_it(self):
-        from segmentation import usernames
+        from accounts import usernames
 
         keys = dict(self.apps.get_model("segmentation", "UsernameKey").objects
                     .values_list("user_id", "digest"))

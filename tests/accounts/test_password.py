@@ -4,7 +4,7 @@ and a new password ends the account's other sessions and revokes its API tokens.
 from django.contrib.auth import get_user_model
 from django.test import Client, override_settings
 
-from cutroom.accounts.models import ApiToken
+from accounts.models import ApiToken
 from tests.segmentation.base import BaseTestCase
 
 NEW = "quiet-harbour-lantern-42"

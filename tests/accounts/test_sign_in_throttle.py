@@ -6,7 +6,7 @@ from datetime import timedelta
 from django.contrib.auth import get_user_model
 from django.test import Client, override_settings
 
-from cutroom.accounts.models import LoginFailure
+from accounts.models import LoginFailure
 from tests.segmentation.base import BaseTestCase
 
 LIMITS = {

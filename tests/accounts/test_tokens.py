@@ -7,7 +7,7 @@ from django.test import Client, override_settings
 from django.utils import timezone
 from django.utils.dateparse import parse_datetime
 
-from cutroom.accounts.models import ApiToken, digest
+from accounts.models import ApiToken, digest
 from tests.segmentation.base import BaseTestCase
 
 

@@ -9,7 +9,7 @@ from django.core.management import CommandError, call_command
 from django.db import IntegrityError, transaction
 from django.test import Client, SimpleTestCase
 
-from segmentation import usernames
+from accounts import usernames
 from tests.segmentation.base import BaseTestCase
 
 

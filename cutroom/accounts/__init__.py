@@ -1,0 +1,1 @@
+"""Only the sign-in backend's former path (``backends``); the accounts app is ``accounts``."""
