@@ -13,7 +13,8 @@ from rest_framework.pagination import PageNumberPagination
 from rest_framework.response import Response
 
 from segmentation.api.common.params import bool_param, float_param, int_param
-from segmentation.api.segments import SegmentListView, SegmentSerializer
+from segmentation.api.common.serializers.library import SegmentSerializer
+from segmentation.api.segments import SegmentListView
 from segmentation.errors import Invalid
 from segmentation.models import LibrarySegment
 

@@ -7,8 +7,8 @@ from rest_framework import serializers
 from rest_framework.response import Response
 from rest_framework.views import APIView
 
-from segmentation.api.agreement import AgreementSerializer
 from segmentation.api.common.params import body
+from segmentation.api.common.serializers.agreement import AgreementSerializer
 from segmentation.api.common.serializers.base import (
     NamedRefSerializer,
     Text,

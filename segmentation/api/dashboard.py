@@ -8,7 +8,7 @@ from rest_framework.exceptions import PermissionDenied
 from rest_framework.response import Response
 from rest_framework.views import APIView
 
-from segmentation.api.agreement import LabelOverlapSerializer
+from segmentation.api.common.serializers.agreement import LabelOverlapSerializer
 from segmentation.api.common.serializers.base import NamedRefSerializer
 from segmentation.models import Review
 from segmentation.queries import dashboard

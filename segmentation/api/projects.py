@@ -13,13 +13,15 @@ from segmentation import services
 from segmentation.api.common.params import body
 from segmentation.api.common.serializers.captures import CutModelSerializer
 from segmentation.api.common.serializers.projects import (
+    INVITED,
+    InvitationSerializer,
+    InvitedSerializer,
     LabelSerializer,
     MemberSerializer,
     MeSerializer,
     MethodSerializer,
     ProjectSerializer,
 )
-from segmentation.api.invitations import InvitationSerializer, InvitedSerializer, invited_response
 from segmentation.files import storage
 from segmentation.models import Membership, Project
 from segmentation.services.team import can_create_accounts
@@ -125,3 +127,11 @@ class MethodsView(APIView):
     @extend_schema(responses=MethodSerializer(many=True))
     def get(self, request):
         return Response(MethodSerializer([cls.schema() for cls in list_segmenters()], many=True).data)
+
+
+def invited_response(invitation):
+    body = {
+        "detail": INVITED.format(username=invitation.username, role=invitation.role),
+        "invitation": invitation,
+    }
+    return Response(InvitedSerializer(body).data, status=202)

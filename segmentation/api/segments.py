@@ -10,8 +10,7 @@ Annotators see their own segments and gold segments; reviewers and admins everyb
 
 from django.http import HttpResponse, StreamingHttpResponse
 from django.urls import path
-from drf_spectacular.utils import OpenApiParameter, extend_schema, extend_schema_field
-from rest_framework import serializers
+from drf_spectacular.utils import OpenApiParameter, extend_schema
 from rest_framework.exceptions import NotFound
 from rest_framework.pagination import PageNumberPagination
 from rest_framework.response import Response
@@ -19,11 +18,10 @@ from rest_framework.utils.urls import remove_query_param, replace_query_param
 from rest_framework.views import APIView
 
 from segmentation.api.common.params import bool_param, float_param, int_param
-from segmentation.api.common.serializers.base import NamedRefSerializer, UserRefSerializer
+from segmentation.api.common.serializers.library import SegmentSerializer
 from segmentation.errors import Invalid
 from segmentation.files import exports
 from segmentation.files.storage import read_take
-from segmentation.models import LibrarySegment
 from segmentation.queries.access import segment_for
 from segmentation.queries.library import (
     ListQuery,
@@ -102,36 +100,6 @@ class SegmentPagination(PageNumberPagination):
         page = super().get_paginated_response_schema(schema)
         page["properties"]["count_capped"] = {"type": "boolean"}
         return page
-
-
-class SegmentSerializer(serializers.ModelSerializer):
-    capture = serializers.SerializerMethodField()
-    annotator = serializers.SerializerMethodField()
-    label = serializers.CharField(source="label.name")
-    color = serializers.SerializerMethodField()
-    gold = serializers.BooleanField(source="is_gold")
-    fps = serializers.FloatField(source="capture.fps")
-    export_formats = serializers.SerializerMethodField()
-
-    class Meta:
-        model = LibrarySegment
-        fields = ["id", "project", "capture", "review", "annotator", "gold", "superseded",
-                  "label", "color", "start", "stop", "fps", "duration", "agreement",
-                  "export_formats"]
-
-    @extend_schema_field(NamedRefSerializer)
-    def get_capture(self, s):
-        return {"id": s.capture_id, "name": s.capture.name}
-
-    @extend_schema_field(UserRefSerializer(allow_null=True))
-    def get_annotator(self, s):
-        return {"id": s.annotator_id, "username": s.annotator.username} if s.annotator_id else None
-
-    def get_export_formats(self, s) -> list[str]:
-        return exports.formats_for(s.capture)
-
-    def get_color(self, s) -> str:
-        return s.label.color if s.label_id else "#888888"
 
 
 # What a list row shows of a segment (``SegmentSerializer``'s fields), read as columns:

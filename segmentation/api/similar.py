@@ -9,7 +9,7 @@ from rest_framework.response import Response
 from rest_framework.views import APIView
 
 from segmentation.api.common.params import int_param
-from segmentation.api.segments import SegmentSerializer
+from segmentation.api.common.serializers.library import SegmentSerializer
 from segmentation.db.statements import Statement
 from segmentation.models import Capture, LibrarySegment
 from segmentation.models.library import STAFF, own

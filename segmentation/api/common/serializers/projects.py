@@ -1,11 +1,12 @@
-"""JSON shapes of projects (docs/api.md): projects, labels, members, the caller, methods."""
+"""JSON shapes of projects (docs/api.md): projects, labels, members, invitations, the
+caller, methods."""
 
 from drf_spectacular.utils import extend_schema_field
 from rest_framework import serializers
 
-from segmentation.api.common.serializers.base import Text
+from segmentation.api.common.serializers.base import DetailSerializer, Text
 from segmentation.limits import USERNAME_LENGTH, text_limit
-from segmentation.models import ROLES, Label, Project
+from segmentation.models import ROLES, Invitation, Label, Project
 
 
 class LabelSerializer(serializers.ModelSerializer):
@@ -81,3 +82,24 @@ class MemberSerializer(serializers.Serializer):
     username = Text(USERNAME_LENGTH, source="user.username", error_messages={
         "max_length": "must be 1 to {max_length} characters, got %(show_value)d"})
     role = serializers.ChoiceField(choices=ROLES)
+
+
+# What a project admin is told, whether or not an account has the username.
+INVITED = ("If an account is named {username!r}, it is invited as {role} and joins the "
+           "project once it accepts.")
+
+
+class InvitationSerializer(serializers.ModelSerializer):
+    """An invitation as the project's admins see it (the invitee's username as typed)."""
+
+    invited_by = serializers.CharField(source="invited_by.username", default=None)
+
+    class Meta:
+        model = Invitation
+        fields = ["id", "username", "role", "invited_by", "created_at", "expires_at"]
+
+
+class InvitedSerializer(DetailSerializer):
+    """What a project admin is told on adding a member who is not one yet."""
+
+    invitation = InvitationSerializer()
