@@ -62,7 +62,7 @@ def clips(seq, clip_frames):
 
 def indexed_pool(index, query, pool, min_lists):
     """The ``pool`` members the vector index proposes for ``query``, as the service asks
-    (``segmentation.similar.index.shortlist``: 4 x the shortlist of 20, at least 64)."""
+    (``segmentation.similar.candidates.shortlist``: 4 x the shortlist of 20, at least 64)."""
     allowed = set(pool)
     vector = query[:PROFILE_ROWS].astype(np.float32).ravel()
     count = max(4 * 20, 64)
