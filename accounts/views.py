@@ -1,9 +1,13 @@
-"""Sign-in pages: Django's login views behind the sign-in throttle."""
+"""Sign-in and sign-out pages: Django's login views behind the sign-in throttle, and a
+sign-out that only a POST with the CSRF token does."""
 
 import math
 from functools import wraps
 
-from django.shortcuts import render
+from django.conf import settings
+from django.contrib.auth import logout
+from django.shortcuts import redirect, render
+from django.views.decorators.http import require_POST
 
 from accounts import throttle
 
@@ -31,3 +35,11 @@ def too_many_attempts(request, wait):
     response = render(request, "registration/throttled.html", context, status=429)
     response["Retry-After"] = str(wait)
     return response
+
+
+@require_POST
+def logout_view(request):
+    # POST only (with the CSRF token, checked by the middleware): a link or an image on
+    # another page must not be able to sign anyone out.
+    logout(request)
+    return redirect(settings.LOGOUT_REDIRECT_URL)

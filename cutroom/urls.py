@@ -2,7 +2,7 @@ from django.contrib import admin
 from django.contrib.auth import views as auth_views
 from django.urls import include, path, re_path
 
-from accounts.views import throttled_sign_in
+from accounts.views import logout_view, throttled_sign_in
 from segmentation import views
 
 urlpatterns = [
@@ -11,7 +11,7 @@ urlpatterns = [
     path("api/", include("accounts.api")),
     path("api/", include("segmentation.api.urls")),
     path("login/", throttled_sign_in(auth_views.LoginView.as_view()), name="login"),
-    path("logout/", views.logout_view, name="logout"),
+    path("logout/", logout_view, name="logout"),
     path("favicon.ico", views.favicon),
     path("favicon.svg", views.favicon, name="favicon"),
     path("", views.app, name="app"),
