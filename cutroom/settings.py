@@ -61,7 +61,7 @@ INSTALLED_APPS = [
     "rest_framework",
     "drf_spectacular",
     "drf_spectacular_sidecar",  # Swagger UI served from /static/, not a CDN
-    "cutroom.accounts",
+    "accounts",
     "segmentation",
 ]
 
@@ -74,8 +74,8 @@ MIDDLEWARE = [
     "django.middleware.common.CommonMiddleware",
     "django.middleware.csrf.CsrfViewMiddleware",
     "django.contrib.auth.middleware.AuthenticationMiddleware",
-    "cutroom.accounts.middleware.new_password_first",
-    "segmentation.api.pathids.PathIdMiddleware",
+    "accounts.middleware.new_password_first",
+    "segmentation.api.common.pathids.PathIdMiddleware",
     "django.contrib.messages.middleware.MessageMiddleware",
     "django.middleware.clickjacking.XFrameOptionsMiddleware",
 ]
@@ -124,8 +124,13 @@ AUTH_PASSWORD_VALIDATORS = [
     {"NAME": "django.contrib.auth.password_validation.CommonPasswordValidator"},
     {"NAME": "django.contrib.auth.password_validation.NumericPasswordValidator"},
 ]
-# Sign-in finds the account by any spelling of its username (segmentation.usernames).
-AUTHENTICATION_BACKENDS = ["cutroom.accounts.backends.UsernameBackend"]
+# Sign-in finds the account by any spelling of its username (accounts.usernames).
+AUTHENTICATION_BACKENDS = [
+    "accounts.backends.UsernameBackend",
+    # The same backend's path before the accounts app left the project package, which
+    # sessions made then still name (it only finds their user).
+    "cutroom.accounts.backends.UsernameBackend",
+]
 # Behind a TLS-terminating proxy: trust its X-Forwarded-Proto and send cookies over HTTPS only.
 if envbool("BEHIND_TLS_PROXY", False):
     SECURE_PROXY_SSL_HEADER = ("HTTP_X_FORWARDED_PROTO", "https")
@@ -193,7 +198,7 @@ if DATABASES["default"]["ENGINE"] == "django.db.backends.sqlite3":
 
 MEDIA_URL = "/media/"
 MEDIA_ROOT = Path(os.environ.get("CUTROOM_MEDIA_ROOT") or VAR_DIR / "media")
-# The similar-clip vector indexes (segmentation.similar_index); rebuilt from the database.
+# The similar-clip vector indexes (segmentation.similar.index); rebuilt from the database.
 SIMILAR_INDEX_DIR = Path(os.environ.get("CUTROOM_SIMILAR_INDEX_DIR") or VAR_DIR / "similar")
 # Each web process reads an index's base (its profiles, 420 bytes a segment) into memory:
 # searching the shared memory-mapped file costs twice the time (docs/operations.md).
@@ -258,7 +263,7 @@ CUTROOM_MAX_EXPANSION = envint("CUTROOM_MAX_EXPANSION", None)
 CUTROOM_JOINT_FRAMES_PER_REQUEST = 250_000
 # Frames and signals answers: at most this many built at once per web process (0: no
 # limit), a waiting request gives up after CUTROOM_HEAVY_WAIT s (429); built answers kept
-# per process up to CUTROOM_ANSWER_CACHE_MB (0: none). See segmentation/api/heavy.py.
+# per process up to CUTROOM_ANSWER_CACHE_MB (0: none). See segmentation/api/common/heavy.py.
 CUTROOM_HEAVY_REQUESTS = envint("CUTROOM_HEAVY_REQUESTS", 1)
 CUTROOM_HEAVY_WAIT = envint("CUTROOM_HEAVY_WAIT", 60)
 CUTROOM_ANSWER_CACHE_MB = envint("CUTROOM_ANSWER_CACHE_MB", 64)
@@ -334,18 +339,18 @@ CELERY_BEAT_SCHEDULE = {
 REST_FRAMEWORK = {
     "DEFAULT_AUTHENTICATION_CLASSES": [
         # First, so an anonymous call gets 401 with "WWW-Authenticate: Token", not 403.
-        "cutroom.accounts.authentication.ExpiringTokenAuthentication",
+        "accounts.authentication.ExpiringTokenAuthentication",
         "rest_framework.authentication.SessionAuthentication",
     ],
     "DEFAULT_PERMISSION_CLASSES": ["rest_framework.permissions.IsAuthenticated"],
-    # Bounded nesting and numbers in every JSON body (see segmentation.api.parsers).
+    # Bounded nesting and numbers in every JSON body (see segmentation.api.common.parsers).
     "DEFAULT_PARSER_CLASSES": [
-        "segmentation.api.parsers.BoundedJSONParser",
+        "segmentation.api.common.parsers.BoundedJSONParser",
         "rest_framework.parsers.FormParser",
         "rest_framework.parsers.MultiPartParser",
     ],
     "DEFAULT_SCHEMA_CLASS": "drf_spectacular.openapi.AutoSchema",
-    "EXCEPTION_HANDLER": "segmentation.api.errors.exception_handler",
+    "EXCEPTION_HANDLER": "segmentation.api.common.errors.exception_handler",
     "UNAUTHENTICATED_USER": "django.contrib.auth.models.AnonymousUser",
 }
 SPECTACULAR_SETTINGS = {
@@ -361,13 +366,13 @@ SPECTACULAR_SETTINGS = {
     "COMPONENT_SPLIT_REQUEST": True,
     "POSTPROCESSING_HOOKS": [
         "drf_spectacular.hooks.postprocess_schema_enums",
-        "segmentation.api.schema.answers_have_every_field",
+        "segmentation.api.common.schema.answers_have_every_field",
     ],
     "ENUM_NAME_OVERRIDES": {
         "JobStatusEnum": "segmentation.models.JOB_STATUSES",
         "ReviewStatusEnum": "segmentation.models.Review.STATUSES",
         "RoleEnum": "segmentation.models.ROLES",
-        "ReviewStateEnum": "segmentation.api.serializers.REVIEW_STATES",
+        "ReviewStateEnum": "segmentation.api.common.serializers.reviews.REVIEW_STATES",
         "QueueStateEnum": "segmentation.api.assignments.QUEUE_STATES",
         "CaptureStateEnum": "segmentation.api.dashboard.CAPTURE_STATES",
     },

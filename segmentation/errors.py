@@ -1,6 +1,6 @@
 """The service's domain errors, all under :class:`CutroomError`.
 
-``segmentation.api.errors`` turns them (and motionlib's ``MotionlibError``) into HTTP, and
+``segmentation.api.common.errors`` turns them (and motionlib's ``MotionlibError``) into HTTP, and
 the job runner's guard (``services.jobs.guard``) stores their message on the failed job. Anything
 else raised is a bug: both boundaries log it with its traceback and answer with an
 internal error and a reference to quote, never with the exception's text as the user's fault.
@@ -86,6 +86,11 @@ class StaleGold(CutroomError):
 
 class NotAllowed(CutroomError, PermissionError):
     """The caller's role does not allow the action: a 403 whose text says who may."""
+
+
+class Missing(CutroomError, LookupError):
+    """No such record among those the caller may see: a 404 (never a 403, which would say
+    that it exists)."""
 
 
 def internal_error(what, logger=log):

@@ -22,9 +22,10 @@ from celery.signals import worker_init, worker_process_init, worker_ready
 from django.conf import settings
 from django.db import connection
 
-from segmentation import similar_index, suggestions, workers
+from segmentation import workers
 from segmentation.services import adaptation, captures, health, jobs, library
 from segmentation.services.convert import CONVERT
+from segmentation.similar import suggestions, updates
 
 log = logging.getLogger(__name__)
 
@@ -190,7 +191,7 @@ def describe_library(capture_id):
 @shared_task(base=ContainedTask)
 def update_similar_index(project_id):
     """Bring a project's similar-clip index in step with its library rows."""
-    similar_index.update(project_id)
+    updates.update(project_id)
 
 
 @shared_task(base=ContainedTask)

@@ -1,12 +1,11 @@
-"""Pages outside the API: the single-page app's index, login and logout."""
+"""Pages outside the API: the single-page app's index and its icon (signing in and out is
+``accounts.views``)."""
 
 from django.conf import settings
-from django.contrib.auth import logout
 from django.contrib.auth.decorators import login_required
 from django.http import HttpResponse
-from django.shortcuts import redirect, render
+from django.shortcuts import render
 from django.views.decorators.csrf import ensure_csrf_cookie
-from django.views.decorators.http import require_POST
 
 
 @login_required
@@ -18,14 +17,6 @@ def app(request, path=""):
         context = {"dist": settings.FRONTEND_DIST}
         return render(request, "segmentation/not_built.html", context, status=503)
     return HttpResponse(index.read_text(encoding="utf-8"))
-
-
-@require_POST
-def logout_view(request):
-    # POST only (with the CSRF token, checked by the middleware): a link or an image on
-    # another page must not be able to sign anyone out.
-    logout(request)
-    return redirect(settings.LOGOUT_REDIRECT_URL)
 
 
 # The app's icon (a cut between two segments), served at the address browsers ask for

@@ -3,7 +3,7 @@ in the folder's own conftest.py."""
 
 import pytest
 
-from segmentation.shared_data import data_dir
+from motionlib.shared_data import data_dir
 from tests.fbx.files import made_fbx  # noqa: F401  (the FBX files Blender writes for tests)
 
 SHARED_DATA = data_dir()

@@ -1,5 +1,6 @@
-"""The import graph of the ``cutroom`` project package and the ``segmentation`` app has no
-cycle, and the services do not depend on Celery.
+"""The import graph of the ``cutroom`` project package, the ``segmentation`` app and the
+``accounts`` app has no cycle, every import goes down the app's layers, and the services do
+not depend on Celery.
 
 The graph is read from the source with ``ast``, without importing anything. An edge goes
 from a module to each module of the two packages it imports:
@@ -13,11 +14,15 @@ from a module to each module of the two packages it imports:
   submodules would otherwise form a cycle with each of them;
 - ``include("dotted.module")`` in a URL configuration is an edge: Django imports it.
 
-Cycles are looked for at three granularities: modules; the app's parts (``api``,
-``services``, ``models``, ``management``, and each other module of ``segmentation`` on
-its own; ``cutroom.accounts``); and the two packages themselves, which may depend on each
-other in one direction only (the project mounts the app, so the app never imports the
-project).
+Cycles are looked for at three granularities: modules; the app's parts (``PARTS``, and
+each other module of ``segmentation`` on its own); and the three packages themselves, which
+depend on each other in one direction only: the project mounts the apps, and the domain
+app uses accounts, so neither app imports the project and accounts imports neither.
+
+Within ``segmentation`` the parts sit in ``LAYERS`` (docs/architecture.md): a module
+imports its own layer and those below, never one above, so views call reads and
+workflows, those use the similar-clip and file subsystems and the models, and the models
+use only the database machinery beneath them. Reads never call a workflow.
 """
 
 import ast
@@ -27,9 +32,22 @@ from pathlib import Path
 from tests.graphs import cycles, package_modules, private_uses
 
 ROOT = Path(__file__).resolve().parent.parent
-PACKAGES = ("cutroom", "segmentation")
-PARTS = ("segmentation.api", "segmentation.services", "segmentation.models",
-         "segmentation.management", "cutroom.accounts")
+PACKAGES = ("cutroom", "segmentation", "accounts")
+PARTS = ("segmentation.api.common", "segmentation.api", "segmentation.queries",
+         "segmentation.services", "segmentation.similar", "segmentation.files",
+         "segmentation.models", "segmentation.db", "segmentation.management", "accounts")
+# Top first. A module's layer is that of the longest name here that it is or is inside.
+LAYERS = (
+    ("entry points", ("segmentation.api", "segmentation.tasks", "segmentation.views",
+                      "segmentation.admin", "segmentation.apps", "segmentation.management")),
+    ("API plumbing", ("segmentation.api.common",)),
+    ("reads and workflows", ("segmentation.queries", "segmentation.services")),
+    ("subsystems", ("segmentation.similar", "segmentation.files")),
+    ("models", ("segmentation.models",)),
+    ("machinery", ("segmentation.db", "segmentation.errors", "segmentation.limits",
+                   "segmentation.workers", "segmentation")),
+    ("accounts", ("accounts",)),
+)
 
 
 def modules():
@@ -95,6 +113,28 @@ def part(module):
     return next((p for p in PARTS if module == p or module.startswith(p + ".")), module)
 
 
+def inside(module, prefix):
+    return module == prefix or module.startswith(prefix + ".")
+
+
+def layer(module):
+    """The index in ``LAYERS`` of a module of the apps (None: the project's)."""
+    found = [(len(prefix), i) for i, (_, prefixes) in enumerate(LAYERS)
+             for prefix in prefixes if inside(module, prefix)]
+    return max(found)[1] if found else None
+
+
+def upward(graph):
+    """The imports that go up the layers, as "module (layer) -> target (layer)"."""
+    found = []
+    for module, edges in sorted(graph.items()):
+        for target in sorted(edges):
+            here, there = layer(module), layer(target)
+            if here is not None and there is not None and there < here:
+                found.append(f"{module} ({LAYERS[here][0]}) -> {target} ({LAYERS[there][0]})")
+    return found
+
+
 def describe(graph, found):
     return "; ".join(
         " ".join(f"{m} -> {sorted(graph[m] & set(component))}" for m in component)
@@ -114,18 +154,56 @@ def test_the_apps_parts_import_each_other_in_one_direction_only():
     assert found == [], describe(graph, found)
 
 
-def test_the_app_never_imports_the_project():
+def test_the_apps_never_import_the_project_and_accounts_never_imports_the_domain():
     graph = import_graph()
     packages = coarsened(graph, lambda module: module.partition(".")[0])
-    assert "segmentation" in packages["cutroom"]  # the project mounts the app
-    back = {m: sorted(t for t in edges if t.startswith("cutroom"))
-            for m, edges in graph.items() if m.startswith("segmentation")}
-    assert cycles(packages) == [], {m: t for m, t in back.items() if t}
+    assert {"segmentation", "accounts"} <= packages["cutroom"]  # the project mounts the apps
+    assert "accounts" in packages["segmentation"]  # the domain uses accounts
+    assert packages["accounts"] == set(), {
+        m: sorted(edges) for m, edges in graph.items() if inside(m, "accounts") and edges
+        and not all(inside(t, "accounts") for t in edges)}
+    assert cycles(packages) == []
+
+
+def test_every_import_goes_down_the_apps_layers():
+    assert upward(import_graph()) == []
+
+
+def test_reads_never_call_a_workflow():
+    graph = import_graph()
+    assert [f"{m} -> {t}" for m, edges in sorted(graph.items()) if inside(m, "segmentation.queries")
+            for t in sorted(edges) if inside(t, "segmentation.services")] == []
+
+
+def test_the_error_translator_imports_no_view():
+    graph = import_graph()
+    views = {m for m in graph if part(m) == "segmentation.api"}
+    assert graph["segmentation.api.common.errors"] & views == set()
+    assert "segmentation.api.common.serializers.gold" in graph["segmentation.api.common.errors"]
+
+
+def test_no_view_imports_another_view():
+    """What two views share (access checks, serializers) is in queries/ or api/common/."""
+    graph = import_graph()
+    views = {m for m in graph if part(m) == "segmentation.api"} - {"segmentation.api",
+                                                                    "segmentation.api.urls"}
+    assert {m: sorted(graph[m] & views) for m in views if graph[m] & views} == {}
+
+
+def test_it_finds_an_upward_import():
+    graph = {"segmentation.models.captures": {"segmentation.services.jobs"},
+             "segmentation.services.jobs": {"segmentation.models"},
+             "segmentation.api.common.errors": {"segmentation.api.captures"}}
+    assert upward(graph) == [
+        "segmentation.api.common.errors (API plumbing) -> segmentation.api.captures (entry points)",
+        "segmentation.models.captures (models) -> segmentation.services.jobs (reads and workflows)",
+    ]
 
 
 def test_the_graph_sees_imports_inside_functions_and_url_includes():
     graph = import_graph()
     assert "segmentation.models" in graph["cutroom.lanes"]  # inside capture_frames
+    assert "accounts.api" in graph["cutroom.urls"]  # include("accounts.api")
     assert "segmentation.api.urls" in graph["cutroom.urls"]  # include("segmentation.api.urls")
     assert "segmentation.services.jobs" in graph["segmentation.services.captures"]
 

@@ -25,3 +25,11 @@ def kept_name(name: str) -> str:
     """``name`` of something a benchmark builds once and keeps (a database), made the
     revision's own when the run is on another revision."""
     return f"{name}_at_{REVISION}" if REVISION else name
+
+
+def data_dir() -> Path:
+    """The shared data folder: ``$CUTROOM_BENCH_DATA`` if set, else ``shared/data`` beside
+    this checkout (the same rule as ``motionlib.shared_data``, kept here so a run against
+    an older revision, whose product keeps that function elsewhere, finds the data too)."""
+    default = PACKAGE.parent / ".." / "shared" / "data"
+    return Path(os.environ.get("CUTROOM_BENCH_DATA", default)).resolve()

@@ -86,7 +86,7 @@ def launcher(revision: Revision | None):
     if revision is None:
         yield PACKAGE.parent, env
         return
-    from segmentation.shared_data import data_dir
+    from benchmarks.harness import data_dir
 
     # The child's first import path entry is its working folder: one holding only this
     # checkout's benchmarks package, so that the worktree's own benchmarks stay unseen.

@@ -5,7 +5,7 @@ CMU 13_29 as the FBX Blender wrote (``../shared/data/fbx/13_29_blender.fbx``) an
 came from (``../shared/data/cmu/bvh/13_29.bvh``) are uploaded to a temporary installation on
 the embedded default (SQLite), converted (FBX) and ingested by the service's own task
 functions, in this process. Then each is read as the service reads a take for detection,
-review, exports and previews (``segmentation.storage.read_take``), and the FBX is also read
+review, exports and previews (``segmentation.files.storage.read_take``), and the FBX is also read
 the way it was read before the conversion kept its take: by Blender's importer, with Blender
 already running (its start-up is paid once per process and stated apart). The take the
 service reads back is checked equal to Blender's read.
@@ -24,8 +24,8 @@ from pathlib import Path
 
 import numpy as np
 
+from benchmarks.harness import data_dir
 from benchmarks.harness.service import start_django
-from segmentation.shared_data import data_dir
 
 
 def parse_args():
@@ -85,7 +85,7 @@ def measure(args, fbx, bvh):
     import motionlib
     from motionlib.io import blender as blender_module
     from segmentation import services
-    from segmentation.storage import read_take
+    from segmentation.files.storage import read_take
 
     started = time.perf_counter()
     blender_module.shared().start()

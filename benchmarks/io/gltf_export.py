@@ -39,9 +39,9 @@ from pathlib import Path
 
 import numpy as np
 
+from benchmarks.harness import data_dir
 from benchmarks.harness.machine import machine
 from benchmarks.harness.service import in_scratch_installation
-from segmentation.shared_data import data_dir
 
 CLIPS_PER_CAPTURE, CLIP_FRAMES, CLIP_STEP = 27, 240, 160  # the last ends on 4401 < 4593
 TARGET_ONE_S, TARGET_ZIP_S = 1.0, 15.0

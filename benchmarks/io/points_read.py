@@ -31,8 +31,8 @@ from pathlib import Path
 import numpy as np
 
 import motionlib
+from benchmarks.harness import data_dir
 from motionlib.io.c3dfile import write_c3d
-from segmentation.shared_data import data_dir
 
 DEFAULT_DATA = data_dir()
 HDM05 = Path("points/hdm05/HDM_bd_05-01_01_120.c3d")

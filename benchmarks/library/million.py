@@ -45,8 +45,8 @@ def base_descriptors(rng, per_take=400):
     """(n_bases,) take index and (n_bases, 35, 35) descriptors of random spans of real and
     synthetic takes."""
     import motionlib
+    from benchmarks.harness import data_dir
     from motionlib import similarity, synth
-    from segmentation.shared_data import data_dir
 
     takes, data = [], data_dir()
     for seq, subject in CMU:

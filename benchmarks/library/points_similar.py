@@ -7,7 +7,7 @@ label is then named from the others, as the service does:
 - ``nearest``: the label of the single most similar segment (``rank_similar``, k = 1), what
   "find similar" shows first;
 - ``vote of 5``: the label with most votes among the 5 most similar, a vote weighing 1 / d²
-  (``segmentation.suggestions.vote``), what a label suggestion is.
+  (``segmentation.similar.suggestions.vote``), what a label suggestion is.
 
 The pool is every segment of the *other* runs (leave one run out) or of the *other* subject
 (leave one subject out: the settings of one performer never choose another's). ``chance`` is
@@ -27,8 +27,8 @@ from pathlib import Path
 import numpy as np
 
 import motionlib
+from benchmarks.harness import data_dir
 from motionlib import similarity
-from segmentation.shared_data import data_dir
 
 NEIGHBOURS = 5
 

@@ -29,6 +29,7 @@ from pathlib import Path
 import numpy as np
 
 import motionlib
+from benchmarks.harness import data_dir
 from motionlib.similarity import (
     PROFILE_ROWS,
     body_scale,
@@ -36,7 +37,6 @@ from motionlib.similarity import (
     segment_descriptor,
 )
 from motionlib.vector_index import VectorIndex, build
-from segmentation.shared_data import data_dir
 
 DATA = data_dir()
 
@@ -68,7 +68,7 @@ def lists(index, count, nprobe):
 
 def indexed_pool(index, query, pool, nprobe):
     """The ``pool`` members the vector index proposes for ``query``, as the service asks
-    (``segmentation.similar_index.shortlist``: 4 x the shortlist of 20, at least 64)."""
+    (``segmentation.similar.candidates.shortlist``: 4 x the shortlist of 20, at least 64)."""
     allowed = set(pool)
     vector = query[:PROFILE_ROWS].astype(np.float32).ravel()
     count = max(4 * 20, 64)

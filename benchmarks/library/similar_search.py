@@ -53,6 +53,7 @@ import platform
 import statistics
 import time
 from contextlib import contextmanager
+from types import SimpleNamespace
 from unittest import mock
 
 import numpy as np
@@ -86,7 +87,7 @@ def exact_top(segment, ids, profiles, spans, k=10):
     (as |x|^2 - 2 x.q + |q|^2) pick the 2,000 nearest; those are measured again exactly as
     the service measures (float64 differences), far more than the 20 the ranking needs."""
     from motionlib import similarity
-    from segmentation import descriptors, search
+    from segmentation.similar import descriptors, search
 
     query = segment.descriptor_array()
     q = query[:similarity.PROFILE_ROWS].ravel()
@@ -181,6 +182,22 @@ def ensure(module, project, folder):
         return manifest, time.perf_counter() - started, "built" if fresh else "brought in step"
 
 
+def similar_steps():
+    """(steps, scheduler, opener): the similar index's steps under one name, the module
+    whose ``schedule_update`` the service calls and the one whose ``open_index`` it calls — one module in revisions before
+    ``segmentation/similar/``, the package's modules since."""
+    try:
+        from segmentation.similar import files, index, updates
+    except ImportError:  # an older revision (--against)
+        from segmentation import similar_index
+        return similar_index, similar_index, similar_index
+    from motionlib import vector_index
+    steps = SimpleNamespace(
+        build=updates.build, update=updates.update, manifest_path=files.manifest_path,
+        read_manifest=files.read_manifest, forget=index.forget, vector_index=vector_index)
+    return steps, updates, index
+
+
 def index_kind(similar_index, manifest):
     """The service's index as the run's header describes it: faiss (with its probe count)
     or, in revisions before it, the numpy inverted file (with its probe share)."""
@@ -233,8 +250,9 @@ def run():
     # Set up as a web server process is (cutroom/wsgi.py: the URLconf loaded, then
     # gc.freeze()), so no full collection rescans the start-up objects inside a request.
     import cutroom.wsgi  # noqa: F401
-    from segmentation import similar_index
     from segmentation.models import Capture, LibrarySegment
+
+    similar_index, scheduler, opener = similar_steps()
 
     if args.nprobe:
         similar_index.vector_index.NPROBE = args.nprobe
@@ -292,7 +310,7 @@ def run():
                 cpu[title].append(CPU[-1])
                 recall[title].append(len(set(found) & set(truth)) / len(truth))
             if n < args.old_queries:
-                with index_dir(out / "none"), mock.patch.object(similar_index, "open_index",
+                with index_dir(out / "none"), mock.patch.object(opener, "open_index",
                                                                lambda project_id: None):
                     found, ms = call_view(user, pk)
                 rows["no index (20,000 recent)"].append(ms)
@@ -337,7 +355,7 @@ def run():
                            profile=s.profile) for i, s in enumerate(source))
         try:
             waiting = {p: [] for p in paths}
-            with mock.patch.object(similar_index, "schedule_update", lambda project_id: None):
+            with mock.patch.object(scheduler, "schedule_update", lambda project_id: None):
                 for pk in picks[:40]:
                     for title, view in paths.items():
                         with index_dir(folders[title]):

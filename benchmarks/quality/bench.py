@@ -57,11 +57,10 @@ from benchmarks.quality.tables import (
 )
 from benchmarks.quality.tried import detector
 from benchmarks.quality.unmatched import unmatched_choice_check, unmatched_guard_check
-from motionlib import adapt, metrics
+from motionlib import adapt, metrics, shared_data
 from motionlib.errors import CaptureError
 from motionlib.segmenters import list_segmenters
 from motionlib.segmenters.default import take_features
-from segmentation import shared_data
 
 RUPTURES_PENALTY = 3.0
 

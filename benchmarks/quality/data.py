@@ -1,6 +1,6 @@
 """The labelled real CMU takes the quality benchmark scores (and the detector's tests read).
 
-Every labelled take in the shared data layout (``segmentation.shared_data.data_dir()``; see
+Every labelled take in the shared data layout (``motionlib.shared_data.data_dir()``; see
 its README) is found, whatever its name:
 
 - ``labels/mocap6/segments/<take>.csv`` (runs of 10 fps blocks, AMC frames 1-based) and
@@ -24,8 +24,8 @@ from pathlib import Path
 
 import numpy as np
 
+from benchmarks.harness import data_dir
 from motionlib.errors import MotionlibError
-from segmentation.shared_data import data_dir
 
 
 class LabelError(MotionlibError):

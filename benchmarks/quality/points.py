@@ -42,11 +42,11 @@ from pathlib import Path
 import numpy as np
 
 import motionlib
+from benchmarks.harness import data_dir
 from motionlib import features, markersets, metrics
 from motionlib.errors import MotionlibError
 from motionlib.points import filled
 from motionlib.segmenters import list_segmenters
-from segmentation.shared_data import data_dir
 
 DEFAULT_DATA = data_dir()
 RUPTURES_PENALTY = 3.0

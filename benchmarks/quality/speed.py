@@ -32,7 +32,7 @@ import time
 import tracemalloc
 from pathlib import Path
 
-from segmentation.shared_data import data_dir
+from benchmarks.harness import data_dir
 
 TARGET_MS, TARGET_SPEEDUP, TARGET_MEMORY = 40.0, 10.0, 5.0
 

@@ -66,7 +66,7 @@ def seed(n_captures):
     (token key, id of the first project)."""
     from django.contrib.auth import get_user_model
 
-    from cutroom.accounts.models import ApiToken
+    from accounts.models import ApiToken
     from segmentation import services
 
     users = get_user_model().objects

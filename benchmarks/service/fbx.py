@@ -27,9 +27,8 @@ from pathlib import Path
 
 import numpy as np
 
-from benchmarks.harness import REPO
+from benchmarks.harness import REPO, data_dir
 from benchmarks.harness.service import start_django, stop
-from segmentation.shared_data import data_dir
 
 DEFAULT_DATA = data_dir()
 

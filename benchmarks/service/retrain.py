@@ -6,7 +6,7 @@ each with a submitted review whose kept cuts are the true boundaries. The traini
 (`segmentation.services.adaptation.train_project_model`, what the Celery task runs once it
 has claimed the row) is timed end to end:
 
-1. the first training: parses every original (then cached, `segmentation.takecache`) and
+1. the first training: parses every original (then cached, `segmentation.files.takecache`) and
    analyses every take, storing what it learnt from each (its study);
 2. a retraining with nothing changed: every study is stored;
 3. retrainings after one more submitted review (each on another take, with one cut the
@@ -105,7 +105,7 @@ def time_fresh_fit(project):
 
 def time_stored_fit(project):
     """CPU seconds of the training's fit alone, from the stored studies (no gate)."""
-    from segmentation import takecache
+    from segmentation.files import takecache
     from segmentation.models import Capture
     from segmentation.services import adaptation
 

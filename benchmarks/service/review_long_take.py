@@ -113,7 +113,7 @@ def synth_capture(project, user, seed, minutes, detect=False):
     import motionlib
     from motionlib import synth
     from motionlib.segmenters import get_segmenter
-    from segmentation import storage
+    from segmentation.files import storage
     from segmentation.models import Capture, DetectionRun
 
     take, truth = synth.generate(seed=seed, fps=120.0, duration=minutes * 60)
@@ -143,7 +143,7 @@ def synth_capture(project, user, seed, minutes, detect=False):
 def populate(args):
     from django.contrib.auth import get_user_model
 
-    from cutroom.accounts.models import ApiToken
+    from accounts.models import ApiToken
     from motionlib import synth
     from segmentation import services
     from segmentation.models import LibrarySegment
@@ -221,7 +221,7 @@ def old_library():
 def time_old_path(data, repeats):
     from django.core.cache import cache
 
-    from segmentation.api.serializers import ReviewSerializer
+    from segmentation.api.common.serializers.reviews import ReviewSerializer
     from segmentation.models import Review
 
     old = old_library()
@@ -561,7 +561,7 @@ def browser_main(args, var):
 
 
 def storage_signals(capture):
-    from segmentation import storage
+    from segmentation.files import storage
 
     run = capture.latest_finished_run()
     return storage.load_npz(run.signals) if run and run.signals else {}

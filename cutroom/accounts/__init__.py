@@ -1,1 +1,1 @@
-"""Accounts: signing in (throttled), API tokens that expire and can be revoked."""
+"""Only the sign-in backend's former path (``backends``); the accounts app is ``accounts``."""

@@ -1,25 +1,15 @@
-from django.contrib.auth import get_user_model
-from django.contrib.auth.backends import ModelBackend
+"""The sign-in backend under the path it had while the accounts app lived in the project
+package.
 
-from segmentation.usernames import find_user
+A session stores the dotted path of the backend that signed it in, and Django keeps the
+session only while that path is in ``AUTHENTICATION_BACKENDS``: without this name, every
+session made before the move would end at once. It finds the user of such a session and
+signs no one in itself (``accounts.backends.UsernameBackend`` does).
+"""
+
+from accounts.backends import UsernameBackend as CurrentBackend
 
 
-class UsernameBackend(ModelBackend):
-    """Django's password check, finding the account by any spelling of its username
-    (``usernames.key``): the sign-in throttle counts by that key, so what it locks is
-    exactly what could sign in."""
-
+class UsernameBackend(CurrentBackend):
     def authenticate(self, request, username=None, password=None, **kwargs):
-        users = get_user_model()
-        if username is None:
-            username = kwargs.get(users.USERNAME_FIELD)
-        if not isinstance(username, str) or password is None:
-            return None
-        user = find_user(username)
-        if user is None:
-            # Hash anyway, so the answer takes as long whether or not the account exists.
-            users().set_password(password)
-            return None
-        if user.check_password(password) and self.user_can_authenticate(user):
-            return user
         return None

@@ -7,37 +7,25 @@ from rest_framework import serializers
 from rest_framework.response import Response
 from rest_framework.views import APIView
 
-from segmentation import agreement
-from segmentation.api.agreement import AgreementSerializer, staff_capture
-from segmentation.api.params import body
-from segmentation.api.serializers import (
-    DetailSerializer,
+from segmentation.api.common.params import body
+from segmentation.api.common.serializers.agreement import AgreementSerializer
+from segmentation.api.common.serializers.base import (
     NamedRefSerializer,
     Text,
     UserRefSerializer,
 )
+from segmentation.api.common.serializers.gold import (
+    GoldBodySerializer,
+    SpanSerializer,
+    StaleGoldSerializer,
+    gold_body,
+)
 from segmentation.errors import Invalid
 from segmentation.limits import text_limit
 from segmentation.models import Adjudication, Label, Review
+from segmentation.queries.access import staff_capture
+from segmentation.services import agreement
 from segmentation.services.gold import do_save_gold
-
-
-class SpanSerializer(serializers.Serializer):
-    start = serializers.IntegerField()
-    stop = serializers.IntegerField()
-    label = serializers.CharField(allow_null=True)
-
-
-class GoldBodySerializer(serializers.Serializer):
-    """The capture's gold version as stored."""
-
-    version = serializers.IntegerField()
-    cuts = serializers.ListField(child=serializers.IntegerField())
-    labels = serializers.ListField(child=serializers.CharField(allow_null=True))
-    segments = SpanSerializer(many=True)
-    adjudicator = serializers.CharField(allow_null=True)
-    source_review = serializers.IntegerField(allow_null=True)
-    updated_at = serializers.DateTimeField()
 
 
 class AdjudicationCaptureSerializer(NamedRefSerializer):
@@ -71,29 +59,11 @@ class AdjudicationSerializer(serializers.Serializer):
     agreement = AgreementSerializer()
 
 
-class StaleGoldSerializer(DetailSerializer):
-    """409: the gold version changed since the one the edit was based on."""
-
-    gold = GoldBodySerializer(allow_null=True)
-
-
 class GoldSerializer(serializers.Serializer):
     cuts = serializers.ListField(child=serializers.IntegerField())
     labels = serializers.ListField(child=Text(text_limit(Label, "name"), allow_null=True))
     version = serializers.IntegerField(min_value=0)
     source_review = serializers.IntegerField(required=False, allow_null=True)
-
-
-def gold_body(gold):
-    if gold is None:
-        return None
-    segments = gold.segments()
-    return {
-        "version": gold.version, "cuts": gold.cuts, "labels": [c for _, _, c in segments],
-        "segments": [{"start": a, "stop": b, "label": c} for a, b, c in segments],
-        "adjudicator": gold.adjudicator.username if gold.adjudicator else None,
-        "source_review": gold.source_review_id, "updated_at": gold.updated_at,
-    }
 
 
 def adjudication_body(capture):

@@ -3,72 +3,13 @@ agree (reviewers and admins; an annotator is told why not, an outsider gets 404)
 
 from django.urls import path
 from drf_spectacular.utils import OpenApiParameter, extend_schema
-from rest_framework import serializers
-from rest_framework.exceptions import PermissionDenied
 from rest_framework.response import Response
 from rest_framework.views import APIView
 
-from segmentation import agreement
-from segmentation.api.captures import capture_for
-from segmentation.api.params import float_param
-from segmentation.api.serializers import UserRefSerializer
-
-
-class AgreementReviewSerializer(serializers.Serializer):
-    id = serializers.IntegerField()
-    annotator = UserRefSerializer()
-    cuts = serializers.IntegerField(help_text="How many cuts it keeps")
-    submitted_at = serializers.DateTimeField(allow_null=True)
-
-
-class PairSideSerializer(serializers.Serializer):
-    review = serializers.IntegerField()
-    annotator = serializers.CharField()
-
-
-class PairSerializer(serializers.Serializer):
-    a = PairSideSerializer()
-    b = PairSideSerializer()
-    precision = serializers.FloatField(allow_null=True)
-    recall = serializers.FloatField(allow_null=True)
-    f1 = serializers.FloatField(allow_null=True)
-    matched = serializers.IntegerField()
-    kappa = serializers.FloatField(allow_null=True)
-
-
-class LabelMeasureSerializer(serializers.Serializer):
-    method = serializers.ChoiceField(choices=["cohen_kappa", "krippendorff_alpha"], allow_null=True)
-    value = serializers.FloatField(allow_null=True)
-
-
-class LabelOverlapSerializer(serializers.Serializer):
-    label = serializers.CharField()
-    overlap = serializers.FloatField(allow_null=True)
-    frames = serializers.IntegerField()
-
-
-class AgreementSerializer(serializers.Serializer):
-    """Agreement of a capture's submitted reviews (measures null where undefined)."""
-
-    capture = serializers.IntegerField()
-    tolerance_s = serializers.FloatField()
-    n_reviews = serializers.IntegerField()
-    reviews = AgreementReviewSerializer(many=True)
-    pairs = PairSerializer(many=True)
-    boundary_f1 = serializers.FloatField(allow_null=True)
-    labels = LabelMeasureSerializer()
-    alpha = serializers.FloatField(allow_null=True)
-    per_label = LabelOverlapSerializer(many=True)
-
-
-def staff_capture(user, pk):
-    """A capture whose project the user reviews or administers; 404 for outsiders, 403
-    (saying why) for an annotator, who sees the capture anyway."""
-    capture = capture_for(user, pk)
-    if not capture.project.can_see_all_reviews(user):
-        raise PermissionDenied("Only the project's reviewers and admins see agreement and "
-                               "adjudicate; you annotate in this project.")
-    return capture
+from segmentation.api.common.params import float_param
+from segmentation.api.common.serializers.agreement import AgreementSerializer
+from segmentation.queries.access import staff_capture
+from segmentation.services import agreement
 
 
 class AgreementView(APIView):

@@ -10,12 +10,12 @@ from rest_framework.exceptions import PermissionDenied
 from rest_framework.response import Response
 from rest_framework.views import APIView
 
-from segmentation.api.captures import capture_for
-from segmentation.api.params import body, int_param
-from segmentation.api.projects import project_for
-from segmentation.api.serializers import NamedRefSerializer, ReviewSerializer, Text
+from segmentation.api.common.params import body, int_param
+from segmentation.api.common.serializers.base import NamedRefSerializer, Text
+from segmentation.api.common.serializers.reviews import ReviewSerializer
 from segmentation.limits import USERNAME_LENGTH, text_limit
 from segmentation.models import Assignment, Project, Review
+from segmentation.queries.access import capture_for, project_for
 from segmentation.services import assignments as service
 from segmentation.services import queue as queues
 from segmentation.services import returns

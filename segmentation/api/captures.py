@@ -9,17 +9,16 @@ from django.db.models import Exists, OuterRef, Prefetch
 from drf_spectacular.utils import OpenApiParameter, PolymorphicProxySerializer, extend_schema
 from rest_framework import mixins, viewsets
 from rest_framework.decorators import action
-from rest_framework.exceptions import NotFound, PermissionDenied
+from rest_framework.exceptions import PermissionDenied
 from rest_framework.pagination import PageNumberPagination
 from rest_framework.parsers import FormParser, MultiPartParser
 from rest_framework.response import Response
 
-from segmentation import services, storage
-from segmentation.api.heavy import immutable
-from segmentation.api.params import body, int_param
-from segmentation.api.parsers import BoundedJSONParser
-from segmentation.api.projects import project_for
-from segmentation.api.serializers import (
+from segmentation import services
+from segmentation.api.common.heavy import immutable
+from segmentation.api.common.params import body, int_param
+from segmentation.api.common.parsers import BoundedJSONParser
+from segmentation.api.common.serializers.captures import (
     CaptureListSerializer,
     CaptureSerializer,
     FramesSerializer,
@@ -31,7 +30,9 @@ from segmentation.api.serializers import (
     UploadSerializer,
 )
 from segmentation.errors import Invalid, NotReady, UploadTooLarge
+from segmentation.files import storage
 from segmentation.models import Capture, DetectionRun, JSONArrayLength, Review
+from segmentation.queries.access import project_for
 
 
 class CapturePagination(PageNumberPagination):
@@ -205,11 +206,3 @@ def _sampled_float32(name, values, max_points):
 
 
 SIGNAL_ENCODINGS = {"json": _sampled, "float32": _sampled_float32}
-
-
-def capture_for(user, pk):
-    """A capture of one of the user's projects, or 404."""
-    capture = Capture.objects.visible_to(user).filter(pk=pk).first()
-    if capture is None:
-        raise NotFound("No such capture.")
-    return capture

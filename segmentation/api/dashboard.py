@@ -8,11 +8,11 @@ from rest_framework.exceptions import PermissionDenied
 from rest_framework.response import Response
 from rest_framework.views import APIView
 
-from segmentation import dashboard
-from segmentation.api.agreement import LabelOverlapSerializer
-from segmentation.api.projects import project_for
-from segmentation.api.serializers import NamedRefSerializer
+from segmentation.api.common.serializers.agreement import LabelOverlapSerializer
+from segmentation.api.common.serializers.base import NamedRefSerializer
 from segmentation.models import Review
+from segmentation.queries import dashboard
+from segmentation.queries.access import project_for
 
 # The schema's CaptureStateEnum (settings.SPECTACULAR_SETTINGS).
 CAPTURE_STATES = dashboard.STATES

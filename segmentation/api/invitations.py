@@ -10,22 +10,9 @@ from rest_framework.response import Response
 from rest_framework.views import APIView
 
 from segmentation import services
-from segmentation.api.serializers import DetailSerializer, MemberSerializer, NamedRefSerializer
+from segmentation.api.common.serializers.base import DetailSerializer, NamedRefSerializer
+from segmentation.api.common.serializers.projects import MemberSerializer
 from segmentation.models import Invitation
-
-# What a project admin is told, whether or not an account has the username.
-INVITED = ("If an account is named {username!r}, it is invited as {role} and joins the "
-           "project once it accepts.")
-
-
-class InvitationSerializer(serializers.ModelSerializer):
-    """An invitation as the project's admins see it (the invitee's username as typed)."""
-
-    invited_by = serializers.CharField(source="invited_by.username", default=None)
-
-    class Meta:
-        model = Invitation
-        fields = ["id", "username", "role", "invited_by", "created_at", "expires_at"]
 
 
 class MyInvitationSerializer(serializers.ModelSerializer):
@@ -43,24 +30,10 @@ class MyInvitationSerializer(serializers.ModelSerializer):
         return {"id": invitation.project_id, "name": invitation.project.name}
 
 
-class InvitedSerializer(DetailSerializer):
-    """What a project admin is told on adding a member who is not one yet."""
-
-    invitation = InvitationSerializer()
-
-
 class AcceptedSerializer(MemberSerializer):
     """The caller's new membership, and its project."""
 
     project = NamedRefSerializer()
-
-
-def invited_response(invitation):
-    body = {
-        "detail": INVITED.format(username=invitation.username, role=invitation.role),
-        "invitation": invitation,
-    }
-    return Response(InvitedSerializer(body).data, status=202)
 
 
 class MyInvitationsView(APIView):

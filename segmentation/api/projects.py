@@ -9,17 +9,20 @@ from rest_framework.response import Response
 from rest_framework.views import APIView
 
 from motionlib.segmenters import list_segmenters
-from segmentation import services, storage
-from segmentation.api.invitations import InvitationSerializer, InvitedSerializer, invited_response
-from segmentation.api.params import body
-from segmentation.api.serializers import (
-    CutModelSerializer,
+from segmentation import services
+from segmentation.api.common.params import body
+from segmentation.api.common.serializers.captures import CutModelSerializer
+from segmentation.api.common.serializers.projects import (
+    INVITED,
+    InvitationSerializer,
+    InvitedSerializer,
     LabelSerializer,
     MemberSerializer,
     MeSerializer,
     MethodSerializer,
     ProjectSerializer,
 )
+from segmentation.files import storage
 from segmentation.models import Membership, Project
 from segmentation.services.invitations import can_see_accounts
 from segmentation.services.team import can_create_accounts
@@ -128,6 +131,9 @@ class MethodsView(APIView):
         return Response(MethodSerializer([cls.schema() for cls in list_segmenters()], many=True).data)
 
 
-def project_for(user, pk):
-    """A project the user is a member of, or 404 (never 403, which would leak it)."""
-    return get_object_or_404(Project.objects.for_user(user), pk=pk)
+def invited_response(invitation):
+    body = {
+        "detail": INVITED.format(username=invitation.username, role=invitation.role),
+        "invitation": invitation,
+    }
+    return Response(InvitedSerializer(body).data, status=202)

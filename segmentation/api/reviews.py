@@ -7,10 +7,9 @@ from rest_framework.exceptions import PermissionDenied
 from rest_framework.response import Response
 from rest_framework.views import APIView
 
-from segmentation import services, suggestions
-from segmentation.api.captures import capture_for
-from segmentation.api.params import body
-from segmentation.api.serializers import (
+from segmentation import services
+from segmentation.api.common.params import body
+from segmentation.api.common.serializers.reviews import (
     ChangeCutSerializer,
     EventSerializer,
     InsertCutSerializer,
@@ -22,9 +21,11 @@ from segmentation.api.serializers import (
     VersionSerializer,
 )
 from segmentation.errors import Invalid
+from segmentation.queries.access import capture_for
 from segmentation.services import history
 from segmentation.services.adaptation import adaptation_summary
 from segmentation.services.reviews import catch_up, started_review
+from segmentation.similar import suggestions
 
 
 class OwnReviewView(APIView):

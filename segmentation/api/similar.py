@@ -8,13 +8,13 @@ from rest_framework.exceptions import NotFound
 from rest_framework.response import Response
 from rest_framework.views import APIView
 
-from segmentation import search
-from segmentation.api.params import int_param
-from segmentation.api.segments import SegmentSerializer
+from segmentation.api.common.params import int_param
+from segmentation.api.common.serializers.library import SegmentSerializer
+from segmentation.db.statements import Statement
 from segmentation.models import Capture, LibrarySegment
 from segmentation.models.library import STAFF, own
-from segmentation.pools import Scope
-from segmentation.statements import Statement
+from segmentation.similar import search
+from segmentation.similar.pools import Scope
 
 
 class SimilarSegmentSerializer(SegmentSerializer):
@@ -39,7 +39,7 @@ def _segment_query(key, pk, user_id):
 
 
 # One query reads the segment, the user's role in its project and whether that role shows
-# it (compiled once: ``segmentation.statements``).
+# it (compiled once: ``segmentation.db.statements``).
 SEGMENT = Statement(_segment_query)
 
 

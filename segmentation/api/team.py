@@ -13,11 +13,12 @@ from rest_framework.exceptions import PermissionDenied
 from rest_framework.response import Response
 from rest_framework.views import APIView
 
-from segmentation.api.params import body
-from segmentation.api.projects import project_for
-from segmentation.api.serializers import LabelSerializer, MemberSerializer, Text
+from segmentation.api.common.params import body
+from segmentation.api.common.serializers.base import Text
+from segmentation.api.common.serializers.projects import LabelSerializer, MemberSerializer
 from segmentation.limits import USERNAME_LENGTH, text_limit
 from segmentation.models import ROLES, Label
+from segmentation.queries.access import project_for
 from segmentation.services import taxonomy, team
 
 

@@ -6,7 +6,7 @@ from django.db import migrations, models
 class Migration(migrations.Migration):
 
     dependencies = [
-        ('segmentation', '0023_one_time_passwords'),
+        ('segmentation', '0023_accounts_models_leave'),
     ]
 
     operations = [

@@ -6,15 +6,12 @@
 - ``reviews``: reviews, cuts, segment labels, the review audit log;
 - ``library``: library segments, gold versions, agreement, label suggestions;
 - ``workers``: the Celery workers' heartbeats;
-- ``locks``: named row locks for counting against a limit atomically;
-- ``accounts``: the key of each account's username; one-time passwords not yet replaced.
 
 Rules about one record live on the models; lookups live on the managers
 (``Capture.objects.visible_to(user)``). Workflows that touch several records are the
 ``do_*`` functions in ``segmentation.services``.
 """
 
-from segmentation.models.accounts import OneTimePassword, UsernameKey
 from segmentation.models.captures import (
     Assignment,
     Capture,
@@ -33,7 +30,6 @@ from segmentation.models.library import (
     LibrarySegment,
     SuggestionRequest,
 )
-from segmentation.models.locks import ThrottleLock
 from segmentation.models.projects import (
     ROLES,
     Invitation,
@@ -73,8 +69,5 @@ __all__ = [
     "SuggestionRequest",
     "derived_path",
     "original_path",
-    "ThrottleLock",
-    "OneTimePassword",
-    "UsernameKey",
     "WorkerHeartbeat",
 ]

@@ -8,7 +8,7 @@
 - ``CaptureAgreement``: the agreement summary of a capture's submitted reviews at the
   default tolerance, kept for the project dashboard.
 - ``LabelSuggestion``, ``SuggestionRequest``: label suggestions computed from the library
-  (see below and ``segmentation.suggestions``).
+  (see below and ``segmentation.similar.suggestions``).
 """
 
 import numpy as np
@@ -17,10 +17,10 @@ from django.db import models
 from django.db.models import OuterRef, Q, Subquery
 from django.utils import timezone
 
+from segmentation.db.statements import Statement
 from segmentation.models.captures import Capture
 from segmentation.models.projects import Label, Membership, Project
 from segmentation.models.reviews import Review
-from segmentation.statements import Statement
 
 # A capture whose annotators agree this well needs no adjudication.
 AGREED_BOUNDARY_F1 = 0.8
@@ -31,7 +31,7 @@ STAFF = ("reviewer", "admin")
 
 def own(user):
     """Q of an annotator's own segments and the gold ones (``is_gold__in``: see
-    ``segmentation.api.segments.segment_filters``); ``user`` or their id."""
+    ``segmentation.queries.library.segment_filters``); ``user`` or their id."""
     return Q(annotator=user) | Q(is_gold__in=[True])
 
 
@@ -251,7 +251,7 @@ class CaptureAgreement(models.Model):
 # - ``SuggestionRequest``: one per (capture, annotator): when suggestions were last asked
 #   of a worker and when that worker finished, so that twenty page loads send one job.
 #
-# See ``segmentation.suggestions``.
+# See ``segmentation.similar.suggestions``.
 
 
 class LabelSuggestion(models.Model):

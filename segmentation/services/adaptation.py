@@ -29,15 +29,15 @@ from django.db import IntegrityError, transaction
 from django.db.models import Max
 from django.utils import timezone
 
+from motionlib.consensus import consensus_cuts
 from motionlib.errors import MotionlibError
 from motionlib.segmenters import get_segmenter
-from segmentation import takecache
-from segmentation.consensus import consensus_cuts
 from segmentation.errors import CutroomError, Invalid
+from segmentation.files import takecache
+from segmentation.files.storage import read_take
 from segmentation.models import Capture, Membership, ProjectCutModel, Review
 from segmentation.services import jobs, model_gate
 from segmentation.services.jobs import Kind, register
-from segmentation.storage import read_take
 
 log = logging.getLogger(__name__)
 

@@ -104,16 +104,3 @@ def check_may_start(capture, user):
     if not capture.assignments.filter(annotator=user).exists():
         raise NotAllowed(f"{capture.name!r} is not assigned to you, and this project lets "
                          "annotators review only the captures assigned to them")
-
-
-def assignment_summary(capture_ids):
-    """Per capture id: who is assigned and each review's state (capture list, dashboard)."""
-    out = {pk: {"assigned": [], "reviews": []} for pk in capture_ids}
-    for a in Assignment.objects.filter(capture_id__in=capture_ids).select_related("annotator"):
-        out[a.capture_id]["assigned"].append(a.annotator.username)
-    reviews = Review.objects.filter(capture_id__in=capture_ids).select_related("annotator")
-    for r in reviews.order_by("id"):
-        out[r.capture_id]["reviews"].append({"id": r.pk, "annotator": r.annotator.username,
-                                             "status": r.status})
-    return out
-

@@ -15,13 +15,13 @@ from django.utils import timezone
 import motionlib
 from motionlib.errors import shorten
 from motionlib.segmenters import ParamError, get_segmenter, list_segmenters
-from segmentation import storage
 from segmentation.errors import CutroomError, NotReady, ReviewStarted, UploadError, UploadTooLarge
+from segmentation.files import storage
+from segmentation.files.storage import read_take
 from segmentation.models import Capture, DetectionRun, Project
 from segmentation.services import adaptation, jobs, quotas
 from segmentation.services.jobs import Kind, enqueue, register
 from segmentation.services.reviews import do_take_in_candidates
-from segmentation.storage import read_take
 
 log = logging.getLogger(__name__)
 

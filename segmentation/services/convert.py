@@ -14,7 +14,7 @@ from django.utils import timezone
 
 from motionlib.io.fbx import read_fbx_all
 from motionlib.io.npz import take_bytes
-from segmentation import storage
+from segmentation.files import storage
 from segmentation.models import Capture
 from segmentation.services import jobs, quotas
 from segmentation.services.jobs import Kind, enqueue, register

@@ -15,10 +15,11 @@ from django.db.models import Max, Min, Q
 from django.db.models.functions import Coalesce
 from django.utils import timezone
 
-from segmentation import similar_index, workers
+from segmentation import workers
 from segmentation.models import Capture, DetectionRun, LibrarySegment, WorkerHeartbeat
 from segmentation.models.jobs import claim_cutoff
 from segmentation.services import jobs
+from segmentation.similar import files
 
 log = logging.getLogger(__name__)
 
@@ -171,10 +172,10 @@ def _similar_index():
     stale = []
     for project_id in projects:
         try:
-            indexed_up_to = similar_index.read_manifest(project_id)["max_id"]
-        except similar_index.IndexUnusable:
+            indexed_up_to = files.read_manifest(project_id)["max_id"]
+        except files.IndexUnusable:
             indexed_up_to = 0
-        waiting = (similar_index.described(project_id).filter(id__gt=indexed_up_to)
+        waiting = (files.described(project_id).filter(id__gt=indexed_up_to)
                    .aggregate(t=Min("created_at"))["t"])
         if waiting is not None and waiting < limit:
             stale.append(project_id)

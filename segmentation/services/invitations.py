@@ -20,7 +20,7 @@ from django.contrib.auth import get_user_model
 from django.db import transaction
 from django.utils import timezone
 
-from segmentation import locks
+from accounts import locks
 from segmentation.errors import Invalid, NotAllowed, TooManyRequests
 from segmentation.models import Invitation
 from segmentation.services import quotas

@@ -3,8 +3,9 @@
 Segments become ``LibrarySegment`` rows when a review is submitted or a gold version is
 saved (``refresh_capture_library`` rebuilds one capture's rows: agreement values change
 whenever another review of the capture comes in). Each row carries its motion descriptor
-(``segmentation.descriptors``), so "find similar" and label suggestions never re-read takes;
-a long capture's rows get theirs from a worker (``describe_library``), not the request.
+(``segmentation.similar.descriptors``), so "find similar" and label suggestions never
+re-read takes; a long capture's rows get theirs from a worker (``describe_library``), not
+the request.
 """
 
 import numpy as np
@@ -12,9 +13,11 @@ from django.conf import settings
 from django.db import transaction
 
 from motionlib.agreement import label_codes, segment_support
-from segmentation import agreement, similar_index, workers
-from segmentation.descriptors import descriptors, store_descriptor
+from segmentation import workers
 from segmentation.models import Adjudication, Capture, LibrarySegment
+from segmentation.services import agreement
+from segmentation.similar import updates
+from segmentation.similar.descriptors import descriptors, store_descriptor
 
 
 def refresh_capture_library(capture):
@@ -53,7 +56,7 @@ def refresh_capture_library(capture):
     with transaction.atomic():
         LibrarySegment.objects.filter(capture=capture).delete()
         LibrarySegment.objects.bulk_create(rows, batch_size=500)
-        similar_index.schedule_update(capture.project_id)
+        updates.schedule_update(capture.project_id)
         if rows and not described_inline(capture):
             transaction.on_commit(lambda: workers.send(
                 "describe_library", capture.pk, then="its segments stay out of similar search"))
@@ -91,7 +94,7 @@ def describe_library(capture_id):
         for row in rows:
             row.pk = None
         LibrarySegment.objects.bulk_create(rows, batch_size=500)
-        similar_index.schedule_update(capture.project_id)
+        updates.schedule_update(capture.project_id)
     return len(rows)
 
 

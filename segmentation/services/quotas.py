@@ -13,7 +13,7 @@ from django.conf import settings
 from django.db.models import Sum
 from django.utils import timezone
 
-from segmentation import locks
+from accounts import locks
 from segmentation.errors import QuotaExceeded, TooManyRequests
 from segmentation.models import Capture, DetectionRun, Project
 

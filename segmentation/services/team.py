@@ -10,9 +10,10 @@ import secrets
 from django.contrib.auth import get_user_model
 from django.db import IntegrityError, transaction
 
-from segmentation import usernames
+from accounts import usernames
+from accounts.models import OneTimePassword
 from segmentation.errors import Invalid, NotAllowed
-from segmentation.models import Membership, OneTimePassword, Project
+from segmentation.models import Membership, Project
 
 ROLES = ("annotator", "reviewer", "admin")
 

@@ -8,10 +8,9 @@ import numpy as np
 import pytest
 
 from benchmarks.quality import bench, checks, data, tables, tuning, unmatched, variants
-from motionlib import adapt, metrics, synth
+from motionlib import adapt, metrics, shared_data, synth
 from motionlib.segmenters import get_segmenter
 from motionlib.segmenters.default import Default
-from segmentation import shared_data
 
 DATA = shared_data.data_dir()
 REPO = Path(__file__).resolve().parents[2]

@@ -2,9 +2,8 @@ import numpy as np
 import pytest
 
 from benchmarks.quality import data, variants
-from motionlib import synth
+from motionlib import shared_data, synth
 from motionlib.errors import InputError
-from segmentation import shared_data
 
 DATA = shared_data.data_dir()
 needs_data = pytest.mark.skipif(not DATA.is_dir(), reason=f"benchmark data not found at {DATA}")

@@ -4,9 +4,8 @@ import numpy as np
 import pytest
 
 from benchmarks.quality import bench, cli, data, tuning
-from motionlib import synth, write_bvh
+from motionlib import shared_data, synth, write_bvh
 from motionlib.segmenters.default import Default
-from segmentation import shared_data
 
 SEGMENTS = "start_block,end_block,start_frame,end_frame,label_id,action_name\n"
 KRUGER = "segment,label,end_lo,end_mid,end_hi\n"

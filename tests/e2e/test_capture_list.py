@@ -6,7 +6,7 @@ import time
 import pytest
 from playwright.sync_api import expect
 
-from segmentation.shared_data import data_dir
+from motionlib.shared_data import data_dir
 from tests.e2e.conftest import synthetic_bvh
 
 SHARED_DATA = data_dir()

@@ -17,7 +17,7 @@ def long_capture(studio):
     from django.core.files.base import ContentFile
 
     import motionlib
-    from segmentation import storage
+    from segmentation.files import storage
     from segmentation.models import Capture, DetectionRun
 
     take, _segments = motionlib.synth.generate(seed=11, fps=120.0, duration=30.0)

@@ -6,7 +6,7 @@ from pathlib import Path
 import pytest
 
 from motionlib.io.blender import blender_python
-from segmentation.shared_data import data_dir
+from motionlib.shared_data import data_dir
 
 SHARED_DATA = data_dir()
 SHARED_FBX = SHARED_DATA / "fbx"

@@ -4,7 +4,7 @@ from pathlib import Path
 
 import pytest
 
-from segmentation.shared_data import data_dir
+from motionlib.shared_data import data_dir
 
 DATA = data_dir()
 CMU = DATA / "cmu"

@@ -6,7 +6,7 @@ import pytest
 from benchmarks.quality import data
 from motionlib import metrics
 from motionlib.segmenters import get_segmenter
-from segmentation.shared_data import data_dir
+from motionlib.shared_data import data_dir
 
 DATA = data_dir()
 pytestmark = [

@@ -13,9 +13,10 @@ from django.core.files.uploadedfile import SimpleUploadedFile
 from django.test import TestCase
 from rest_framework.test import APIClient
 
-from segmentation import services, storage, tasks
+from motionlib.shared_data import data_dir
+from segmentation import services, tasks
+from segmentation.files import storage
 from segmentation.models import Capture, DetectionRun
-from segmentation.shared_data import data_dir
 
 SHARED_DATA = data_dir()
 

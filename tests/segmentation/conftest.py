@@ -29,19 +29,19 @@ def _media_root_on_testcase(request, media_root):
 def similar_index_dir(settings, tmp_path):
     """Each test keeps its similar-clip indexes in its own folder, and no process cache
     of an index outlives the test (ids are reused once a test's rows are rolled back)."""
-    from segmentation import similar_index
+    from segmentation.similar import index
 
     settings.SIMILAR_INDEX_DIR = tmp_path / "similar"
-    similar_index.forget()
+    index.forget()
     yield settings.SIMILAR_INDEX_DIR
-    similar_index.forget()
+    index.forget()
 
 
 @pytest.fixture(autouse=True)
 def answer_cache():
     """No built frames or signals answer outlives its test (ids and file names recur once a
     test's rows and media folder are gone)."""
-    from segmentation.api import heavy
+    from segmentation.api.common import heavy
 
     heavy.answer_cache().clear()
     yield heavy.answer_cache()

@@ -31,8 +31,9 @@ def synthetic_bvh(seed):
 
 def populate():
     """Build the installation (in an empty database); returns its project."""
-    from segmentation import services, similar_index
+    from segmentation import services
     from segmentation.services.gold import do_save_gold
+    from segmentation.similar import updates
 
     users = get_user_model().objects
     alice = users.create_user("alice", password="alice-password", is_staff=True)
@@ -53,7 +54,7 @@ def populate():
     gold_labels = [("walk", "punch")[i % 2] for i in range(len(cuts) + 1)]
     do_save_gold(first, alice, cuts, gold_labels, 0, source_review=bobs)
     _train(project)
-    similar_index.build(project.pk)
+    updates.build(project.pk)
     return project
 
 

@@ -6,10 +6,11 @@ tests/segmentation/integration/test_adaptation_flow.py."""
 from django.core.files.base import ContentFile
 
 from motionlib import adapt, synth
-from segmentation import services, takecache, tasks
+from segmentation import services, tasks
+from segmentation.files import takecache
+from segmentation.files.takecache import StoredStudies
 from segmentation.models import DetectionRun, ProjectCutModel
 from segmentation.services import adaptation
-from segmentation.takecache import StoredStudies
 from tests.segmentation.base import BaseTestCase, synthetic_bvh
 
 SECONDS = 30.0

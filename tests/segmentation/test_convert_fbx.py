@@ -8,8 +8,8 @@ from django.test import override_settings
 
 import motionlib
 from segmentation import services, tasks
+from segmentation.files.storage import read_take
 from segmentation.models import Capture, DetectionRun
-from segmentation.storage import read_take
 from tests.fbx.files import shared_fbx
 from tests.segmentation.base import BaseTestCase, synthetic_bvh
 

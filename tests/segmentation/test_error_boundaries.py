@@ -55,7 +55,7 @@ class TranslatorTestCase(BaseTestCase):
     def test_it_answers_a_bare_value_error_with_500_and_a_reference(self):
         numpy_bug = ValueError("zero-size array to reduction operation maximum")
         with mock.patch.object(services, "do_start_run", side_effect=numpy_bug), \
-                self.assertLogs("segmentation.api.errors", "ERROR") as logs:
+                self.assertLogs("segmentation.api.common.errors", "ERROR") as logs:
             response = self.start_run()
         self.assertEqual(response.status_code, 500)
         body = response.json()

@@ -11,9 +11,9 @@ from django.utils import timezone
 
 from cutroom.celery import app
 from motionlib import similarity
-from segmentation import descriptors, similar_index
 from segmentation.models import Capture, DetectionRun, LibrarySegment, WorkerHeartbeat
 from segmentation.services import health
+from segmentation.similar import descriptors, updates
 from tests.segmentation.base import BaseTestCase
 
 
@@ -167,7 +167,7 @@ class HealthEndpointTestCase(BaseTestCase):
         self.assertEqual(body["failing"], ["similar_index"])
         self.assertIn(f"the similar-clip index of project(s) {self.project.pk} lacks segments "
                       "older than 900 s", body["checks"]["similar_index"]["error"])
-        similar_index.build(self.project.pk)
+        updates.build(self.project.pk)
         self.assertEqual(self.health(200)["checks"]["similar_index"],
                          {"ok": True, "projects": 1, "stale": []})
 

@@ -6,8 +6,8 @@ import threading
 import numpy as np
 from django.test import override_settings
 
-from segmentation import storage
-from segmentation.api import heavy
+from segmentation.api.common import heavy
+from segmentation.files import storage
 from segmentation.models import DetectionRun
 from tests.segmentation.base import BaseTestCase
 

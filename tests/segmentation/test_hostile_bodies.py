@@ -2,7 +2,7 @@
 (issue 33, item 2): integers beyond 64 bits in path ids, in lists and in method
 parameters, non-finite numbers, and JSON nested deep enough to exhaust the decoder."""
 
-from segmentation.api.parsers import MAX_DEPTH
+from segmentation.api.common.parsers import MAX_DEPTH
 from segmentation.models import Review
 from tests.segmentation.test_library import LibraryTestCase, submit_review
 

@@ -5,7 +5,8 @@ import numpy as np
 
 import motionlib
 from motionlib.segmenters import get_segmenter
-from segmentation import storage, tasks
+from segmentation import tasks
+from segmentation.files import storage
 from segmentation.models import Capture, DetectionRun
 from tests.segmentation.base import SHARED_DATA, BaseTestCase
 

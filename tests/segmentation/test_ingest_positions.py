@@ -6,7 +6,7 @@ from pathlib import Path
 from unittest import mock
 
 import motionlib
-from segmentation import importing
+from segmentation.services import importing
 from tests.segmentation.base import BaseTestCase, synthetic_bvh
 
 

@@ -138,7 +138,7 @@ def test_the_import_command_checks_files_under_the_same_limits(tmp_path):
     import pytest
 
     from motionlib import CaptureError
-    from segmentation.importing import check_readable
+    from segmentation.services.importing import check_readable
 
     path = tmp_path / "empty.bvh"
     path.write_bytes(two_joint_bvh(n_frames=0))

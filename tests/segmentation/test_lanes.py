@@ -14,8 +14,8 @@ from django.core.handlers.wsgi import WSGIHandler
 from django.http import HttpResponse
 from django.test import RequestFactory, override_settings
 
+from accounts.models import ApiToken
 from cutroom import lanes
-from cutroom.accounts.models import ApiToken
 from tests.segmentation.base import BaseTestCase
 
 LARGE = 300

@@ -219,7 +219,7 @@ class UnreadableTakeTest(LibraryTestCase):
         assert "could not be mapped to body parts" in response.json()["detail"]
 
     def test_it_refuses_an_export_of_more_than_the_limit(self):
-        from segmentation import exports
+        from segmentation.files import exports
 
         saved, exports.MAX_EXPORT_SEGMENTS = exports.MAX_EXPORT_SEGMENTS, 3
         try:

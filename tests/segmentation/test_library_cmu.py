@@ -14,7 +14,8 @@ from django.core.files.base import ContentFile
 from numpy.testing import assert_allclose
 
 import motionlib
-from segmentation import services, storage, tasks
+from segmentation import services, tasks
+from segmentation.files import storage
 from segmentation.models import Capture, DetectionRun, LibrarySegment
 from segmentation.services import gold
 from tests.segmentation.base import SHARED_DATA

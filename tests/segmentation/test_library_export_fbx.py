@@ -10,7 +10,8 @@ import pytest
 
 import motionlib
 from motionlib.io.units import length_unit
-from segmentation import storage, tasks
+from segmentation import tasks
+from segmentation.files import storage
 from segmentation.models import Capture, DetectionRun, LibrarySegment
 from tests.fbx.files import shared_fbx
 from tests.segmentation.base import BaseTestCase, synthetic_bvh

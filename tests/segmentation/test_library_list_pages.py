@@ -12,9 +12,9 @@ import pytest
 from django.db import connection
 
 from segmentation import services
-from segmentation.api import segments
-from segmentation.api.segments import ORDERINGS
 from segmentation.models import Capture, LibrarySegment
+from segmentation.queries import library
+from segmentation.queries.library import ORDERINGS
 from segmentation.services.taxonomy import do_change_label
 from tests.segmentation.test_library import LibraryTestCase
 
@@ -129,7 +129,7 @@ class ListPagesTest(LibraryTestCase):
                 query = self.query(template, "recent")
                 expected = oracle(user, query)
                 with self.subTest(user=user.username, query=query, most=most), \
-                        mock.patch.object(segments, "MAX_MERGED_RUNS", most):
+                        mock.patch.object(library, "MAX_MERGED_RUNS", most):
                     assert self.pages(query, 7) == expected
                     body = self.client.get(f"/api/segments/?{query}&page_size=7").json()
                     assert body["count"] == len(expected)
@@ -160,7 +160,7 @@ class ListPagesTest(LibraryTestCase):
 
     def test_a_query_of_a_shape_seen_before_is_run_with_its_values_not_built_again(self):
         self.login(self.bob)
-        with mock.patch.object(segments, "ordered_parts", wraps=segments.ordered_parts) as built:
+        with mock.patch.object(library, "ordered_parts", wraps=library.ordered_parts) as built:
             for label, low in (("walk", 1), ("punch", 2), ("walk", 3), ("punch", 1)):
                 query = self.query(f"label={label}&min_duration={low}", "recent")
                 assert self.pages(query, 5) == oracle(self.bob, query)

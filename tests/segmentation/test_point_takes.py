@@ -13,8 +13,11 @@ from pathlib import Path
 import numpy as np
 
 import motionlib
-from segmentation import importing, services, storage, suggestions, tasks
+from segmentation import services, tasks
+from segmentation.files import storage
 from segmentation.models import Label, LibrarySegment
+from segmentation.services import importing
+from segmentation.similar import suggestions
 from tests.motionlib.points_data import HDM05, points_file
 from tests.segmentation.base import BaseTestCase, synthetic_bvh
 from tests.segmentation.test_library import submit_review

@@ -13,8 +13,9 @@ from django.test.utils import CaptureQueriesContext
 import motionlib
 from motionlib import similarity, synth, vector_index
 from motionlib.vector_index import VectorIndex
-from segmentation import descriptors, search, services, similar_index, tasks
+from segmentation import services, tasks
 from segmentation.models import Capture, LibrarySegment
+from segmentation.similar import candidates, descriptors, files, index, search, updates
 from tests.segmentation.base import BaseTestCase
 from tests.segmentation.test_library import submit_review
 
@@ -67,13 +68,13 @@ class SimilarIndexTestCase(BaseTestCase):
 
     def exact(self, segment, k=10):
         """The exact scan: ``similar`` while the project has no index."""
-        similar_index.manifest_path(self.project.pk).unlink(missing_ok=True)
-        similar_index.forget()
-        assert similar_index.open_index(self.project.pk) is None
+        files.manifest_path(self.project.pk).unlink(missing_ok=True)
+        index.forget()
+        assert index.open_index(self.project.pk) is None
         return [(s.pk, round(d, 5)) for s, d in search.similar(segment, self.visible(), k=k)]
 
     def indexed(self, segment, k=10):
-        assert similar_index.open_index(self.project.pk) is not None
+        assert index.open_index(self.project.pk) is not None
         return [(s.pk, round(d, 5)) for s, d in search.similar(segment, self.visible(), k=k)]
 
 
@@ -82,15 +83,15 @@ class SameResultsTest(SimilarIndexTestCase):
         rows = self.add_segments(self.spans, self.descs)
         queries = rows[::30]
         expected = [self.exact(q) for q in queries]
-        similar_index.build(self.project.pk)
-        similar_index.forget()
+        updates.build(self.project.pk)
+        index.forget()
         assert [self.indexed(q) for q in queries] == expected
         assert all(len(found) == 10 for found in expected)
 
     def test_it_leaves_out_segments_the_caller_may_not_see(self):
         dana_rows = self.add_segments(self.spans[:150], self.descs[:150], annotator=self.alice)
         bob_rows = self.add_segments(self.spans[150:], self.descs[150:])
-        similar_index.build(self.project.pk)
+        updates.build(self.project.pk)
         # bob (an annotator) sees his own segments only; alice's are nearer to her own query.
         visible = LibrarySegment.objects.visible_to(self.bob).preferred()
         found = search.similar(dana_rows[0], visible, k=10)
@@ -107,8 +108,8 @@ class ShownTest(SimilarIndexTestCase):
         self.login(self.rachel)
         url = f"/api/segments/{rows[0].pk}/similar/?k=30"
         exact = self.client.get(url).json()
-        similar_index.build(self.project.pk)
-        assert similar_index.open_index(self.project.pk) is not None
+        updates.build(self.project.pk)
+        assert index.open_index(self.project.pk) is not None
         assert self.client.get(url).json() == exact
         assert len(exact["results"]) == 30
 
@@ -127,9 +128,9 @@ class AccessTest(SimilarIndexTestCase):
 
     def both_paths(self, check):
         check()
-        similar_index.build(self.project.pk)
-        similar_index.forget()
-        assert similar_index.open_index(self.project.pk) is not None
+        updates.build(self.project.pk)
+        index.forget()
+        assert index.open_index(self.project.pk) is not None
         check()
 
     def ids(self, segment, user, k=50):
@@ -177,7 +178,7 @@ def needs_postgres():
 @pytest.mark.integration
 class PostgresAccessTest(AccessTest):
     """The same refusals on PostgreSQL, where the view reads through compiled statements
-    (``segmentation.statements``)."""
+    (``segmentation.db.statements``)."""
 
     def setUp(self):
         needs_postgres()
@@ -199,8 +200,8 @@ class PostgresStatementPathTest(SimilarIndexTestCase):
         alices = self.add_segments(self.spans[120:240], self.descs[120:240], annotator=self.alice)
         LibrarySegment.objects.filter(pk__in=[r.pk for r in alices[1::4]]).update(
             is_gold=True, annotator=None)
-        similar_index.build(self.project.pk)
-        similar_index.forget()
+        updates.build(self.project.pk)
+        index.forget()
         newer = self.add_segments(self.spans[240:], self.descs[240:])
         # The newest take is one of bare points: compared with its own kind only.
         Capture.objects.filter(pk=newer[0].capture_id).update(
@@ -230,7 +231,7 @@ class PostgresStatementPathTest(SimilarIndexTestCase):
 class QueryCountTest(SimilarIndexTestCase):
     def test_it_answers_with_the_same_number_of_queries_whatever_k(self):
         rows = self.add_segments(self.spans[:100], self.descs[:100])
-        similar_index.build(self.project.pk)
+        updates.build(self.project.pk)
         self.login(self.rachel)
         self.client.get(f"/api/segments/{rows[0].pk}/similar/")  # opens and checks the index
         counts = []
@@ -245,12 +246,12 @@ class QueryCountTest(SimilarIndexTestCase):
 class ReadsTest(SimilarIndexTestCase):
     def test_it_reads_the_descriptors_of_the_shortlist_only(self):
         rows = self.add_segments(self.spans, self.descs)
-        similar_index.build(self.project.pk)
-        similar_index.forget()
+        updates.build(self.project.pk)
+        index.forget()
         expected = self.indexed(rows[7])
-        index = similar_index.open_index(self.project.pk)
+        opened = index.open_index(self.project.pk)
         asked, proposed = [], []
-        read, nearest = index.descriptors, index.nearest
+        read, nearest = opened.descriptors, opened.nearest
 
         def spy_read(ids):
             asked.append(list(ids))
@@ -261,13 +262,13 @@ class ReadsTest(SimilarIndexTestCase):
             proposed.append(len(found[0]))
             return found
 
-        with mock.patch.object(index, "descriptors", spy_read), \
-                mock.patch.object(index, "nearest", spy_nearest), \
+        with mock.patch.object(opened, "descriptors", spy_read), \
+                mock.patch.object(opened, "nearest", spy_nearest), \
                 CaptureQueriesContext(connection) as queries:
             assert self.indexed(rows[7]) == expected
         # The index proposed MIN_CANDIDATES, their profiles with them; only the SHORTLIST
         # nearest were read whole, from the index, and no descriptor from the database.
-        assert proposed == [similar_index.MIN_CANDIDATES]
+        assert proposed == [candidates.MIN_CANDIDATES]
         assert [len(ids) for ids in asked] == [search.SHORTLIST]
         assert not [q for q in queries if '"descriptor"' in q["sql"]]
 
@@ -275,36 +276,36 @@ class ReadsTest(SimilarIndexTestCase):
 class IncrementalTest(SimilarIndexTestCase):
     def test_it_finds_segments_added_after_the_index_was_written(self):
         rows = self.add_segments(self.spans[:200], self.descs[:200])
-        similar_index.build(self.project.pk)
+        updates.build(self.project.pk)
         assert self.indexed(rows[0])  # the process has seen this index generation
         # The same motion again, in another capture, newer than the index file.
         twin = self.add_segments([self.spans[0]], [self.descs[0]])[0]
         found = self.indexed(rows[0], k=3)
         assert found[0] == (twin.pk, 0.0)
-        assert similar_index.read_manifest(self.project.pk)["max_id"] < twin.pk
+        assert files.read_manifest(self.project.pk)["max_id"] < twin.pk
 
     def test_a_process_reads_the_newer_segments_once_for_every_caller(self):
         rows = self.add_segments(self.spans[:200], self.descs[:200])
-        similar_index.build(self.project.pk)
+        updates.build(self.project.pk)
         # Twins of the first 20, newer than the index, alice's: bob may not see them.
         twins = self.add_segments(self.spans[:20], self.descs[:20], annotator=self.alice)
         bobs = LibrarySegment.objects.visible_to(self.bob).preferred()
         found = search.similar(rows[0], bobs, k=10)
         assert len(found) == 10 and not {s.pk for s, _ in found} & {r.pk for r in twins}
-        opened = similar_index.open_index(self.project.pk)
+        opened = index.open_index(self.project.pk)
         assert set(opened.newer[1].tolist()) == {r.pk for r in twins}, "read whatever bob may see"
         # The reviewer's searches find them through what bob's search read, reading no
         # profiles of their own.
         with CaptureQueriesContext(connection) as queries:
             indexed = [self.indexed(q) for q in rows[:20:4]]
         assert not [q for q in queries if "SELECT u.id, u.profile" in q["sql"]]
-        assert similar_index.open_index(self.project.pk).newer[0] == twins[-1].pk
+        assert index.open_index(self.project.pk).newer[0] == twins[-1].pk
         assert [found[0] for found in indexed] == [(twins[i].pk, 0.0) for i in range(0, 20, 4)]
         assert indexed == [self.exact(q) for q in rows[:20:4]]
 
     def test_it_finds_newer_segments_of_its_own_project_only(self):
         rows = self.add_segments(self.spans[:50], self.descs[:50])
-        similar_index.build(self.project.pk)
+        updates.build(self.project.pk)
         capture = self.ready_capture(name="theirs.bvh")
         capture.project = self.other_project
         capture.save()
@@ -320,10 +321,10 @@ class IncrementalTest(SimilarIndexTestCase):
 
     def test_it_queues_one_update_when_many_segments_are_newer_than_the_index(self):
         rows = self.add_segments(self.spans[:50], self.descs[:50])
-        similar_index.build(self.project.pk)
+        updates.build(self.project.pk)
         self.add_segments(self.spans[50:53], self.descs[50:53])
         queued = []
-        with mock.patch.object(similar_index, "DELTA_LIMIT", 2):
+        with mock.patch.object(index, "DELTA_LIMIT", 2):
             for _ in range(2):
                 with self.captureOnCommitCallbacks() as callbacks:
                     self.indexed(rows[0])
@@ -332,7 +333,7 @@ class IncrementalTest(SimilarIndexTestCase):
 
     def test_it_brings_the_index_in_step_when_a_review_is_submitted(self):
         self.add_segments(self.spans, self.descs)
-        similar_index.build(self.project.pk)
+        updates.build(self.project.pk)
         capture = self.ready_capture(name="reviewed.bvh")
         with self.captureOnCommitCallbacks() as callbacks:
             submit_review(capture, self.bob, [100, 200], ["walk", "punch", "walk"])
@@ -341,20 +342,20 @@ class IncrementalTest(SimilarIndexTestCase):
         gone = list(LibrarySegment.objects.order_by("id").values_list("id", flat=True)[:5])
         LibrarySegment.objects.filter(pk__in=gone).delete()
         tasks.update_similar_index(self.project.pk)  # what the worker runs
-        manifest = similar_index.read_manifest(self.project.pk)
-        index = VectorIndex.open(similar_index.folder_of(manifest), manifest["state"])
-        ids = set(similar_index.described(self.project.pk).values_list("id", flat=True))
-        assert set(index.keys().tolist()) == ids
+        manifest = files.read_manifest(self.project.pk)
+        stored = VectorIndex.open(files.folder_of(manifest), manifest["state"])
+        ids = set(files.described(self.project.pk).values_list("id", flat=True))
+        assert set(stored.keys().tolist()) == ids
         assert manifest["count"] == len(ids) == self.N - 5
 
     def test_an_update_appends_and_leaves_the_base_file_alone(self):
         rows = self.add_segments(self.spans[:200], self.descs[:200])
-        first = similar_index.build(self.project.pk)
-        base = similar_index.folder_of(first) / vector_index.BASE
+        first = updates.build(self.project.pk)
+        base = files.folder_of(first) / vector_index.BASE
         before = (base.stat().st_ino, base.read_bytes())
         added = self.add_segments(self.spans[:10], self.descs[:10])  # twins, in another capture
         LibrarySegment.objects.filter(pk=added[0].pk).delete()
-        manifest = similar_index.update(self.project.pk)
+        manifest = updates.update(self.project.pk)
         assert manifest["file"] == first["file"]
         assert (base.stat().st_ino, base.read_bytes()) == before
         assert (manifest["state"]["delta"], manifest["state"]["removed"]) == (9, 0)
@@ -363,44 +364,44 @@ class IncrementalTest(SimilarIndexTestCase):
 
     def test_it_compacts_when_the_appended_records_outgrow_their_share(self):
         self.add_segments(self.spans[:100], self.descs[:100])
-        first = similar_index.build(self.project.pk)
+        first = updates.build(self.project.pk)
         self.add_segments(self.spans[100:], self.descs[100:])
-        with mock.patch.object(similar_index, "COMPACT_MIN", 50):
-            manifest = similar_index.update(self.project.pk)
+        with mock.patch.object(updates, "COMPACT_MIN", 50):
+            manifest = updates.update(self.project.pk)
         assert manifest["file"] != first["file"]
         assert manifest["state"] == {**first["state"], "base": self.N}
         assert (first["state"]["delta"], first["state"]["removed"]) == (0, 0)
         assert (first["lists"], manifest["lists"]) == (6, 18)
-        assert not similar_index.folder_of(first).exists()
+        assert not files.folder_of(first).exists()
 
     def test_an_update_that_dies_before_publishing_leaves_the_last_state_in_force(self):
         rows = self.add_segments(self.spans[:100], self.descs[:100])
-        first = similar_index.build(self.project.pk)
+        first = updates.build(self.project.pk)
         twin = self.add_segments([self.spans[0]], [self.descs[0]])[0]
-        with mock.patch.object(similar_index, "_publish", side_effect=OSError("disk full")):
+        with mock.patch.object(updates, "publish", side_effect=OSError("disk full")):
             with self.assertRaises(OSError):
-                similar_index.update(self.project.pk)
-        assert similar_index.read_manifest(self.project.pk) == first
-        similar_index.forget()
+                updates.update(self.project.pk)
+        assert files.read_manifest(self.project.pk) == first
+        index.forget()
         assert self.indexed(rows[0], k=1)[0] == (twin.pk, 0.0)  # read from the database
-        manifest = similar_index.update(self.project.pk)
+        manifest = updates.update(self.project.pk)
         assert manifest["state"]["delta"] == 1 and manifest["max_id"] == twin.pk
 
     def test_it_leaves_an_index_in_step_unchanged(self):
         self.add_segments(self.spans[:50], self.descs[:50])
-        first = similar_index.build(self.project.pk)
-        assert similar_index.update(self.project.pk) == first
+        first = updates.build(self.project.pk)
+        assert updates.update(self.project.pk) == first
 
 
 class RebuildTest(SimilarIndexTestCase):
     def test_it_scans_exactly_and_queues_a_rebuild_when_the_index_file_is_deleted(self):
         rows = self.add_segments(self.spans, self.descs)
         expected = self.exact(rows[7])
-        manifest = similar_index.build(self.project.pk)
-        (similar_index.folder_of(manifest) / vector_index.BASE).unlink()
-        similar_index.forget()
+        manifest = updates.build(self.project.pk)
+        (files.folder_of(manifest) / vector_index.BASE).unlink()
+        index.forget()
         with self.captureOnCommitCallbacks() as callbacks:
-            assert similar_index.open_index(self.project.pk) is None
+            assert index.open_index(self.project.pk) is None
             found = [(s.pk, round(d, 5)) for s, d in search.similar(rows[7], self.visible())]
         assert found == expected
         assert callbacks, "a rebuild is queued"
@@ -409,15 +410,15 @@ class RebuildTest(SimilarIndexTestCase):
 
     def test_it_does_not_use_an_index_of_another_format(self):
         self.add_segments(self.spans[:50], self.descs[:50])
-        similar_index.build(self.project.pk)
-        path = similar_index.manifest_path(self.project.pk)
+        updates.build(self.project.pk)
+        path = files.manifest_path(self.project.pk)
         path.write_text(path.read_text().replace('"format": 2', '"format": 1'))
-        similar_index.forget()
-        assert similar_index.open_index(self.project.pk) is None
+        index.forget()
+        assert index.open_index(self.project.pk) is None
 
     def test_it_rebuilds_every_index_from_the_command(self):
         self.add_segments(self.spans[:50], self.descs[:50])
         call_command("similar_index", "--rebuild", verbosity=0)
-        manifest = similar_index.read_manifest(self.project.pk)
+        manifest = files.read_manifest(self.project.pk)
         assert manifest["count"] == 50
-        assert not similar_index.manifest_path(self.other_project.pk).exists()
+        assert not files.manifest_path(self.other_project.pk).exists()

@@ -6,8 +6,8 @@ from unittest import mock
 import pytest
 from django.db import connection
 
+from segmentation.db.statements import Statement
 from segmentation.models import LibrarySegment
-from segmentation.statements import Statement
 from tests.segmentation.base import BaseTestCase
 
 

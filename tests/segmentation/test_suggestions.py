@@ -15,10 +15,12 @@ from django.test.utils import CaptureQueriesContext
 
 import motionlib
 from motionlib import synth
-from segmentation import services, storage, suggestions, tasks
+from segmentation import services, tasks
+from segmentation.files import storage
 from segmentation.models import Capture, LabelSuggestion
 from segmentation.services import gold
 from segmentation.services.taxonomy import do_change_label
+from segmentation.similar import suggestions
 from tests.segmentation.test_library import LibraryTestCase, submit_review
 
 

@@ -6,8 +6,8 @@ import dataclasses
 import numpy as np
 
 from motionlib import adapt, synth
-from segmentation import takecache
-from segmentation.storage import read_take
+from segmentation.files import takecache
+from segmentation.files.storage import read_take
 from tests.segmentation.base import BaseTestCase, synthetic_bvh
 
 

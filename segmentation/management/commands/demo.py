@@ -15,9 +15,10 @@ from django.core.management.base import BaseCommand
 from django.db import transaction
 
 from motionlib import synth, write_bvh
-from segmentation import importing, services
+from motionlib.shared_data import data_dir
+from segmentation import services
 from segmentation.models import Project
-from segmentation.shared_data import data_dir
+from segmentation.services import importing
 
 PROJECT = "Demo studio"
 PASSWORD = "cutroom-demo"

@@ -3,8 +3,8 @@
 from django.contrib.auth import get_user_model
 from django.core.management.base import BaseCommand, CommandError
 
-from segmentation import importing
 from segmentation.models import Project
+from segmentation.services import importing
 
 
 class Command(BaseCommand):

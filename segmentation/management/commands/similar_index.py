@@ -1,7 +1,7 @@
 from django.core.management.base import BaseCommand, CommandError
 
-from segmentation import similar_index
 from segmentation.models import Project
+from segmentation.similar import updates
 
 
 class Command(BaseCommand):
@@ -22,7 +22,7 @@ class Command(BaseCommand):
         if unknown:
             raise CommandError(f"--project: no project with id {', '.join(map(str, sorted(unknown)))}")
         for pk in ids:
-            manifest = similar_index.build(pk) if rebuild else similar_index.update(pk)
+            manifest = updates.build(pk) if rebuild else updates.update(pk)
             if manifest is None:
                 self.stdout.write(f"project {pk}: no described segments, no index")
             else:

@@ -4,8 +4,9 @@ process, which had the index open, sees the worker's appended update."""
 import pytest
 from django.contrib.auth import get_user_model
 
-from segmentation import search, services, similar_index
+from segmentation import services
 from segmentation.models import LibrarySegment
+from segmentation.similar import files, index, search
 from tests.segmentation.base import synthetic_bvh
 from tests.segmentation.integration.conftest import wait_for
 from tests.segmentation.integration.test_pipeline import client_for, settled, upload
@@ -18,7 +19,7 @@ pytestmark = pytest.mark.integration
 def people(transactional_db, settings, shared_media):
     # The workers write the index where this process reads it.
     settings.SIMILAR_INDEX_DIR = shared_media / "similar"
-    similar_index.forget()
+    index.forget()
     users = get_user_model().objects
     alice = users.create_user("alice", password="alice-password")
     bob = users.create_user("bob", password="bob-password")
@@ -27,12 +28,12 @@ def people(transactional_db, settings, shared_media):
     services.do_add_label(project, "walk", "#2563eb", "1")
     services.do_add_label(project, "squat", "#dc2626", "2")
     yield project, alice, bob
-    similar_index.forget()
+    index.forget()
 
 
 def indexed_ids(project):
     """The keys of the project's index as this process sees it (kept open between calls)."""
-    opened = similar_index.open_index(project.pk)
+    opened = index.open_index(project.pk)
     return None if opened is None else set(opened.index.keys().tolist())
 
 
@@ -46,18 +47,18 @@ def test_it_indexes_the_segments_of_a_submitted_review_on_a_worker(running_worke
     first = set(LibrarySegment.objects.values_list("id", flat=True))
     assert len(first) == 3
     wait_for(lambda: indexed_ids(project) == first, what="the index of the first review")
-    built = similar_index.read_manifest(project.pk)
+    built = files.read_manifest(project.pk)
 
     # A second take's review: the worker adds its segments to the same index.
     submit_review(captures[1], bob, [400], ["squat", "walk"])
     every = set(LibrarySegment.objects.values_list("id", flat=True))
     wait_for(lambda: indexed_ids(project) == every, what="the index of both reviews")
-    appended = similar_index.read_manifest(project.pk)
+    appended = files.read_manifest(project.pk)
     assert appended["file"] == built["file"], "the update appended to the same generation"
     assert appended["state"]["delta"] == len(every - first)
     query = LibrarySegment.objects.get(capture=captures[1], start=0)
     visible = LibrarySegment.objects.visible_to(bob).preferred()
-    assert similar_index.open_index(project.pk) is not None
+    assert index.open_index(project.pk) is not None
     found = [s.pk for s, _ in search.similar(query, visible, k=10)]
     # Every other segment, the query's own span left out.
     assert sorted(found) == sorted(every - {query.pk})

@@ -1,0 +1,1 @@
+"""Accounts: signing in (throttled), API tokens that expire and can be revoked."""
