@@ -221,3 +221,34 @@ def _seen_height(positions: np.ndarray) -> float:
         return 0.0
     y = y[seen]
     return float(np.median(np.nanmax(y, axis=1) - np.nanmin(y, axis=1)))
+
+
+def local_transforms(take) -> tuple[np.ndarray, np.ndarray]:
+    """Each joint's rotation and translation relative to its parent, every frame, of a
+    ``motionlib.take.Take`` (the exporters' common step: BVH-free writers such as glTF
+    key these, where FBX and BVH write the channels).
+
+    Returns
+    -------
+    rotations : ndarray, shape (n_frames, n_joints, 3, 3)
+        From the rotation channels in the joint's order (``C @ R @ C.T`` with ASF axes).
+    translations : ndarray, shape (n_frames, n_joints, 3)
+        The offset, with position channels replacing its axes where the joint has them.
+    """
+    sk = take.skeleton
+    n = take.n_frames
+    rotations = np.broadcast_to(np.eye(3), (n, sk.n_joints, 3, 3)).copy()
+    translations = np.broadcast_to(sk.offsets, (n, sk.n_joints, 3)).copy()
+    for j, (names, first) in enumerate(zip(sk.channels, sk.channel_starts, strict=True)):
+        column = {name: first + k for k, name in enumerate(names)}
+        for a, axis in enumerate("XYZ"):
+            if f"{axis}position" in column:
+                translations[:, j, a] = take.channels[:, column[f"{axis}position"]]
+        order = "".join(a for a in sk.rotation_orders[j] if f"{a}rotation" in column)
+        if order:
+            angles = take.channels[:, [column[f"{a}rotation"] for a in order]]
+            R = euler_to_matrix(angles, order)
+            if sk.axes is not None:
+                R = sk.axes[j] @ R @ sk.axes[j].T
+            rotations[:, j] = R
+    return rotations, translations

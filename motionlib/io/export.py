@@ -34,9 +34,10 @@ from motionlib.io.fbx import (
     check_fbx_header,
     matrix_to_quaternion,
 )
+from motionlib.io.gltf import write_glb
 from motionlib.io.pointcsv import write_points_csv
 from motionlib.io.units import length_unit
-from motionlib.kinematics import euler_to_matrix
+from motionlib.kinematics import local_transforms
 from motionlib.take import Take, frame_range
 
 FORMATS = ("bvh", "fbx", "glb", "c3d", "csv")
@@ -133,7 +134,6 @@ def check_export_format(take, format: str) -> None:
 def _write_glb_clips(take, clips):
     """glTF of a take that is not cut from an FBX original (no mesh to keep): written here,
     without Blender (:mod:`motionlib.io.gltf`)."""
-    from motionlib.io.gltf import write_glb  # it builds on this module's local_transforms
 
     metres = length_unit(take).metres
     for start, stop, out in clips:
@@ -183,32 +183,3 @@ def armature_pose(take: Take, *, metres: float | None = None) -> tuple[dict, dic
             "moving": [any(c.endswith("position") for c in ch) for ch in sk.channels]}
     arrays = {"heads": rest @ to_z.T * scale, "quaternions": quats, "locations": locations}
     return meta, arrays
-
-
-def local_transforms(take: Take) -> tuple[np.ndarray, np.ndarray]:
-    """Each joint's rotation and translation relative to its parent, every frame.
-
-    Returns
-    -------
-    rotations : ndarray, shape (n_frames, n_joints, 3, 3)
-        From the rotation channels in the joint's order (``C @ R @ C.T`` with ASF axes).
-    translations : ndarray, shape (n_frames, n_joints, 3)
-        The offset, with position channels replacing its axes where the joint has them.
-    """
-    sk = take.skeleton
-    n = take.n_frames
-    rotations = np.broadcast_to(np.eye(3), (n, sk.n_joints, 3, 3)).copy()
-    translations = np.broadcast_to(sk.offsets, (n, sk.n_joints, 3)).copy()
-    for j, (names, first) in enumerate(zip(sk.channels, sk.channel_starts, strict=True)):
-        column = {name: first + k for k, name in enumerate(names)}
-        for a, axis in enumerate("XYZ"):
-            if f"{axis}position" in column:
-                translations[:, j, a] = take.channels[:, column[f"{axis}position"]]
-        order = "".join(a for a in sk.rotation_orders[j] if f"{a}rotation" in column)
-        if order:
-            angles = take.channels[:, [column[f"{a}rotation"] for a in order]]
-            R = euler_to_matrix(angles, order)
-            if sk.axes is not None:
-                R = sk.axes[j] @ R @ sk.axes[j].T
-            rotations[:, j] = R
-    return rotations, translations

@@ -25,8 +25,8 @@ import struct
 
 import numpy as np
 
-from motionlib.io.export import local_transforms
 from motionlib.io.fbx import matrix_to_quaternion
+from motionlib.kinematics import local_transforms
 from motionlib.take import Take
 
 FLOAT = 5126  # glTF componentType: 32-bit float
