@@ -154,6 +154,7 @@ export class Timeline {
     ctx.setTransform(1, 0, 0, 1, 0, 0);
     ctx.drawImage(this.base, 0, 0);
     ctx.setTransform(dpr, 0, 0, dpr, 0, 0);
+    this.drawCurrentSegment(ctx, m, r);
     this.drawHover(ctx, m, r);
     this.drawPlayhead(ctx, m, r);
     this.drawWindow(ctx, m, r);
@@ -168,16 +169,15 @@ export class Timeline {
   /** Redraw the offscreen layer only when something it shows changed. */
   private drawBase(m: TimelineModel, r: Rows, dpr: number): void {
     const loop = this.loopPreview ?? m.loop;
-    const current = m.segments.find((s) => s.start <= m.playhead && m.playhead < s.stop);
     const drag = this.dragged();
     const key = [this.view.start, this.view.span, this.width, dpr, m.signals, m.cuts, m.segments, m.labels, m.selectedCutId,
-      loop?.start, loop?.stop, current, drag?.id, drag?.frame, this.lanes];
+      loop?.start, loop?.stop, drag?.id, drag?.frame, this.lanes];
     if (key.length === this.baseKey.length && key.every((v, i) => v === this.baseKey[i])) return;
     this.baseKey = key;
     const ctx = this.base.getContext("2d");
     if (!ctx) return;
     ctx.setTransform(dpr, 0, 0, dpr, 0, 0);
-    const scene: Scene = { ctx, width: this.width, view: this.view, rows: r, model: { ...m, loop }, lanes: this.lanes, dense: false, drag, current };
+    const scene: Scene = { ctx, width: this.width, view: this.view, rows: r, model: { ...m, loop }, lanes: this.lanes, dense: false, drag };
     scene.dense = denseCuts(cutsInView(scene).length, this.width);
     if (scene.dense !== this.dense || this.container.dataset.denseCuts === undefined) {
       this.dense = scene.dense;
@@ -220,6 +220,19 @@ export class Timeline {
     const cut = this.hitCut(x, y);
     if (cut) return m.readOnly ? `cut at ${cut.frame}` : `cut at ${cut.frame} · click to select, drag to move`;
     return where;
+  }
+
+  /** The segment under the playhead, outlined (per frame: it changes as the playhead moves). */
+  private drawCurrentSegment(ctx: CanvasRenderingContext2D, m: TimelineModel, r: Rows): void {
+    const seg = m.segments.find((s) => s.start <= m.playhead && m.playhead < s.stop);
+    if (!seg) return;
+    const x0 = Math.max(this.x(seg.start), -2);
+    const x1 = Math.min(this.x(seg.stop), this.width + 2);
+    if (x1 < 0 || x0 > this.width) return;
+    ctx.strokeStyle = "#ffffff";
+    ctx.lineWidth = 2;
+    ctx.strokeRect(x0 + 2, r.segTop + 1, Math.max(x1 - x0 - 4, 1), SEGMENTS - 2);
+    ctx.lineWidth = 1;
   }
 
   private drawPlayhead(ctx: CanvasRenderingContext2D, m: TimelineModel, r: Rows): void {

@@ -41,8 +41,6 @@ export interface Scene {
   dense: boolean;
   /** A cut being dragged, drawn at `frame`. */
   drag: { id: number; frame: number } | null;
-  /** The segment under the playhead, outlined. */
-  current: Segment | undefined;
 }
 
 const SIGNAL_COLOURS = ["#7fd3ff", "#b39dff", "#7ee2a8"];
@@ -197,12 +195,6 @@ function drawSegments(s: Scene): void {
     ctx.globalAlpha = colour ? 0.85 : 1;
     ctx.fillRect(x0 + 1, top, Math.max(x1 - x0 - 2, 1), SEGMENTS);
     ctx.globalAlpha = 1;
-    if (seg === s.current) {
-      ctx.strokeStyle = "#ffffff";
-      ctx.lineWidth = 2;
-      ctx.strokeRect(x0 + 2, top + 1, Math.max(x1 - x0 - 4, 1), SEGMENTS - 2);
-      ctx.lineWidth = 1;
-    }
     const text = seg.label ?? "unlabelled";
     if (x1 - x0 > ctx.measureText(text).width + 12) {
       ctx.fillStyle = colour ? readableOn(colour) : "#6b7687";
