@@ -22,6 +22,20 @@ def frame_shown(page):
     return int(page.get_by_test_id("hud-frame").inner_text().split()[1])
 
 
+# Columns of the overview strip (the canvas's last 26 px) showing a pending candidate's amber tick.
+AMBER_OVERVIEW_COLUMNS = """() => {
+    const c = document.querySelector("[data-testid=timeline] canvas");
+    const dpr = c.width / c.clientWidth;
+    const top = Math.round((c.clientHeight - 26) * dpr);
+    const d = c.getContext("2d").getImageData(0, top, c.width, Math.round(9 * dpr)).data;
+    const columns = new Set();
+    for (let i = 0; i < d.length; i += 4) {
+        if (d[i] > 230 && d[i + 1] > 170 && d[i + 1] < 230 && d[i + 2] < 90) columns.add((i / 4) % c.width);
+    }
+    return columns.size / dpr;
+}"""
+
+
 def server_review(page, base_url, capture):
     response = page.request.get(f"{base_url}/api/captures/{capture.pk}/review/")
     assert response.ok, response.text()
@@ -85,6 +99,9 @@ def test_an_hour_long_take_has_an_overview_and_a_working_window(live_server, new
     # It opens on a one-minute working window, its candidates drawn one by one.
     expect(timeline).to_have_attribute("data-view-span", str(60 * 120))
     expect(timeline).to_have_attribute("data-dense-cuts", "false")
+    # The overview strip shows the whole hour's pending candidates meanwhile (~470, ticks in
+    # as many pixel columns but where two share one).
+    assert page.evaluate(AMBER_OVERVIEW_COLUMNS) > 300
     page.screenshot(path=str(screenshots / "long-take-window.png"))
 
     # A click on the overview seeks there, and the working window follows the playhead.
