@@ -5,12 +5,12 @@ default detector's on 13_29, repeated with it. Built from frames, not a BVH uplo
 text of an hour would be ~240 MB and ingest is not what these measure."""
 
 from functools import cache
-from pathlib import Path
 
 import numpy as np
 
-REPO = Path(__file__).resolve().parents[2]
-TAKE_13_29 = REPO.parent / "shared" / "data" / "cmu" / "bvh" / "13_29.bvh"
+from segmentation.shared_data import data_dir
+
+TAKE_13_29 = data_dir() / "cmu" / "bvh" / "13_29.bvh"
 
 
 @cache

@@ -43,7 +43,7 @@ def server_review(page, base_url, capture):
 
 
 @pytest.mark.parametrize("minutes", [10, 60])
-def test_a_click_or_drag_on_the_ruler_seeks_and_never_edits(live_server, new_page, studio, minutes):
+def test_a_click_or_drag_on_the_ruler_seeks_and_never_edits(live_server, new_page, studio, shared_data, minutes):
     capture = repeated_capture(studio["project"], studio["alice"], minutes * 60)
     page = new_page("ann")
     open_long_take(page, live_server.url, capture)
@@ -84,7 +84,7 @@ def test_a_click_or_drag_on_the_ruler_seeks_and_never_edits(live_server, new_pag
     assert page.errors == []
 
 
-def test_an_hour_long_take_has_an_overview_and_a_working_window(live_server, new_page, studio, screenshots):
+def test_an_hour_long_take_has_an_overview_and_a_working_window(live_server, new_page, studio, shared_data, screenshots):
     capture = repeated_capture(studio["project"], studio["alice"], 60 * 60, name="13_29_one_hour.bvh")
     page = new_page("ann")
     open_long_take(page, live_server.url, capture)
