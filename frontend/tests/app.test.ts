@@ -4,7 +4,7 @@ import { filtersFrom, queryOf } from "../src/captures/list";
 import { pairFiles } from "../src/captures/upload";
 import { failure, match, registerRoute } from "../src/router";
 import { eventDetail } from "../src/review/events";
-import { columnExtremes, finiteRange, readableOn } from "../src/review/timeline";
+import { readableOn } from "../src/review/timeline";
 
 describe("api client", () => {
   it("test_it_reads_the_csrf_cookie_among_others", () => {
@@ -82,18 +82,6 @@ describe("router", () => {
 });
 
 describe("timeline helpers", () => {
-  it("test_it_scales_signals_by_their_finite_range", () => {
-    expect(finiteRange([3, NaN, -1, Infinity, 2])).toEqual([-1, 3]);
-    expect(finiteRange([2, 2])).toEqual([1.5, 2.5]);
-    expect(finiteRange([])).toEqual([0, 1]);
-  });
-
-  it("test_it_reduces_dense_signals_to_a_min_max_per_pixel_column", () => {
-    const signal = { name: "q", start: 0, step: 1, values: [0, 5, 1, 9, 2, 3] };
-    const columns = columnExtremes(signal, 0, 5, (i) => i / 2, 3);
-    expect(columns).toEqual([[0, 5], [1, 9], [2, 3]]);
-  });
-
   it("test_it_picks_readable_text_on_label_colours", () => {
     expect(readableOn("#ffeb3b")).toBe("#111418");
     expect(readableOn("#1a237e")).toBe("#ffffff");

@@ -62,7 +62,8 @@ def test_it_opens_a_ten_minute_take_in_under_two_seconds_and_plays_it(live_serve
     # Then the feature signal is fetched again at full resolution (first paint used ~4,000 points).
     expect(page.get_by_test_id("timeline")).to_have_attribute("data-signal-step", "1")
 
-    # Scrub across the whole take on the ruler: the frame readout follows the pointer.
+    # Scrub across the whole take ("Fit") on the ruler: the frame readout follows the pointer.
+    page.get_by_test_id("zoom-fit").click()
     box = page.locator("[data-testid=timeline] canvas").bounding_box()
     page.mouse.move(box["x"] + 2, box["y"] + 12)
     page.mouse.down()

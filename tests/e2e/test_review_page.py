@@ -44,6 +44,10 @@ class ReviewScreen:
     def signal_y(self):
         return self.box()["y"] + 60
 
+    def handle_y(self):
+        """The strip of cut handles under the ruler: the only place a cut is grabbed."""
+        return self.box()["y"] + 32
+
     def ruler_y(self):
         return self.box()["y"] + 12
 
@@ -72,19 +76,22 @@ def test_it_saves_every_edit_and_restores_the_review_exactly_after_reload(live_s
     assert {c["fate"] for c in start["cuts"]} == {"pending"}
     frames_per_px = ingested_capture.n_frames / screen.box()["width"]
 
-    # Accept: click the dashed candidate line. The first edit starts the review.
-    page.mouse.click(screen.x(min(c["frame"] for c in start["cuts"])), screen.signal_y())
+    # Accept: a click on the candidate's handle selects it; Accept accepts it. The first
+    # edit starts the review.
+    page.mouse.click(screen.x(min(c["frame"] for c in start["cuts"])), screen.handle_y())
+    expect(page.get_by_test_id("selected-cut")).to_be_visible()
+    page.get_by_test_id("accept").click()
     screen.saved()
     start = screen.review()
     c0, c1, c2, c3 = sorted(start["cuts"], key=lambda c: c["frame"])[:4]
     assert start["status"] == "in_progress" and c0["fate"] == "accepted"
 
-    # Move: drag a candidate right, less than halfway to the next one.
+    # Move: drag a candidate by its handle right, less than halfway to the next one.
     shift_px = min(20.0, (c2["frame"] - c1["frame"]) / 3 / frames_per_px)
-    page.mouse.move(screen.x(c1["frame"]), screen.signal_y())
+    page.mouse.move(screen.x(c1["frame"]), screen.handle_y())
     page.mouse.down()
     for step in range(1, 6):
-        page.mouse.move(screen.x(c1["frame"]) + shift_px * step / 5, screen.signal_y())
+        page.mouse.move(screen.x(c1["frame"]) + shift_px * step / 5, screen.handle_y())
     page.mouse.up()
     screen.saved()
     moved = cut_by_id(screen.review(), c1["id"])
@@ -218,7 +225,8 @@ def test_it_shows_what_changed_when_the_review_was_edited_elsewhere(live_server,
     first, second = sorted(start["cuts"], key=lambda c: c["frame"])[:2]
     services.do_change_cut(review, studio["ann"], review.cuts.get(pk=first["id"]), start["version"], fate="deleted")
 
-    page.mouse.click(screen.x(second["frame"]), screen.signal_y())
+    page.mouse.click(screen.x(second["frame"]), screen.handle_y())
+    page.get_by_test_id("accept").click()
     dialog = page.get_by_role("dialog")
     expect(dialog).to_contain_text("This review changed elsewhere")
     # It says what happened in words: no internal review id, and no "reload" (it already
@@ -312,9 +320,9 @@ def test_it_undoes_and_redoes_moves_inserts_and_deletes_on_the_server(live_serve
     c0, c1 = sorted(start["cuts"], key=lambda c: c["frame"])[:2]
 
     # Move c0 with the mouse, delete c1 with the keyboard, insert a cut between them.
-    page.mouse.move(screen.x(c0["frame"]), screen.signal_y())
+    page.mouse.move(screen.x(c0["frame"]), screen.handle_y())
     page.mouse.down()
-    page.mouse.move(screen.x(c0["frame"]) + 12, screen.signal_y(), steps=4)
+    page.mouse.move(screen.x(c0["frame"]) + 12, screen.handle_y(), steps=4)
     page.mouse.up()
     screen.saved()
     # The move started the review: its candidates have ids now.
@@ -350,9 +358,9 @@ def test_it_undoes_and_redoes_moves_inserts_and_deletes_on_the_server(live_serve
     assert {c["id"]: (c["fate"], c["frame"]) for c in redone["cuts"]} == {c["id"]: (c["fate"], c["frame"]) for c in edited["cuts"]}
     assert redone["segments"] == edited["segments"]
 
-    # A deleted candidate stays on the ruler as a grey ×; clicking it restores the cut.
+    # A deleted candidate stays in the handle strip as a grey ×; clicking it restores the cut.
     page.get_by_test_id("zoom-fit").click()
-    page.mouse.click(screen.x(c1["frame"]), screen.box()["y"] + 21)
+    page.mouse.click(screen.x(c1["frame"]), screen.handle_y())
     screen.saved()
     assert cut_by_id(screen.review(), c1["id"])["fate"] == "pending"
     assert screen.events()[-1]["action"] == "reset"

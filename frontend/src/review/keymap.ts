@@ -115,9 +115,11 @@ export const HELP: [string, string][] = [
   ["Alt + drag, middle drag", "pan the timeline"],
   ["[ / ]", "slower / faster"],
   ["+ / −, wheel", "zoom the timeline (Shift+wheel pans)"],
-  ["Click a dashed cut", "accept it · drag any cut to move it"],
-  ["Double-click", "insert a cut there"],
-  ["Click a grey × in the ruler", "restore that deleted candidate"],
+  ["Click the ruler or a lane", "seek there (never edits)"],
+  ["Click a cut's handle", "select it (A accepts) · drag the handle to move the cut"],
+  ["Double-click a lane", "insert a cut there"],
+  ["Click a grey × under the ruler", "restore that deleted candidate"],
+  ["Click the overview strip", "seek anywhere in the take; the working window follows"],
   ["?", "show / hide this help"],
 ];
 

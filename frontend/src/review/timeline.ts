@@ -1,10 +1,17 @@
-// The timeline: ruler, feature signal lane(s), cut lines, segment bands and an overview
-// strip, all drawn on one canvas against one time axis (timescale.ts). No DOM node per
-// frame or per cut, so a 72,000-frame take with hundreds of cuts draws in a few ms.
+// The timeline: ruler, cut handles, feature signal lane(s), segment bands and an overview
+// of the whole take, all on one canvas against one time axis (timescale.ts). No DOM node per
+// frame or per cut. What does not move while playing (lanes, cuts, segments) is drawn once
+// per view and edit into an offscreen canvas (timelinedraw.ts); each animation frame copies
+// it and draws only the playhead, the pointer and the working window on the overview.
+// Where a pointer may do what is decided in hits.ts.
 
 import type { Cut, Label, Segment, Signal } from "../api/types";
+import { denseCuts, hitHandle, isDrag, overviewFrame, overviewX, OVERVIEW, RULER, HANDLES, rows, SEGMENTS, zoneAt, type Rows } from "./hits";
 import { isKept } from "./state";
-import { clampView, follow, formatTime, frameToX, fullView, panBy, resize, snapFrame, ticks, zoomAround, type View } from "./timescale";
+import { clampView, formatTime, frameToX, fullView, openingView, pageFollow, panBy, resize, snapFrame, zoomAround, type View } from "./timescale";
+import { cutsInView, drawScene, prepareLane, type Lane, type Scene } from "./timelinedraw";
+
+export { readableOn } from "./timelinedraw";
 
 export interface TimelineModel {
   nFrames: number;
@@ -29,21 +36,6 @@ export interface TimelineHandlers {
   restoreCut(id: number): void;
 }
 
-const RULER = 26;
-const LANE = 70;
-const SEGMENTS = 30;
-const OVERVIEW = 16;
-const GAP = 6;
-const HIT_PX = 6;
-const SIGNAL_COLOURS = ["#7fd3ff", "#b39dff", "#7ee2a8"];
-
-interface Layout {
-  lanes: { top: number; height: number }[];
-  segTop: number;
-  overviewTop: number;
-  height: number;
-}
-
 type Gesture =
   | { kind: "scrub" }
   | { kind: "overview" }
@@ -55,13 +47,17 @@ export class Timeline {
   readonly canvas = document.createElement("canvas");
   view: View;
   private model: TimelineModel | null = null;
-  private ranges = new Map<Signal, [number, number]>();
+  private lanes = new Map<Signal, Lane>();
   private gesture: Gesture | null = null;
   private loopPreview: { start: number; stop: number } | null = null;
   private hoverX: number | null = null;
   private hoverY: number | null = null;
   private queued = false;
   private width = 1;
+  /** Everything but the playhead, the pointer and the working window, drawn once per `baseKey`. */
+  private readonly base = document.createElement("canvas");
+  private baseKey: unknown[] = [];
+  private dense = false;
   onViewChange: (() => void) | null = null;
 
   constructor(
@@ -86,10 +82,10 @@ export class Timeline {
 
   update(model: TimelineModel): void {
     const first = this.model === null || this.model.nFrames !== model.nFrames;
-    if (this.model?.signals !== model.signals) this.ranges = new Map(model.signals.map((s) => [s, finiteRange(s.values)]));
+    if (this.model?.signals !== model.signals) this.lanes = new Map(model.signals.map((s) => [s, prepareLane(s)]));
     this.model = model;
     if (first) {
-      this.view = fullView(model.nFrames, this.width);
+      this.view = openingView(model.nFrames, model.fps, this.width, model.playhead);
       this.layoutCanvas();
     }
     this.schedule();
@@ -97,6 +93,7 @@ export class Timeline {
 
   setView(view: View): void {
     this.view = clampView(view);
+    this.publishView();
     this.onViewChange?.();
     this.schedule();
   }
@@ -106,29 +103,35 @@ export class Timeline {
     this.setView(zoomAround(this.view, Math.min(Math.max(x, 0), this.width), factor));
   }
 
-  /** Keep the playhead visible while playing or stepping. */
+  /** Keep the playhead visible while playing or stepping: the working window turns a page when it leaves. */
   reveal(frame: number): void {
-    const next = follow(this.view, frame);
+    const next = pageFollow(this.view, frame);
     if (next !== this.view) this.setView(next);
   }
 
-  private layout(): Layout {
-    const n = Math.max(this.model?.signals.length ?? 1, 1);
-    const lanes = Array.from({ length: n }, (_, i) => ({ top: RULER + GAP + i * (LANE + GAP), height: LANE }));
-    const segTop = RULER + GAP + n * (LANE + GAP);
-    const overviewTop = segTop + SEGMENTS + GAP;
-    return { lanes, segTop, overviewTop, height: overviewTop + OVERVIEW + 2 };
+  /** The view on the container (data-view-start, data-view-span), for tests and benchmarks. */
+  private publishView(): void {
+    this.container.dataset.viewStart = String(Math.round(this.view.start));
+    this.container.dataset.viewSpan = String(Math.round(this.view.span));
+  }
+
+  private rows(): Rows {
+    return rows(this.model?.signals.length ?? 1);
   }
 
   private layoutCanvas(): void {
     this.width = Math.max(this.container.clientWidth, 1);
-    const height = this.layout().height;
+    const height = this.rows().height;
     const dpr = window.devicePixelRatio || 1;
-    this.canvas.width = Math.round(this.width * dpr);
-    this.canvas.height = Math.round(height * dpr);
+    for (const canvas of [this.canvas, this.base]) {
+      canvas.width = Math.round(this.width * dpr);
+      canvas.height = Math.round(height * dpr);
+    }
     this.canvas.style.width = `${this.width}px`;
     this.canvas.style.height = `${height}px`;
+    this.baseKey = [];
     this.view = clampView(resize(this.view, this.width));
+    this.publishView();
     this.draw();
   }
 
@@ -146,277 +149,143 @@ export class Timeline {
     const ctx = this.canvas.getContext("2d");
     if (!m || !ctx) return;
     const dpr = window.devicePixelRatio || 1;
+    const r = this.rows();
+    this.drawBase(m, r, dpr);
+    ctx.setTransform(1, 0, 0, 1, 0, 0);
+    ctx.drawImage(this.base, 0, 0);
     ctx.setTransform(dpr, 0, 0, dpr, 0, 0);
-    const L = this.layout();
-    ctx.fillStyle = "#12161c";
-    ctx.fillRect(0, 0, this.width, L.height);
-    this.drawRuler(ctx, m);
-    L.lanes.forEach((lane, i) => this.drawSignal(ctx, m.signals[i], lane, SIGNAL_COLOURS[i % SIGNAL_COLOURS.length]));
-    this.drawSegments(ctx, m, L.segTop);
-    this.drawCuts(ctx, m, RULER, L.segTop + SEGMENTS);
-    this.drawHover(ctx, m, L.segTop + SEGMENTS);
-    this.drawPlayhead(ctx, m, L.segTop + SEGMENTS);
-    this.drawOverview(ctx, m, L.overviewTop);
+    this.drawCurrentSegment(ctx, m, r);
+    this.drawHover(ctx, m, r);
+    this.drawPlayhead(ctx, m, r);
+    this.drawWindow(ctx, m, r);
+    this.drawDragLabel(ctx, r);
+  }
+
+  private dragged(): { id: number; frame: number } | null {
+    const g = this.gesture;
+    return g?.kind === "drag" && g.moved ? { id: g.cut.id, frame: g.frame } : null;
+  }
+
+  /** Redraw the offscreen layer only when something it shows changed. */
+  private drawBase(m: TimelineModel, r: Rows, dpr: number): void {
+    const loop = this.loopPreview ?? m.loop;
+    const drag = this.dragged();
+    const key = [this.view.start, this.view.span, this.width, dpr, m.signals, m.cuts, m.segments, m.labels, m.selectedCutId,
+      loop?.start, loop?.stop, drag?.id, drag?.frame, this.lanes];
+    if (key.length === this.baseKey.length && key.every((v, i) => v === this.baseKey[i])) return;
+    this.baseKey = key;
+    const ctx = this.base.getContext("2d");
+    if (!ctx) return;
+    ctx.setTransform(dpr, 0, 0, dpr, 0, 0);
+    const scene: Scene = { ctx, width: this.width, view: this.view, rows: r, model: { ...m, loop }, lanes: this.lanes, dense: false, drag };
+    scene.dense = denseCuts(cutsInView(scene).length, this.width);
+    if (scene.dense !== this.dense || this.container.dataset.denseCuts === undefined) {
+      this.dense = scene.dense;
+      this.container.dataset.denseCuts = String(scene.dense);
+    }
+    drawScene(scene);
   }
 
   private x(frame: number): number {
     return frameToX(this.view, frame);
   }
 
-  private drawRuler(ctx: CanvasRenderingContext2D, m: TimelineModel): void {
-    ctx.fillStyle = "#1a1f27";
-    ctx.fillRect(0, 0, this.width, RULER);
-    const loop = this.loopPreview ?? m.loop;
-    if (loop) {
-      ctx.fillStyle = "rgba(126, 226, 168, 0.25)";
-      ctx.fillRect(this.x(loop.start), 0, this.x(loop.stop) - this.x(loop.start), RULER);
-    }
-    ctx.font = "11px ui-monospace, SFMono-Regular, Menlo, monospace";
-    ctx.textBaseline = "middle";
-    for (const frame of ticks(this.view, m.fps, 130)) {
-      const x = Math.round(this.x(frame)) + 0.5;
-      ctx.strokeStyle = "#3a4350";
-      ctx.beginPath();
-      ctx.moveTo(x, RULER - 10);
-      ctx.lineTo(x, RULER);
-      ctx.stroke();
-      const time = formatTime(frame, m.fps);
-      ctx.fillStyle = "#aab4c3";
-      ctx.fillText(time, x + 4, RULER / 2 - 2);
-      ctx.fillStyle = "#5f6b7c";
-      ctx.fillText(String(frame), x + 10 + ctx.measureText(time).width, RULER / 2 - 2);
-    }
-  }
-
-  private drawSignal(ctx: CanvasRenderingContext2D, signal: Signal | undefined, lane: { top: number; height: number }, colour: string): void {
-    ctx.fillStyle = "#161b22";
-    ctx.fillRect(0, lane.top, this.width, lane.height);
-    if (!signal || signal.values.length === 0) {
-      ctx.fillStyle = "#5c6778";
-      ctx.fillText("no feature signal for this capture yet", 10, lane.top + lane.height / 2);
-      return;
-    }
-    const [lo, hi] = this.ranges.get(signal) ?? [0, 1];
-    const y = (v: number) => lane.top + 4 + (1 - (v - lo) / (hi - lo || 1)) * (lane.height - 8);
-    const step = signal.step || 1;
-    const first = Math.max(Math.floor((this.view.start - signal.start) / step) - 1, 0);
-    const last = Math.min(Math.ceil((this.view.start + this.view.span - signal.start) / step) + 1, signal.values.length - 1);
-    ctx.beginPath();
-    if (last - first > this.width * 2) {
-      // More samples than pixels: draw each pixel column's min-max, the classic waveform view.
-      // Joined column to column, so a smooth curve stays a line and a noisy one a band.
-      const columns = columnExtremes(signal, first, last, (i) => this.x(signal.start + i * step), this.width);
-      let started = false;
-      columns.forEach(([a, b], px) => {
-        if (Number.isNaN(a)) return;
-        if (started) ctx.lineTo(px + 0.5, y(a));
-        else ctx.moveTo(px + 0.5, y(a));
-        ctx.lineTo(px + 0.5, y(b) + 0.5);
-        started = true;
-      });
-    } else {
-      for (let i = first; i <= last; i++) {
-        const v = signal.values[i];
-        if (!Number.isFinite(v)) continue;
-        if (i === first) ctx.moveTo(this.x(signal.start + i * step), y(v));
-        else ctx.lineTo(this.x(signal.start + i * step), y(v));
-      }
-    }
-    ctx.strokeStyle = colour;
-    ctx.lineWidth = 1.25;
-    ctx.stroke();
-    ctx.lineWidth = 1;
-    // The lane's name on a backing plate, so the curve never runs through it.
-    ctx.font = "11px system-ui, sans-serif";
-    const w = ctx.measureText(signal.name).width;
-    ctx.fillStyle = "rgba(22, 27, 34, 0.85)";
-    ctx.fillRect(4, lane.top + 3, w + 8, 15);
-    ctx.fillStyle = "#8792a3";
-    ctx.fillText(signal.name, 8, lane.top + 11);
-  }
-
-  private drawSegments(ctx: CanvasRenderingContext2D, m: TimelineModel, top: number): void {
-    const colours = new Map(m.labels.map((l) => [l.name, l.color]));
-    const current = m.segments.find((s) => s.start <= m.playhead && m.playhead < s.stop);
-    ctx.font = "600 12px system-ui, sans-serif";
-    for (const s of m.segments) {
-      const x0 = Math.max(this.x(s.start), -2);
-      const x1 = Math.min(this.x(s.stop), this.width + 2);
-      if (x1 < 0 || x0 > this.width) continue;
-      const colour = s.label ? colours.get(s.label) ?? "#8a93a3" : null;
-      ctx.fillStyle = colour ?? "#222933";
-      ctx.globalAlpha = colour ? 0.85 : 1;
-      ctx.fillRect(x0 + 1, top, Math.max(x1 - x0 - 2, 1), SEGMENTS);
-      ctx.globalAlpha = 1;
-      if (s === current) {
-        ctx.strokeStyle = "#ffffff";
-        ctx.lineWidth = 2;
-        ctx.strokeRect(x0 + 2, top + 1, Math.max(x1 - x0 - 4, 1), SEGMENTS - 2);
-        ctx.lineWidth = 1;
-      }
-      const text = s.label ?? "unlabelled";
-      if (x1 - x0 > ctx.measureText(text).width + 12) {
-        ctx.fillStyle = colour ? readableOn(colour) : "#6b7687";
-        ctx.fillText(text, Math.max(x0, 0) + 6, top + SEGMENTS / 2);
-      }
-    }
-  }
-
-  private drawCuts(ctx: CanvasRenderingContext2D, m: TimelineModel, top: number, bottom: number): void {
-    const drag = this.gesture?.kind === "drag" && this.gesture.moved ? this.gesture : null;
-    this.drawDeleted(ctx, m, top);
-    for (const cut of m.cuts) {
-      if (!isKept(cut)) continue;
-      const frame = drag && drag.cut.id === cut.id ? drag.frame : cut.frame;
-      const x = Math.round(this.x(frame)) + 0.5;
-      if (x < -4 || x > this.width + 4) continue;
-      const selected = cut.id === m.selectedCutId;
-      if (cut.fate === "moved" && cut.candidate_frame !== null) this.drawGhost(ctx, cut.candidate_frame, x, top);
-      const pending = cut.fate === "pending";
-      const confidence = cut.confidence ?? 0.6;
-      ctx.setLineDash(pending ? [5, 4] : []);
-      ctx.globalAlpha = pending ? 0.3 + 0.7 * confidence : 1;
-      ctx.strokeStyle = selected ? "#4fc3f7" : pending ? "#ffca28" : "#f5f7fa";
-      ctx.lineWidth = selected ? 2.5 : pending ? 1 + confidence : 2;
-      ctx.beginPath();
-      ctx.moveTo(x, top);
-      ctx.lineTo(x, bottom);
-      ctx.stroke();
-      // A handle in the ruler shows where to grab.
-      ctx.setLineDash([]);
-      ctx.fillStyle = ctx.strokeStyle;
-      ctx.beginPath();
-      ctx.moveTo(x - 5, top - 9);
-      ctx.lineTo(x + 5, top - 9);
-      ctx.lineTo(x, top - 1);
-      ctx.fill();
-      ctx.globalAlpha = 1;
-    }
-    ctx.setLineDash([]);
-    ctx.lineWidth = 1;
-    if (drag) {
-      ctx.fillStyle = "#4fc3f7";
-      ctx.font = "600 11px ui-monospace, monospace";
-      ctx.fillText(`→ ${drag.frame}`, this.x(drag.frame) + 6, top + 12);
-    }
-  }
-
-  /** Deleted candidates stay findable: a small grey × each, which a click restores. */
-  private drawDeleted(ctx: CanvasRenderingContext2D, m: TimelineModel, top: number): void {
-    ctx.strokeStyle = "#6b7687";
-    ctx.lineWidth = 1.25;
-    ctx.beginPath();
-    for (const cut of m.cuts) {
-      if (cut.fate !== "deleted" || cut.origin !== "candidate") continue;
-      const x = Math.round(this.x(cut.frame)) + 0.5;
-      if (x < -4 || x > this.width + 4) continue;
-      ctx.moveTo(x - 3, top - 8);
-      ctx.lineTo(x + 3, top - 2);
-      ctx.moveTo(x + 3, top - 8);
-      ctx.lineTo(x - 3, top - 2);
-    }
-    ctx.stroke();
-    ctx.lineWidth = 1;
-  }
-
-  /** Where a moved cut was proposed: a hollow marker in the ruler joined to the cut. */
-  private drawGhost(ctx: CanvasRenderingContext2D, frame: number, cutX: number, top: number): void {
-    const x = Math.round(this.x(frame)) + 0.5;
-    ctx.setLineDash([2, 3]);
-    ctx.strokeStyle = "#7f8a9b";
-    ctx.lineWidth = 1;
-    ctx.beginPath();
-    ctx.moveTo(x - 4, top - 8);
-    ctx.lineTo(x + 4, top - 8);
-    ctx.lineTo(x, top - 1);
-    ctx.closePath();
-    ctx.moveTo(x, top - 4);
-    ctx.lineTo(cutX, top - 4);
-    ctx.stroke();
-    ctx.setLineDash([]);
-  }
-
   /** A faint line under the pointer with its frame and time, so a cut can be aimed. */
-  private drawHover(ctx: CanvasRenderingContext2D, m: TimelineModel, bottom: number): void {
-    if (this.hoverX === null || this.gesture) return;
+  private drawHover(ctx: CanvasRenderingContext2D, m: TimelineModel, r: Rows): void {
+    if (this.hoverX === null || this.hoverY === null || this.gesture) return;
     const frame = snapFrame(this.view, this.hoverX);
     const x = Math.round(this.x(frame)) + 0.5;
     ctx.strokeStyle = "rgba(255, 255, 255, 0.25)";
     ctx.beginPath();
     ctx.moveTo(x, RULER);
-    ctx.lineTo(x, bottom);
+    ctx.lineTo(x, r.segTop + SEGMENTS);
     ctx.stroke();
-    const deleted = this.hoverY === null ? null : this.hitDeleted(this.hoverX, this.hoverY);
-    const text = deleted ? `deleted cut at ${deleted.frame} · click to restore` : `${frame} · ${formatTime(frame, m.fps)}`;
     ctx.font = "11px ui-monospace, SFMono-Regular, Menlo, monospace";
+    ctx.textBaseline = "middle";
+    const text = this.hoverText(this.hoverX, this.hoverY, frame, m);
     const w = ctx.measureText(text).width + 8;
     const left = Math.min(Math.max(x + 4, 0), this.width - w);
     ctx.fillStyle = "#2a3340";
-    ctx.fillRect(left, RULER + 2, w, 15);
+    ctx.fillRect(left, RULER + HANDLES + 2, w, 15);
     ctx.fillStyle = "#dfe5ee";
-    ctx.fillText(text, left + 4, RULER + 10);
+    ctx.fillText(text, left + 4, RULER + HANDLES + 10);
   }
 
-  private drawPlayhead(ctx: CanvasRenderingContext2D, m: TimelineModel, bottom: number): void {
+  private hoverText(x: number, y: number, frame: number, m: TimelineModel): string {
+    const where = `${frame} · ${formatTime(frame, m.fps)}`;
+    if (zoneAt(this.rows(), y) !== "handles") return where;
+    if (this.dense) return `${where} · zoom in to grab a cut`;
+    const deleted = this.hitDeleted(x, y);
+    if (deleted) return `deleted cut at ${deleted.frame} · click to restore`;
+    const cut = this.hitCut(x, y);
+    if (cut) return m.readOnly ? `cut at ${cut.frame}` : `cut at ${cut.frame} · click to select, drag to move`;
+    return where;
+  }
+
+  /** The segment under the playhead, outlined (per frame: it changes as the playhead moves). */
+  private drawCurrentSegment(ctx: CanvasRenderingContext2D, m: TimelineModel, r: Rows): void {
+    const seg = m.segments.find((s) => s.start <= m.playhead && m.playhead < s.stop);
+    if (!seg) return;
+    const x0 = Math.max(this.x(seg.start), -2);
+    const x1 = Math.min(this.x(seg.stop), this.width + 2);
+    if (x1 < 0 || x0 > this.width) return;
+    ctx.strokeStyle = "#ffffff";
+    ctx.lineWidth = 2;
+    ctx.strokeRect(x0 + 2, r.segTop + 1, Math.max(x1 - x0 - 4, 1), SEGMENTS - 2);
+    ctx.lineWidth = 1;
+  }
+
+  private drawPlayhead(ctx: CanvasRenderingContext2D, m: TimelineModel, r: Rows): void {
     const x = Math.round(this.x(m.playhead)) + 0.5;
     ctx.strokeStyle = "#ff5a5f";
     ctx.lineWidth = 1.5;
     ctx.beginPath();
     ctx.moveTo(x, 0);
-    ctx.lineTo(x, bottom);
+    ctx.lineTo(x, r.segTop + SEGMENTS);
     ctx.stroke();
     ctx.fillStyle = "#ff5a5f";
     ctx.fillRect(x - 4, 0, 8, 6);
     ctx.lineWidth = 1;
   }
 
-  private drawOverview(ctx: CanvasRenderingContext2D, m: TimelineModel, top: number): void {
-    const whole = fullView(m.nFrames, this.width);
-    const colours = new Map(m.labels.map((l) => [l.name, l.color]));
-    ctx.fillStyle = "#1a1f27";
-    ctx.fillRect(0, top, this.width, OVERVIEW);
-    for (const s of m.segments) {
-      if (!s.label) continue;
-      ctx.fillStyle = colours.get(s.label) ?? "#8a93a3";
-      ctx.globalAlpha = 0.6;
-      ctx.fillRect(frameToX(whole, s.start), top + 3, frameToX(whole, s.stop) - frameToX(whole, s.start), OVERVIEW - 6);
-    }
-    ctx.globalAlpha = 1;
-    const x0 = frameToX(whole, this.view.start);
-    const w = Math.max(frameToX(whole, this.view.start + this.view.span) - x0, 3);
+  /** The working window and the playhead on the overview of the whole take. */
+  private drawWindow(ctx: CanvasRenderingContext2D, m: TimelineModel, r: Rows): void {
+    const x0 = overviewX(this.view.start, this.width, m.nFrames);
+    const w = Math.max(overviewX(this.view.start + this.view.span, this.width, m.nFrames) - x0, 3);
+    ctx.fillStyle = "rgba(159, 179, 200, 0.12)";
+    ctx.fillRect(x0, r.overviewTop, w, OVERVIEW);
     ctx.strokeStyle = "#9fb3c8";
-    ctx.strokeRect(x0 + 0.5, top + 0.5, w - 1, OVERVIEW - 1);
+    ctx.strokeRect(x0 + 0.5, r.overviewTop + 0.5, w - 1, OVERVIEW - 1);
     ctx.fillStyle = "#ff5a5f";
-    ctx.fillRect(frameToX(whole, m.playhead) - 0.5, top, 1.5, OVERVIEW);
+    ctx.fillRect(overviewX(m.playhead, this.width, m.nFrames) - 0.5, r.overviewTop, 1.5, OVERVIEW);
+  }
+
+  private drawDragLabel(ctx: CanvasRenderingContext2D, r: Rows): void {
+    const drag = this.dragged();
+    if (!drag) return;
+    ctx.fillStyle = "#4fc3f7";
+    ctx.font = "600 11px ui-monospace, monospace";
+    ctx.fillText(`→ ${drag.frame}`, this.x(drag.frame) + 8, r.handlesTop + HANDLES + 12);
   }
 
   // ---- interaction -------------------------------------------------------------------
 
+  /** The kept cut whose handle is under the pointer (only in the handle strip, never while dense). */
   private hitCut(x: number, y: number): Cut | null {
     const m = this.model;
-    if (!m || y >= this.layout().overviewTop) return null;
-    let best: Cut | null = null;
-    let bestDistance = HIT_PX + 1;
-    for (const cut of m.cuts) {
-      if (!isKept(cut)) continue;
-      const d = Math.abs(this.x(cut.frame) - x) - (cut.id === m.selectedCutId ? 1 : 0);
-      if (d < bestDistance) [best, bestDistance] = [cut, d];
-    }
-    return bestDistance <= HIT_PX ? best : null;
+    if (!m) return null;
+    const cuts = m.cuts.filter(isKept).map((cut) => ({ id: cut.id, x: this.x(cut.frame), cut }));
+    const id = hitHandle(this.rows(), cuts, x, y, this.dense, m.selectedCutId);
+    return cuts.find((c) => c.id === id)?.cut ?? null;
   }
 
-  /** A deleted candidate's marker (a small × at the foot of the ruler) under the pointer. */
+  /** A deleted candidate's × in the handle strip under the pointer. */
   private hitDeleted(x: number, y: number): Cut | null {
     const m = this.model;
-    if (!m || y < RULER - 12 || y > RULER + 2) return null;
-    let best: Cut | null = null;
-    let bestDistance = HIT_PX + 1;
-    for (const cut of m.cuts) {
-      if (cut.fate !== "deleted" || cut.origin !== "candidate") continue;
-      const d = Math.abs(this.x(cut.frame) - x);
-      if (d < bestDistance) [best, bestDistance] = [cut, d];
-    }
-    return bestDistance <= HIT_PX ? best : null;
+    if (!m) return null;
+    const deleted = m.cuts.filter((c) => c.fate === "deleted" && c.origin === "candidate").map((cut) => ({ id: cut.id, x: this.x(cut.frame), cut }));
+    const id = hitHandle(this.rows(), deleted, x, y, this.dense, null);
+    return deleted.find((c) => c.id === id)?.cut ?? null;
   }
 
   private point(e: MouseEvent): [number, number] {
@@ -428,33 +297,33 @@ export class Timeline {
     if (!this.model || (e.button !== 0 && e.button !== 1)) return;
     const [x, y] = this.point(e);
     this.canvas.setPointerCapture(e.pointerId);
+    const zone = zoneAt(this.rows(), y);
     if (e.button === 1 || e.altKey) {
       e.preventDefault();
       this.gesture = { kind: "pan", lastX: x };
-      return;
-    }
-    if (e.shiftKey && y < RULER) {
+    } else if (zone === "overview") {
+      this.gesture = { kind: "overview" };
+      this.seekOverview(x);
+    } else if (zone === "ruler" && e.shiftKey) {
       const frame = snapFrame(this.view, x);
       this.gesture = { kind: "loop", from: frame, to: frame };
-      return;
+    } else if (!this.grab(x, y)) {
+      this.gesture = { kind: "scrub" };
+      this.handlers.seek(snapFrame(this.view, x));
     }
-    if (y >= this.layout().overviewTop) {
-      this.gesture = { kind: "overview" };
-      this.centreOverview(x);
-      return;
-    }
+  }
+
+  /** A press in the handle strip: on a cut's handle it grabs the cut, on a deleted ×, restores it. */
+  private grab(x: number, y: number): boolean {
     const cut = this.hitCut(x, y);
     if (cut) {
       this.gesture = { kind: "drag", cut, startX: x, moved: false, frame: cut.frame };
-      return;
+      return true;
     }
     const deleted = this.hitDeleted(x, y);
-    if (deleted && !this.model.readOnly) {
-      this.handlers.restoreCut(deleted.id);
-      return;
-    }
-    this.gesture = { kind: "scrub" };
-    this.handlers.seek(snapFrame(this.view, x));
+    if (!deleted || this.model?.readOnly) return false;
+    this.handlers.restoreCut(deleted.id);
+    return true;
   }
 
   private onMove(e: PointerEvent): void {
@@ -462,12 +331,12 @@ export class Timeline {
     const g = this.gesture;
     if (!g) {
       this.canvas.style.cursor = this.hitCut(x, y) ? (this.model?.readOnly ? "pointer" : "ew-resize") : this.hitDeleted(x, y) ? "pointer" : "crosshair";
-      this.hoverX = y < this.layout().overviewTop ? x : null;
+      this.hoverX = zoneAt(this.rows(), y) === "overview" ? null : x;
       this.hoverY = y;
       this.schedule();
       return;
     }
-    if (g.kind === "overview") this.centreOverview(x);
+    if (g.kind === "overview") this.seekOverview(x);
     else if (g.kind === "scrub") this.handlers.seek(snapFrame(this.view, x));
     else if (g.kind === "pan") {
       this.setView(panBy(this.view, x - g.lastX));
@@ -476,8 +345,7 @@ export class Timeline {
       g.to = snapFrame(this.view, x);
       this.loopPreview = { start: Math.min(g.from, g.to), stop: Math.max(g.from, g.to) + 1 };
       this.schedule();
-    }
-    else if (!this.model?.readOnly && (g.moved || Math.abs(x - g.startX) > 3)) {
+    } else if (!this.model?.readOnly && (g.moved || isDrag(g.startX, x))) {
       g.moved = true;
       g.frame = Math.min(Math.max(snapFrame(this.view, x), 1), this.model!.nFrames - 1);
       this.schedule();
@@ -496,15 +364,17 @@ export class Timeline {
       return;
     }
     if (g?.kind !== "drag") return;
+    // A click on a handle selects its cut; only a drag past the threshold moves it.
+    // Accepting is a command of its own (A, or the Accept button), never a side effect.
     this.handlers.selectCut(g.cut.id);
     if (g.moved && g.frame !== g.cut.frame) this.handlers.moveCut(g.cut.id, g.frame);
-    else if (!g.moved && g.cut.fate === "pending" && !this.model?.readOnly) this.handlers.acceptCut(g.cut.id);
     this.schedule();
   }
 
+  /** A double-click in the lanes inserts a cut there; not on the ruler, a handle or the overview. */
   private onDoubleClick(e: MouseEvent): void {
     const [x, y] = this.point(e);
-    if (!this.model || this.model.readOnly || y >= this.layout().overviewTop || this.hitCut(x, y)) return;
+    if (!this.model || this.model.readOnly || zoneAt(this.rows(), y) !== "lanes") return;
     this.handlers.insertAt(snapFrame(this.view, x));
   }
 
@@ -518,43 +388,11 @@ export class Timeline {
     }
   }
 
-  private centreOverview(x: number): void {
+  /** The overview is a ruler for the whole take: seek there, and the working window centres on it. */
+  private seekOverview(x: number): void {
     if (!this.model) return;
-    const frame = (x / this.width) * this.model.nFrames;
+    const frame = overviewFrame(x, this.width, this.model.nFrames);
     this.setView({ ...this.view, start: frame - this.view.span / 2 });
+    this.handlers.seek(frame);
   }
-}
-
-/** Finite min and max of a signal (NaN gaps allowed), widened when flat. */
-export function finiteRange(values: readonly number[]): [number, number] {
-  let lo = Infinity;
-  let hi = -Infinity;
-  for (const v of values) {
-    if (!Number.isFinite(v)) continue;
-    if (v < lo) lo = v;
-    if (v > hi) hi = v;
-  }
-  if (lo === Infinity) return [0, 1];
-  return hi > lo ? [lo, hi] : [lo - 0.5, hi + 0.5];
-}
-
-/** Per pixel column, the min and max of the samples that land in it (NaN where none do). */
-export function columnExtremes(signal: Signal, first: number, last: number, xOf: (i: number) => number, width: number): [number, number][] {
-  const columns: [number, number][] = Array.from({ length: Math.ceil(width) }, () => [NaN, NaN]);
-  for (let i = first; i <= last; i++) {
-    const px = Math.floor(xOf(i));
-    const v = signal.values[i];
-    if (px < 0 || px >= columns.length || !Number.isFinite(v)) continue;
-    const c = columns[px];
-    if (Number.isNaN(c[0]) || v < c[0]) c[0] = v;
-    if (Number.isNaN(c[1]) || v > c[1]) c[1] = v;
-  }
-  return columns;
-}
-
-/** Black or white text, whichever reads better on `hex`. */
-export function readableOn(hex: string): string {
-  const n = parseInt(hex.replace("#", "").slice(0, 6), 16);
-  const [r, g, b] = [(n >> 16) & 255, (n >> 8) & 255, n & 255];
-  return 0.299 * r + 0.587 * g + 0.114 * b > 150 ? "#111418" : "#ffffff";
 }

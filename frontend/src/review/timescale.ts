@@ -57,6 +57,33 @@ export function follow(view: View, frame: number): View {
   return view;
 }
 
+/**
+ * Scroll by pages, as a studio editor's timeline does while playing: nothing moves until
+ * `frame` leaves the view, then the view jumps so the frame sits near its left edge. The
+ * view changes once a page instead of on every frame, so the drawn lanes can be reused.
+ */
+export function pageFollow(view: View, frame: number): View {
+  if (frame >= view.start && frame <= view.start + view.span) return view;
+  // Going back (a step or a jump), the frame lands near the right edge instead.
+  const at = frame < view.start ? 0.95 : 0.05;
+  return clampView({ ...view, start: frame - view.span * at });
+}
+
+/** Takes longer than this open on a working window instead of the whole take. */
+export const LONG_TAKE_SECONDS = 300;
+/** The working window's length when a long take opens. */
+export const WINDOW_SECONDS = 60;
+
+/**
+ * The view a take opens on: the whole take, or for a long take a working window of
+ * WINDOW_SECONDS holding `playhead` (the overview strip shows the whole take).
+ */
+export function openingView(nFrames: number, fps: number, width: number, playhead = 0): View {
+  const whole = fullView(nFrames, width);
+  if (nFrames / fps <= LONG_TAKE_SECONDS) return whole;
+  return clampView({ ...whole, span: WINDOW_SECONDS * fps, start: playhead - WINDOW_SECONDS * fps * 0.05 });
+}
+
 export function resize(view: View, width: number): View {
   return { ...view, width: Math.max(width, 1) };
 }
