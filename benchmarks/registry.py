@@ -57,6 +57,9 @@ BENCHMARKS = {
                                    "list under load on PostgreSQL"),
     "review-long-take": Benchmark("benchmarks.service.review_long_take", "review requests "
                                   "on a one-hour take"),
+    "review-playback": Benchmark("benchmarks.service.review_playback", "the review page's "
+                                 "redraw interval and scrub latency on 38-s, 10- and "
+                                 "60-minute takes, the old front end against the new"),
     "retrain": Benchmark("benchmarks.service.retrain", "retraining a project's cut model"),
     "poisoning": Benchmark("benchmarks.service.poisoning", "one annotator against a "
                            "project's model"),

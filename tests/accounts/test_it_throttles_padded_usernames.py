@@ -7,8 +7,8 @@ name made every guess count for no one, and a locked account still signed in.
 
 from django.test import Client, override_settings
 
-from tests.segmentation.base import BaseTestCase
 from tests.accounts.test_sign_in_throttle import LIMITS
+from tests.segmentation.base import BaseTestCase
 
 PADDINGS = (" " * 3000 + "bob", "\u3000" * 3000 + "bob", "\t\n" * 2000 + "bob",
             "bob" + " " * 3000, " " * 5000 + "bob" + "\u3000" * 5000)

@@ -8,7 +8,7 @@ from functools import cache
 
 import numpy as np
 
-from segmentation.shared_data import data_dir
+from motionlib.shared_data import data_dir
 
 TAKE_13_29 = data_dir() / "cmu" / "bvh" / "13_29.bvh"
 

@@ -26,7 +26,7 @@ untimed:
   "Fit". The press is at least 8 px from any cut, since the old page grabs a cut within
   6 px even on the ruler (at "Fit" on the hour no such point exists: n/a for the old page).
 
-    .venv/bin/python -m benchmarks.review_playback [--frames 120] [--moves 40]
+    .venv/bin/python -m benchmarks review-playback -- [--frames 120] [--moves 40]
 
 Target: a 60-minute take plays within 1.5x the redraw interval of the 38-s take (median),
 in each view.
@@ -47,7 +47,8 @@ from pathlib import Path
 
 import numpy as np
 
-from benchmarks.harness import REPO, start_django, stop, up_script
+from benchmarks.harness import REPO
+from benchmarks.harness.service import start_django, stop, up_script
 
 CHROMIUM = "/usr/bin/chromium"
 PASSWORD = "benchmark-password"
