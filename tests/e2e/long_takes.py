@@ -34,7 +34,7 @@ def repeated_capture(project, user, seconds, name=None):
     from django.core.files.base import ContentFile
 
     import motionlib
-    from segmentation import storage
+    from segmentation.files import storage
     from segmentation.models import Capture, DetectionRun
 
     take, base, cuts, confidence, signals = take_13_29()
