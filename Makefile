@@ -60,9 +60,17 @@ vitest: $(FRONT_STAMP)
 INTEGRATION_ENV := DATABASE_URL=postgres://postgres@127.0.0.1:5432/test \
 	CELERY_BROKER_URL=redis://127.0.0.1:6379/15
 
+# Both runs spread their tests over one process per core (pytest-xdist); an idle process
+# takes tests from a busy one's queue, so one long test does not leave a core waiting at the
+# end. Each process has its own test database (pytest-django suffixes it: _gw0, _gw1),
+# temporary folders and var/ (tests/conftest.py); each integration test's Celery workers
+# read that process's database from a Redis queue of their own.
+PYTEST_WORKERS ?= auto
+XDIST := -n $(PYTEST_WORKERS) --dist worksteal
+
 pytest: install
-	$(PY) -m pytest -m "not integration"
-	$(INTEGRATION_ENV) $(PY) -m pytest -m integration
+	$(PY) -m pytest -m "not integration" $(XDIST)
+	$(INTEGRATION_ENV) $(PY) -m pytest -m integration $(XDIST)
 
 # Each benchmark's output goes to benchmarks/results/<name>.md (generated, committed: every
 # figure quoted has one source, and a change shows as a diff), headed by date, commit and load.

@@ -15,3 +15,24 @@ def shared_data():
     if not SHARED_DATA.is_dir():
         pytest.skip(f"real CMU data not found at {SHARED_DATA}")
     return SHARED_DATA
+
+
+@pytest.fixture(scope="session", autouse=True)
+def _var_of_this_process(tmp_path_factory):
+    """What a test writes outside its own folders (uploads, similar-clip indexes, the
+    embedded broker's spool) goes to a folder of this test process, never to the
+    checkout's var/: ``make pytest`` runs several test processes at once (pytest-xdist),
+    and none may see another's files. Folder fixtures still override it per test."""
+    from django.test import override_settings
+
+    from cutroom.celery import app
+
+    var = tmp_path_factory.mktemp("var")
+    isolated = override_settings(MEDIA_ROOT=var / "media", SIMILAR_INDEX_DIR=var / "similar")
+    isolated.enable()
+    saved = app.conf.broker_transport_options
+    if app.conf.broker_url.startswith("sqlite"):
+        app.conf.broker_transport_options = {**saved, "path": str(var / "broker.sqlite3")}
+    yield var
+    app.conf.broker_transport_options = saved
+    isolated.disable()

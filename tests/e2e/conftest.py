@@ -5,6 +5,7 @@ The front end must be built (``make test`` runs ``npm run build`` first). Withou
 ``frontend/dist`` the tests skip loudly, except under CI where that is a failure.
 """
 
+import functools
 import io
 import os
 import shutil
@@ -146,7 +147,10 @@ def studio(transactional_db):
     return {"project": project, **people}
 
 
+@functools.cache
 def synthetic_bvh(seed, duration):
+    """The BVH text of a seeded synthetic take. The same seed and duration give the same
+    bytes, so each is generated once per test process (most tests ingest the same take)."""
     import motionlib
 
     take, _segments = motionlib.synth.generate(seed=seed, fps=120.0, duration=duration)

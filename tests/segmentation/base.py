@@ -4,6 +4,7 @@ alice owns the project (admin), bob annotates, rachel reviews, charlie is an out
 with a project of his own.
 """
 
+import functools
 import io
 
 import numpy as np
@@ -21,8 +22,10 @@ from segmentation.models import Capture, DetectionRun
 SHARED_DATA = data_dir()
 
 
+@functools.cache
 def synthetic_bvh(seed=0, **kwargs):
-    """Bytes of a seeded synthetic BVH take with known boundaries."""
+    """Bytes of a seeded synthetic BVH take with known boundaries (made once per test
+    process for each seed and settings: the same ones give the same bytes)."""
     from motionlib import synth, write_bvh
 
     take, _segments = synth.generate(seed=seed, fps=120.0, **kwargs)
