@@ -1,0 +1,203 @@
+"""The label-aware cut scorer: what the frame posterior says at every candidate cut.
+
+The cut learner (``motionlib.adapt``) scores candidates by how much the motion changes.
+A studio that cuts where its *actions* change needs what changes: at every candidate,
+from the posterior of :mod:`motionlib.labelling` over a window on each side
+(``WINDOW_S``), the evidence ``EVIDENCE``:
+
+- ``mix``: how much the label mix differs across it (total variation, 0..1);
+- ``change``: whether the most likely label changes;
+- ``opens`` / ``closes``: how much more likely "unlabelled" is before than after it (a
+  labelled stretch opens) or after than before (one closes);
+- ``same``: the same label holds on both sides (a change inside one action);
+- ``length``: how usual the segment it closes is for its label's length (Gaussian
+  log-likelihood of the log length, 0 at the label's mean).
+
+A :class:`LabelCutModel` adds them to the cut model's logit in a logistic scorer whose
+prior is the cut model itself (weight 1 on its logit, 0 on every evidence): with no frame
+model, or no evidence fitted, it keeps exactly the cut model's cuts, so k = 0 is exactly
+zero-shot. Its evidence weights are fitted on the reviewed takes' candidates, each take
+seen through a posterior that leaves that take out (``posterior(exclude=...)``).
+"""
+
+from __future__ import annotations
+
+import bisect
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import minimize
+from scipy.special import expit
+
+from motionlib import metrics
+from motionlib.labelling import FrameModel, posterior
+
+EVIDENCE = ("mix", "change", "opens", "closes", "same", "length")
+WINDOW_S = 1.0
+# Strength of the prior that keeps the scorer at the cut model (pseudo-observations).
+PRECISION = 10.0
+# The count calibration's search range and bisection steps (logits).
+CALIBRATION_RANGE = 8.0
+CALIBRATION_STEPS = 12
+
+
+def evidence(post: np.ndarray, frames, fps: float, model: FrameModel) -> np.ndarray:
+    """(n, len(EVIDENCE)) the evidence at candidate ``frames`` (take frames) of a take
+    whose per-frame posterior is ``post`` (n_frames, n_labels)."""
+    frames = np.asarray(frames, dtype=np.int64)
+    n = len(post)
+    if len(frames) == 0 or n == 0:
+        return np.zeros((len(frames), len(EVIDENCE)))
+    w = max(1, int(round(WINDOW_S * fps)))
+    cum = np.vstack([np.zeros((1, post.shape[1])), np.cumsum(post, axis=0)])
+    lo, mid, hi = np.clip(frames - w, 0, n), np.clip(frames, 1, n - 1), np.clip(frames + w, 0, n)
+    left = (cum[mid] - cum[lo]) / np.maximum(mid - lo, 1)[:, None]
+    right = (cum[hi] - cum[mid]) / np.maximum(hi - mid, 1)[:, None]
+    a, b = left.argmax(axis=1), right.argmax(axis=1)
+    opening = left[:, 0] - right[:, 0]
+    return np.column_stack([0.5 * np.abs(left - right).sum(axis=1), (a != b).astype(float),
+                            np.maximum(opening, 0), np.maximum(-opening, 0),
+                            ((a == b) & (a != 0)).astype(float),
+                            _length(post, mid, fps, model)])
+
+
+def _length(post, frames, fps, model: FrameModel) -> np.ndarray:
+    """Log-likelihood (up to a constant, floored at -8) of the run of the frame-wise most
+    likely label that ends at each frame, under that label's usual log length."""
+    best = post.argmax(axis=1)
+    starts = np.flatnonzero(np.diff(best)) + 1
+    out = np.zeros(len(frames))
+    for i, f in enumerate(frames.tolist()):
+        at = bisect.bisect_right(starts.tolist(), f - 1) if len(starts) else 0
+        start = int(starts[at - 1]) if at else 0
+        usual = model.lengths.get(model.names[int(best[f - 1])])
+        if usual is not None and f > start:
+            z = (np.log((f - start) / fps) - usual[0]) / usual[1]
+            out[i] = max(-0.5 * z * z, -8.0)
+    return out
+
+
+@dataclass
+class LabelCutModel:
+    """A cut model and a frame model, and the weights that join them: logit =
+    ``weights @ [cut logit, *evidence, 1]``."""
+
+    frames: FrameModel | None
+    weights: np.ndarray
+    threshold: float = 0.0
+
+    @classmethod
+    def identity(cls, frames: FrameModel | None = None) -> LabelCutModel:
+        return cls(frames, _prior())
+
+
+def _prior() -> np.ndarray:
+    w = np.zeros(len(EVIDENCE) + 2)
+    w[0] = 1.0
+    return w
+
+
+def candidate_logits(cut_model, study: dict) -> tuple[np.ndarray, np.ndarray]:
+    """(logits, frames): the cut model's logit of every candidate of a study and its
+    frame as the model places it."""
+    from motionlib.adapt import _learner
+
+    logits = _learner.design(study["features"]) @ np.asarray(cut_model.weights)
+    return logits - cut_model.threshold, _learner.placed(cut_model, study)
+
+
+def design(cut_model, model: LabelCutModel, study: dict, post) -> tuple[np.ndarray, np.ndarray]:
+    """(x, frames): the joint scorer's design rows of a study's candidates."""
+    logits, frames = candidate_logits(cut_model, study)
+    ev = np.zeros((len(frames), len(EVIDENCE))) if post is None or model.frames is None \
+        else evidence(post, frames, float(study["fps"]), model.frames)
+    return np.column_stack([logits, ev, np.ones(len(frames))]), frames
+
+
+def select(cut_model, model: LabelCutModel, study: dict | None, post) -> tuple:
+    """(cuts, probability): the candidates the joint scorer finds more likely true than
+    not, most probable first, none within the cut model's shortest segment of a kept one."""
+    if study is None or len(study["features"]) == 0:
+        return np.zeros(0, dtype=np.int64), np.zeros(0)
+    x, frames = design(cut_model, model, study, post)
+    logit = x @ model.weights
+    order, kept = _ranked(logit, frames, int(round(cut_model.min_segment_s *
+                                                    float(study["fps"]))))
+    chosen = order[kept & (logit[order] > model.threshold)]
+    chosen = chosen[np.argsort(frames[chosen], kind="stable")]
+    return frames[chosen].astype(np.int64), expit(logit[chosen] - model.threshold)
+
+
+def _ranked(logit: np.ndarray, frames: np.ndarray, gap: int) -> tuple[np.ndarray, np.ndarray]:
+    """(order, kept): candidates from the most probable down, and which of them are no
+    closer than ``gap`` frames to a more probable kept one. A candidate's fate depends
+    only on those ranked before it, so one pass serves every threshold."""
+    order = np.argsort(-logit, kind="stable")
+    kept = np.zeros(len(order), dtype=bool)
+    taken: list[int] = []
+    for rank, i in enumerate(order.tolist()):
+        f = int(frames[i])
+        at = bisect.bisect_left(taken, f)
+        if (at < len(taken) and taken[at] - f < gap) or (at and f - taken[at - 1] < gap):
+            continue
+        taken.insert(at, f)
+        kept[rank] = True
+    return order, kept
+
+
+def fit_label_cuts(cut_model, frames: FrameModel | None, studies, examples, cuts,
+                   *, tolerance_s: float) -> LabelCutModel:
+    """Fit the evidence weights on reviewed takes: ``studies`` (their candidates),
+    ``examples`` (their ``FrameExample``s, in the order the frame model was fitted on)
+    and ``cuts`` (their human cuts). With no frame model, or fewer than two takes (no
+    take can then be seen out of sample), the scorer stays the cut model's."""
+    if frames is None or len(studies) < 2:
+        return LabelCutModel.identity(frames)
+    xs, ys, gaps = [], [], []
+    model = LabelCutModel.identity(frames)
+    for i, (study, example, c) in enumerate(zip(studies, examples, cuts, strict=True)):
+        if study is None or len(study["features"]) == 0:
+            continue
+        x, placed = design(cut_model, model, study, posterior(frames, example, exclude=i))
+        y = np.zeros(len(placed))
+        hit, _ = metrics.match(placed, np.asarray(c, dtype=np.int64),
+                               tolerance=int(round(tolerance_s * float(study["fps"]))))
+        y[hit] = 1.0
+        xs.append(x)
+        ys.append(y)
+        gaps.append((placed, int(round(cut_model.min_segment_s * float(study["fps"])))))
+    if not xs:
+        return model
+    weights = _map_fit(np.vstack(xs), np.concatenate(ys))
+    ranked = []
+    for x, y, (placed, gap) in zip(xs, ys, gaps, strict=True):
+        logit = x @ weights
+        order, kept = _ranked(logit, placed, gap)
+        ranked.append((logit[order][kept], int(y.sum())))
+    return LabelCutModel(frames, weights, _calibrated(ranked))
+
+
+def _calibrated(ranked) -> float:
+    """The threshold at which the median reviewed take keeps as many cuts as its
+    reviewers made (``ranked``: each take's kept logits, descending, and its true count):
+    the scorer's probabilities are too low where true cuts are rare among candidates."""
+    def excess(t):
+        return float(np.median([np.log((np.sum(kept > t) + 1) / (n + 1))
+                                for kept, n in ranked]))
+    lo, hi = -CALIBRATION_RANGE, CALIBRATION_RANGE
+    for _ in range(CALIBRATION_STEPS):
+        mid = (lo + hi) / 2
+        lo, hi = (mid, hi) if excess(mid) > 0 else (lo, mid)
+    return round((lo + hi) / 2, 4)
+
+
+def _map_fit(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """Logistic regression with a Gaussian prior centred on the cut model."""
+    prior = _prior()
+
+    def objective(w):
+        z = x @ w
+        loss = np.sum(np.logaddexp(0, z) - y * z) + 0.5 * PRECISION * np.sum((w - prior) ** 2)
+        grad = x.T @ (expit(z) - y) + PRECISION * (w - prior)
+        return loss, grad
+    return minimize(objective, prior, jac=True, method="L-BFGS-B").x
