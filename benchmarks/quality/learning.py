@@ -121,9 +121,23 @@ def load_sets(root: Path, log) -> list[LabelSet]:
     return sets
 
 
+_FITTED: dict = {}
+
+
 def fit(items: list[Item], tolerance_s: float, cuts=None) -> adapt.CutModel:
     """A model fitted on ``items`` (their human cuts, or ``cuts``) through the public
-    API, every take's candidates standing in for it (``studies``)."""
+    API, every take's candidates standing in for it (``studies``). A fit on the human
+    cuts is kept: the label-aware tables refit the same draws."""
+    key = (tuple(id(i) for i in items), tolerance_s)
+    if cuts is None and key in _FITTED:
+        return _FITTED[key]
+    model = _fit(items, tolerance_s, cuts)
+    if cuts is None:
+        _FITTED[key] = model
+    return model
+
+
+def _fit(items: list[Item], tolerance_s: float, cuts=None) -> adapt.CutModel:
     studies = Known({f"{item.subject}/{item.name}": item.study for item in items})
     examples = []
     for i, item in enumerate(items):
@@ -420,12 +434,16 @@ def main(root: Path | None = None, out=None) -> int:
     sets = load_sets(root, out)
     print(__doc__.split("\n\n")[1], file=out)
     curves = print_curves(sets, True, out)
+    labels = learning_labels.print_curves(sets, KS, DRAWS, _pool, fit, scored, baseline, out)
     within = print_curves(sets, False, out)
     conv = convention(sets, out)
+    conv_labels = learning_labels.convention(sets, fit, scored, out)
+    costs = learning_labels.cost(out)
     print_ceiling(sets, {**curves, **within}, out)
     poison = poisoning(sets, out)
     print_tried(sets, curves, poison, out)
     targets({**curves, **{f"{k} (within)": v for k, v in within.items()}}, conv, poison, out)
+    learning_labels.targets(labels, conv_labels, costs, out)
     print(f"\nlearning curve: {time.perf_counter() - started:.0f} s, load average "
           f"{' '.join(f'{x:.2f}' for x in os.getloadavg())}", file=out)
     return 0

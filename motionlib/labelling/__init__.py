@@ -166,14 +166,14 @@ def posterior(model: FrameModel, example, *, exclude: int | None = None) -> np.n
 
 
 def propose(model: FrameModel, post: np.ndarray, cuts) -> list[tuple[str | None, float]]:
-    """For each segment between ``cuts`` (take frames), its most likely label (None when
-    the reviewers would most likely leave it unlabelled) and that label's probability:
-    the label with the most probability summed over its frames."""
+    """For each segment between ``cuts`` (take frames), its most likely label and that
+    label's probability (the mean over its frames); None, with the probability of
+    "unlabelled", when that is more likely than not."""
     bounds = np.concatenate([[0], np.sort(np.asarray(cuts, dtype=np.int64)), [len(post)]])
     out = []
     for lo, hi in zip(bounds[:-1], bounds[1:], strict=True):
         mean = post[lo:max(hi, lo + 1)].mean(axis=0)
-        best = int(np.argmax(mean))
+        best = 0 if mean[0] > 0.5 else 1 + int(np.argmax(mean[1:]))
         out.append((model.names[best] or None, round(float(mean[best]), 4)))
     return out
 
@@ -191,3 +191,30 @@ def relabelled(model: FrameModel, mapping: dict[str, str | None]) -> FrameModel:
         lengths.setdefault(mapping.get(old, old) or UNLABELLED, (m, s))
     return FrameModel(names, model.reduction, model.references, index[model.labels],
                       model.owners, lengths, model.n_takes)
+
+
+def decode(model: FrameModel, post: np.ndarray, fps: float) -> np.ndarray:
+    """(n_frames,) the most likely label index at every frame as a sequence of stretches:
+    Viterbi over the posterior sampled at the frame model's rate, a label change costing
+    the log of the project's usual segment length (in samples), so that a stretch ends
+    where the posterior changes for longer than a moment, not at every flicker."""
+    n = len(post)
+    step = max(1, int(round(fps / _frames.RATE_HZ)))
+    emit = np.log(np.maximum(post[::step], 1e-6))
+    usual = np.exp(np.mean([m for m, _ in model.lengths.values()])) if model.lengths else 5.0
+    stay = max(2.0, usual * fps / step)
+    switch = np.log(1.0 / stay / max(1, post.shape[1] - 1))
+    keep = np.log(1.0 - 1.0 / stay)
+    score = emit[0].copy()
+    back = np.zeros(emit.shape, dtype=np.int64)
+    for t in range(1, len(emit)):
+        best = int(np.argmax(score))
+        moved = score[best] + switch
+        back[t] = np.where(score + keep >= moved, np.arange(len(score)), best)
+        score = np.maximum(score + keep, moved) + emit[t]
+    path = np.empty(len(emit), dtype=np.int64)
+    path[-1] = int(np.argmax(score))
+    for t in range(len(emit) - 1, 0, -1):
+        path[t - 1] = back[t, path[t]]
+    return np.repeat(path, step)[:n] if len(path) * step >= n else \
+        np.concatenate([np.repeat(path, step), np.full(n - len(path) * step, path[-1])])

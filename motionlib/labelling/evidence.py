@@ -11,7 +11,10 @@ from the posterior of :mod:`motionlib.labelling` over a window on each side
   labelled stretch opens) or after than before (one closes);
 - ``same``: the same label holds on both sides (a change inside one action);
 - ``length``: how usual the segment it closes is for its label's length (Gaussian
-  log-likelihood of the log length, 0 at the label's mean).
+  log-likelihood of the log length, 0 at the label's mean);
+- ``decoded`` / ``decoded_labelled``: how near (``exp(-d / WINDOW_S)``) the nearest
+  change of the decoded label sequence (``labelling.decode``) lies, of any change and of
+  one between two labelled stretches.
 
 A :class:`LabelCutModel` adds them to the cut model's logit in a logistic scorer whose
 prior is the cut model itself (weight 1 on its logit, 0 on every evidence): with no frame
@@ -30,9 +33,10 @@ from scipy.optimize import minimize
 from scipy.special import expit
 
 from motionlib import metrics
-from motionlib.labelling import FrameModel, posterior
+from motionlib.labelling import FrameModel, decode, posterior
 
-EVIDENCE = ("mix", "change", "opens", "closes", "same", "length")
+EVIDENCE = ("mix", "change", "opens", "closes", "same", "length", "decoded",
+            "decoded_labelled")
 WINDOW_S = 1.0
 # Strength of the prior that keeps the scorer at the cut model (pseudo-observations).
 PRECISION = 10.0
@@ -55,25 +59,42 @@ def evidence(post: np.ndarray, frames, fps: float, model: FrameModel) -> np.ndar
     right = (cum[hi] - cum[mid]) / np.maximum(hi - mid, 1)[:, None]
     a, b = left.argmax(axis=1), right.argmax(axis=1)
     opening = left[:, 0] - right[:, 0]
-    return np.column_stack([0.5 * np.abs(left - right).sum(axis=1), (a != b).astype(float),
+    near, near_labelled = _decoded(post, mid, fps, model)
+    return np.column_stack([near, near_labelled, 0.5 * np.abs(left - right).sum(axis=1), (a != b).astype(float),
                             np.maximum(opening, 0), np.maximum(-opening, 0),
                             ((a == b) & (a != 0)).astype(float),
-                            _length(post, mid, fps, model)])
+                            _length(post, mid, fps, model)])[:, [2, 3, 4, 5, 6, 7, 0, 1]]
+
+
+def _decoded(post, frames, fps, model: FrameModel) -> tuple[np.ndarray, np.ndarray]:
+    """Closeness of each frame to the nearest decoded label change, and to the nearest
+    one between two labelled stretches."""
+    path = decode(model, post, fps)
+    changes = np.flatnonzero(np.diff(path)) + 1
+    both = changes[(path[changes - 1] != 0) & (path[changes] != 0)]
+    return tuple(_closeness(frames, c, fps) for c in (changes, both))
+
+
+def _closeness(frames: np.ndarray, marks: np.ndarray, fps: float) -> np.ndarray:
+    if len(marks) == 0:
+        return np.zeros(len(frames))
+    at = np.clip(np.searchsorted(marks, frames), 1, len(marks)) if len(marks) > 1 else \
+        np.ones(len(frames), dtype=np.int64)
+    d = np.minimum(np.abs(frames - marks[at - 1]), np.abs(frames - marks[np.minimum(at, len(marks) - 1)]))
+    return np.exp(-d / (WINDOW_S * fps))
 
 
 def _length(post, frames, fps, model: FrameModel) -> np.ndarray:
     """Log-likelihood (up to a constant, floored at -8) of the run of the frame-wise most
     likely label that ends at each frame, under that label's usual log length."""
     best = post.argmax(axis=1)
-    starts = np.flatnonzero(np.diff(best)) + 1
-    out = np.zeros(len(frames))
-    for i, f in enumerate(frames.tolist()):
-        at = bisect.bisect_right(starts.tolist(), f - 1) if len(starts) else 0
-        start = int(starts[at - 1]) if at else 0
-        usual = model.lengths.get(model.names[int(best[f - 1])])
-        if usual is not None and f > start:
-            z = (np.log((f - start) / fps) - usual[0]) / usual[1]
-            out[i] = max(-0.5 * z * z, -8.0)
+    starts = np.concatenate([[0], np.flatnonzero(np.diff(best)) + 1])
+    start = starts[np.searchsorted(starts, frames - 1, side="right") - 1]
+    label = best[frames - 1]
+    usual = np.asarray([model.lengths.get(n, (np.nan, 1.0)) for n in model.names])
+    with np.errstate(invalid="ignore", divide="ignore"):
+        z = (np.log(np.maximum(frames - start, 1) / fps) - usual[label, 0]) / usual[label, 1]
+    out = np.where(np.isfinite(z), np.maximum(-0.5 * z * z, -8.0), 0.0)
     return out
 
 
