@@ -5,7 +5,7 @@ Conventions:
 
 - ``plug-in gait``: Vicon's Plug-in Gait full-body markers (``LFHD``, ``C7``, ``LASI``,
   ``LKNE``, ...; the older waist names ``LFWT``/``LBWT`` as in HDM05 are the same markers as
-  ``LASI``/``LPSI``). Markers sit on the skin, not at the joint centres, so a body part is
+  ``LASI``/``LPSI``, HDM05's shin ``LSHN`` is ``LTIB``). Markers sit on the skin, not at the joint centres, so a body part is
   the mean of the markers around it (the head of the four head markers, the pelvis of the
   four pelvis markers, a hip of its side's front and back pelvis markers, a wrist of its two
   wrist-bar markers) or the marker on it (shoulder, elbow, knee, ankle, toe). That is a few
@@ -36,7 +36,8 @@ def normalise(name: str) -> str:
     return PIG_ALIASES.get(plain, plain)
 
 
-PIG_ALIASES = {"lfwt": "lasi", "rfwt": "rasi", "lbwt": "lpsi", "rbwt": "rpsi", "rbac": "rbak"}
+PIG_ALIASES = {"lfwt": "lasi", "rfwt": "rasi", "lbwt": "lpsi", "rbwt": "rpsi", "rbac": "rbak",
+               "lshn": "ltib", "rshn": "rtib"}
 
 
 def _sided(left: dict[str, list[str]], mirror) -> dict[str, list[str]]:
@@ -89,13 +90,19 @@ def _links(left: dict[str, str], centre: dict[str, str], mirror) -> dict[str, st
     return table
 
 
-# Point -> the point it is drawn linked to (a forest).
+# Point -> the point it is drawn linked to (a forest). A known marker set is one tree: for
+# Plug-in Gait it hangs from LASI, the trunk rises from the back of the pelvis (LPSI, T10,
+# C7), crosses at the neck to the front (CLAV, STRN); a wand marker (UPA in the upper third
+# of the upper arm, FRM, THI, TIB in the lower third of theirs) hangs from the joint marker
+# nearest it, RBAK (on the right shoulder blade) from C7.
 LINKS: dict[str, dict[str, str]] = {
     "plug-in gait": _links(
-        {"lsho": "clav", "lelb": "lsho", "lwra": "lelb", "lwrb": "lwra", "lfin": "lwra",
-         "lkne": "lasi", "lank": "lkne", "lhee": "lank", "ltoe": "lank", "lmt5": "ltoe",
-         "lfhd": "c7", "lbhd": "lfhd"},
-        {"rasi": "lasi", "lpsi": "lasi", "rpsi": "lpsi", "clav": "strn", "c7": "t10"},
+        {"lsho": "clav", "lupa": "lsho", "lelb": "lsho", "lfrm": "lwra", "lwra": "lelb",
+         "lwrb": "lwra", "lfin": "lwra", "lkne": "lasi", "lthi": "lkne", "ltib": "lank",
+         "lank": "lkne", "lhee": "lank", "ltoe": "lank", "lmt5": "ltoe", "lfhd": "c7",
+         "lbhd": "lfhd"},
+        {"rasi": "lasi", "lpsi": "lasi", "rpsi": "lpsi", "t10": "lpsi", "c7": "t10",
+         "clav": "c7", "strn": "clav", "rbak": "c7"},
         _pig_mirror),
     "kinect v1": _links(
         {"shoulderleft": "shouldercenter", "elbowleft": "shoulderleft",

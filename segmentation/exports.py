@@ -23,6 +23,8 @@ import tempfile
 import zipfile
 from pathlib import PurePath
 
+from django.db.models import Q
+
 import motionlib
 from motionlib.errors import MotionlibError
 from motionlib.io.export import write_clips
@@ -50,6 +52,20 @@ def formats_for(capture):
     """The export formats that apply to a capture's segments: points as C3D or CSV, joint
     rotations as BVH, FBX or glTF (``motionlib.io.export.check_export_format``)."""
     return ["c3d", "csv"] if capture.format in POINT_CAPTURE_FORMATS else ["bvh", "fbx", "glb"]
+
+
+def writable_in(segments, fmt):
+    """The segments of a queryset whose clips ``fmt`` writes (:func:`formats_for`)."""
+    points = Q(capture__format__in=POINT_CAPTURE_FORMATS)
+    return segments.filter(points) if fmt in ("c3d", "csv") else segments.exclude(points)
+
+
+def left_out_note(count, fmt):
+    """What ``errors.txt`` says of the ``count`` matching segments of the other kind."""
+    kind, formats = (("joint-rotation takes", "BVH, FBX or glTF") if fmt in ("c3d", "csv")
+                     else ("point takes", "C3D or CSV"))
+    return (f"{count} segment{'s are' if count != 1 else ' is'} not in this archive: "
+            f"segments of {kind} export as {formats}, not {EXPORT_FORMATS[fmt]}")
 
 
 def check_format(fmt):
@@ -181,17 +197,21 @@ class _Sink:
         return data
 
 
-def stream_zip(segments, fmt="bvh"):
+def stream_zip(segments, fmt="bvh", left_out=0):
     """Yield a zip archive of one clip per segment (BVH, FBX or glTF binary: ``fmt``) plus
-    ``manifest.csv`` and ``manifest.json``.
+    ``manifest.csv`` and ``manifest.json``; ``left_out`` segments of the other kind of take
+    (:func:`writable_in`) are counted in ``errors.txt``.
 
     ``segments`` should be ordered by capture so each take is read once; the archive is
     written as it goes (at most one take and one capture's clips are in memory). A take that
     cannot be read any more cannot turn into an error response once streaming has begun: its
     segments are left out and ``errors.txt`` says why.
     """
+    # An empty first chunk sends the response's headers (the clip count the page shows)
+    # before the first take is read and its clips written.
+    yield b""
     sink = _Sink()
-    manifest, errors, used = [], [], set()
+    manifest, errors, used = [], [left_out_note(left_out, fmt)] if left_out else [], set()
     with zipfile.ZipFile(sink, "w", compression=zipfile.ZIP_DEFLATED) as archive:
         for _, group in itertools.groupby(segments, key=lambda s: s.capture_id):
             group = list(group)

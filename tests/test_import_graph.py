@@ -24,7 +24,7 @@ import ast
 import collections
 from pathlib import Path
 
-from tests.graphs import cycles
+from tests.graphs import cycles, package_modules, private_uses
 
 ROOT = Path(__file__).resolve().parent.parent
 PACKAGES = ("cutroom", "segmentation")
@@ -144,3 +144,61 @@ def test_no_service_imports_celery():
         if any(name == "celery" or name.startswith("celery.") for name in names):
             importers.append(module)
     assert importers == []
+
+
+# ---- motionlib ---------------------------------------------------------------------------
+# The library is read the same way, every import counted: those under ``if TYPE_CHECKING:``
+# too, since a circle of types is still two modules each of which needs the other to be
+# read. The learner (``motionlib.adapt``) uses only the public names of the segmenters, so
+# that the detector's stages can change without it noticing.
+
+def motionlib_graph():
+    known = package_modules(ROOT, "motionlib")
+    graph = {}
+    for module, path in known.items():
+        if path.suffix != ".py":
+            graph[module] = set()
+            continue
+        names = imported_names(ast.parse(path.read_text()), module, path.name == "__init__.py",
+                               known)
+        graph[module] = {name for name in names if name in known} - {module}
+    return graph
+
+
+def private_segmenter_names(module, source):
+    tree = ast.parse(source)
+    is_package = module == "motionlib.adapt"
+    return private_uses(tree, list(imported_names(tree, module, is_package)),
+                        "motionlib.segmenters")
+
+
+def test_no_motionlib_module_imports_a_module_that_imports_it_back():
+    graph = motionlib_graph()
+    found = cycles(graph)
+    assert found == [], describe(graph, found)
+
+
+def test_the_motionlib_graph_counts_imports_only_type_checkers_see():
+    source = "from typing import TYPE_CHECKING\nif TYPE_CHECKING:\n    from motionlib.take import Take\n"
+    assert list(imported_names(ast.parse(source), "motionlib.x", False)) == [
+        "typing.TYPE_CHECKING", "motionlib.take.Take"]
+    assert "motionlib.segmenters.default._analysis" in motionlib_graph()[
+        "motionlib.segmenters.default._peaks"]
+
+
+def test_the_learner_uses_no_private_name_of_the_segmenters():
+    found = {module: private_segmenter_names(module, path.read_text())
+             for module, path in package_modules(ROOT, "motionlib").items()
+             if module == "motionlib.adapt" or module.startswith("motionlib.adapt.")}
+    assert {module: names for module, names in found.items() if names} == {}
+
+
+def test_it_finds_a_private_segmenter_name_imported_or_reached():
+    source = ("from motionlib.segmenters.default._peaks import cross_support\n"
+              "from motionlib.segmenters.base import Segmentation, _checked\n"
+              "from motionlib.segmenters import default\n"
+              "def f(a):\n    return default._placement.place_stages(a), default.place(a)\n")
+    assert private_segmenter_names("motionlib.adapt._x", source) == [
+        "motionlib.segmenters.default._peaks.cross_support", "motionlib.segmenters.base._checked",
+        "motionlib.segmenters.default._placement.place_stages",
+        "motionlib.segmenters.default._placement"]

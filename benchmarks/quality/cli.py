@@ -8,7 +8,7 @@ import argparse
 
 from benchmarks.quality import bench
 from benchmarks.quality.speed import add_speed
-from motionlib.arguments import run
+from motionlib.cli.common import run
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -32,6 +32,7 @@ import os
 import sys
 import time
 import warnings
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -47,6 +48,9 @@ POISONED = 3  # of POISON_K reviewed takes
 POISON_K = 10
 TARGET_F1, TARGET_EDITS, TARGET_K = 0.92, 0.4, 5
 TARGET_CONVENTION, TARGET_POISON = 0.15, 0.05
+# How every fit here labels the candidates (``adapt.fit_cut_model``'s ``labels``): the
+# shipped labelling, unless ``labelled_as`` tries another.
+LABELS = adapt.matched_labels
 
 
 @dataclass
@@ -146,7 +150,8 @@ def _fit(items: list[Item], tolerance_s: float, cuts=None) -> adapt.CutModel:
                                       else cuts[i], fps=item.fps,
                                       n_frames=int(item.study["n_frames"]),
                                       read=_unread(item.name), key=key))
-    return adapt.fit_cut_model(examples, studies=studies, tolerance_s=tolerance_s)
+    return adapt.fit_cut_model(examples, studies=studies, tolerance_s=tolerance_s,
+                               labels=LABELS)
 
 
 class Known:
@@ -449,6 +454,18 @@ def main(root: Path | None = None, out=None) -> int:
     return 0
 
 
+@contextmanager
+def labelled_as(labelling):
+    """Every fit of this benchmark labels candidates with ``labelling`` inside the block
+    (``LABELS``, its ``adapt.fit_cut_model(labels=...)``)."""
+    global LABELS
+    shipped, LABELS = LABELS, labelling
+    try:
+        yield
+    finally:
+        LABELS = shipped
+
+
 def print_tried(sets, curves: dict, poison: dict, out) -> None:
     """For each labelling: the by-subject curve (F1, edits) beside the shipped one, the
     best count at k = TARGET_K, the poisoning case, and whether the shipping rule holds."""
@@ -460,7 +477,7 @@ def print_tried(sets, curves: dict, poison: dict, out) -> None:
           "over.", file=out)
     for name, labelling in learning_tried.LABELLINGS.items():
         worse = []
-        with learning_tried.labelled_as(labelling):
+        with labelled_as(labelling):
             tried = {s.name: curve(s) for s in chosen}
             tried_poison = poisoning(sets, io.StringIO())
         for label in chosen:

@@ -10,9 +10,9 @@ and peak traced memory of read + FK against the file size; plus the time to synt
 five-minute take.
 
 ``adapt``: the adapted default detector's speed on five-minute 120 fps synthetic takes,
-for the first model format (threshold model) and the current one (candidate scorer) in
-one run: detection zero-shot and with a model (median of several runs), and fitting a
-model on 50 such
+for the model format the learner learns (candidate scorer; nothing learns the first
+format any more, so its figures come from an older revision): detection zero-shot and
+with a model (median of several runs), and fitting a model on 50 such
 takes (10 distinct takes, each given five times, so the examples fit in memory; fitting
 visits every example in full either way), and refitting them after one example's cuts
 changed with every example's study stored (``adapt.MemoryStudies``; what the service
@@ -164,10 +164,8 @@ def _run_adapt(args) -> int:
     examples = [takes[i % distinct] for i in range(args.takes)]
     target, _ = synth.generate(seed=99, fps=120.0, duration=60.0 * minutes)
     print(f"{'case':<58}{'wall s':>9}{'cpu s':>9}{'target s':>10}")
-    for title, fit in (("format 1, threshold model (before)", adapt.fit_threshold_model),
-                       ("format 2, candidate scorer (now)", adapt.fit_cut_model)):
-        print(title)
-        _time_learner(fit, examples, target, minutes, args)
+    print("format 2, candidate scorer (now)")
+    _time_learner(adapt.fit_cut_model, examples, target, minutes, args)
     print("ok/MISSED compare the CPU time of this single-threaded process, its time on one "
           "free core;\nwall time also counts waiting for a core on a busy machine.")
     print("threads: one BLAS thread, as the workers run; "

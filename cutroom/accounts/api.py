@@ -60,6 +60,9 @@ class TokenView(APIView):
         serializer.is_valid(raise_exception=True)
         user = serializer.validated_data["user"]
         throttle.succeeded(request, user.get_username())
+        if passwords.is_one_time(user):
+            raise PermissionDenied("This account still has its one-time password: sign in at "
+                                   "/login/ and choose your own first, then ask for a token.")
         token, key = ApiToken.objects.issue(user)
         return Response(IssuedTokenSerializer({"token": key, "expires_at": token.expires_at}).data)
 

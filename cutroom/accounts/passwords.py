@@ -1,5 +1,7 @@
 """Changing one's password, and a site admin's reset of someone's.
 
+A reset gives a one-time password (``segmentation.models.OneTimePassword``): signed in
+with it, its owner must first choose their own (``middleware``, ``views.new_password``).
 Either way the new password ends the account's other sessions (Django signs each session
 with the password's hash) and revokes its API tokens (``signals``): whoever had the old
 password, or a session or token made with it, is signed out.
@@ -9,6 +11,9 @@ import secrets
 
 from django.contrib.auth import password_validation
 from django.core.exceptions import ValidationError
+from django.db import transaction
+
+from segmentation.models import OneTimePassword
 
 
 class PasswordError(ValueError):
@@ -38,8 +43,20 @@ def change(user, current, new):
     if current == new:
         raise PasswordError("new_password", "must differ from the current password")
     check_new(user, new)
-    user.set_password(new)
-    user.save()
+    choose(user, new)
+
+
+def choose(user, new):
+    """Set ``user``'s password to ``new``, one they chose: no longer a one-time password."""
+    with transaction.atomic():
+        user.set_password(new)
+        user.save()
+        OneTimePassword.objects.filter(user=user).delete()
+
+
+def is_one_time(user):
+    """Whether ``user`` still has a password someone else made for them."""
+    return OneTimePassword.objects.filter(user=user).exists()
 
 
 def can_reset(actor):
@@ -50,6 +67,8 @@ def can_reset(actor):
 def reset(user):
     """Give ``user`` a new one-time password (returned; shown once) to change at sign-in."""
     password = secrets.token_urlsafe(12)
-    user.set_password(password)
-    user.save()
+    with transaction.atomic():
+        user.set_password(password)
+        user.save()
+        OneTimePassword.objects.update_or_create(user=user)
     return password

@@ -8,7 +8,7 @@ from django.contrib.auth.signals import user_logged_in, user_login_failed
 from django.db.models.signals import post_save, pre_save
 from django.dispatch import receiver
 
-from cutroom.accounts import throttle
+from cutroom.accounts import middleware, passwords, throttle
 from cutroom.accounts.models import ApiToken
 from segmentation import usernames
 
@@ -22,6 +22,13 @@ def count_failure(sender, credentials, request=None, **kwargs):
 @receiver(user_logged_in)
 def clear_failures(sender, request, user, **kwargs):
     throttle.succeeded(request, user.get_username())
+
+
+@receiver(user_logged_in)
+def note_one_time_password(sender, request, user, **kwargs):
+    """A sign-in with a one-time password leads to choosing a new one (``middleware``)."""
+    if passwords.is_one_time(user):
+        request.session[middleware.SESSION_KEY] = True
 
 
 @receiver(post_save, sender=settings.AUTH_USER_MODEL)

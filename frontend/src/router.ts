@@ -1,6 +1,8 @@
 // A small client-side router. Pages register a path pattern and a render function that
 // returns its clean-up; links inside the app navigate without a full reload.
 
+import { ApiError } from "./api/client";
+
 export type Render = (root: HTMLElement, params: Record<string, string>) => Promise<() => void>;
 
 const routes: { pattern: RegExp; keys: string[]; render: Render }[] = [];
@@ -42,13 +44,28 @@ export async function show(): Promise<void> {
   try {
     cleanup = await found.render(root, found.params);
   } catch (err) {
-    const message = err instanceof Error ? err.message : String(err);
+    const { title, message, refusal } = failure(err);
     const box = document.createElement("div");
     box.className = "loading-page";
-    box.innerHTML = `<h1>Something went wrong</h1><p class="error-text"></p><a href="/">← Captures</a>`;
+    box.dataset.testid = "page-failure";
+    box.innerHTML = `<h1></h1><p></p><a href="/">← Captures</a>`;
+    box.querySelector("h1")!.textContent = title;
     box.querySelector("p")!.textContent = message;
+    if (!refusal) box.querySelector("p")!.className = "error-text";
     root.replaceChildren(box);
   }
+}
+
+/**
+ * What a page that could not be shown says: a refusal (403: the caller's role, say) or a
+ * missing thing (404) by its name, with the server's reason in plain text; anything else
+ * is a failure, in red.
+ */
+export function failure(err: unknown): { title: string; message: string; refusal: boolean } {
+  const message = err instanceof Error ? err.message : String(err);
+  if (err instanceof ApiError && err.status === 403) return { title: "Not allowed", message, refusal: true };
+  if (err instanceof ApiError && err.status === 404) return { title: "Not found", message, refusal: true };
+  return { title: "Something went wrong", message, refusal: false };
 }
 
 function notFound(path: string): HTMLElement {

@@ -8,12 +8,12 @@ const figure = { n_takes: 5, edits_per_cut: 0.3, f1: 0.912 };
 
 describe("adaptation line of the review page", () => {
   it("test_it_says_candidates_are_not_adapted_yet", () => {
-    expect(adaptationLines(zeroShot)).toEqual({ line: "Candidates not adapted yet (zero-shot detector).", figure: "", notes: [] });
+    expect(adaptationLines(zeroShot)).toEqual({ line: "Candidates not adapted yet (zero-shot detector).", figure: "", notes: [], failure: "" });
   });
 
   it("test_it_says_how_many_reviewed_takes_the_candidates_came_from", () => {
     const a = { ...zeroShot, model_version: 3, n_takes: 12, project_model: { version: 3, n_takes: 12, n_cuts: 80, held_out: null } };
-    expect(adaptationLines(a)).toEqual({ line: "Candidates adapted from 12 reviewed takes (model v3).", figure: "", notes: [] });
+    expect(adaptationLines(a)).toEqual({ line: "Candidates adapted from 12 reviewed takes (model v3).", figure: "", notes: [], failure: "" });
     expect(adaptationLines({ ...a, n_takes: 1 }).line).toBe("Candidates adapted from 1 reviewed take (model v3).");
   });
 
@@ -42,12 +42,15 @@ describe("adaptation line of the review page", () => {
   it("test_it_says_why_the_last_model_was_refused_and_what_is_kept", () => {
     const refused = "refused: on 2 held-out reviewed takes that the current model v1 learnt from it needs 1.00 edits per true cut (F1 0.00), the current model 0.25 edits per true cut (F1 1.00)";
     const a = { ...zeroShot, project_model: { version: 1, n_takes: 2, n_cuts: 8, held_out: null }, model_version: 1, n_takes: 2, training_refused: refused };
+    // The project's news for its reviewers and admins, not a failure: drawn neutral.
     expect(adaptationLines(a).notes).toEqual([`Last retraining ${refused}. The project keeps model v1.`]);
+    expect(adaptationLines(a).failure).toBe("");
   });
 
   it("test_it_says_why_the_last_training_failed_and_what_is_kept", () => {
     const a = { ...zeroShot, training_error: "training: capture 4 cannot be read." };
-    expect(adaptationLines(a).notes).toEqual(["Last retraining failed: training: capture 4 cannot be read. The project keeps the zero-shot detector."]);
+    expect(adaptationLines(a).failure).toBe("Last retraining failed: training: capture 4 cannot be read. The project keeps the zero-shot detector.");
+    expect(adaptationLines(a).notes).toEqual([]);
   });
 });
 

@@ -1,8 +1,8 @@
 import { describe, expect, it } from "vitest";
-import { errorText, isLoggedOut, readCookie } from "../src/api/client";
+import { ApiError, errorText, isLoggedOut, readCookie } from "../src/api/client";
 import { filtersFrom, queryOf } from "../src/captures/list";
 import { pairFiles } from "../src/captures/upload";
-import { match, registerRoute } from "../src/router";
+import { failure, match, registerRoute } from "../src/router";
 import { eventDetail } from "../src/review/events";
 import { columnExtremes, finiteRange, readableOn } from "../src/review/timeline";
 
@@ -44,8 +44,15 @@ describe("capture list", () => {
     const file = (name: string) => new File(["x"], name);
     expect(pairFiles([file("13_29.amc"), file("notes.txt")]).problems).toEqual([
       "13_29.amc: an .amc needs its skeleton; drop the matching .asf with it.",
-      "notes.txt: not a .bvh, .fbx or .amc file.",
+      "notes.txt: not a take Cutroom reads (.bvh, .fbx, .amc with its .asf, .c3d, .tsv or .csv).",
     ]);
+  });
+
+  it("test_it_uploads_point_takes_alone", () => {
+    const file = (name: string) => new File(["x"], name);
+    const { items, problems } = pairFiles([file("HDM_bd_05-01_01_120.C3D"), file("subject1_run1.tsv"), file("s01_e01.csv")]);
+    expect(items.map((i) => [i.file.name, i.asf])).toEqual([["HDM_bd_05-01_01_120.C3D", null], ["subject1_run1.tsv", null], ["s01_e01.csv", null]]);
+    expect(problems).toEqual([]);
   });
 
   it("test_it_uploads_an_fbx_alone", () => {
@@ -57,6 +64,14 @@ describe("capture list", () => {
 });
 
 describe("router", () => {
+  it("test_it_titles_a_refusal_by_role_as_a_refusal_not_a_failure", () => {
+    const refused = failure(new ApiError(403, "Only the project's reviewers and admins see its dashboard.", null));
+    expect(refused).toEqual({ title: "Not allowed", message: "Only the project's reviewers and admins see its dashboard.", refusal: true });
+    expect(failure(new ApiError(404, "Not found.", null)).title).toBe("Not found");
+    expect(failure(new ApiError(500, "The server answered 500.", null))).toMatchObject({ title: "Something went wrong", refusal: false });
+    expect(failure(new Error("network down")).title).toBe("Something went wrong");
+  });
+
   it("test_it_matches_routes_with_or_without_the_trailing_slash", () => {
     const render = async () => () => {};
     registerRoute("/test-captures/:id/", render);

@@ -1,5 +1,5 @@
 import { describe, expect, it } from "vitest";
-import { attachmentName, formatBytes } from "../src/library/download";
+import { attachmentName, clipsWhat, formatBytes } from "../src/library/download";
 
 describe("export downloads", () => {
   it("says how much has arrived in the unit a person reads", () => {
@@ -11,5 +11,14 @@ describe("export downloads", () => {
   it("saves under the server's file name, else the fallback", () => {
     expect(attachmentName('attachment; filename="segments-glb.zip"', "x.zip")).toBe("segments-glb.zip");
     expect(attachmentName(null, "segment-3.fbx")).toBe("segment-3.fbx");
+  });
+});
+
+describe("bulk export progress", () => {
+  it("test_it_counts_the_clips_the_server_writes_not_every_matching_segment", () => {
+    expect(clipsWhat("2", "BVH")).toBe("2 clips as BVH");
+    expect(clipsWhat("1", "C3D (points)")).toBe("1 clip as C3D (points)");
+    expect(clipsWhat(null, "BVH")).toBeNull();
+    expect(clipsWhat("two", "BVH")).toBeNull();
   });
 });

@@ -40,8 +40,24 @@ describe("commandFor", () => {
     expect(commandFor(key("q"))).toBeNull();
   });
 
+  it("test_it_nudges_with_alt_arrows_a_frame_and_with_alt_shift_arrows_a_step", () => {
+    expect(commandFor(key("ArrowLeft", { altKey: true }))).toEqual({ kind: "nudge", frames: -1 });
+    expect(commandFor(key("ArrowRight", { altKey: true }))).toEqual({ kind: "nudge", frames: 1 });
+    expect(commandFor(key("ArrowRight", { altKey: true, shiftKey: true }))).toEqual({ kind: "nudge", frames: 10 });
+    expect(commandFor(key("ArrowLeft", { altKey: true, ctrlKey: true }))).toBeNull();
+  });
+
+  it("test_it_maps_the_navigation_restore_and_goto_keys", () => {
+    expect(commandFor(key("n"))).toEqual({ kind: "pending", direction: 1 });
+    expect(commandFor(key("N", { shiftKey: true }))).toEqual({ kind: "pending", direction: -1 });
+    expect(commandFor(key("u"))).toEqual({ kind: "unlabelled", direction: 1 });
+    expect(commandFor(key("U", { shiftKey: true }))).toEqual({ kind: "unlabelled", direction: -1 });
+    expect(commandFor(key("r"))).toEqual({ kind: "restore" });
+    expect(commandFor(key("g"))).toEqual({ kind: "goto" });
+  });
+
   it("test_it_documents_every_required_key_in_the_help", () => {
     const text = HELP.map(([k]) => k).join(" | ");
-    for (const k of ["Space", "← / →", "Shift + ← / →", "A", "D", "I", "1 – 9", "Z", "Shift+Z", "?"]) expect(text).toContain(k);
+    for (const k of ["Space", "← / →", "Shift + ← / →", "A", "D", "I", "1 – 9", "Z", "Shift+Z", "?", "Alt + ← / →", "Alt + Shift + ← / →", "N / Shift+N", "U / Shift+U", "R", "G"]) expect(text).toContain(k);
   });
 });

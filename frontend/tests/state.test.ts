@@ -1,6 +1,6 @@
 import { describe, expect, it } from "vitest";
 import type { Review } from "../src/api/types";
-import { applyEdit, deriveSegments, labelsByStartCut, describeDifferences, editRequest, EditError, findInsertedId, labelRequest, neighbourCut, segmentAt, startedIds, withTempIds } from "../src/review/state";
+import { applyEdit, deriveSegments, labelsByStartCut, describeDifferences, editRequest, EditError, findInsertedId, labelRequest, nearestDeleted, neighbourCut, neighbourPending, neighbourUnlabelled, segmentAt, startedIds, withTempIds } from "../src/review/state";
 import { cut, review } from "./fixtures";
 
 const N = 1000;
@@ -134,6 +134,30 @@ describe("navigation", () => {
     expect(neighbourCut(cuts, 200, 1)?.id).toBe(3);
     expect(neighbourCut(cuts, 800, -1)?.id).toBe(1);
     expect(neighbourCut(cuts, 200, -1)).toBeUndefined();
+  });
+
+  it("test_it_finds_the_neighbouring_pending_candidate_skipping_decided_cuts", () => {
+    const cuts = [cut(1, 200, "accepted"), cut(2, 500), cut(3, 800, "deleted"), cut(4, 900)];
+    expect(neighbourPending(cuts, 0, 1)?.id).toBe(2);
+    expect(neighbourPending(cuts, 500, 1)?.id).toBe(4);
+    expect(neighbourPending(cuts, 500, -1)).toBeUndefined();
+  });
+
+  it("test_it_finds_the_neighbouring_unlabelled_segment_by_its_start", () => {
+    const segments = review().segments; // walk, —, punch, —
+    expect(neighbourUnlabelled(segments, 0, 1)?.start).toBe(200);
+    expect(neighbourUnlabelled(segments, 200, 1)?.start).toBe(800);
+    expect(neighbourUnlabelled(segments, 900, -1)?.start).toBe(800);
+    expect(neighbourUnlabelled(segments, 800, -1)?.start).toBe(200);
+    expect(neighbourUnlabelled(segments, 800, 1)).toBeUndefined();
+  });
+
+  it("test_it_finds_the_deleted_candidate_nearest_a_frame_not_a_deleted_inserted_cut", () => {
+    const inserted = { ...cut(5, 480, "deleted"), origin: "inserted" as const, candidate_frame: null };
+    const cuts = [cut(1, 200, "deleted"), cut(2, 500), cut(3, 800, "deleted"), inserted];
+    expect(nearestDeleted(cuts, 490)?.id).toBe(1);
+    expect(nearestDeleted(cuts, 700)?.id).toBe(3);
+    expect(nearestDeleted([cut(2, 500)], 700)).toBeUndefined();
   });
 
   it("test_it_finds_the_segment_under_a_frame_with_stop_exclusive", () => {

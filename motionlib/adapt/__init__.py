@@ -6,20 +6,35 @@ segment, where exactly the cut goes. Given example takes with their human cuts,
 cuts a new take with it:
 
 1. every take is described by an over-complete set of candidate cuts (the zero-shot cuts,
-   every weaker novelty peak, the peaks of short novelty windows), each with a few
-   evidence features and its frame at each placement step (``_candidates``);
-2. a logistic scorer whose prior is the zero-shot decision keeps the candidates more
-   likely true than not, no two closer than the convention's shortest segment, each cut
-   at the placement step and shift the examples follow (``_learner``).
+   every weaker novelty peak, the peaks of short novelty windows), each with its frame at
+   each placement step (``_candidates``) and a few evidence features (``_evidence``):
+   the take's *study* (:func:`study`), kept per example in a :class:`Studies` store;
+2. each example's candidates are labelled against its human cuts (``labels``,
+   :func:`matched_labels` by default), and a logistic scorer over their evidence, whose
+   prior is the zero-shot decision, is fitted to them, with the convention's shortest
+   segment and the placement step and shift the examples follow (``_learner``);
+3. a :class:`CutModel` keeps a take's candidates more likely true than not, no two closer
+   than that shortest segment, each cut where its placement puts it (``_model``:
+   :func:`cuts_in` from a study, :func:`detect` from a take).
 
 With no example the model is the zero-shot detector (:meth:`CutModel.zero_shot`); each
 example moves it as far as the examples agree, and a take that disagrees with the others
 (a reviewer who under- or over-cut it) is weighted down. A take's candidates do not depend
 on its cuts: stored once (``studies``), they serve every refit, so retraining after one
 more reviewed take analyses only that take. :func:`score` gives a model's figure on a
-reviewed take. Models stored in the first format (``ThresholdModel``) load and detect
-exactly as before. How the design and its fixed settings were chosen:
-``docs/detector/adaptation.md``.
+reviewed take. Models stored in the first format (``ThresholdModel``, ``_threshold``) load
+and detect exactly as before; nothing learns that format any more. How the design and its
+fixed settings were chosen: ``docs/detector/adaptation.md``.
+
+Where new work goes: evidence a take alone gives is a row of ``_evidence.EVIDENCE`` and
+a column of its ``evidence`` (its prior weight is 0, so the zero-shot model stays the
+zero-shot detector); evidence that needs a model of the other reviewed takes (what
+happens at each frame, say) is fitted in ``_learner.fit`` beside the scorer, from what
+the studies keep of each take (a study may hold more arrays than the candidates'), is
+carried by the :class:`CutModel`, and joins the stored evidence where fitting and
+selecting read a study (``_model.scorer_inputs``). The learner reads the detector through
+its public steps only (``segmenters.default``: ``analyse``, ``peaks``, ``place``,
+``peak_support``, ``place_samples``).
 
 Pure numpy/scipy, no Django; the service stores ``model.to_json()`` and reads it back
 with :meth:`CutModel.from_json`.
@@ -34,21 +49,21 @@ import numpy as np
 
 from motionlib import metrics
 from motionlib.adapt import _learner
-from motionlib.adapt._candidates import candidates_of
-from motionlib.adapt._examples import EXAMPLE_COLUMNS, ExampleError, read_examples
-from motionlib.adapt._learner import FORMAT, CutModel, select
-from motionlib.adapt._threshold import (
+from motionlib.adapt._candidates import candidates_of, study_take
+from motionlib.adapt._examples import (
+    EXAMPLE_COLUMNS,
     Example,
-    MemoryStudies,
-    Studies,
-    ThresholdModel,
-    _as_example,
-    _checked_cuts,
-    detect_threshold,
-    fit_threshold_model,
+    ExampleError,
+    as_example,
+    checked_cuts,
+    read_examples,
 )
+from motionlib.adapt._learner import Labels, matched_labels
+from motionlib.adapt._model import FORMAT, CutModel, placed, select
+from motionlib.adapt._studies import MemoryStudies, Studies, kept_study
+from motionlib.adapt._threshold import ThresholdModel, detect_threshold
 from motionlib.points import segmenter_input
-from motionlib.segmenters.base import Segmentation, _checked
+from motionlib.segmenters.base import Segmentation
 from motionlib.segmenters.default import Default
 
 __all__ = [
@@ -57,6 +72,7 @@ __all__ = [
     "CutModel",
     "Example",
     "ExampleError",
+    "Labels",
     "MemoryStudies",
     "Refits",
     "Studies",
@@ -65,15 +81,18 @@ __all__ = [
     "detect",
     "example_study",
     "fit_cut_model",
-    "fit_threshold_model",
+    "matched_labels",
+    "placed",
     "read_examples",
     "score",
+    "score_cuts",
     "study",
 ]
 
 
 def fit_cut_model(examples: Sequence, *, studies: Studies | None = None,
-                  base: dict | None = None, tolerance_s: float = 1.0) -> CutModel:
+                  base: dict | None = None, tolerance_s: float = 1.0,
+                  labels: Labels | None = None) -> CutModel:
     """Learn a studio's convention from example takes with human cuts.
 
     Parameters
@@ -91,6 +110,9 @@ def fit_cut_model(examples: Sequence, *, studies: Studies | None = None,
         **base)``).
     tolerance_s : how far (s) a candidate may lie from a human cut to count as it: the
         precision the studio reviews at.
+    labels : which candidates of an example the scorer learns from, and which of them
+        are human cuts (:data:`Labels`): :func:`matched_labels` when None, the shipped
+        labelling; another is for trying a labelling out.
 
     Returns
     -------
@@ -102,7 +124,8 @@ def fit_cut_model(examples: Sequence, *, studies: Studies | None = None,
     outside the take, a take too short to analyse; ValueError for a tolerance that is
     not a positive number.
     """
-    return Refits(examples, studies=studies, base=base, tolerance_s=tolerance_s).model
+    return Refits(examples, studies=studies, base=base, tolerance_s=tolerance_s,
+                  labels=labels).model
 
 
 class Refits:
@@ -118,19 +141,19 @@ class Refits:
     """
 
     def __init__(self, examples: Sequence, *, studies: Studies | None = None,
-                 base: dict | None = None, tolerance_s: float = 1.0):
+                 base: dict | None = None, tolerance_s: float = 1.0,
+                 labels: Labels | None = None):
         if len(examples) == 0:
             raise ExampleError("no example takes to learn from")
         if not (isinstance(tolerance_s, int | float) and 0 < tolerance_s <= 10):
             raise ExampleError(f"tolerance_s must be a number of seconds in (0, 10], "
                                f"got {tolerance_s!r}")
         p = Default.validate_params(base or {})
-        checked = [(example, _checked_cuts(example, example.cuts))
-                   for example in map(_as_example, examples)]
-        self._found = [_study(example, p, studies) for example, _ in checked]
+        checked = [(example, checked_cuts(example)) for example in map(as_example, examples)]
+        self._found = [kept_study(example, p, studies) for example, _ in checked]
         self._cuts = [cuts for _, cuts in checked]
         self._settings = {"tolerance_s": float(tolerance_s),
-                          "zero_min_segment_s": p["min_segment_s"]}
+                          "zero_min_segment_s": p["min_segment_s"], "labels": labels}
         self.model, self._choice = _learner.fit(self._found, self._cuts, **self._settings)
 
     def without(self, i: int) -> CutModel | None:
@@ -154,24 +177,7 @@ def example_study(example: Example, *, studies: Studies | None = None,
     ------
     ExampleError for a take too short to analyse.
     """
-    return _study(_as_example(example), Default.validate_params(base or {}), studies)
-
-
-def _study(example: Example, p: dict, studies: Studies | None) -> dict:
-    keep = studies is not None and example.key is not None
-    key = _learner.study_key(p) if keep else ""
-    if keep:
-        stored = studies.load(example.key, key)
-        if stored is not None and {"features", "zero_shot", "stages", "fps",
-                                   "n_frames"} <= set(stored):
-            return stored
-    arrays = study(example.read(), **p)
-    if arrays is None:
-        raise ExampleError(f"{example.name}: too short to learn from "
-                           f"({example.n_frames} frames)")
-    if keep:
-        studies.save(example.key, key, arrays)
-    return arrays
+    return kept_study(as_example(example), Default.validate_params(base or {}), studies)
 
 
 def study(take, **params) -> dict[str, np.ndarray] | None:
@@ -179,8 +185,7 @@ def study(take, **params) -> dict[str, np.ndarray] | None:
     with the ``default`` segmenter's ``params``; None for a take too short to analyse.
     Computing them is most of detection: a benchmark that scores many models on one
     take computes them once and calls :func:`cuts_in`."""
-    found = candidates_of(segmenter_input(take, Default.name), Default.validate_params(params))
-    return None if found is None else found[0]
+    return study_take(take, Default.validate_params(params))
 
 
 def cuts_in(arrays: dict | None, model: CutModel) -> np.ndarray:
@@ -215,7 +220,7 @@ def detect(take, model: CutModel | ThresholdModel | None = None, **params) -> Se
         arrays, analysis, speed = found
         cuts, prob = select(model, arrays)
         result = analysis.segmentation(cuts - analysis.first, prob, speed)
-        result = _checked(result, int(arrays["n_frames"]))
+        result = result.checked(int(arrays["n_frames"]))
     result.timings["total"] = time.perf_counter() - start
     return result
 

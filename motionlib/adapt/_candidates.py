@@ -14,10 +14,11 @@ take is first described by many more candidates than any convention keeps:
   phases (reach, grasp, lift) cut, finer than any novelty window sees.
 
 Peaks closer than ``MERGE_S`` to a candidate already listed add nothing (the earlier
-source wins: zero-shot cut, then long, then short, then turning point). Each candidate carries a few evidence
-features (``FEATURES``) and its frame at each placement step of the detector (the
-anchors a model picks from). Nothing here depends on a studio's cuts, so a take's
-candidates are computed once and serve every model and every refit.
+source wins: zero-shot cut, then long, then short, then turning point). Each candidate
+carries a few evidence features (``_evidence``) and its frame at each placement step of
+the detector (the anchors a model picks from). Nothing here depends on a studio's cuts,
+so a take's candidates are computed once and serve every model and every refit. Only
+the detector's public steps are read (``segmenters.default``).
 """
 
 from __future__ import annotations
@@ -25,10 +26,10 @@ from __future__ import annotations
 import numpy as np
 from scipy.signal import find_peaks
 
+from motionlib.adapt._evidence import evidence
+from motionlib.points import segmenter_input
 from motionlib.segmenters import default
 from motionlib.segmenters.default import PLACEMENTS
-from motionlib.segmenters.default._peaks import cross_support
-from motionlib.segmenters.default._placement import place_stages
 
 # The short novelty windows (s): activities of a second or two.
 SHORT_WINDOWS = (1.0, 2.0)
@@ -38,16 +39,12 @@ LONG_PROMINENCE = 0.005
 SHORT_PROMINENCE = 0.01
 MERGE_S = 0.3
 TURN_DEPTH = 0.1
-# Evidence features, in the order of a study's ``features`` columns. MMD² values are
-# logged (their scale is multiplicative) with a floor well below the weakest peak listed.
-FEATURES = ("zero_shot", "long_height", "long_prominence", "short_height",
-            "short_prominence", "support", "speed", "near_zero_shot", "turn_depth")
-FLOOR = 0.003
 
 
 def study_take(take, p: dict) -> dict[str, np.ndarray] | None:
-    """The arrays of :func:`candidates_of` alone (what is stored of an example)."""
-    found = candidates_of(take, p)
+    """The arrays of :func:`candidates_of` alone (what is stored of an example) for a take
+    as read (bare points become their coordinates, as the detector reads them)."""
+    found = candidates_of(segmenter_input(take, default.Default.name), p)
     return None if found is None else found[0]
 
 
@@ -84,16 +81,14 @@ def candidates_of(take, p: dict):
         # The extra candidates are placed among each other and the zero-shot cuts, each
         # step bounded half-way to its neighbours as the detector bounds its own cuts.
         order = np.argsort(samples, kind="stable")
-        extra_stages, _ = place_stages(analysis.x, analysis.peak_frames(samples[order]),
-                                       analysis.fps, analysis.gamma, p, analysis.speeds,
-                                       only=order >= zero)
+        extra_stages = default.place_samples(analysis, samples[order], p, only=order >= zero)
         back = np.empty_like(order)
         back[order] = np.arange(len(order))
         for j, name in enumerate(PLACEMENTS):
             stages[zero:, j] = extra_stages[name][back][zero:]
     stages += analysis.first
-    features = _features(analysis, short, samples, zero, (long_peaks, long_prom),
-                         (short_peaks, short_prom))
+    features = evidence(analysis, samples, zero, merge, (long_peaks, long_prom),
+                        (short, short_peaks, short_prom))
     order = np.argsort(stages[:, 0], kind="stable")
     zero_shot = np.arange(len(samples)) < zero
     arrays = {"features": features[order], "zero_shot": zero_shot[order],
@@ -109,16 +104,6 @@ def _turns(analysis, merge: int) -> np.ndarray:
     frames, _ = find_peaks(-fine, prominence=TURN_DEPTH * typical,
                            distance=max(1, merge * analysis.step))
     return np.unique(frames // analysis.step)
-
-
-def _depth(fine: np.ndarray, frames: np.ndarray, fps: float) -> np.ndarray:
-    """How far the pose speed dips at each frame: the highest speed within 0.5 s less the
-    lowest within 0.15 s, over the take's median speed."""
-    _n, wide, narrow = len(fine), int(round(0.5 * fps)), max(1, int(round(0.15 * fps)))
-    typical = max(float(np.median(fine)), 1e-9)
-    return np.asarray([(fine[max(0, f - wide):f + wide + 1].max() -
-                        fine[max(0, f - narrow):f + narrow + 1].min()) / typical
-                       for f in frames.tolist()])
 
 
 def _apart(new: np.ndarray, old: np.ndarray, merge: int) -> np.ndarray:
@@ -142,52 +127,3 @@ def _all_peaks(curve: np.ndarray, distance: int, prominence: float):
     return peaks - 1, props["prominences"]
 
 
-def _near(samples: np.ndarray, peaks: np.ndarray, values: np.ndarray, reach: int) -> np.ndarray:
-    """For each sample, the value of the nearest peak within ``reach`` samples (0 if none)."""
-    out = np.zeros(len(samples))
-    if len(peaks) == 0:
-        return out
-    j = np.clip(np.searchsorted(peaks, samples), 1, len(peaks)) - 1
-    j = np.where((j + 1 < len(peaks)) & (np.abs(peaks[np.minimum(j + 1, len(peaks) - 1)]
-                                                - samples) < np.abs(peaks[j] - samples)),
-                 j + 1, j)
-    near = np.abs(peaks[j] - samples) <= reach
-    out[near] = values[j[near]]
-    return out
-
-
-def _height(curve: np.ndarray, samples: np.ndarray, reach: int) -> np.ndarray:
-    """The curve's highest value within ``reach`` samples of each sample."""
-    n = len(curve)
-    return np.asarray([curve[max(0, k - reach):min(n, k + reach + 1)].max()
-                       for k in samples.tolist()]) if n else np.zeros(len(samples))
-
-
-def _features(analysis, short, samples, zero, long, short_peaks) -> np.ndarray:
-    """(n, len(FEATURES)) evidence of each candidate (see FEATURES)."""
-    reach = max(1, int(round(MERGE_S * analysis.rate)))
-    log = lambda v: np.log(np.maximum(v, 0.0) + FLOOR)  # noqa: E731
-    support = cross_support(analysis.blocks, samples, analysis.rate, analysis.gamma)
-    support = np.where(np.isfinite(support), support, 2.0)
-    speed = analysis.speeds[0]
-    frames = np.clip(analysis.peak_frames(samples), 0, len(speed) - 1)
-    typical = max(float(np.median(speed)), 1e-9)
-    zs = np.arange(len(samples)) < zero
-    zero_frames = samples[zs]
-    near = np.full(len(samples), 10.0)
-    if len(zero_frames):
-        gap = np.abs(samples[:, None] - zero_frames[None, :]) / analysis.rate
-        gap[zs] = np.inf  # a zero-shot cut's distance to the others is not the point
-        near = np.minimum(gap.min(axis=1), 10.0)
-    near[zs] = 10.0
-    return np.stack([
-        zs.astype(float),
-        log(_height(analysis.novelty, samples, reach)),
-        log(_near(samples, *long, reach)),
-        log(_height(short.novelty, samples, reach)),
-        log(_near(samples, *short_peaks, reach)),
-        np.log(np.minimum(support, 20.0) + 0.05),
-        np.log(speed[frames] / typical + 0.05),
-        np.log(near + 0.1),
-        np.log(_depth(analysis.speeds[1], frames, analysis.fps) + 0.05),
-    ], axis=1)

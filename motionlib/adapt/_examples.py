@@ -1,8 +1,14 @@
-"""The examples CSV: take files and their human cuts, for ``fit_cut_model``."""
+"""Example takes and their human cuts, as the learner is given them: a (take, cuts) pair
+or an :class:`Example` described before it is read, its cuts checked against the take
+(``checked_cuts``); and the examples CSV of the command line (``read_examples``)."""
 
 from __future__ import annotations
 
 import csv
+import math
+import os
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -15,6 +21,53 @@ class ExampleError(MotionlibError):
 
 
 EXAMPLE_COLUMNS = ("file", "asf", "cuts")
+
+
+@dataclass(frozen=True)
+class Example:
+    """An example take described before it is read, so that a stored study can stand in
+    for reading and analysing it (``fit_cut_model``'s ``studies``).
+
+    name : how an error names the take; cuts : its human cuts (0-based take frames);
+    fps, n_frames : the take's frame rate and length; read : returns the take;
+    key : identifies the take's content (e.g. its file's checksum), or None to never
+    store its study.
+    """
+
+    name: str
+    cuts: Sequence[int]
+    fps: float
+    n_frames: int
+    read: Callable[[], object]
+    key: str | None = None
+
+
+def as_example(item) -> Example:
+    """``item`` as an :class:`Example`: itself, or a (take, cuts) pair whose take is at hand."""
+    if isinstance(item, Example):
+        return item
+    take, cuts = item
+    return Example(name=_where(take), cuts=cuts, fps=float(take.fps), n_frames=take.n_frames,
+                   read=lambda: take)
+
+
+def _where(take) -> str:
+    return os.path.basename(take.path) if getattr(take, "path", None) else take.name
+
+
+def checked_cuts(example: Example) -> np.ndarray:
+    """The example's cuts as sorted unique int frames inside its take; ExampleError naming
+    a bad one."""
+    out = []
+    for value in example.cuts:
+        number = float(value)
+        if not math.isfinite(number) or number != int(number):
+            raise ExampleError(f"{example.name}: cut {value!r} is not a whole frame")
+        if not 0 < int(number) < example.n_frames:
+            raise ExampleError(f"{example.name}: cut {int(number)} is outside the take "
+                               f"(frames 1 to {example.n_frames - 1} can start a segment)")
+        out.append(int(number))
+    return np.unique(np.asarray(out, dtype=np.int64))
 
 
 def read_examples(path) -> list[tuple[object, np.ndarray]]:

@@ -1,46 +1,39 @@
-"""A studio's cutting convention learnt as a scorer over over-complete candidates.
+"""How a studio's convention is learnt from its reviewed takes: a :class:`CutModel`'s
+scorer, fineness and placement fitted to example takes' candidates and human cuts.
 
-Every take is described by many candidate cuts with a few evidence features each
-(``_candidates``). A :class:`CutModel` keeps a candidate when a logistic scorer over
-those features says it is more likely a human cut than not (a reviewer gains from a
-candidate only then: a false one costs a delete, a missing one an insert), keeps no two
-kept candidates closer than its ``min_segment_s`` (the convention's fineness), and cuts
-each at its ``placement`` step moved by ``offset_s``.
-
-The scorer is a maximum-a-posteriori logistic regression whose Gaussian prior is centred
-on the zero-shot decision (keep exactly the zero-shot cuts): with no example it *is* the
-zero-shot detector, a few examples move it a little, many move it as far as they agree.
-Takes are weighted before the final fit: each is predicted by a model fitted on the
-others, and one that disagrees far more than the rest (a reviewer who cut half the
-cuts, or twice as many) is down-weighted, so that a minority of bad reviews cannot
-drag the model. Fineness and placement are medians over takes for the same reason.
-How the fixed settings were chosen is in ``docs/detector/adaptation.md``.
+Each example's candidates are labelled true or false against its human cuts (``labels``:
+by default, a candidate matched one-to-one to a human cut within the tolerance is true,
+:func:`matched_labels`), and the scorer is a maximum-a-posteriori logistic regression
+over their evidence whose Gaussian prior is centred on the zero-shot decision (keep
+exactly the zero-shot cuts): with no example it *is* the zero-shot detector, a few
+examples move it a little, many move it as far as they agree. Takes are weighted before
+the final fit: each is predicted by a model fitted on the others, and one that disagrees
+far more than the rest (a reviewer who cut half the cuts, or twice as many) is
+down-weighted, so that a minority of bad reviews cannot drag the model. Fineness and
+placement are medians over takes for the same reason. How the fixed settings were
+chosen is in ``docs/detector/adaptation.md``.
 """
 
 from __future__ import annotations
 
-import bisect
-import hashlib
-import json
 import math
-from dataclasses import dataclass, replace
+from collections.abc import Callable
+from dataclasses import replace
 
 import numpy as np
 from scipy.special import expit
 
 from motionlib import metrics
-from motionlib.adapt._candidates import FEATURES, study_take
-from motionlib.errors import InputError
+from motionlib.adapt._model import (
+    CutModel,
+    placed,
+    prior_weights,
+    ranked,
+    scorer_inputs,
+    select,
+)
 from motionlib.segmenters.default import PLACEMENTS, shipped_stage
 
-FORMAT = 2
-# Fixed centres of the features (typical values), so that the intercept means "a typical
-# candidate" and the prior on it is not dodged through a feature's offset.
-CENTRES = np.array([0.0, -2.3, -2.3, -1.0, -2.3, 0.0, 0.0, 1.0, 0.0])
-# The zero-shot decision as a scorer: a zero-shot cut has odds e^3 of being kept, any
-# other candidate e^-3; nothing else counts.
-PRIOR_INTERCEPT = -3.0
-PRIOR_ZERO_SHOT = 6.0
 # Prior precision on every weight, in units of one candidate's worth of evidence: fixed
 # (strong: a take or two move the scorer little) below CV_TAKES examples; from there on
 # chosen among PRECISIONS (inf: the zero-shot scorer itself) by cross-validation over
@@ -70,185 +63,40 @@ MAX_SEGMENT_S = 8.0
 PLACEMENT_MIN_CUTS = 6
 PLACEMENT_MIN_TAKES = 2
 PLACEMENT_GAIN = (0.2, 0.03)
-STUDY_VERSION = 1
 
 
-@dataclass(frozen=True)
-class CutModel:
-    """A studio's convention over the default detector's candidates (format 2).
-
-    n_takes, n_cuts : example takes and human cuts it learnt from (0: zero-shot).
-    weights : one per ``features`` plus the intercept last: the logistic scorer over the
-        centred evidence features.
-    features : names of the features the weights are for (``_candidates.FEATURES``).
-    min_segment_s : no two kept candidates lie closer (s); the more probable one stays.
-    placement : the placement step cuts are taken from (``PLACEMENTS``).
-    offset_s : signed shift (s) added to every cut; positive moves cuts later.
-    tolerance_s : how far (s) a candidate may lie from a human cut to count as it.
-    down_weighted : example takes weighted down as disagreeing with the others.
-    precision : the prior precision the scorer was fitted with (inf: the zero-shot one).
-    threshold : the scorer's logit a candidate must exceed: 0 keeps those more likely
-        true than not; another value makes the typical example take's count right.
-    """
-
-    n_takes: int
-    n_cuts: int
-    weights: tuple[float, ...]
-    features: tuple[str, ...]
-    min_segment_s: float
-    placement: str
-    offset_s: float
-    tolerance_s: float
-    down_weighted: int = 0
-    precision: float = math.inf
-    threshold: float = 0.0
-
-    @classmethod
-    def zero_shot(cls, tolerance_s: float = 1.0) -> CutModel:
-        """The prior: detects exactly what the zero-shot detector does (it keeps only the
-        zero-shot cuts, spaced as the detector spaces them: ``min_segment_s`` 0)."""
-        return cls(n_takes=0, n_cuts=0, weights=tuple(_prior().tolist()), features=FEATURES,
-                   min_segment_s=0.0, placement=shipped_stage({"onset": True}),
-                   offset_s=0.0, tolerance_s=tolerance_s)
-
-    def to_json(self) -> str:
-        """Stable JSON text (sorted keys) with ``"format": 2``."""
-        data = {"format": FORMAT, "n_takes": self.n_takes, "n_cuts": self.n_cuts,
-                "weights": list(self.weights), "features": list(self.features),
-                "min_segment_s": self.min_segment_s, "placement": self.placement,
-                "offset_s": self.offset_s, "tolerance_s": self.tolerance_s,
-                "down_weighted": self.down_weighted,
-                "precision": self.precision if math.isfinite(self.precision) else None,
-                "threshold": self.threshold}
-        return json.dumps(data, sort_keys=True)
-
-    @classmethod
-    def from_json(cls, text: str):
-        """Parse a stored model of any format: a :class:`CutModel` (format 2) or a
-        ``ThresholdModel`` (format 1, detecting as it always did); InputError (a
-        ValueError) naming what is wrong."""
-        from motionlib.adapt._threshold import ThresholdModel
-
-        try:
-            data = json.loads(text)
-        except (TypeError, json.JSONDecodeError) as exc:
-            raise InputError(f"cut model: not JSON: {exc}") from None
-        if not isinstance(data, dict):
-            raise InputError(f"cut model: expected a JSON object, got {type(data).__name__}")
-        if data.get("format") == 1:
-            return ThresholdModel.from_json(text)
-        if data.get("format") != FORMAT:
-            raise InputError(f"cut model: unsupported format {data.get('format')!r} "
-                             f"(expected 1 or {FORMAT})")
-
-        def fault(message):
-            raise InputError(f"cut model: {message}")
-        return cls.from_dict(data, fault)
-
-    @classmethod
-    def from_dict(cls, data: dict, fault) -> CutModel:
-        """A format-2 model from parsed JSON; ``fault(message)`` raises for bad values."""
-        if data.get("features") != list(FEATURES):
-            fault(f"features must be {list(FEATURES)}, got {data.get('features')!r}")
-        weights = data.get("weights")
-        if not isinstance(weights, list) or len(weights) != len(FEATURES) + 1 or not all(
-                _finite(w) for w in weights):
-            fault(f"weights must be {len(FEATURES) + 1} finite numbers, got {weights!r}")
-        values = {}
-        for name, kind in (("n_takes", int), ("n_cuts", int), ("down_weighted", int),
-                           ("min_segment_s", float), ("offset_s", float),
-                           ("tolerance_s", float), ("threshold", float)):
-            value = data.get(name)
-            if not _finite(value) or (kind is int and value != int(value)):
-                fault(f"{name} must be a finite {'integer' if kind is int else 'number'}, "
-                      f"got {value!r}")
-            values[name] = kind(value)
-        if data.get("placement") not in PLACEMENTS:
-            fault(f"placement must be one of {', '.join(PLACEMENTS)}, "
-                  f"got {data.get('placement')!r}")
-        precision = data.get("precision")
-        if precision is not None and not (_finite(precision) and precision > 0):
-            fault(f"precision must be a positive number or null, got {precision!r}")
-        return cls(**values, weights=tuple(float(w) for w in weights), features=FEATURES,
-                   placement=data["placement"],
-                   precision=math.inf if precision is None else float(precision))
+# How a study's candidates are labelled for the scorer: ``labels(model, study, cuts)``
+# -> (rows, y), the candidates learnt from (indices into the study's candidates) and
+# whether each is a human cut (0/1), with ``model`` placing the candidates (its placement
+# and offset, already chosen) and ``cuts`` the take's human cuts (take frames).
+Labels = Callable[[CutModel, dict, np.ndarray], tuple[np.ndarray, np.ndarray]]
 
 
-def _finite(value) -> bool:
-    return isinstance(value, int | float) and not isinstance(value, bool) and \
-        math.isfinite(value)
-
-
-def _prior() -> np.ndarray:
-    w = np.zeros(len(FEATURES) + 1)
-    w[FEATURES.index("zero_shot")] = PRIOR_ZERO_SHOT
-    w[-1] = PRIOR_INTERCEPT
-    return w
-
-
-def design(features: np.ndarray) -> np.ndarray:
-    """(n, len(FEATURES) + 1) the centred features and a column of ones."""
-    return np.hstack([features - CENTRES, np.ones((len(features), 1))])
-
-
-def study_key(p: dict) -> str:
-    """What a take's study depends on besides the take: the detector settings."""
-    text = json.dumps([STUDY_VERSION, sorted(p.items())])
-    return hashlib.sha256(text.encode()).hexdigest()
-
-
-def study(take, p: dict) -> dict[str, np.ndarray] | None:
-    """A take's candidates (``_candidates.study_take``)."""
-    return study_take(take, p)
-
-
-# ---- detection from a study ----------------------------------------------------------------
-
-def select(model: CutModel, one: dict) -> tuple[np.ndarray, np.ndarray]:
-    """The cuts ``model`` keeps among a study's candidates: (frames, probability),
-    in frame order. Most probable first, a candidate is kept when its scorer's logit
-    exceeds the model's ``threshold`` and no kept cut lies within ``min_segment_s``."""
-    logits, order, frames, kept = _ranked(model, one)
-    chosen = order[kept & (logits > model.threshold)]
-    chosen = chosen[np.argsort(frames[chosen], kind="stable")]
-    return frames[chosen], expit(logits[np.argsort(order)][chosen])
-
-
-def _ranked(model: CutModel, one: dict):
-    """(logits, order, frames, kept): the candidates' logits from the most probable down,
-    their indices, every candidate's frame (``placed``), and which of the ranked
-    candidates ``select`` keeps at a threshold below all of them. A candidate's fate
-    depends only on those ranked before it, so at any threshold ``select`` keeps exactly
-    the kept ones above it: one pass serves every threshold (``_calibrated``)."""
-    logit = design(one["features"]) @ np.asarray(model.weights)
+def matched_labels(model: CutModel, one: dict, cuts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The shipped labelling (:data:`Labels`): every candidate is learnt from, and is a
+    cut when, placed as ``model`` places it, it is matched one-to-one to a human cut
+    within the model's tolerance."""
     frames = placed(model, one)
-    gap = int(round(model.min_segment_s * float(one["fps"])))
-    order = np.argsort(-logit, kind="stable")
-    kept = np.zeros(len(order), dtype=bool)
-    taken: list[int] = []  # kept frames, sorted
-    for rank, i in enumerate(order.tolist()):
-        f = int(frames[i])
-        at = bisect.bisect_left(taken, f)
-        if (at < len(taken) and taken[at] - f < gap) or (at and f - taken[at - 1] < gap):
-            continue
-        taken.insert(at, f)
-        kept[rank] = True
-    return logit[order], order, frames, kept
+    y = np.zeros(len(frames))
+    ci, _ = metrics.match(frames, cuts, tolerance=int(round(model.tolerance_s *
+                                                               float(one["fps"]))))
+    y[ci] = 1.0
+    return np.arange(len(frames)), y
 
 
-def placed(model: CutModel, one: dict) -> np.ndarray:
-    """(n,) every candidate's frame at the model's placement step and offset."""
-    fps, n = float(one["fps"]), int(one["n_frames"])
-    frames = one["stages"][:, PLACEMENTS.index(model.placement)] + \
-        int(round(model.offset_s * fps))
-    return np.clip(frames, 1, max(1, n - 1))
+def _labelled(labels: Labels, model: CutModel, one: dict,
+              cuts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(design matrix, 0/1 labels) of the candidates ``labels`` learns from."""
+    rows, y = labels(model, one, cuts)
+    return scorer_inputs(model, one)[rows], np.asarray(y, dtype=float)
 
-
-# ---- learning ------------------------------------------------------------------------------
 
 def fit(studies: list[dict], cuts: list[np.ndarray], *, tolerance_s: float,
-        zero_min_segment_s: float, choice: tuple | None = None):
+        zero_min_segment_s: float, choice: tuple | None = None, labels: Labels | None = None):
     """Learn a :class:`CutModel` from example studies and their human cuts (take frames).
+
+    ``labels`` says which candidates of a study the scorer learns from and which of them
+    are human cuts (:data:`Labels`; :func:`matched_labels` when None).
 
     Returns (model, choice). ``choice`` is what the fit chose from all its examples
     together: the examples' weights, the prior's precision and whether the count is
@@ -262,7 +110,8 @@ def fit(studies: list[dict], cuts: list[np.ndarray], *, tolerance_s: float,
     fine = _min_segment([(c, float(s["fps"])) for c, s in zip(cuts, studies, strict=True)],
                         zero_min_segment_s)
     base = replace(prior, placement=placement, offset_s=offset, min_segment_s=fine)
-    data = [_labelled(base, one, c) for one, c in zip(studies, cuts, strict=True)]
+    labels = labels or matched_labels
+    data = [_labelled(labels, base, one, c) for one, c in zip(studies, cuts, strict=True)]
     if choice is None or len(studies) < CV_TAKES:
         weights = _take_weights(base, studies, cuts, data)
     else:
@@ -288,16 +137,16 @@ def _calibrated(model: CutModel, studies, cuts) -> float:
     """The logit threshold at which the median example take keeps as many cuts as its
     reviewers made (bisection; more threshold, fewer cuts). A count set by the median
     take, so a minority of under- or over-cut takes moves it little."""
-    ranked = []
+    rows = []
     for one, c in zip(studies, cuts, strict=True):
-        logits, _, _, kept = _ranked(model, one)
-        ranked.append((-logits, np.concatenate([[0], np.cumsum(kept)]), len(c)))
+        logits, _, _, kept = ranked(model, one)
+        rows.append((-logits, np.concatenate([[0], np.cumsum(kept)]), len(c)))
 
     def excess(threshold):
         # The ranked candidates above the threshold are a prefix; count its kept ones.
         return float(np.median([
             math.log((kept[np.searchsorted(descending, -threshold, side="left")] + 1) /
-                     (n_true + 1)) for descending, kept, n_true in ranked]))
+                     (n_true + 1)) for descending, kept, n_true in rows]))
     lo, hi = -CALIBRATION_RANGE, CALIBRATION_RANGE
     for _ in range(CALIBRATION_STEPS):
         mid = (lo + hi) / 2
@@ -306,17 +155,6 @@ def _calibrated(model: CutModel, studies, cuts) -> float:
         else:
             hi = mid
     return round((lo + hi) / 2, 4)
-
-
-def _labelled(model: CutModel, one: dict, cuts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(design matrix, 0/1 labels): a candidate is a cut when, placed as ``model``
-    places it, it is matched one-to-one to a human cut within the tolerance."""
-    frames = placed(model, one)
-    y = np.zeros(len(frames))
-    ci, _ = metrics.match(frames, cuts, tolerance=int(round(model.tolerance_s *
-                                                               float(one["fps"]))))
-    y[ci] = 1.0
-    return design(one["features"]), y
 
 
 def _choose(base: CutModel, studies, cuts, data, weights) -> tuple[float, bool]:
@@ -357,7 +195,7 @@ def _map_fit(data, take_weights: np.ndarray, precision: float,
     ``precision`` around the zero-shot scorer (Newton's method from ``start``, the prior
     by default; the objective is strictly convex, so every start reaches its one
     minimum). An infinite precision is the prior itself."""
-    w0 = _prior()
+    w0 = prior_weights()
     if not data or not math.isfinite(precision):
         return w0
     x = np.vstack([d[0] for d in data])

@@ -291,12 +291,17 @@ def _parse_motion_lines(text: str, first_line: int, n_frames: int, n_channels: i
     return np.array(rows, dtype=np.float64).reshape(n_frames, n_channels)
 
 
-def detect_rest_pose(skeleton: Skeleton, channels: np.ndarray) -> int | None:
+def detect_rest_pose(skeleton: Skeleton, channels: np.ndarray, *,
+                     atol: float = 0.0) -> int | None:
     """Index of an added rest (T-) pose at the start of a take, or None.
 
     Converters such as cgspeed's prepend a frame whose rotations are whole degrees, nearly all
     zero (a few fixed limb corrections), which no captured frame has. Positions are ignored:
     the added frame copies the first captured root position.
+
+    ``atol`` (degrees) is how far from a whole degree a rotation may be: 0 for a BVH, whose
+    numbers are as written; an FBX's rotations come back through Blender's float32 matrices
+    (:mod:`motionlib.io.fbx`), a few 1e-5 degrees off.
     """
     if channels.shape[0] < 2:
         return None
@@ -306,9 +311,10 @@ def detect_rest_pose(skeleton: Skeleton, channels: np.ndarray) -> int | None:
     if not cols:
         return None
     first = channels[0, cols]
-    whole = np.all(first == np.round(first))
-    mostly_zero = np.mean(first == 0) >= 0.75
-    return 0 if whole and mostly_zero and not np.array_equal(first, channels[1, cols]) else None
+    whole = np.all(np.abs(first - np.round(first)) <= atol)
+    mostly_zero = np.mean(np.abs(first) <= atol) >= 0.75
+    moves = np.abs(first - channels[1, cols]).max() > atol
+    return 0 if whole and mostly_zero and moves else None
 
 
 def _snap_fps(frame_time: float) -> float:

@@ -34,6 +34,9 @@ BINARY_MAGIC = b"Kaydara FBX Binary  \x00"
 CENTIMETRES_PER_METRE = 100.0
 # Blender's Z-up world to Y up: (x, y, z) -> (x, z, -y).
 Z_UP_TO_Y_UP = np.array([[1.0, 0, 0], [0, 0, 1], [0, -1, 0]])
+# Rotations read back through Blender's float32 matrices are this close (degrees) to what was
+# written: a rest-pose frame of whole degrees comes back within it (the 13_29 copy: 4e-5).
+ROTATION_TOLERANCE_DEG = 1e-3
 # A bone whose head strays from where its rest offset puts it by more than this share of the
 # skeleton's size gets position channels (Blender computes in float32: ~1e-7 is noise).
 MOVING_BONE_SHARE = 1e-5
@@ -138,7 +141,8 @@ def _take(path, animation, name, arrays, scene_fps, single) -> Take:
     stem = Path(path).stem
     return Take(name=stem if single else f"{stem}#{name}", format="fbx",
                 fps=_snap_fps(frame_time), frame_time=frame_time, channels=channels,
-                skeleton=skeleton, rest_pose_frame=detect_rest_pose(skeleton, channels),
+                skeleton=skeleton,
+                rest_pose_frame=detect_rest_pose(skeleton, channels, atol=ROTATION_TOLERANCE_DEG),
                 path=os.fspath(path), animation=name)
 
 

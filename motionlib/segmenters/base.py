@@ -100,6 +100,24 @@ class Segmentation:
     signals: dict[str, np.ndarray] = field(default_factory=dict)
     timings: dict[str, float] = field(default_factory=dict)
 
+    def checked(self, n_frames: int) -> Segmentation:
+        """This result held to the contract above for a take of ``n_frames`` (in place,
+        and returned): cuts as sorted unique ints inside the take, each confidence clipped
+        to [0, 1]; a cut outside the take, or a repeated one, is dropped with its
+        confidence. RuntimeError when there are not as many confidences as cuts."""
+        cuts = np.asarray(self.cuts, dtype=np.int64)
+        confidence = np.clip(np.asarray(self.confidence, dtype=float), 0.0, 1.0)
+        if cuts.shape != confidence.shape:
+            raise RuntimeError("segmenter returned cuts and confidence of different lengths")
+        keep = (cuts > 0) & (cuts < n_frames)
+        cuts, confidence = cuts[keep], confidence[keep]
+        order = np.argsort(cuts, kind="stable")
+        cuts, confidence = cuts[order], confidence[order]
+        first = np.ones(len(cuts), dtype=bool)
+        first[1:] = np.diff(cuts) > 0
+        self.cuts, self.confidence = cuts[first], confidence[first]
+        return self
+
 
 class Segmenter:
     """Base class: subclasses set the class attributes and implement ``_segment``."""
@@ -149,7 +167,7 @@ class Segmenter:
         start = time.perf_counter()
         result = self._segment(take, **values)
         result.timings["total"] = time.perf_counter() - start
-        self.result_ = _checked(result, take.n_frames)
+        self.result_ = result.checked(take.n_frames)
         return self
 
     def predict(self) -> Segmentation:
@@ -162,22 +180,6 @@ class Segmenter:
 
     def _segment(self, take: Any, **params: Any) -> Segmentation:
         raise NotImplementedError
-
-
-def _checked(result: Segmentation, n_frames: int) -> Segmentation:
-    """Enforce the result contract: sorted, unique, interior cuts; confidence in [0, 1]."""
-    cuts = np.asarray(result.cuts, dtype=np.int64)
-    confidence = np.clip(np.asarray(result.confidence, dtype=float), 0.0, 1.0)
-    if cuts.shape != confidence.shape:
-        raise RuntimeError("segmenter returned cuts and confidence of different lengths")
-    keep = (cuts > 0) & (cuts < n_frames)
-    cuts, confidence = cuts[keep], confidence[keep]
-    order = np.argsort(cuts, kind="stable")
-    cuts, confidence = cuts[order], confidence[order]
-    first = np.ones(len(cuts), dtype=bool)
-    first[1:] = np.diff(cuts) > 0
-    result.cuts, result.confidence = cuts[first], confidence[first]
-    return result
 
 
 def first_frame(take: Any) -> int:

@@ -21,6 +21,7 @@ from segmentation.api.serializers import (
     ProjectSerializer,
 )
 from segmentation.models import Membership, Project
+from segmentation.services.invitations import can_see_accounts
 from segmentation.services.team import can_create_accounts
 
 
@@ -117,7 +118,8 @@ class MeView(APIView):
         limits = {"max_joints": storage.input_limits().max_joints}
         return Response(MeSerializer({
             "id": request.user.pk, "username": request.user.username, "projects": projects,
-            "limits": limits, "can_create_accounts": can_create_accounts(request.user)}).data)
+            "limits": limits, "can_create_accounts": can_create_accounts(request.user),
+            "can_see_accounts": can_see_accounts(request.user)}).data)
 
 
 class MethodsView(APIView):

@@ -15,11 +15,14 @@ from segmentation.api.serializers import (
     EventSerializer,
     InsertCutSerializer,
     LabelSegmentSerializer,
+    RestoreSerializer,
     ReviewPageSerializer,
     ReviewSerializer,
     SuggestionsSerializer,
     VersionSerializer,
 )
+from segmentation.errors import Invalid
+from segmentation.services import history
 from segmentation.services.adaptation import adaptation_summary
 from segmentation.services.reviews import catch_up, started_review
 
@@ -74,7 +77,7 @@ def unstarted_review(capture, user):
         "return_comment": "", "cuts": cuts,
         "segments": [{"index": i, "start": a, "stop": b, "label": None}
                      for i, (a, b) in enumerate(zip(bounds[:-1], bounds[1:], strict=True))],
-        "adaptation": adaptation_summary(run, capture.project_id),
+        "adaptation": adaptation_summary(run, capture.project_id, user),
     }
 
 
@@ -128,6 +131,57 @@ class EventsView(OwnReviewView):
         review = services.own_review(capture_for(request.user, pk), request.user)
         events = review.events.select_related("user") if review else []
         return Response(EventSerializer(events, many=True).data)
+
+
+class UndoView(APIView):
+    """Undo (or, as RedoView, redo) the caller's last step, as the review's log has it:
+    undo survives a reload. The answer is the review as restored; the restore is an event."""
+
+    verb = "undo"
+
+    @extend_schema(request=VersionSerializer, responses=ReviewSerializer)
+    def post(self, request, pk):
+        data = body(request, VersionSerializer)
+        review = started_review(request.user, pk)
+        if review is None:
+            capture_for(request.user, pk)  # 404 for a capture the caller does not see
+            raise Invalid(f"{self.verb}: you have not started a review of capture {pk}")
+        step = history.do_undo if self.verb == "undo" else history.do_redo
+        return Response(ReviewSerializer(step(review, request.user, data["version"])).data)
+
+
+class RedoView(UndoView):
+    verb = "redo"
+
+
+def review_for(user, pk, review_id):
+    """Review ``review_id`` of capture ``pk`` for its annotator or the project's reviewers
+    and admins; 404 for a capture the caller does not see, 403 for another annotator."""
+    capture = capture_for(user, pk)
+    review = get_object_or_404(capture.reviews, pk=review_id)
+    if review.annotator_id != user.pk and not capture.project.can_see_all_reviews(user):
+        raise PermissionDenied("Only the review's annotator and the project's reviewers and admins see its history.")
+    review.capture = capture
+    return review
+
+
+class ReviewEventsView(APIView):
+    @extend_schema(responses=EventSerializer(many=True))
+    def get(self, request, pk, review_id):
+        """The activity log of one review (its annotator, reviewers, admins)."""
+        review = review_for(request.user, pk, review_id)
+        return Response(EventSerializer(review.events.select_related("user"), many=True).data)
+
+
+class RestoreView(APIView):
+    @extend_schema(request=RestoreSerializer, responses=ReviewSerializer)
+    def post(self, request, pk, review_id):
+        """Restore the review as it was right after one of its events; the restore is an
+        event itself (so it can be undone). A stale ``version`` is refused (409)."""
+        data = body(request, RestoreSerializer)
+        review = review_for(request.user, pk, review_id)
+        history.do_restore_review(review, request.user, data["event"], data["version"])
+        return Response(ReviewSerializer(review).data)
 
 
 class AllReviewsView(APIView):

@@ -554,16 +554,21 @@ class SegmentZipView(APIView):
     def get(self, request):
         # Not "format": DRF reads that one to pick a renderer.
         fmt = exports.check_format(request.query_params.get("file_format"))
-        segments = segment_query(request)
+        matching = segment_query(request)
+        # Only the clips the format writes are counted (the page's progress says how many)
+        # and sent; segments of the other kind of take are named in errors.txt.
+        segments = exports.writable_in(matching, fmt)
         count = segments.count()
         if count > exports.MAX_EXPORT_SEGMENTS:
             raise Invalid(f"export: the query matches {count} segments; export at most "
                           f"{exports.MAX_EXPORT_SEGMENTS} at a time (narrow the filters)")
+        left_out = matching.count() - count
         rows = (segments.select_related("capture", "annotator", "label").defer("descriptor", "profile")
                 .order_by("capture_id", "start", "id").iterator(chunk_size=200))
-        response = StreamingHttpResponse(exports.stream_zip(rows, fmt),
+        response = StreamingHttpResponse(exports.stream_zip(rows, fmt, left_out),
                                          content_type="application/zip")
         response["Content-Disposition"] = f'attachment; filename="segments-{fmt}.zip"'
+        response["X-Clip-Count"] = str(count)
         return response
 
 

@@ -97,6 +97,9 @@ class MeSerializer(serializers.Serializer):
     projects = MyProjectSerializer(many=True)
     limits = LimitsSerializer()
     can_create_accounts = serializers.BooleanField()
+    can_see_accounts = serializers.BooleanField(
+        help_text="A site admin who may see accounts: inviting a name no account has is refused, "
+        "saying so (to anyone else the answer is the same whether or not the name exists).")
 
 
 class ParamSerializer(serializers.Serializer):
@@ -368,7 +371,8 @@ class AdaptationSerializer(serializers.Serializer):
     training = serializers.BooleanField(help_text="A training is queued or running.")
     training_error = serializers.CharField(allow_null=True, help_text="Why the last training failed.")
     training_refused = serializers.CharField(
-        allow_null=True, help_text="Why the model of the last training was refused (the project keeps its model).")
+        allow_null=True, help_text="Why the model of the last training was refused (the project keeps its "
+        "model; null for an annotator).")
 
 
 # A review's statuses, and that of the review a caller has not started yet (the schema's
@@ -433,8 +437,9 @@ class ReviewPageSerializer(ReviewSerializer):
     @extend_schema_field(AdaptationSerializer)
     def get_adaptation(self, review):
         """Which project model the review's candidates came from (model_version null:
-        the zero-shot detector), the project's newest model and its last failed training."""
-        return adaptation_summary(review.run, review.capture.project_id)
+        the zero-shot detector), the project's newest model, its last failed training and,
+        for a reviewer or admin, its last refused one. The page's review is its caller's own."""
+        return adaptation_summary(review.run, review.capture.project_id, review.annotator)
 
 
 class SuggestionSerializer(serializers.Serializer):
@@ -450,6 +455,12 @@ class SuggestionsSerializer(serializers.Serializer):
 
 class VersionSerializer(serializers.Serializer):
     version = serializers.IntegerField(min_value=1)
+
+
+class RestoreSerializer(VersionSerializer):
+    """Restore the review as it was right after its event ``event`` (an id of its log)."""
+
+    event = serializers.IntegerField(min_value=1)
 
 
 class InsertCutSerializer(VersionSerializer):

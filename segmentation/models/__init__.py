@@ -7,14 +7,14 @@
 - ``library``: library segments, gold versions, agreement, label suggestions;
 - ``workers``: the Celery workers' heartbeats;
 - ``locks``: named row locks for counting against a limit atomically;
-- ``accounts``: the key of each account's username.
+- ``accounts``: the key of each account's username; one-time passwords not yet replaced.
 
 Rules about one record live on the models; lookups live on the managers
 (``Capture.objects.visible_to(user)``). Workflows that touch several records are the
 ``do_*`` functions in ``segmentation.services``.
 """
 
-from segmentation.models.accounts import UsernameKey
+from segmentation.models.accounts import OneTimePassword, UsernameKey
 from segmentation.models.captures import (
     Assignment,
     Capture,
@@ -74,6 +74,7 @@ __all__ = [
     "derived_path",
     "original_path",
     "ThrottleLock",
+    "OneTimePassword",
     "UsernameKey",
     "WorkerHeartbeat",
 ]

@@ -1,7 +1,9 @@
-"""The key of each account's username (``segmentation.usernames``), stored and unique."""
+"""The key of each account's username (``segmentation.usernames``), stored and unique; and
+which accounts still sign in with a one-time password."""
 
 from django.conf import settings
 from django.db import models
+from django.utils import timezone
 
 
 class UsernameKey(models.Model):
@@ -26,3 +28,20 @@ class UsernameKey(models.Model):
 
     def __str__(self):
         return f"{self.user_id}: {(self.digest or '-')[:8]}…"
+
+
+class OneTimePassword(models.Model):
+    """An account whose password someone else made (a site admin's reset, an account a
+    site admin created) and its owner has not replaced yet.
+
+    Signed in with it, the owner must choose a new password before anything else
+    (``cutroom.accounts.middleware``); choosing one deletes the row, so the password made
+    for them is used once.
+    """
+
+    user = models.OneToOneField(settings.AUTH_USER_MODEL, on_delete=models.CASCADE,
+                                primary_key=True, related_name="one_time_password")
+    issued_at = models.DateTimeField(default=timezone.now)
+
+    def __str__(self):
+        return f"{self.user_id}: one-time password of {self.issued_at:%Y-%m-%d %H:%M}"

@@ -34,7 +34,7 @@ from motionlib.segmenters import get_segmenter
 from segmentation import takecache
 from segmentation.consensus import consensus_cuts
 from segmentation.errors import CutroomError, Invalid
-from segmentation.models import Capture, ProjectCutModel, Review
+from segmentation.models import Capture, Membership, ProjectCutModel, Review
 from segmentation.services import jobs, model_gate
 from segmentation.services.jobs import Kind, register
 from segmentation.storage import read_take
@@ -268,10 +268,12 @@ def _parsed(text, version, pk):
 # ---- what the review page shows ----------------------------------------------------------
 
 
-def adaptation_summary(run, project_id):
+def adaptation_summary(run, project_id, viewer):
     """What a review page says about adaptation: the model its candidates came from
-    (None: zero-shot) with its own held-out figure, the project's current model, and why
-    the last training failed or was refused."""
+    (None: zero-shot) with its own held-out figure, the project's current model, why the
+    last training failed, and, for the project's reviewers and admins (``viewer``), why its
+    model was refused: news for those who look after the model, not an error, and nothing
+    an annotator can act on."""
     newest = ProjectCutModel.objects.newest(project_id)
     # Trainings end in the order they were asked for (one at a time per project).
     last = (
@@ -283,6 +285,8 @@ def adaptation_summary(run, project_id):
         project_id=project_id, status__in=("queued", "processing")
     ).exists()
     version = run.model_version if run else None
+    oversees = Membership.objects.filter(project_id=project_id, user=viewer,
+                                         role__in=("reviewer", "admin")).exists()
     used = newest if newest is not None and newest.version == version else (
         ProjectCutModel.objects.filter(project_id=project_id, version=version).first()
         if version is not None else None
@@ -298,7 +302,7 @@ def adaptation_summary(run, project_id):
         ),
         "training": training,
         "training_error": last.error if last is not None and last.status == "failed" else None,
-        "training_refused": (last.refused or None) if last is not None and last.status == "ready" else None,
+        "training_refused": (last.refused or None) if oversees and last is not None and last.status == "ready" else None,
     }
 
 

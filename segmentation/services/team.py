@@ -12,7 +12,7 @@ from django.db import IntegrityError, transaction
 
 from segmentation import usernames
 from segmentation.errors import Invalid, NotAllowed
-from segmentation.models import Membership, Project
+from segmentation.models import Membership, OneTimePassword, Project
 
 ROLES = ("annotator", "reviewer", "admin")
 
@@ -62,7 +62,7 @@ def do_create_account(project, actor, username, role):
     """A new account with a one-time password, made a member of the project.
 
     Returns (membership, password); the password is not stored anywhere readable and is
-    shown once. The person should change it at first sign-in.
+    shown once. Signed in with it, the person must first choose their own.
     """
     if not can_create_accounts(actor):
         raise NotAllowed("Only site admins create accounts; invite an existing user instead.")
@@ -77,6 +77,7 @@ def do_create_account(project, actor, username, role):
         with transaction.atomic():
             _check_available(username)
             user = get_user_model().objects.create_user(username, password=password)
+            OneTimePassword.objects.create(user=user)
             membership = Membership.objects.create(project=project, user=user, role=role)
     except IntegrityError:
         raise Invalid(f"username: an account named {username!r} already exists; invite it") from None

@@ -77,7 +77,15 @@ def test_the_review_page_shows_the_models_figure_and_why_a_retraining_was_refuse
     assert (v1.version, refused.version) == (1, None), refused.error
     capture = ingest(studio, seed=93)
 
-    page = new_page("bob")
+    # The gate's refusal is the project's news: its reviewers and admins read it, in the
+    # panel's neutral text; an annotator is not told on every take.
+    annotator = new_page("bob")
+    annotator.goto(f"{live_server.url}/captures/{capture.pk}/")
+    expect(annotator.get_by_test_id("adaptation-line")).to_have_text(
+        "Candidates adapted from 2 reviewed takes (model v1).")
+    expect(annotator.get_by_test_id("adaptation-note")).to_have_count(0)
+
+    page = new_page("rachel")
     page.goto(f"{live_server.url}/captures/{capture.pk}/")
 
     figure = page.get_by_test_id("adaptation-figure")
@@ -85,9 +93,10 @@ def test_the_review_page_shows_the_models_figure_and_why_a_retraining_was_refuse
         r"Learnt from 2 reviewed takes; on 2 held-out reviewed takes \d\.\d\d edits per cut, F1 \d\.\d\d\."))
     shown = [float(x) for x in re.findall(r"\d\.\d\d", figure.inner_text())]
     assert shown == pytest.approx([v1.held_out_edits_per_cut, v1.held_out_f1], abs=0.0051)  # rounded to 2 decimals
-    expect(page.get_by_test_id("adaptation-note")).to_have_text(
-        f"Last retraining {refused.refused}. The project keeps model v1.")
-    assert page.errors == []
+    note = page.get_by_test_id("adaptation-note")
+    expect(note).to_have_text(f"Last retraining {refused.refused}. The project keeps model v1.")
+    expect(note).not_to_have_class(re.compile("error"))
+    assert page.errors == [] and annotator.errors == []
 
 
 def test_a_reviewer_redetects_an_untouched_capture_from_the_list(live_server, new_page, studio):

@@ -83,7 +83,8 @@ def test_it_uploads_dropped_files_and_shows_their_status_as_it_changes(live_serv
     expect(page.get_by_test_id("uploads")).to_contain_text("already uploaded")
     # A file that is not a capture is refused before anything is sent.
     page.evaluate(DROP, ["notes.txt", "hello"])
-    expect(page.locator(".toast-error")).to_contain_text("notes.txt: not a .bvh, .fbx or .amc file.")
+    expect(page.locator(".toast-error")).to_contain_text(
+        "notes.txt: not a take Cutroom reads (.bvh, .fbx, .amc with its .asf, .c3d, .tsv or .csv).")
     expect(rows.locator("tr.capture-row")).to_have_count(2)
 
     page.get_by_test_id("filter-status").select_option("failed")
@@ -166,5 +167,5 @@ def test_it_pairs_a_dropped_cmu_amc_with_its_asf_and_plays_the_real_take(live_se
     page.wait_for_selector("[data-testid=frames-loading][data-done]", state="attached")
     page.keyboard.press("End")
     expect(page.get_by_test_id("hud-frame")).to_have_text("Frame 4591 / 4591")
-    expect(page.get_by_test_id("hud-time")).to_contain_text("0:38.26 / 0:38.26 · 120 fps")
+    expect(page.get_by_test_id("hud-time")).to_contain_text("00:00:38:031 / 00:00:38:031 · 120 fps")
     assert page.errors == []

@@ -2,6 +2,8 @@
 at laptop sizes, the submit dialog, the library's filters and export progress, the capture
 list's upload and assignment."""
 
+import time
+
 import pytest
 from playwright.sync_api import expect
 
@@ -149,11 +151,49 @@ def test_an_annotator_is_offered_no_page_that_would_refuse_them(live_server, new
     assert page.errors == []
 
 
-def test_the_file_chooser_and_drop_zone_take_point_takes(live_server, new_page, studio):
-    page = new_page("alice")
+def test_a_newcomer_creates_a_project_and_uploads_point_takes_until_ready(live_server,
+                                                                         new_page, studio):
+    """dora, signed in with no project, creates one from the capture list (becoming its
+    admin); a Vicon C3D, a Qualisys TSV and a Kinect joint CSV chosen in the page's file
+    dialog are each uploaded to it, and each row turns ready once a worker has read it."""
+    from django.contrib.auth import get_user_model
+
+    from segmentation import tasks
+    from segmentation.models import Capture, DetectionRun, Project
+    from tests.motionlib.points_data import points_file
+
+    dora = get_user_model().objects.create_user("dora", password="dora-password")
+    paths = [points_file("hdm05", "HDM_bd_05-01_01_120.c3d"),
+             points_file("vmci", "subject1_run1.tsv"), points_file("utkinect", "s01_e01.csv")]
+    page = new_page("dora")
+    page.get_by_test_id("new-project").click()
+    page.get_by_test_id("prompt-text").fill("Dora's mocap")
+    page.get_by_test_id("prompt-ok").click()
+    project = page.get_by_test_id("filter-project")
+    expect(project.locator("option:checked")).to_have_text("Dora's mocap")
+    created = Project.objects.get(name="Dora's mocap")
+    assert created.role_of(dora) == "admin"
+    expect(page.get_by_test_id("nav-team")).to_be_visible()  # her project's admin pages
+
     expect(page.get_by_test_id("dropzone")).to_contain_text(".c3d")
-    accept = page.locator("input[type=file]").get_attribute("accept").split(",")
-    assert {".bvh", ".fbx", ".amc", ".asf", ".c3d", ".tsv", ".csv"} <= set(accept)
+    page.locator("input[type=file]").set_input_files([str(p) for p in paths])
+    uploads = page.get_by_test_id("uploads")
+    for path in paths:  # each gets its progress row at once, then they go one at a time
+        expect(uploads).to_contain_text(path.name)
+    expect(page.locator(".toast-error")).to_have_count(0)
+    deadline = time.monotonic() + 30
+    while Capture.objects.count() < len(paths) and time.monotonic() < deadline:
+        time.sleep(0.2)
+    captures = {c.name: c for c in Capture.objects.filter(project=created)}
+    assert sorted(captures) == sorted(p.name for p in paths)
+    for capture in captures.values():  # the worker's jobs, run here in-process
+        tasks.ingest(capture.pk)
+        for run in DetectionRun.objects.filter(capture=capture, status="queued"):
+            tasks.detect(run.pk)
+    for capture in captures.values():
+        row = page.get_by_test_id(f"capture-{capture.pk}")
+        expect(row.locator(".badge")).to_have_text("ready", timeout=30_000)
+    assert page.errors == []
 
 
 def test_the_capture_list_speaks_to_a_first_upload(live_server, new_page, ingested_capture,

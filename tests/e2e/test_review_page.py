@@ -120,7 +120,7 @@ def test_it_saves_every_edit_and_restores_the_review_exactly_after_reload(live_s
     segments = {s["start"]: s["label"] for s in screen.review()["segments"]}
     assert segments[0] == "walk" and segments[inserted_at] == "punch"
 
-    # Undo takes the last label off; redo puts it back; both are saved edits too.
+    # Undo takes the last label off; redo puts it back; both are saved on the server too.
     page.keyboard.press("z")
     screen.saved()
     assert screen.review()["segments"][0]["label"] is None
@@ -148,9 +148,10 @@ def test_it_saves_every_edit_and_restores_the_review_exactly_after_reload(live_s
     assert fates[c2["id"]][0] == "deleted"
     assert stored.version == after_reload["version"]
 
-    # The audit log, in the API and on the page, shows each action in order.
+    # The audit log, in the API and on the page, shows each action in order; the undo and
+    # the redo are restores the server made from the log.
     actions = [e["action"] for e in screen.events()]
-    assert actions == ["create", "accept", "move", "delete", "insert", "label", "label", "label", "label"]
+    assert actions == ["create", "accept", "move", "delete", "insert", "label", "label", "restore", "restore"]
     shown = page.locator("[data-testid=events] li").evaluate_all("els => els.map(e => e.dataset.action)")
     assert shown == list(reversed(actions))
 
@@ -237,12 +238,20 @@ def test_it_shows_what_changed_when_the_review_was_edited_elsewhere(live_server,
     assert page.errors == []
 
 
-@pytest.mark.parametrize("path", ["/captures/999999/"])
-def test_it_explains_a_capture_that_does_not_exist(live_server, new_page, studio, path):
+@pytest.mark.parametrize(("path", "title", "reason"), [
+    ("/captures/999999/", "Not found", "No such capture."),
+    ("/projects/{project}/dashboard/", "Not allowed", "Only the project's reviewers and admins"),
+])
+def test_it_explains_a_capture_that_does_not_exist_or_a_page_not_for_this_role(
+        live_server, new_page, studio, path, title, reason):
+    """A refusal says so, with the server's reason; it is not a failure ("Something went
+    wrong") of the service."""
     page = new_page("ann")
-    page.goto(f"{live_server.url}{path}")
-    expect(page.locator(".loading-page")).to_contain_text("Something went wrong")
-    expect(page.locator(".loading-page .error-text")).not_to_be_empty()
+    page.goto(f"{live_server.url}{path.format(project=studio['project'].pk)}")
+    failure = page.get_by_test_id("page-failure")
+    expect(failure.locator("h1")).to_have_text(title)
+    expect(failure.locator("p")).to_contain_text(reason)
+    expect(failure.locator(".error-text")).to_have_count(0)
 
 
 def test_it_lists_the_shortcuts_and_locks_the_review_once_submitted(live_server, new_page, ingested_capture, studio):

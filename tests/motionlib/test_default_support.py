@@ -5,8 +5,7 @@ import numpy as np
 import pytest
 
 from motionlib import metrics
-from motionlib.adapt import _threshold
-from motionlib.segmenters.default import Analysis, Default, candidates
+from motionlib.segmenters.default import Analysis, Default, candidates, peak_support
 from motionlib.segmenters.default._peaks import SUPPORT_GAP_S, SUPPORT_SIDE_S, cross_support
 from tests.motionlib.conftest import labelled_takes, skeleton_takes
 
@@ -101,17 +100,23 @@ def test_window_peaks_drops_the_unsupported_peak_only():
     assert strength.tolist() == pytest.approx([1.0])
 
 
-def test_a_threshold_models_count_cannot_bring_back_a_dropped_peak():
-    # A format-1 model's study holds every peak at every prominence, but not one the support
-    # test drops: no prominence the count is learnt at can cut there.
+def test_no_prominence_brings_back_a_peak_the_support_test_drops():
+    # ``candidates`` lists every peak any prominence would keep, but not one the support
+    # test drops: a count chosen among them cannot cut there.
     analysis = _two_joins()
     on = Default.validate_params({})
     off = Default.validate_params({"support": 0.0})
     for p, kept in ((off, [100, 200]), (on, [200])):
         peaks, _ = candidates(analysis, Default.peaks(analysis, p), p)
         assert peaks.tolist() == kept
-        study = _threshold._all_peaks("zero", analysis, Default.peaks(analysis, p), p, {})
-        assert study["zero_raw"].tolist() == analysis.peak_frames(kept).tolist()
+
+
+def test_the_support_the_learner_reads_is_the_support_test_s():
+    analysis = _two_joins()
+    expected = cross_support(analysis.blocks, np.array([100, 200]), analysis.rate,
+                             analysis.gamma)
+    np.testing.assert_array_equal(peak_support(analysis, [100, 200]), expected)
+    assert Default.peaks(analysis, Default.validate_params({})).samples.tolist() == [200]
 
 
 def test_the_four_channel_cuts_it_drops_are_far_from_every_true_cut():

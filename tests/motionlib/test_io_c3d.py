@@ -192,3 +192,45 @@ def test_it_names_the_frame_range_parameters_it_cannot_read(original, tmp_path):
     with pytest.raises(motionlib.CaptureError, match=r"broken\.c3d: header words 4-5 and "
                        r"parameters TRIAL:ACTUAL_START_FIELD.*the frame range cannot be read"):
         motionlib.read(broken(tmp_path, data))
+
+
+# Vicon's Plug-in Gait full-body marker set, from its product guide: head, trunk, arms with
+# their wand markers (UPA, FRM), pelvis, legs with theirs (THI, TIB), feet.
+PLUG_IN_GAIT = ["LFHD", "RFHD", "LBHD", "RBHD", "C7", "T10", "CLAV", "STRN", "RBAK",
+                "LSHO", "LUPA", "LELB", "LFRM", "LWRA", "LWRB", "LFIN",
+                "RSHO", "RUPA", "RELB", "RFRM", "RWRA", "RWRB", "RFIN",
+                "LASI", "RASI", "LPSI", "RPSI", "LTHI", "LKNE", "LTIB", "LANK", "LHEE", "LTOE",
+                "RTHI", "RKNE", "RTIB", "RANK", "RHEE", "RTOE"]
+
+
+def roots_of(parents: list[int]) -> set[int]:
+    """The point each point's chain of links ends at."""
+    def root(i):
+        seen = set()
+        while parents[i] != -1:
+            assert i not in seen, "the links form a cycle"
+            seen.add(i)
+            i = parents[i]
+        return i
+    return {root(i) for i in range(len(parents))}
+
+
+def test_every_plug_in_gait_marker_of_hdm05_is_drawn_in_one_body(hdm05):
+    """Regression: T10 and STRN were roots of their own (the trunk apart from the waist) and
+    the wand markers (LUPA, LFRM, LTHI, LSHN, ...) and RBAC were drawn unlinked."""
+    named = [i for i, n in enumerate(hdm05.point_names) if not n.startswith("*")]
+    parents = hdm05.skeleton.parents
+    assert len(named) == 41
+    kept = {i: j for j, i in enumerate(named)}
+    assert all(parents[i] in kept for i in named if parents[i] != -1)
+    assert len(roots_of([kept.get(parents[i], -1) for i in named])) == 1
+    # the unlabelled markers (*0, *1, *2) belong to no body part and stay apart
+    assert all(parents[i] == -1 for i, n in enumerate(hdm05.point_names) if n.startswith("*"))
+
+
+def test_the_full_plug_in_gait_set_is_one_tree():
+    from motionlib import markersets
+
+    names = [f"Subject:{n}" for n in PLUG_IN_GAIT]
+    assert markersets.identify(names) == "plug-in gait"
+    assert len(roots_of(markersets.link_parents(names, "plug-in gait"))) == 1

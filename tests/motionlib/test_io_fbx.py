@@ -39,6 +39,22 @@ def test_it_reads_the_blender_export_of_13_29_as_the_bvh_moves(take_13_29):
     assert error.max() < 1e-4 * motionlib.skeleton_height(bvh)
 
 
+def test_it_finds_the_added_t_pose_of_a_cgspeed_take_in_its_fbx_copy(take_13_29):
+    """Regression: the FBX copy of 13_29 kept its T-pose frame (rest_pose_frame None), so the
+    speed lane's first value (the jump out of the T-pose) dwarfed the take's own speeds and
+    clips exported from frame 0 started in T-pose."""
+    from motionlib.segmenters import get_segmenter
+
+    assert take_13_29.rest_pose_frame == 0 == motionlib.read(shared_bvh_13_29()).rest_pose_frame
+    speed = get_segmenter("default")().fit_predict(take_13_29).signals["speed"]
+    assert speed.max() < 10 * np.median(speed)
+
+
+def test_it_finds_no_rest_pose_where_a_take_starts_moving():
+    take = motionlib.read(shared_fbx("samba_dancing.fbx"))
+    assert take.rest_pose_frame is None
+
+
 def test_it_poses_a_mixamo_rig_as_blender_itself_does():
     path = shared_fbx("samba_dancing.fbx")
     take = motionlib.read(path)

@@ -13,6 +13,16 @@ from segmentation.takecache import StoredStudies
 from tests.segmentation.base import BaseTestCase, synthetic_bvh
 
 SECONDS = 30.0
+FORMAT_1_MODELS = [
+    ('{"format": 1, "min_segment_s": 0.85, "n_cuts": 8, "n_takes": 2, "offset_s": 0.0, '
+     '"placement": "onset", "prominence": 0.1, "scale_max_s": 6.0, "scale_min_s": 3.0, '
+     '"threshold": 0.1}',
+     98, [922, 1448, 1898, 2586, 3085], [0.6575, 0.8871, 0.8344, 0.7624, 0.782]),
+    ('{"format": 1, "min_segment_s": 1.125, "n_cuts": 51, "n_takes": 3, "offset_s": 0.0, '
+     '"placement": "split", "prominence": 0.1, "scale_max_s": 3.0, "scale_min_s": 1.5, '
+     '"threshold": 0.1}',
+     99, [770, 1458, 2246, 3006, 3398], [0.8602, 0.8618, 0.8865, 0.9149, 0.5838]),
+]
 
 
 class ReviewedTakesTestCase(BaseTestCase):
@@ -62,6 +72,19 @@ class DetectionWithModelTestCase(ReviewedTakesTestCase):
         self.assertEqual((model.version, model.n_takes), (1, 2))
         self.assertEqual((run.status, run.model_version, run.model_n_takes), ("ready", 1, 2), run.error)
         self.assertTrue(run.candidates)
+
+    def test_a_model_stored_in_the_first_format_still_detects_as_it_did(self):
+        # Models as format 1 stored them, read from their row, cut a take where they cut it
+        # when format-1 models were still learnt: the one the release v0.2.0 stored
+        # (upgrade/v0.2.0.sqlite), and one learnt from short activities, which cuts
+        # elsewhere than the zero-shot detector.
+        for version, (text, seed, frames, confidence) in enumerate(FORMAT_1_MODELS, start=1):
+            ProjectCutModel.objects.create(project=self.project, status="ready",
+                                           version=version, model=text, n_takes=2, n_cuts=8)
+            run = self.ingested(seed=seed).latest_run()
+            self.assertEqual((run.status, run.model_version), ("ready", version), run.error)
+            self.assertEqual([c["frame"] for c in run.candidates], frames)
+            self.assertEqual([round(c["confidence"], 4) for c in run.candidates], confidence)
 
     def test_other_methods_ignore_the_model(self):
         self.train([95])

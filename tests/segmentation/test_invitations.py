@@ -92,6 +92,13 @@ class InvitationsTestCase(BaseTestCase):
         self.assertIn("no user named 'nobody-has-this-name'", r.json()["detail"])
         self.assertFalse(Invitation.objects.filter(username="nobody-has-this-name").exists())
 
+    def test_the_caller_learns_whether_their_invitations_say_that_no_account_has_a_name(self):
+        """The Team page tells a site admin that a name no account has is refused, and a
+        project admin that the answer is the same either way: both read it from /api/me/."""
+        for user, sees in ((self.root, True), (self.alice, False)):
+            self.login(user)
+            self.assertIs(self.client.get("/api/me/").json()["can_see_accounts"], sees, user)
+
     def test_a_site_admin_cannot_place_anyone_in_the_project_either(self):
         self.add("root", "admin")
         self.answer(self.root, Invitation.objects.get(username="root").pk, "accept")

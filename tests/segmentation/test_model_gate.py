@@ -102,10 +102,18 @@ class RefusedModelTestCase(GateTestCase):
         self.assertTrue(run.candidates)
 
     def test_the_review_page_says_why_and_which_model_is_kept(self):
-        self.login(self.bob)
+        self.login(self.rachel)
         adapted = self.client.get(f"/api/captures/{self.next.pk}/review/").json()["adaptation"]
         self.assertEqual(adapted["training_refused"], self.job.refused)
         self.assertIsNone(adapted["training_error"])
+        self.assertEqual(adapted["project_model"]["version"], 1)
+
+    def test_an_annotators_review_page_leaves_the_refusal_to_reviewers_and_admins(self):
+        """The gate's refusal is news for those who look after the project's model, not
+        something an annotator can act on, on every take they open."""
+        self.login(self.bob)
+        adapted = self.client.get(f"/api/captures/{self.next.pk}/review/").json()["adaptation"]
+        self.assertIsNone(adapted["training_refused"])
         self.assertEqual(adapted["project_model"]["version"], 1)
 
     def test_the_project_lists_the_refused_training_with_its_reason(self):

@@ -143,6 +143,23 @@ class PointLibraryTest(BaseTestCase):
         assert sorted(n for n in archive.namelist() if n.endswith(".c3d")) == [
             "hdm05_punch_1200-2400.c3d", "hdm05_walk_0-1200.c3d"]
 
+    def test_the_zip_counts_and_holds_only_the_clips_its_format_writes(self):
+        """Regression: a library of point and rotation takes exported as BVH announced every
+        matching segment (the progress said 4 clips) and wrote 2."""
+        self.login(self.alice)
+        bvh = self.ingest(self.upload(synthetic_bvh(seed=3, duration=20.0), name="walks.bvh").json()["id"])
+        submit_review(bvh, self.bob, [1200], ["walk", "punch"])
+        self.login(self.bob)
+        for fmt, clips in (("bvh", ["walks_punch_1200-2400.bvh", "walks_walk_0-1200.bvh"]),
+                           ("c3d", ["hdm05_punch_1200-2400.c3d", "hdm05_walk_0-1200.c3d"])):
+            response = self.client.get(f"/api/segments/export.zip?file_format={fmt}")
+            assert response["X-Clip-Count"] == "2"
+            archive = zipfile.ZipFile(io.BytesIO(b"".join(response.streaming_content)))
+            assert sorted(n for n in archive.namelist() if n.endswith(f".{fmt}")) == clips
+            assert len(json.loads(archive.read("manifest.json"))) == 2
+            left_out = archive.read("errors.txt").decode()
+            assert left_out.startswith("2 segments are not in this archive: "), left_out
+
     def test_point_segments_have_motion_descriptors_and_similar_segments(self):
         assert all(s.descriptor for s in LibrarySegment.objects.filter(capture=self.capture))
         response = self.client.get(f"/api/segments/{self.segment.pk}/similar/")

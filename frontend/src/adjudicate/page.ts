@@ -8,8 +8,9 @@ import type { Capture, LabelChoice } from "../api/types";
 import { addCut, fromSpans, moveCut, removeCut, sameDraft, segmentAt, setLabel, toSpans, type Draft } from "../library/gold";
 import { topbar } from "../library/nav";
 import type { Adjudication, Span } from "../library/types";
-import { advance, frameOf, seek, togglePlay, type Playback } from "../player/clock";
+import { PlaybackController } from "../player/playback";
 import { SkeletonView } from "../player/skeletonView";
+import { helpOverlay } from "../review/commands";
 import { FrameStore, loadFrames } from "../review/frames";
 import { labelForHotkey, pageCommand } from "../review/keys";
 import type { Command } from "../review/keymap";
@@ -53,10 +54,8 @@ class AdjudicationPage {
   private history: Timeline<Draft>;
   private saved: Draft | null;
   private source: number | null;
-  private playback: Playback;
+  private readonly playback: PlaybackController;
   private selectedCut: number | null = null;
-  private raf = 0;
-  private lastTick = 0;
   private readonly reviews: Review[];
   private readonly labels: LabelChoice[];
   private readonly store: FrameStore;
@@ -82,7 +81,7 @@ class AdjudicationPage {
     this.history = start(gold);
     this.saved = data.gold ? gold : null;
     this.source = data.gold?.source_review ?? null;
-    this.playback = { position: 0, playing: false, speed: 1, fps: capture.fps!, nFrames: capture.n_frames!, loop: null };
+    this.playback = new PlaybackController(capture.fps!, capture.n_frames!, 0, () => this.refresh());
     clear(root, this.layout());
     try {
       this.player = new SkeletonView(this.el.viewport, capture.skeleton!);
@@ -112,7 +111,7 @@ class AdjudicationPage {
 
   dispose(): void {
     this.abort.abort();
-    cancelAnimationFrame(this.raf);
+    this.playback.dispose();
     document.removeEventListener("keydown", this.onKey);
     window.removeEventListener("resize", this.onResize);
     this.player?.dispose();
@@ -127,7 +126,7 @@ class AdjudicationPage {
   }
 
   private frame(): number {
-    return frameOf(this.playback);
+    return this.playback.frame;
   }
 
   // ---- layout --------------------------------------------------------------------------
@@ -304,22 +303,14 @@ class AdjudicationPage {
   // ---- playback and keys ---------------------------------------------------------------
 
   private seekTo(frame: number): void {
-    this.playback = { ...seek(this.playback, Math.min(Math.max(frame, 0), this.n - 1)), playing: this.playback.playing };
+    this.playback.seek(frame);
     this.refresh();
   }
-
-  private tick = (now: number): void => {
-    this.playback = advance(this.playback, (now - this.lastTick) / 1000);
-    this.lastTick = now;
-    this.refresh();
-    if (this.playback.playing) this.raf = requestAnimationFrame(this.tick);
-  };
 
   private toggleHelp(): void {
     const open = document.querySelector(".adj-help");
     if (open) return open.remove();
-    const rows = ADJ_HELP.map(([keys, what]) => h("tr", {}, h("th", {}, h("kbd", {}, keys)), h("td", {}, what)));
-    const box = h("div", { class: "modal-backdrop help adj-help", "data-testid": "help", onclick: () => box.remove() }, h("div", { class: "modal" }, h("h2", {}, "Keyboard"), h("table", { class: "keys" }, ...rows)));
+    const box = helpOverlay(ADJ_HELP, () => box.remove(), "adj-help");
     document.body.append(box);
   }
 
@@ -328,9 +319,7 @@ class AdjudicationPage {
     const all = [...new Set([...this.draft.cuts, ...this.reviews.flatMap((r) => r.cuts)])].sort((a, b) => a - b);
     switch (c.kind) {
       case "play":
-        this.playback = togglePlay(this.playback);
-        this.lastTick = performance.now();
-        if (this.playback.playing) this.raf = requestAnimationFrame(this.tick);
+        this.playback.toggle();
         break;
       case "step":
         return this.seekTo(frame + c.frames);

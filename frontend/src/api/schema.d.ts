@@ -293,6 +293,26 @@ export interface paths {
         patch?: never;
         trace?: never;
     };
+    "/api/captures/{id}/review/redo/": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /**
+         * @description Undo (or, as RedoView, redo) the caller's last step, as the review's log has it:
+         *     undo survives a reload. The answer is the review as restored; the restore is an event.
+         */
+        post: operations["captures_review_redo_create"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
     "/api/captures/{id}/review/segments/{index}/": {
         parameters: {
             query?: never;
@@ -344,6 +364,26 @@ export interface paths {
         patch?: never;
         trace?: never;
     };
+    "/api/captures/{id}/review/undo/": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /**
+         * @description Undo (or, as RedoView, redo) the caller's last step, as the review's log has it:
+         *     undo survives a reload. The answer is the review as restored; the restore is an event.
+         */
+        post: operations["captures_review_undo_create"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
     "/api/captures/{id}/reviews/": {
         parameters: {
             query?: never;
@@ -354,6 +394,43 @@ export interface paths {
         get: operations["captures_reviews_list"];
         put?: never;
         post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/captures/{id}/reviews/{review_id}/events/": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** @description The activity log of one review (its annotator, reviewers, admins). */
+        get: operations["captures_reviews_events_list"];
+        put?: never;
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/captures/{id}/reviews/{review_id}/restore/": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /**
+         * @description Restore the review as it was right after one of its events; the restore is an
+         *     event itself (so it can be undone). A stale ``version`` is refused (409).
+         */
+        post: operations["captures_reviews_restore_create"];
         delete?: never;
         options?: never;
         head?: never;
@@ -872,7 +949,7 @@ export interface components {
             training: boolean;
             /** @description Why the last training failed. */
             training_error: string | null;
-            /** @description Why the model of the last training was refused (the project keeps its model). */
+            /** @description Why the model of the last training was refused (the project keeps its model; null for an annotator). */
             training_refused: string | null;
         };
         Adjudication: {
@@ -1275,6 +1352,8 @@ export interface components {
             projects: components["schemas"]["MyProject"][];
             limits: components["schemas"]["Limits"];
             can_create_accounts: boolean;
+            /** @description A site admin who may see accounts: inviting a name no account has is refused, saying so (to anyone else the answer is the same whether or not the name exists). */
+            can_see_accounts: boolean;
         };
         Member: {
             readonly id: number;
@@ -1533,6 +1612,11 @@ export interface components {
          * @enum {string}
          */
         QueueStateEnum: "assigned" | "in_progress" | "returned" | "submitted";
+        /** @description Restore the review as it was right after its event ``event`` (an id of its log). */
+        RestoreRequest: {
+            version: number;
+            event: number;
+        };
         ReturnRequestRequest: {
             comment: string;
         };
@@ -2293,6 +2377,33 @@ export interface operations {
             };
         };
     };
+    captures_review_redo_create: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path: {
+                id: number;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["VersionRequest"];
+                "application/x-www-form-urlencoded": components["schemas"]["VersionRequest"];
+                "multipart/form-data": components["schemas"]["VersionRequest"];
+            };
+        };
+        responses: {
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["Review"];
+                };
+            };
+        };
+    };
     captures_review_segments_partial_update: {
         parameters: {
             query?: never;
@@ -2369,6 +2480,33 @@ export interface operations {
             };
         };
     };
+    captures_review_undo_create: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path: {
+                id: number;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["VersionRequest"];
+                "application/x-www-form-urlencoded": components["schemas"]["VersionRequest"];
+                "multipart/form-data": components["schemas"]["VersionRequest"];
+            };
+        };
+        responses: {
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["Review"];
+                };
+            };
+        };
+    };
     captures_reviews_list: {
         parameters: {
             query?: never;
@@ -2386,6 +2524,56 @@ export interface operations {
                 };
                 content: {
                     "application/json": components["schemas"]["Review"][];
+                };
+            };
+        };
+    };
+    captures_reviews_events_list: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path: {
+                id: number;
+                review_id: number;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["Event"][];
+                };
+            };
+        };
+    };
+    captures_reviews_restore_create: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path: {
+                id: number;
+                review_id: number;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["RestoreRequest"];
+                "application/x-www-form-urlencoded": components["schemas"]["RestoreRequest"];
+                "multipart/form-data": components["schemas"]["RestoreRequest"];
+            };
+        };
+        responses: {
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["Review"];
                 };
             };
         };

@@ -8,8 +8,9 @@ import { clear, clip, formatDuration, h, toast } from "../ui/dom";
 import { accountLinks, appLinks } from "../ui/appnav";
 import { assignmentBar, teamCell } from "./assign";
 import { invitationsBox } from "./invitations";
+import { newProjectButton } from "./newProject";
 import { navigate } from "../router";
-import { pairFiles, upload, type UploadItem } from "./upload";
+import { CHOOSER_ACCEPT, pairFiles, upload, type UploadItem } from "./upload";
 
 const STATUSES = ["", "queued", "processing", "ready", "failed"];
 
@@ -46,7 +47,7 @@ export async function renderCaptureList(root: HTMLElement): Promise<() => void> 
   const rows = h("tbody", { "data-testid": "capture-rows" });
   const pager = h("div", { class: "pager" });
   const uploads = h("div", { class: "uploads", "data-testid": "uploads" });
-  const fileInput = h("input", { type: "file", multiple: true, accept: ".bvh,.fbx,.amc,.asf,.c3d,.tsv,.csv", hidden: true });
+  const fileInput = h("input", { type: "file", multiple: true, accept: CHOOSER_ACCEPT, hidden: true });
   const projectName = new Map(projects.map((p) => [p.id, p.name]));
   const projectRole = new Map(projects.map((p) => [p.id, p.role]));
 
@@ -66,7 +67,7 @@ export async function renderCaptureList(root: HTMLElement): Promise<() => void> 
   const uploadProject = () => Number(filters.project) || (projects.length === 1 ? projects[0].id : undefined);
   const startUploads = (files: File[]) => {
     const project = uploadProject();
-    if (!projects.length) return toast("Create or join a project before uploading.", "error");
+    if (!projects.length) return toast("Create a project (New project, above) or accept an invitation to one before uploading.", "error");
     if (!project) return toast("Choose the project to upload to in the project filter first.", "error");
     const { items, problems } = pairFiles(files);
     problems.forEach((p) => toast(p, "error"));
@@ -125,6 +126,8 @@ export async function renderCaptureList(root: HTMLElement): Promise<() => void> 
         select("project", [["", "All projects"], ...projects.map((p) => [String(p.id), p.name] as [string, string])]),
         select("status", STATUSES.map((s) => [s, s ? s : "Any status"] as [string, string])),
         search,
+        h("span", { class: "spacer" }),
+        newProjectButton(),
       ),
       dropzone,
       fileInput,

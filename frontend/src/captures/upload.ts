@@ -8,24 +8,32 @@ export interface UploadItem {
   asf: File | null;
 }
 
+/** Files uploaded alone: motion (.bvh, .fbx) and point takes (.c3d, a Qualisys .tsv, a joint
+ * .csv). The upload API takes the same list (FORMATS in segmentation/services/captures.py). */
+export const SINGLE_FILE_SUFFIXES = [".bvh", ".fbx", ".c3d", ".tsv", ".csv"];
+/** What the file chooser offers: the single files, and an .amc with its .asf skeleton. */
+export const CHOOSER_ACCEPT = [...SINGLE_FILE_SUFFIXES, ".amc", ".asf"].join(",");
+
+const suffixOf = (name: string) => name.slice(name.lastIndexOf(".")).toLowerCase();
+
 /**
- * Pair dropped files into uploads: every .bvh and .fbx alone, every .amc with an .asf (the one
- * sharing its subject prefix, e.g. 13_29.amc ↔ 13.asf, else the only one dropped).
- * Returns the uploads and, per file that cannot be uploaded, why.
+ * Pair dropped files into uploads: every .bvh, .fbx and point take alone, every .amc with an
+ * .asf (the one sharing its subject prefix, e.g. 13_29.amc ↔ 13.asf, else the only one
+ * dropped). Returns the uploads and, per file that cannot be uploaded, why.
  */
 export function pairFiles(files: File[]): { items: UploadItem[]; problems: string[] } {
   const asfs = files.filter((f) => /\.asf$/i.test(f.name));
   const items: UploadItem[] = [];
   const problems: string[] = [];
   for (const file of files) {
-    if (/\.(bvh|fbx)$/i.test(file.name)) items.push({ file, asf: null });
+    if (SINGLE_FILE_SUFFIXES.includes(suffixOf(file.name))) items.push({ file, asf: null });
     else if (/\.amc$/i.test(file.name)) {
       const subject = file.name.split(/[_.]/)[0];
       const asf = asfs.find((a) => a.name.replace(/\.asf$/i, "") === subject) ?? (asfs.length === 1 ? asfs[0] : null);
       if (asf) items.push({ file, asf });
       else problems.push(`${file.name}: an .amc needs its skeleton; drop the matching .asf with it.`);
     } else if (!/\.asf$/i.test(file.name)) {
-      problems.push(`${file.name}: not a .bvh, .fbx or .amc file.`);
+      problems.push(`${file.name}: not a take Cutroom reads (.bvh, .fbx, .amc with its .asf, .c3d, .tsv or .csv).`);
     }
   }
   if (asfs.length && !files.some((f) => /\.amc$/i.test(f.name))) problems.push("An .asf alone is only a skeleton; drop it together with its .amc takes.");

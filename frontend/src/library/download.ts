@@ -32,8 +32,17 @@ function progressBox(): HTMLElement {
   return box;
 }
 
-/** Download `url`, showing its progress once it has run for a second (`what` says what it is). */
-export async function downloadWithProgress(url: string, what: string, fallbackName: string): Promise<void> {
+/** "3 clips as glTF" from the zip's X-Clip-Count header (the clips the server writes, not
+ * every segment that matched), or null without one. */
+export function clipsWhat(header: string | null, format: string): string | null {
+  if (header === null || !/^\d+$/.test(header)) return null;
+  const n = Number(header);
+  return `${n} clip${n === 1 ? "" : "s"} as ${format}`;
+}
+
+/** Download `url`, showing its progress once it has run for a second (`what` says what it
+ * is, until `answered` tells it better from the response's headers). */
+export async function downloadWithProgress(url: string, what: string, fallbackName: string, answered?: (response: Response) => string | null): Promise<void> {
   const started = performance.now();
   const bar = h("div", { class: "export-progress-bar" });
   const text = h("span", {}, `Exporting ${what}…`);
@@ -47,6 +56,7 @@ export async function downloadWithProgress(url: string, what: string, fallbackNa
   const timer = window.setInterval(show, PROGRESS_AFTER_MS);
   try {
     const response = await fetch(url, { credentials: "same-origin" });
+    what = (response.ok && answered?.(response)) || what;
     if (!response.ok) {
       const body = (response.headers.get("content-type") ?? "").includes("json") ? await response.json() : await response.text();
       throw new Error(errorText(response.status, body));

@@ -5,7 +5,7 @@ import { get } from "../api/client";
 import type { Me, Page, Project } from "../api/types";
 import type { Member } from "../queue/api";
 import { clear, clip, formatDuration, h, toast } from "../ui/dom";
-import { downloadWithProgress } from "./download";
+import { clipsWhat, downloadWithProgress } from "./download";
 import { topbar } from "./nav";
 import { GlbPreview } from "./gltfPreview";
 import { ClipPreview } from "./preview";
@@ -84,12 +84,12 @@ export async function renderLibrary(root: HTMLElement): Promise<() => void> {
   let filters = libraryFiltersFrom(location.search);
   const rows = h("tbody", { "data-testid": "segment-rows" });
   const pager = h("div", { class: "pager" });
-  let matching = 0;
   const exportZip = h("a", { class: "btn", "data-testid": "export-zip", download: "" }, "Export these as zip");
   exportZip.addEventListener("click", (e) => {
     e.preventDefault();
-    const what = `${matching} clip${matching === 1 ? "" : "s"} as ${zipFormat.selectedOptions[0]?.text ?? zipFormat.value}`;
-    void downloadWithProgress(zipHref(), what, `segments-${zipFormat.value}.zip`);
+    // Only the clips the chosen format writes are counted: the server says how many.
+    const format = zipFormat.selectedOptions[0]?.text ?? zipFormat.value;
+    void downloadWithProgress(zipHref(), `clips as ${format}`, `segments-${zipFormat.value}.zip`, (r) => clipsWhat(r.headers.get("X-Clip-Count"), format));
   });
   const zipFormat = h(
     "select",
@@ -196,7 +196,6 @@ export async function renderLibrary(root: HTMLElement): Promise<() => void> {
     });
     if (!data) return;
     metricHead.textContent = "Agreement";
-    matching = data.count;
     clear(rows, ...data.results.map(row));
     if (!data.results.length) rows.append(h("tr", {}, h("td", { colspan: 7, class: "muted empty" }, "No segments match. Segments appear here when reviews are submitted.")));
     clear(

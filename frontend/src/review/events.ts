@@ -9,6 +9,7 @@ export function eventDetail(e: Pick<ReviewEvent, "action" | "before" | "after">)
   if (e.action === "create") return `${after.candidates ?? 0} candidates`;
   // A review opened before detection finished takes the run's candidates in afterwards.
   if (e.action === "candidates") return `${after.candidates ?? 0} candidates arrived`;
+  if (e.action === "restore") return restoreDetail(after);
   if ("index" in after || "index" in before) {
     const index = Number(after.index ?? before.index);
     return `segment ${index + 1}: ${before.label ?? "—"} → ${after.label ?? "—"}`;
@@ -19,4 +20,12 @@ export function eventDetail(e: Pick<ReviewEvent, "action" | "before" | "after">)
   }
   if (after.frame !== undefined) return `frame ${after.frame}: ${before.fate ?? "—"} → ${after.fate}`;
   return "";
+}
+
+/** "as at 10:42:07 · 3 changes", or for an undo/redo "3 changes". */
+function restoreDetail(after: Record<string, unknown>): string {
+  const n = ((after.cuts as unknown[] | undefined)?.length ?? 0) + ((after.labels as unknown[] | undefined)?.length ?? 0);
+  const changes = `${n} change${n === 1 ? "" : "s"}`;
+  if (after.intent || typeof after.at !== "string") return changes;
+  return `as at ${new Date(after.at).toLocaleTimeString()} · ${changes}`;
 }

@@ -1,105 +1,64 @@
-// Undo/redo over server-side edits. A history step remembers the state of one cut (or one
-// segment's label) before and after; undoing computes, against the review as it is *now*,
-// the API edits that bring it back. An inserted cut is "undone" by deleting it and "redone"
-// by restoring it, so ids stay stable and no step ever refers to a cut that vanished.
+// Undo/redo as the server keeps them. The review's audit log is its history: an edit (or a
+// restore from the activity log) is a step; undo and redo are restores the server makes
+// (POST …/review/undo/, …/redo/), logged with their intent, so the stacks read from the
+// log after a reload are the ones the page had (segmentation/services/history.py reads
+// them the same way). Between two reads of the log the page keeps the stacks itself:
+// only step titles, for the buttons and the toasts.
 
-import type { Fate, Review } from "../api/types";
-import { EditError, movedFate, type Edit } from "./state";
-
-export interface CutState {
-  fate: Fate;
-  frame: number;
-}
-
-export type Change =
-  | { kind: "cut"; title: string; cutId: number; before: CutState; after: CutState }
-  | { kind: "label"; title: string; start: number; stop: number; before: string | null; after: string | null };
+import type { Review, ReviewEvent } from "../api/types";
+import { eventDetail } from "./events";
+import { EditError, type Edit } from "./state";
 
 export interface History {
-  past: Change[];
-  future: Change[];
+  /** Titles of the steps undo would take back, the next one last. */
+  past: string[];
+  /** Titles of the undone steps redo would make again, the next one last. */
+  future: string[];
 }
+
+/** Events that change cuts or labels: the steps of the history. */
+const STEP_ACTIONS = new Set(["insert", "accept", "delete", "reset", "move", "label", "restore"]);
 
 export const emptyHistory = (): History => ({ past: [], future: [] });
 
-export function record(history: History, change: Change, limit = 500): History {
-  return { past: [...history.past, change].slice(-limit), future: [] };
+export function record(history: History, title: string, limit = 500): History {
+  return { past: [...history.past, title].slice(-limit), future: [] };
 }
 
-/** Describe what `edit` will change, measured on the review before it is applied. */
-export function changeFor(review: Review, edit: Edit): Change {
-  if (edit.kind === "label") {
-    const segment = review.segments.find((s) => s.start === edit.start && s.stop === edit.stop);
-    return {
-      kind: "label", title: edit.label ? `label ${edit.label}` : "clear label",
-      start: edit.start, stop: edit.stop, before: segment?.label ?? null, after: edit.label,
-    };
+/** The history after an undo (`which` "undo") or a redo, with the title of that step. */
+export function stepped(history: History, which: "undo" | "redo"): { history: History; title: string } | null {
+  const [from, to] = which === "undo" ? [history.past, history.future] : [history.future, history.past];
+  const title = from[from.length - 1];
+  if (title === undefined) return null;
+  const moved = { from: from.slice(0, -1), to: [...to, title] };
+  return { history: which === "undo" ? { past: moved.from, future: moved.to } : { past: moved.to, future: moved.from }, title };
+}
+
+/** The undo and redo stacks as the review's log (oldest event first) leaves them. */
+export function historyFromEvents(events: readonly ReviewEvent[]): History {
+  let history = emptyHistory();
+  for (const e of events) {
+    const intent = e.action === "restore" ? ((e.after ?? {}) as { intent?: string | null }).intent ?? null : null;
+    if (intent === "undo" || intent === "redo") history = stepped(history, intent)?.history ?? history;
+    else if (STEP_ACTIONS.has(e.action)) history = record(history, eventTitle(e));
   }
-  if (edit.kind === "insert") {
-    return {
-      kind: "cut", title: `insert cut at ${edit.frame}`, cutId: edit.tempId,
-      before: { fate: "deleted", frame: edit.frame }, after: { fate: "accepted", frame: edit.frame },
-    };
-  }
+  return history;
+}
+
+function eventTitle(e: ReviewEvent): string {
+  const detail = eventDetail(e);
+  return detail ? `${e.action} ${detail}` : e.action;
+}
+
+/** What `edit` does in words, measured on the review before it is applied. */
+export function editTitle(review: Review, edit: Edit): string {
+  if (edit.kind === "label") return edit.label ? `label ${edit.label}` : "clear label";
+  if (edit.kind === "insert") return `insert cut at ${edit.frame}`;
+  if (edit.kind === "undo" || edit.kind === "redo") return edit.kind;
+  if (edit.kind === "restore") return "restore an earlier point";
   const cut = review.cuts.find((c) => c.id === edit.cutId);
   if (!cut) throw new EditError(`Cut ${edit.cutId} is not in this review.`);
-  const before = { fate: cut.fate, frame: cut.frame };
-  if (edit.kind === "move") {
-    return { kind: "cut", title: `move cut ${cut.frame} → ${edit.frame}`, cutId: cut.id, before, after: { fate: movedFate(cut), frame: edit.frame } };
-  }
+  if (edit.kind === "move") return `move cut ${cut.frame} → ${edit.frame}`;
   const verb = { accepted: "accept", deleted: "delete", pending: cut.fate === "deleted" ? "restore" : "reset" }[edit.fate];
-  return { kind: "cut", title: `${verb} cut at ${cut.frame}`, cutId: cut.id, before, after: { fate: edit.fate, frame: cut.frame } };
-}
-
-/**
- * The API edits that take a cut from `current` to `target`. A move makes the server mark
- * the cut "moved", so a target fate of pending/accepted is set again after moving back;
- * "moved" itself cannot be asked for, only reached by moving.
- */
-export function transitionEdits(cutId: number, current: CutState, target: CutState, origin: "candidate" | "inserted" = "candidate"): Edit[] {
-  if (target.fate === "deleted") {
-    return current.fate === "deleted" ? [] : [{ kind: "fate", cutId, fate: "deleted" }];
-  }
-  const edits: Edit[] = [];
-  let fate = current.fate;
-  if (fate === "deleted") {
-    fate = target.fate === "moved" ? "accepted" : target.fate;
-    edits.push({ kind: "fate", cutId, fate });
-  }
-  if (current.frame !== target.frame) {
-    edits.push({ kind: "move", cutId, frame: target.frame });
-    fate = movedFate({ origin });
-  }
-  if (target.fate !== "moved" && fate !== target.fate) {
-    edits.push({ kind: "fate", cutId, fate: target.fate });
-  }
-  return edits;
-}
-
-/** Edits that bring `review` to one side of `change`; throws if the review moved on. */
-export function editsToward(review: Review, change: Change, side: "before" | "after", resolveId: (id: number) => number): Edit[] {
-  if (change.kind === "label") {
-    const segment = review.segments.find((s) => s.start === change.start && s.stop === change.stop);
-    if (!segment) throw new EditError(`Segment ${change.start}–${change.stop} no longer exists, so "${change.title}" cannot be reversed.`);
-    const label = change[side];
-    return segment.label === label ? [] : [{ kind: "label", start: change.start, stop: change.stop, label }];
-  }
-  const id = resolveId(change.cutId);
-  const cut = review.cuts.find((c) => c.id === id);
-  if (!cut) throw new EditError(`The cut of "${change.title}" is not in this review any more.`);
-  return transitionEdits(cut.id, { fate: cut.fate, frame: cut.frame }, change[side], cut.origin);
-}
-
-export function undo(history: History, review: Review, resolveId: (id: number) => number): { history: History; edits: Edit[]; change: Change } | null {
-  const change = history.past[history.past.length - 1];
-  if (!change) return null;
-  const edits = editsToward(review, change, "before", resolveId);
-  return { history: { past: history.past.slice(0, -1), future: [...history.future, change] }, edits, change };
-}
-
-export function redo(history: History, review: Review, resolveId: (id: number) => number): { history: History; edits: Edit[]; change: Change } | null {
-  const change = history.future[history.future.length - 1];
-  if (!change) return null;
-  const edits = editsToward(review, change, "after", resolveId);
-  return { history: { past: [...history.past, change], future: history.future.slice(0, -1) }, edits, change };
+  return `${verb} cut at ${cut.frame}`;
 }

@@ -5,6 +5,11 @@ export type Command =
   | { kind: "play" }
   | { kind: "step"; frames: number }
   | { kind: "jump"; direction: -1 | 1 }
+  | { kind: "nudge"; frames: number }
+  | { kind: "pending"; direction: -1 | 1 }
+  | { kind: "unlabelled"; direction: -1 | 1 }
+  | { kind: "restore" }
+  | { kind: "goto" }
   | { kind: "accept" }
   | { kind: "delete" }
   | { kind: "insert" }
@@ -35,12 +40,22 @@ export function commandFor(e: KeyInput): Command | null {
   const key = e.key.length === 1 ? e.key.toLowerCase() : e.key;
   if (mod && key === "z") return e.shiftKey ? { kind: "redo" } : { kind: "undo" };
   if (mod && key === "y") return { kind: "redo" };
-  if (mod || e.altKey) return null;
+  if (mod) return null;
+  if (e.altKey) return nudgeFor(key, e.shiftKey);
   if (key === "ArrowLeft") return e.shiftKey ? { kind: "jump", direction: -1 } : { kind: "step", frames: -1 };
   if (key === "ArrowRight") return e.shiftKey ? { kind: "jump", direction: 1 } : { kind: "step", frames: 1 };
   if (/^[1-9]$/.test(key)) return { kind: "label", hotkey: key };
   if (key === "0" || key === "Backspace") return { kind: "clearLabel" };
   return SIMPLE[e.shiftKey ? `shift+${key}` : key] ?? SIMPLE[key] ?? null;
+}
+
+/** Frames a cut moves with Alt+Shift+←/→: the same step as "," and ".". */
+export const NUDGE_STEP = 10;
+
+/** Alt+←/→ nudge the selected cut by a frame, Alt+Shift+←/→ by a step; other Alt keys are the browser's. */
+function nudgeFor(key: string, shift: boolean): Command | null {
+  const sign = key === "ArrowLeft" ? -1 : key === "ArrowRight" ? 1 : 0;
+  return sign ? { kind: "nudge", frames: sign * (shift ? NUDGE_STEP : 1) } : null;
 }
 
 const SIMPLE: Record<string, Command> = {
@@ -59,8 +74,14 @@ const SIMPLE: Record<string, Command> = {
   "=": { kind: "zoom", factor: 1 / 1.5 },
   "+": { kind: "zoom", factor: 1 / 1.5 },
   "-": { kind: "zoom", factor: 1.5 },
-  ",": { kind: "step", frames: -10 },
-  ".": { kind: "step", frames: 10 },
+  ",": { kind: "step", frames: -NUDGE_STEP },
+  ".": { kind: "step", frames: NUDGE_STEP },
+  n: { kind: "pending", direction: 1 },
+  "shift+n": { kind: "pending", direction: -1 },
+  u: { kind: "unlabelled", direction: 1 },
+  "shift+u": { kind: "unlabelled", direction: -1 },
+  r: { kind: "restore" },
+  g: { kind: "goto" },
   Home: { kind: "home" },
   End: { kind: "end" },
   "?": { kind: "help" },
@@ -74,9 +95,15 @@ export const HELP: [string, string][] = [
   [", / .", "10 frames back / forward"],
   ["Shift + ← / →", "jump to previous / next cut"],
   ["Home / End", "first / last frame"],
+  ["N / Shift+N", "next / previous pending candidate (selects it)"],
+  ["U / Shift+U", "next / previous unlabelled segment"],
+  ["G", "go to a frame or a timecode (HH:MM:SS:FF), typed"],
+  ["Alt + ← / →", "nudge the selected cut one frame earlier / later"],
+  ["Alt + Shift + ← / →", `nudge the selected cut ${NUDGE_STEP} frames`],
   ["A", "accept the selected candidate"],
   ["D or Delete", "delete the selected cut"],
   ["I", "insert a cut at the playhead"],
+  ["R", "restore the deleted candidate nearest the playhead"],
   ["1 – 9", "label the segment under the playhead"],
   ["0 or Backspace", "clear that segment's label"],
   ["S", "accept that segment's suggested label"],

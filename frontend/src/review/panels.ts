@@ -75,18 +75,38 @@ export function renderStats(el: HTMLElement, review: Review): void {
   );
 }
 
-/** The audit log, newest first. */
-export function renderEvents(el: HTMLElement, events: ReviewEvent[]): void {
+/**
+ * The audit log, newest first. With `restore`, every entry but the newest offers to bring
+ * the review back to how it was right after that entry.
+ */
+export function renderEvents(el: HTMLElement, events: ReviewEvent[], restore?: (e: ReviewEvent) => void): void {
+  const newest = events[events.length - 1];
   const item = (e: ReviewEvent) =>
     h(
       "li",
-      { "data-action": e.action },
-      h("span", { class: "ev-action" }, e.action.replace(/_/g, " ")),
+      { "data-action": e.action, "data-event": String(e.id) },
+      h("span", { class: "ev-action" }, actionText(e)),
       h("span", { class: "ev-detail", title: eventDetail(e) }, eventDetail(e)),
       h("time", { datetime: e.created_at, title: e.created_at }, new Date(e.created_at).toLocaleTimeString()),
+      restore && e !== newest
+        ? h("button", {
+            class: "btn btn-ghost ev-restore", "data-testid": `restore-event-${e.id}`, "aria-label": "Restore",
+            title: "Restore the review as it was right after this entry (the restore is an entry too: undo takes it back)",
+            onclick: (ev: Event) => {
+              (ev.currentTarget as HTMLElement).blur();
+              restore(e);
+            },
+          }, "↺")
+        : null,
     );
   clear(el, ...events.slice().reverse().map(item));
   if (!events.length) el.append(h("li", { class: "muted" }, "No edits yet."));
+}
+
+/** An entry's action in words: a restore the server made for undo or redo says so. */
+function actionText(e: ReviewEvent): string {
+  const intent = e.action === "restore" ? (e.after as { intent?: string | null } | null)?.intent : null;
+  return intent ?? e.action.replace(/_/g, " ");
 }
 
 const takes = (n: number) => `${n} reviewed take${n === 1 ? "" : "s"}`;
@@ -94,10 +114,11 @@ const takes = (n: number) => `${n} reviewed take${n === 1 ? "" : "s"}`;
 /**
  * Where the candidates came from — "adapted from 12 reviewed takes" or "not adapted yet" —
  * that model's own figure on held-out reviewed takes, then the project's newer model, a
- * training under way, or why the last one failed or its model was refused.
+ * training under way or why its model was refused (news: the server tells reviewers and
+ * admins only), and apart, as a failure, why the last training failed.
  */
-export function adaptationLines(a: Adaptation | undefined): { line: string; figure: string; notes: string[] } {
-  if (!a) return { line: "", figure: "", notes: [] };
+export function adaptationLines(a: Adaptation | undefined): { line: string; figure: string; notes: string[]; failure: string } {
+  if (!a) return { line: "", figure: "", notes: [], failure: "" };
   const adapted = a.model_version !== null && a.n_takes !== null;
   const line = adapted ? `Candidates adapted from ${takes(a.n_takes!)} (model v${a.model_version}).` : "Candidates not adapted yet (zero-shot detector).";
   const figure = adapted && a.held_out ? `Learnt from ${takes(a.n_takes!)}; ${heldOut(a.held_out)}.` : "";
@@ -108,9 +129,9 @@ export function adaptationLines(a: Adaptation | undefined): { line: string; figu
   }
   if (a.training) notes.push("Retraining on the newest reviews…");
   const kept = project ? `model v${project.version}` : "the zero-shot detector";
-  if (a.training_error) notes.push(`Last retraining failed: ${a.training_error} The project keeps ${kept}.`);
   if (a.training_refused) notes.push(`Last retraining ${a.training_refused}. The project keeps ${kept}.`);
-  return { line, figure, notes };
+  const failure = a.training_error ? `Last retraining failed: ${a.training_error} The project keeps ${kept}.` : "";
+  return { line, figure, notes, failure };
 }
 
 /** "on 5 held-out reviewed takes 0.30 edits per cut, F1 0.91" */
@@ -119,11 +140,12 @@ function heldOut(h: HeldOut): string {
 }
 
 export function renderAdaptation(el: HTMLElement, a: Adaptation | undefined): void {
-  const { line, figure, notes } = adaptationLines(a);
+  const { line, figure, notes, failure } = adaptationLines(a);
   clear(
     el,
     line ? h("div", { "data-testid": "adaptation-line" }, line) : null,
     figure ? h("div", { class: "muted small", "data-testid": "adaptation-figure" }, figure) : null,
-    ...notes.map((note) => h("div", { class: note.startsWith("Last retraining") ? "error-text small" : "muted small", "data-testid": "adaptation-note" }, note)),
+    ...notes.map((note) => h("div", { class: "muted small", "data-testid": "adaptation-note" }, note)),
+    failure ? h("div", { class: "error-text small", "data-testid": "adaptation-failure" }, failure) : null,
   );
 }

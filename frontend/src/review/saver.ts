@@ -2,7 +2,7 @@
 // server last returned. Edits are never merged or retried blindly: on a 409 the queue is
 // dropped, the caller is told which edits were not saved, and the server's review wins.
 
-import { api, ApiError, get } from "../api/client";
+import { api, ApiError } from "../api/client";
 import type { Review } from "../api/types";
 import { editRequest, findInsertedId, labelRequest, startedIds, type Edit } from "./state";
 
@@ -21,6 +21,9 @@ export interface SaverEvents {
   busy(pending: number): void;
 }
 
+/** How the saver reaches the server: the API client, or a stand-in server in unit tests. */
+export type Send = <T>(method: string, url: string, body?: unknown) => Promise<T>;
+
 export class Saver {
   private queue: { edit: Edit; title: string }[] = [];
   private running = false;
@@ -30,6 +33,7 @@ export class Saver {
     private readonly captureId: number,
     public server: Review,
     private readonly events: SaverEvents,
+    private readonly send: Send = api,
   ) {}
 
   get pending(): number {
@@ -54,8 +58,8 @@ export class Saver {
         const request =
           edit.kind === "label"
             ? labelRequest(this.captureId, this.server, edit, this.server.version)
-            : editRequest(this.captureId, edit, this.server.version, this.resolve);
-        const next = await api<Review>(request.method, request.url, request.body);
+            : editRequest(this.captureId, edit, this.server.version, this.resolve, this.server.id);
+        const next = await this.send<Review>(request.method, request.url, request.body);
         const renamed = new Map<number, number>();
         if (edit.kind === "insert") {
           const id = findInsertedId(this.server, next, edit.frame);
@@ -77,7 +81,7 @@ export class Saver {
 
   /** The first save starts the review (reading it did not); its candidates get real ids. */
   private async start(): Promise<void> {
-    const started = await api<Review>("POST", `/api/captures/${this.captureId}/review/`);
+    const started = await this.send<Review>("POST", `/api/captures/${this.captureId}/review/`);
     const renamed = startedIds(this.server, started);
     for (const [temp, id] of renamed) this.ids.set(temp, id);
     this.events.saved(started, false, renamed);
@@ -102,7 +106,7 @@ export class Saver {
       return;
     }
     try {
-      this.server = await get<Review>(`/api/captures/${this.captureId}/review/`);
+      this.server = await this.send<Review>("GET", `/api/captures/${this.captureId}/review/`);
       this.events.failed(this.server, unsaved, message);
     } catch {
       this.events.failed(null, unsaved, message);

@@ -8,7 +8,15 @@ export type Edit =
   | { kind: "fate"; cutId: number; fate: "accepted" | "deleted" | "pending" }
   | { kind: "move"; cutId: number; frame: number }
   | { kind: "insert"; frame: number; tempId: number }
-  | { kind: "label"; start: number; stop: number; label: string | null };
+  | { kind: "label"; start: number; stop: number; label: string | null }
+  // Made by the server from the review's log (history.ts): the page cannot predict them.
+  | { kind: "undo" }
+  | { kind: "redo" }
+  | { kind: "restore"; event: number };
+
+/** Edits whose result only the server knows: the page shows its answer. */
+export const isServerEdit = (edit: Edit): edit is Extract<Edit, { kind: "undo" | "redo" | "restore" }> =>
+  edit.kind === "undo" || edit.kind === "redo" || edit.kind === "restore";
 
 export class EditError extends Error {}
 
@@ -59,6 +67,24 @@ export function neighbourCut(cuts: readonly Cut[], frame: number, direction: -1 
   return [...sorted].reverse().find((c) => c.frame < frame);
 }
 
+/** The nearest pending candidate strictly before (-1) or after (+1) `frame`. */
+export function neighbourPending(cuts: readonly Cut[], frame: number, direction: -1 | 1): Cut | undefined {
+  return neighbourCut(cuts.filter((c) => c.fate === "pending"), frame, direction);
+}
+
+/** The nearest unlabelled segment starting strictly before (-1) or after (+1) `frame`. */
+export function neighbourUnlabelled(segments: readonly Segment[], frame: number, direction: -1 | 1): Segment | undefined {
+  const open = segments.filter((s) => !s.label);
+  if (direction > 0) return open.find((s) => s.start > frame);
+  return [...open].reverse().find((s) => s.start < frame);
+}
+
+/** The deleted candidate nearest `frame` (either side; the earlier one on a tie). */
+export function nearestDeleted(cuts: readonly Cut[], frame: number): Cut | undefined {
+  const deleted = cuts.filter((c) => c.fate === "deleted" && c.origin === "candidate");
+  return deleted.sort((a, b) => Math.abs(a.frame - frame) - Math.abs(b.frame - frame) || a.frame - b.frame)[0];
+}
+
 /**
  * An unstarted review (id null: reading never creates one) with temporary negative ids
  * on its candidate cuts, so they can be selected and edited before the first save
@@ -82,6 +108,7 @@ export function startedIds(unstarted: Review, started: Review): Map<number, numb
 
 /** Predict the server's answer to `edit`; throws `EditError` for an edit it would refuse. */
 export function applyEdit(review: Review, edit: Edit, nFrames: number): Review {
+  if (isServerEdit(edit)) return review;
   const cuts = review.cuts.map((c) => ({ ...c }));
   if (edit.kind === "label") {
     const segments = review.segments.map((s) =>
@@ -144,10 +171,18 @@ export interface Request {
   body: Record<string, unknown>;
 }
 
-/** The API call for `edit` (docs/api.md, "Reviews"); `resolveId` maps local ids to server ids. */
-export function editRequest(captureId: number, edit: Edit, version: number, resolveId: (id: number) => number): Request {
+/**
+ * The API call for `edit` (docs/api.md, "Reviews"); `resolveId` maps local ids to server
+ * ids, `reviewId` is the started review's id (a restore names it).
+ */
+export function editRequest(captureId: number, edit: Edit, version: number, resolveId: (id: number) => number, reviewId: number | null = null): Request {
   const base = `/api/captures/${captureId}/review`;
   switch (edit.kind) {
+    case "undo":
+    case "redo":
+      return { method: "POST", url: `${base}/${edit.kind}/`, body: { version } };
+    case "restore":
+      return { method: "POST", url: `/api/captures/${captureId}/reviews/${reviewId}/restore/`, body: { event: edit.event, version } };
     case "insert":
       return { method: "POST", url: `${base}/cuts/`, body: { frame: edit.frame, version } };
     case "fate":

@@ -155,7 +155,7 @@ export async function renderTeam(root: HTMLElement, projectId: number): Promise<
           "section",
           { class: "team-section" },
           h("h2", {}, "Add people"),
-          h("p", { class: "muted" }, "An existing user is invited and joins once they accept; the answer is the same whether or not the name exists."),
+          h("p", { class: "muted", "data-testid": "invite-note" }, inviteNote(me.can_see_accounts)),
           userForm("invite-form", "Invite", invite),
           h("h3", {}, "Pending invitations"),
           invitations,
@@ -171,9 +171,17 @@ export async function renderTeam(root: HTMLElement, projectId: number): Promise<
   return () => {};
 }
 
+/** What the invite form promises: to a site admin (who may see accounts) that a name no
+ * account has is refused; to anyone else, the same answer whether or not it exists. */
+export function inviteNote(canSeeAccounts: boolean): string {
+  return canSeeAccounts
+    ? "An existing user is invited and joins once they accept. As a site admin you are told when no account has the name."
+    : "An existing user is invited and joins once they accept; the answer is the same whether or not the name exists.";
+}
+
 function oneTimePassword(title: string, password: string): Promise<void> {
   return dialog(title, [
-    h("p", {}, "Give this one-time password to the person; it is shown only now. They should change it after signing in, with the Password button at the top of any page."),
+    h("p", {}, "Give this one-time password to the person; it is shown only now. At their first sign-in with it they choose their own password."),
     h("pre", { class: "one-time-password", "data-testid": "one-time-password" }, password),
   ], "I have noted it");
 }

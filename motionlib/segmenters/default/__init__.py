@@ -20,8 +20,21 @@ is a pipeline of three public steps, each a function of the one before:
 
 ``Default`` runs the three steps as a registered segmenter; a variant is a subclass that
 overrides a step or the hook ``window_peaks`` (the peaks before the short-activity step).
-``candidates`` lists every peak any prominence would keep, for adapting the count to a
-studio's cuts (``motionlib.adapt``). Every other name lives in a private stage module.
+
+The learner (``motionlib.adapt``) describes a take by many more candidate cuts than the
+detector keeps, and reads them through three more public steps, never a stage module:
+
+- ``candidates(analysis, peaks, p)``: every peak any prominence would keep, and its
+  prominence (what format-1 models choose a count among);
+- ``peak_support(analysis, samples) -> (n,)``: the support test's evidence at any novelty
+  samples (how much of each side the other lacks; inf near an end of the take);
+- ``place_samples(analysis, samples, p, only=None) -> {step: (n,) frames}``: every
+  placement step's estimate of a cut at any novelty samples, bounded by their neighbours
+  as ``place`` bounds the detector's cuts.
+
+Every other name lives in a private stage module, and the stage modules import each
+other in one direction: features and novelty, then ``_placement``, ``_analysis``,
+``_unmatched``, ``_peaks``.
 All durations are in seconds, so the same defaults work at any frame rate. How every
 setting was chosen, and the designs tried and not kept, are in ``docs/detector/``.
 """
@@ -36,12 +49,18 @@ from motionlib.segmenters.base import Param, Segmentation, Segmenter
 from motionlib.segmenters.default import _analysis, _peaks, _placement, _unmatched
 from motionlib.segmenters.default._analysis import MAX_WINDOW_SAMPLES, Analysis
 from motionlib.segmenters.default._features import take_features
-from motionlib.segmenters.default._peaks import Peaks, candidates
-from motionlib.segmenters.default._placement import PLACEMENTS, Placement, shipped_stage
+from motionlib.segmenters.default._peaks import Peaks, candidates, peak_support
+from motionlib.segmenters.default._placement import (
+    PLACEMENTS,
+    Placement,
+    place_samples,
+    shipped_stage,
+)
 
 __all__ = [
     "MAX_WINDOW_SAMPLES", "PLACEMENTS", "Analysis", "Default", "Peaks", "Placement",
-    "analyse", "candidates", "peaks", "place", "shipped_stage", "take_features",
+    "analyse", "candidates", "peak_support", "peaks", "place", "place_samples",
+    "shipped_stage", "take_features",
 ]
 
 

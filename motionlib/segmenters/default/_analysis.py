@@ -5,8 +5,9 @@ its width from the median heuristic (``bandwidth`` times the median squared dist
 between blocks), serves detection and placement; the novelty is the mean MMD² over three
 windows evenly spread from ``scale_min_s`` to ``scale_max_s`` (a window must span several
 repetitions of a periodic activity, about 1 Hz for most exercises, so that the poses of
-one activity look alike from window to window). An ``Analysis`` also computes, once
-each, the curves the later stages read.
+one activity look alike from window to window). An ``Analysis`` also keeps, computed
+once each, the curves the later stages read (``once``); the stages compute them, so that
+this module imports none of theirs.
 """
 
 from __future__ import annotations
@@ -19,9 +20,7 @@ import numpy as np
 from motionlib.segmenters.base import ParamError, Segmentation, full_length
 from motionlib.segmenters.default._features import block_mean, median_sq_distance, take_features
 from motionlib.segmenters.default._novelty import mirrored_novelties, window_widths
-from motionlib.segmenters.default._peaks import cross_support
 from motionlib.segmenters.default._placement import pose_speeds
-from motionlib.segmenters.default._unmatched import unmatched_poses
 
 # Poses in the longest comparison window (rate_hz * scale_max_s); the cost of a take
 # grows with its square.
@@ -54,9 +53,18 @@ class Analysis:
     gamma: float
     novelty: np.ndarray
     timings: dict[str, float]
-    # Curves of the pose blocks and kernel, computed once; none depends on the novelty
-    # windows, so ``with_windows`` shares them.
+    # Curves of the pose blocks and kernel, computed once (``once``); none depends on the
+    # novelty windows, so ``with_windows`` shares them.
     _short: dict = field(default_factory=dict, repr=False)
+
+    def once(self, key, compute):
+        """``compute()``, computed the first time ``key`` is asked for and kept: for what
+        the later stages read of the pose blocks and kernel (unmatched poses, each peak's
+        support), which no novelty window changes, so the copies ``with_windows`` makes
+        share it."""
+        if key not in self._short:
+            self._short[key] = compute()
+        return self._short[key]
 
     @property
     def rate(self) -> float:
@@ -78,24 +86,6 @@ class Analysis:
             self._short[w] = mirrored_novelties(blocks, [w], self.gamma)[0] \
                 if len(blocks) >= 4 else np.zeros(len(blocks))
         return self._short[w]
-
-    def unmatched(self, nearest_s: float) -> np.ndarray:
-        """(n // step,) ``unmatched_poses`` of the novelty blocks (computed once)."""
-        key = ("unmatched", nearest_s)
-        if key not in self._short:
-            self._short[key] = unmatched_poses(self.blocks, self.rate, self.gamma, nearest_s)
-        return self._short[key]
-
-    def supported(self, peaks: np.ndarray, level: float) -> np.ndarray:
-        """(len(peaks),) bool: the peaks whose ``cross_support`` reaches ``level`` (each
-        peak's computed once)."""
-        known = self._short.setdefault("support", {})
-        peaks = np.asarray(peaks).tolist()
-        new = [k for k in dict.fromkeys(peaks) if k not in known]
-        if new:
-            known.update(zip(new, cross_support(self.blocks, np.asarray(new), self.rate,
-                                                self.gamma).tolist(), strict=True))
-        return np.asarray([known[k] >= level for k in peaks], dtype=bool)
 
     @property
     def speeds(self) -> tuple[np.ndarray, np.ndarray]:

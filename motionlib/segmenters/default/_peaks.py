@@ -13,12 +13,12 @@ does. ``docs/detector/support.md`` says how its level and windows were chosen.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
 
 import numpy as np
 from scipy.signal import find_peaks
 from scipy.spatial.distance import cdist
 
+from motionlib.segmenters.default._analysis import Analysis
 from motionlib.segmenters.default._unmatched import (
     UNMATCHED_HALF_S,
     UNMATCHED_RELATIVE,
@@ -26,9 +26,6 @@ from motionlib.segmenters.default._unmatched import (
     unmatched_peaks,
     unmatched_sides,
 )
-
-if TYPE_CHECKING:
-    from motionlib.segmenters.default._analysis import Analysis
 
 
 @dataclass(frozen=True)
@@ -130,6 +127,18 @@ def cross_support(blocks: np.ndarray, peaks: np.ndarray, rate: float, gamma: flo
     return out
 
 
+def peak_support(analysis: Analysis, peaks: np.ndarray) -> np.ndarray:
+    """(len(peaks),) ``cross_support`` of each novelty sample of ``analysis`` (each
+    sample's computed once: the support test and the learner's evidence read the same)."""
+    known = analysis.once("support", dict)
+    peaks = np.asarray(peaks).tolist()
+    new = [k for k in dict.fromkeys(peaks) if k not in known]
+    if new:
+        known.update(zip(new, cross_support(analysis.blocks, np.asarray(new), analysis.rate,
+                                            analysis.gamma).tolist(), strict=True))
+    return np.asarray([known[k] for k in peaks], dtype=float)
+
+
 def supported_peaks(analysis: Analysis, peaks: np.ndarray, p: dict,
                     short: dict | None = None) -> np.ndarray:
     """(len(peaks),) bool: the peaks the support test keeps (all of them with
@@ -140,7 +149,7 @@ def supported_peaks(analysis: Analysis, peaks: np.ndarray, p: dict,
     across."""
     if p["support"] <= 0:
         return np.ones(len(peaks), dtype=bool)
-    keep = analysis.supported(peaks, p["support"])
+    keep = peak_support(analysis, peaks) >= p["support"]
     if not keep.all():
         short = unmatched_sides(analysis, peaks, p) if short is None else short
         keep |= np.isin(peaks, list(short))

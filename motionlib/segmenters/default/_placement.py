@@ -238,7 +238,16 @@ class Placement:
 
 def place(analysis, found, p: dict) -> Placement:
     """Each placement step's estimate of every cut of ``found`` (a ``Peaks``)."""
-    speeds = analysis.speeds
-    stages, speed = place_stages(analysis.x, analysis.peak_frames(found.samples), analysis.fps,
-                                 analysis.gamma, p, speeds)
-    return Placement(stages, shipped_stage(p), speed, speed_minima(speeds[1]))
+    speed, fine = analysis.speeds
+    stages = place_samples(analysis, found.samples, p)
+    return Placement(stages, shipped_stage(p), speed, speed_minima(fine))
+
+
+def place_samples(analysis, samples: np.ndarray, p: dict,
+                  only: np.ndarray | None = None) -> dict[str, np.ndarray]:
+    """Each placement step's estimate (frames of ``analysis.x``) of a cut at each of the
+    novelty ``samples`` (increasing), each bounded half-way to its neighbours as
+    ``place`` bounds the detector's cuts; with ``only`` ((n,) bool), the others are
+    neighbours only and keep their own frame (``place_stages``)."""
+    return place_stages(analysis.x, analysis.peak_frames(samples), analysis.fps,
+                        analysis.gamma, p, analysis.speeds, only=only)[0]

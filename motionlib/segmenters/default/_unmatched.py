@@ -14,12 +14,9 @@ says how the constants were chosen.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
 import numpy as np
 
-if TYPE_CHECKING:
-    from motionlib.segmenters.default._analysis import Analysis
+from motionlib.segmenters.default._analysis import Analysis
 
 # How far around a pose (s) its look-alikes are sought, the stretch (s) whose
 # poses must all be unmatched, how far from a kept peak (s) that stretch may lie, and
@@ -58,6 +55,13 @@ def unmatched_poses(blocks: np.ndarray, rate: float, gamma: float, nearest_s: fl
         np.minimum(out[:-lag], d, out=out[:-lag])
     out[~np.isfinite(out)] = 0.0
     return gamma * out
+
+
+def unmatched_of(analysis: Analysis, nearest_s: float) -> np.ndarray:
+    """(n // step,) ``unmatched_poses`` of the novelty blocks of ``analysis`` (computed
+    once per ``nearest_s``)."""
+    return analysis.once(("unmatched", nearest_s), lambda: unmatched_poses(
+        analysis.blocks, analysis.rate, analysis.gamma, nearest_s))
 
 
 def unmatched_peaks(analysis: Analysis, peaks: np.ndarray, strength: np.ndarray,
@@ -135,7 +139,7 @@ def unmatched_firings(analysis: Analysis, peaks: np.ndarray, p: dict,
     stretch in reach passes the other tests, with its two sides and the stretch's mean
     ``unmatched_poses``; and the take's median of ``unmatched_poses`` per block."""
     rate = analysis.rate
-    unmatched = analysis.unmatched(p["min_segment_s"])
+    unmatched = unmatched_of(analysis, p["min_segment_s"])
     w = max(1, int(round(UNMATCHED_STRETCH_S * rate)))
     if len(unmatched) < w:
         return {}, 0.0

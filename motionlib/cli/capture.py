@@ -1,17 +1,8 @@
-"""Command line: ``python -m motionlib <command> …``.
-
-Each command is one ``add_<command>(subparsers)`` function that declares its arguments and sets
-``handler``; a handler takes the parsed arguments, prints its result and returns an exit code.
-Adding a command is adding one such function to :data:`COMMANDS`. Errors a user can fix
-(bad files, bad arguments) print one line on stderr and exit with status 2.
-"""
+"""The ``info`` and ``convert`` commands: a capture file described, or written as BVH."""
 
 from __future__ import annotations
 
-import argparse
-
-from motionlib.arguments import EXIT_USAGE, add_animation, animation_arg, run
-from motionlib.segmenters.command import add_segment
+from motionlib.cli.common import add_animation, animation_arg
 
 
 def add_info(subparsers) -> None:
@@ -100,27 +91,3 @@ def run_convert(args) -> int:
     print(f"wrote {args.output}: frames {start} to {stop - 1} of {args.input} "
           f"({stop - start} frames at {take.fps:g} fps)")
     return 0
-
-
-COMMANDS = [add_info, add_convert, add_segment]
-
-
-class _Parser(argparse.ArgumentParser):
-    """Usage errors in one line (``--help`` still shows the full usage)."""
-
-    def error(self, message: str):
-        self.exit(EXIT_USAGE, f"{self.prog}: error: {message} (see --help)\n")
-
-
-def build_parser() -> argparse.ArgumentParser:
-    parser = _Parser(prog="python -m motionlib",
-                     description="Motion-capture takes: inspect, convert, segment.")
-    subparsers = parser.add_subparsers(dest="command", required=True, metavar="command")
-    for add in COMMANDS:
-        add(subparsers)
-    return parser
-
-
-def main(argv: list[str] | None = None) -> int:
-    """Run the command line; return the exit status."""
-    return run(build_parser(), argv, "motionlib")

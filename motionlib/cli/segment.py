@@ -1,4 +1,5 @@
-"""The ``python -m motionlib segment`` command (registered in ``motionlib.cli``)."""
+"""The ``python -m motionlib segment`` command: a method's cuts, or the learner's cuts after
+``--examples``."""
 
 from __future__ import annotations
 
@@ -28,14 +29,14 @@ def add_segment(subparsers) -> None:
 
 
 def run_segment(args) -> int:
-    from motionlib.arguments import animation_arg
+    from motionlib.cli.common import animation_arg
     from motionlib.io import read
     from motionlib.segmenters import ParamError, get_segmenter, parse_param_args
 
     cls = get_segmenter(args.method)
     params = cls.validate_params(parse_param_args(args.param))  # before the slow read
     if args.plot:  # before the slow read too
-        from motionlib.segmenters.plot import require_matplotlib
+        from motionlib.cli.plot import require_matplotlib
 
         require_matplotlib()
     if args.examples and cls.name != "default":
@@ -53,7 +54,7 @@ def run_segment(args) -> int:
     else:
         result = cls(**params).fit_predict(take)
     if args.plot:
-        from motionlib.segmenters.plot import plot_segmentation
+        from motionlib.cli.plot import plot_segmentation
 
         plot_segmentation(result, fps=take.fps, path=args.plot,
                           title=f"{args.file} ({cls.name})")

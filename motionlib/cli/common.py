@@ -1,8 +1,8 @@
 """Command-line arguments shared by several ``python -m motionlib`` commands, and how a
 command line runs (``run``), which the benchmarks' command line shares.
 
-A module of its own so that ``motionlib.cli`` and the commands it registers from other
-packages (``segmenters.command``) both import it, and neither imports the other back.
+A module of its own so that the package's parser and the command modules it registers
+both import it, and no command module imports the parser back.
 """
 
 from __future__ import annotations
