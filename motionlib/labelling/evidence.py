@@ -121,10 +121,11 @@ def _prior() -> np.ndarray:
 def candidate_logits(cut_model, study: dict) -> tuple[np.ndarray, np.ndarray]:
     """(logits, frames): the cut model's logit of every candidate of a study and its
     frame as the model places it."""
-    from motionlib.adapt import _learner
+    from motionlib.adapt import placed
+    from motionlib.adapt._model import scorer_inputs
 
-    logits = _learner.design(study["features"]) @ np.asarray(cut_model.weights)
-    return logits - cut_model.threshold, _learner.placed(cut_model, study)
+    logits = scorer_inputs(cut_model, study) @ np.asarray(cut_model.weights)
+    return logits - cut_model.threshold, placed(cut_model, study)
 
 
 def design(cut_model, model: LabelCutModel, study: dict, post) -> tuple[np.ndarray, np.ndarray]:
