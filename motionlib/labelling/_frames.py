@@ -99,6 +99,7 @@ def vote(tree: cKDTree, labels: np.ndarray, owners: np.ndarray, prior: np.ndarra
         rank = np.cumsum(weight > 0, axis=1)
         weight = np.where(rank <= NEIGHBOURS, weight, 0.0)
     rows = np.repeat(np.arange(len(z)), k)
-    np.add.at(out, (rows, labels[idx].ravel()), weight.ravel() /
-              np.maximum(weight.sum(axis=1, keepdims=True), 1e-12).repeat(k, axis=1).ravel())
+    # each query's votes sum to NEIGHBOURS, against PRIOR pseudo-votes
+    share = NEIGHBOURS * weight / np.maximum(weight.sum(axis=1, keepdims=True), 1e-12)
+    np.add.at(out, (rows, labels[idx].ravel()), share.ravel())
     return out / out.sum(axis=1, keepdims=True)
