@@ -40,6 +40,8 @@ EVIDENCE = ("mix", "change", "opens", "closes", "same", "length", "decoded",
 WINDOW_S = 1.0
 # Strength of the prior that keeps the scorer at the cut model (pseudo-observations).
 PRECISION = 10.0
+# How much better (mean F1 on the reviewed takes) the evidence must cut to be kept.
+GATE_MARGIN = 0.05
 # The count calibration's search range and bisection steps (logits).
 CALIBRATION_RANGE = 8.0
 CALIBRATION_STEPS = 12
@@ -196,7 +198,27 @@ def fit_label_cuts(cut_model, frames: FrameModel | None, studies, examples, cuts
         logit = x @ weights
         order, kept = _ranked(logit, placed, gap)
         ranked.append((logit[order][kept], int(y.sum())))
-    return LabelCutModel(frames, weights, _calibrated(ranked))
+    fitted = LabelCutModel(frames, weights, _calibrated(ranked))
+    # The gate: the evidence is kept only where it cuts the reviewed takes, each seen
+    # through a posterior without it, better than the cut model alone.
+    kept_f1 = _mean_f1(fitted, xs, gaps, cuts, studies, tolerance_s)
+    alone_f1 = _mean_f1(model, xs, gaps, cuts, studies, tolerance_s)
+    return fitted if kept_f1 > alone_f1 + GATE_MARGIN else model
+
+
+def _mean_f1(model: LabelCutModel, xs, gaps, cuts, studies, tolerance_s) -> float:
+    """Mean F1 over the reviewed takes of what ``model`` keeps among their candidates."""
+    scores = []
+    fitted = [s for s in studies if s is not None and len(s["features"])]
+    for x, (placed, gap), c, study in zip(xs, gaps, cuts, fitted, strict=False):
+        logit = x @ model.weights
+        order, kept = _ranked(logit, placed, gap)
+        chosen = order[kept & (logit[order] > model.threshold)]
+        found = np.sort(placed[chosen])
+        scores.append(metrics.boundary_scores(
+            found, metrics.as_windows(np.asarray(c, dtype=np.int64)),
+            fps=float(study["fps"]), tolerance_s=tolerance_s)["f1"])
+    return float(np.mean(scores)) if scores else 0.0
 
 
 def _calibrated(ranked) -> float:
