@@ -66,3 +66,19 @@ class LabelledDetectionTestCase(ReviewedTakesTestCase):
         last = self.redetect(capture)
         self.assertNotIn(label_id, [p["label"] for p in last.proposals])
         self.assertTrue(ProjectCutModel.objects.filter(project=self.project, version=1).exists())
+
+    def test_the_review_page_suggests_the_proposed_label_of_an_untouched_segment(self):
+        self.train([92, 93])
+        capture = self.ingested(seed=94)
+        run = capture.latest_run()
+        names = dict(self.project.labels.values_list("id", "name"))
+        frames = [c["frame"] for c in run.candidates]
+        bounds = [0, *frames, capture.n_frames]
+        expected = {(a, b): names[p["label"]] for a, b, p in
+                    zip(bounds[:-1], bounds[1:], run.proposals, strict=True) if p["label"]}
+        self.assertTrue(expected)
+        self.login(self.rachel)  # no review in the project: her own pool is empty
+        body = self.client.get(f"/api/captures/{capture.pk}/review/suggestions/").json()
+        got = {(s["start"], s["stop"]): s["label"] for s in body["suggestions"]}
+        for span, label in expected.items():
+            self.assertEqual(got.get(span), label)
