@@ -38,8 +38,9 @@ from pathlib import Path
 
 import numpy as np
 
-from benchmarks.quality import ceiling, data, learning_tried
+from benchmarks.quality import ceiling, data, learning_labels, learning_tried
 from motionlib import adapt
+from motionlib import labelling as frame_labels
 
 KS = (0, 1, 3, 5, 10)
 DRAWS = 5
@@ -62,6 +63,8 @@ class Item:
     truth: np.ndarray  # (n, 3) windows
     study: dict | None
     ruptures: np.ndarray
+    example: object = None  # labelling.FrameExample: the take's descriptors
+    frames: np.ndarray | None = None  # (n_frames,) true label per frame, "" unlabelled
 
     @property
     def cuts(self) -> np.ndarray:
@@ -77,14 +80,18 @@ class LabelSet:
     items: list[Item] = field(default_factory=list)
 
 
-def _item(name, subject, take, truth, tolerance_s, ruptures) -> Item:
+def _item(name, subject, take, truth, tolerance_s, ruptures, *, root=None,
+          set_name="") -> Item:
+    raw = learning_labels.raw_segments(root, set_name, name, take)
     return Item(name, subject, float(take.fps), np.asarray(truth, dtype=np.int64),
-                adapt.study(take), np.asarray(ruptures(take, tolerance_s)))
+                adapt.study(take), np.asarray(ruptures(take, tolerance_s)),
+                frame_labels.frame_example(take, raw),
+                learning_labels.per_frame(raw, int(take.n_frames)))
 
 
 def load_sets(root: Path, log) -> list[LabelSet]:
     """Every labelled set with its takes read and studied once."""
-    from benchmarks import points_quality
+    from benchmarks.quality import points as points_quality
     from benchmarks.quality.bench import ruptures_kernel
 
     rot = lambda take, _tol: ruptures_kernel(take)  # noqa: E731
@@ -99,10 +106,11 @@ def load_sets(root: Path, log) -> list[LabelSet]:
         else:
             continue
         target.items.append(_item(labelled.name, labelled.name.split("_")[0],
-                                  labelled.read(), labelled.truth, 1.0, rot))
+                                  labelled.read(), labelled.truth, 1.0, rot, root=root,
+                                  set_name=target.name))
     for labelled in data.baak_takes(root):
         sets[2].items.append(_item(labelled.name, "86", labelled.read(), labelled.truth,
-                                   1.0, rot))
+                                   1.0, rot, root=root, set_name=sets[2].name))
     if (root / "points").is_dir():
         for name, loader in points_quality.SETS.items():
             found = loader(root)
@@ -110,15 +118,30 @@ def load_sets(root: Path, log) -> list[LabelSet]:
             label = LabelSet(name, found.tolerance_s, len(subjects) > 1)
             for t in found.takes:
                 label.items.append(_item(t.name, t.subject, t.read(), t.truth,
-                                         found.tolerance_s, points_quality.ruptures_cuts))
+                                         found.tolerance_s, points_quality.ruptures_cuts,
+                                         root=root, set_name=name))
             sets.append(label)
     print(f"read and studied {sum(len(s.items) for s in sets)} takes", file=log)
     return sets
 
 
+_FITTED: dict = {}
+
+
 def fit(items: list[Item], tolerance_s: float, cuts=None) -> adapt.CutModel:
     """A model fitted on ``items`` (their human cuts, or ``cuts``) through the public
-    API, every take's candidates standing in for it (``studies``)."""
+    API, every take's candidates standing in for it (``studies``). A fit on the human
+    cuts is kept: the label-aware tables refit the same draws."""
+    key = (tuple(id(i) for i in items), tolerance_s)
+    if cuts is None and key in _FITTED:
+        return _FITTED[key]
+    model = _fit(items, tolerance_s, cuts)
+    if cuts is None:
+        _FITTED[key] = model
+    return model
+
+
+def _fit(items: list[Item], tolerance_s: float, cuts=None) -> adapt.CutModel:
     studies = Known({f"{item.subject}/{item.name}": item.study for item in items})
     examples = []
     for i, item in enumerate(items):
@@ -416,12 +439,16 @@ def main(root: Path | None = None, out=None) -> int:
     sets = load_sets(root, out)
     print(__doc__.split("\n\n")[1], file=out)
     curves = print_curves(sets, True, out)
+    labels = learning_labels.print_curves(sets, KS, DRAWS, _pool, fit, scored, baseline, out)
     within = print_curves(sets, False, out)
     conv = convention(sets, out)
+    conv_labels = learning_labels.convention(sets, fit, scored, out)
+    costs = learning_labels.cost(out)
     print_ceiling(sets, {**curves, **within}, out)
     poison = poisoning(sets, out)
     print_tried(sets, curves, poison, out)
     targets({**curves, **{f"{k} (within)": v for k, v in within.items()}}, conv, poison, out)
+    learning_labels.targets(labels, conv_labels, costs, out)
     print(f"\nlearning curve: {time.perf_counter() - started:.0f} s, load average "
           f"{' '.join(f'{x:.2f}' for x in os.getloadavg())}", file=out)
     return 0

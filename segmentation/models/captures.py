@@ -143,6 +143,10 @@ class DetectionRun(Job):
     # the zero-shot detector and for other methods.
     model_version = models.PositiveIntegerField(null=True, blank=True)
     model_n_takes = models.PositiveIntegerField(null=True, blank=True)
+    # The label that model's frame model proposes for each segment between the
+    # candidates, in frame order: ``{"label": label id or None, "probability": float}``
+    # (``len(candidates) + 1`` entries; [] without a frame model).
+    proposals = models.JSONField(default=list, blank=True)
 
     objects = ClaimQuerySet.as_manager()
     task = "detect"

@@ -196,6 +196,9 @@ class ProjectCutModel(Job):
     project = models.ForeignKey(Project, models.CASCADE, related_name="cut_models")
     version = models.PositiveIntegerField(null=True, blank=True)
     model = models.TextField(blank=True)
+    # motionlib.labelling.FrameModel.to_json() of the same examples, labels by id ("":
+    # no labelled segment to learn from).
+    labels_model = models.TextField(blank=True, default="")
     n_takes = models.PositiveIntegerField(default=0)
     n_cuts = models.PositiveIntegerField(default=0)
     seconds = models.FloatField(null=True, blank=True)

@@ -24,6 +24,7 @@ import logging
 import time
 from collections import defaultdict
 
+import numpy as np
 from django.conf import settings
 from django.db import IntegrityError, transaction
 from django.db.models import Max
@@ -35,7 +36,7 @@ from motionlib.segmenters import get_segmenter
 from segmentation.errors import CutroomError, Invalid
 from segmentation.files import takecache
 from segmentation.files.storage import read_take
-from segmentation.models import Capture, Membership, ProjectCutModel, Review
+from segmentation.models import Capture, Label, Membership, ProjectCutModel, Review
 from segmentation.services import jobs, model_gate
 from segmentation.services.jobs import Kind, register
 
@@ -110,6 +111,46 @@ def project_examples(project_id):
     return examples
 
 
+def example_segments(capture, cuts):
+    """The capture's labelled segments as the frame model learns them: ``(start, stop,
+    label id as text or "")``. Gold where saved; else the segments between the example's
+    (consensus) cuts, each with the label its submitted reviews give most of its frames
+    (ids, so that a rename changes nothing the model keeps)."""
+    n = capture.n_frames or 0
+    gold = getattr(capture, "adjudication", None)
+    if gold is not None:
+        bounds = [0, *sorted(gold.cuts), n]
+        return [(a, b, str(lab) if lab else "")
+                for a, b, lab in zip(bounds[:-1], bounds[1:], gold.labels, strict=False)]
+    reviews = list(Review.objects.filter(capture=capture, status="submitted"))
+    labelled = [(start, stop, label) for review in reviews
+                for _, start, stop, label in review.segments(label="label_id")
+                if label is not None]
+    names = sorted({label for _, _, label in labelled})
+    votes = np.zeros((n, len(names)))
+    for start, stop, label in labelled:
+        votes[start:stop, names.index(label)] += 1
+    bounds = [0, *cuts, n]
+    out = []
+    for a, b in zip(bounds[:-1], bounds[1:], strict=True):
+        mass = votes[a:b].sum(axis=0)
+        # a segment its reviewers mostly left unlabelled stays unlabelled
+        named = len(names) and b > a and mass.max() * 2 >= (b - a) * len(reviews)
+        out.append((a, b, str(names[int(np.argmax(mass))]) if named else ""))
+    return out
+
+
+def fit_labels(examples):
+    """The project's frame model (``motionlib.labelling``) as stored text; "" when no
+    reviewed take carries a label. Each take is read (from ``takecache``) once."""
+    from motionlib import labelling
+
+    chosen = [labelling.frame_example(example_take(capture), example_segments(capture, cuts))
+              for capture, cuts in examples]
+    model = labelling.fit_frame_model(chosen)
+    return model.to_json() if model is not None else ""
+
+
 def example_name(capture):
     """How training names a reviewed capture: motionlib names a take by its path when it
     has one, and the stored file's name is a random folder away from what the studio knows."""
@@ -173,6 +214,7 @@ def _train(job):
             version=None if verdict.refused else (newest["v"] or 0) + 1,
             refused=verdict.refused,
             model=model.to_json(),
+            labels_model=fit_labels(examples),
             n_takes=model.n_takes,
             n_cuts=model.n_cuts,
             trained_on=[capture.pk for capture, _cuts in examples],
@@ -238,7 +280,44 @@ def detect(run, take):
     from motionlib import adapt
 
     result = adapt.detect(take, model, **params)
-    return result, {"model_version": newest.version, "model_n_takes": newest.n_takes}
+    return result, {"model_version": newest.version, "model_n_takes": newest.n_takes,
+                    "proposals": proposals(newest, take, result.cuts)}
+
+
+def proposals(row, take, cuts):
+    """``[{"label", "probability"}]`` for each segment between ``cuts``: the label the
+    model's frame model finds most likely there (a label id; None for a retired label or
+    where the reviewers would most likely leave it unlabelled); [] without a frame model."""
+    frames = _loaded_labels(row.pk)
+    if frames is None:
+        return []
+    from motionlib import labelling
+
+    retired = Label.objects.filter(project_id=row.project_id, retired=True).values_list("id", flat=True)
+    alive = set(Label.objects.filter(project_id=row.project_id).values_list("id", flat=True))
+    # A retired or deleted label is proposed no more: its frames count as unlabelled.
+    gone = {name: None for name in frames.names if name and (int(name) in set(retired) or int(name) not in alive)}
+    if gone:
+        frames = labelling.relabelled(frames, gone)
+    post = labelling.posterior(frames, take)
+    return [{"label": int(name) if name else None, "probability": p}
+            for name, p in labelling.propose(frames, post, cuts)]
+
+
+def _loaded_labels(pk):
+    text = ProjectCutModel.objects.values_list("labels_model", flat=True).get(pk=pk)
+    return _parsed_labels(text, pk) if text else None
+
+
+@functools.lru_cache(maxsize=32)
+def _parsed_labels(text, pk):
+    from motionlib import labelling
+
+    try:
+        return labelling.FrameModel.from_json(text)
+    except ValueError:
+        log.exception("frame model (row %s) cannot be read; no label proposals", pk)
+        return None
 
 
 def _loaded(pk, version):

@@ -33,7 +33,14 @@ from django.utils import timezone
 from motionlib import similarity
 from segmentation import workers
 from segmentation.errors import internal_error
-from segmentation.models import Capture, LabelSuggestion, LibrarySegment, Review, SuggestionRequest
+from segmentation.models import (
+    Capture,
+    Label,
+    LabelSuggestion,
+    LibrarySegment,
+    Review,
+    SuggestionRequest,
+)
 from segmentation.similar.descriptors import Describer, load_descriptors, profile_pool, same_kind
 from segmentation.similar.search import SHORTLIST, SIMILAR_POOL
 
@@ -115,11 +122,34 @@ def for_review(capture, annotator):
     pending = bool(key) and len(found) < len(spans)
     if pending:
         pending = ask(capture, annotator) or not recently_failed(capture, annotator)
+    # Where the annotator's own pool suggests nothing, the label the detection proposed
+    # for a segment it left as it was.
+    found = dict(found)
+    for span, label in proposed(capture, spans).items():
+        if found.get(span) is None:
+            found[span] = label
     return {
         "pending": pending,
         "suggestions": [{"start": s, "stop": e, "label": label}
                         for (s, e), label in sorted(found.items())],
     }
+
+
+def proposed(capture, spans):
+    """``{(start, stop): label name}`` of the latest finished run's proposals
+    (``DetectionRun.proposals``) for the ``spans`` that are still one of its segments;
+    labels retired since are left out."""
+    run = capture.latest_finished_run()
+    if run is None or not run.proposals:
+        return {}
+    frames = sorted({c["frame"] for c in run.candidates})
+    bounds = [0, *frames, capture.n_frames or 0]
+    names = dict(Label.objects.filter(project_id=capture.project_id, retired=False)
+                 .values_list("id", "name"))
+    wanted = set(spans)
+    return {(a, b): names[p["label"]]
+            for a, b, p in zip(bounds[:-1], bounds[1:], run.proposals, strict=False)
+            if (a, b) in wanted and p["label"] in names}
 
 
 def ask(capture, annotator):

@@ -1576,6 +1576,15 @@ export interface components {
             /** @default true */
             annotators_pick_unassigned: boolean;
         };
+        /**
+         * @description The label a project's frame model proposes for one segment between the candidates
+         *     (``label``: a label id, null when it would most likely stay unlabelled).
+         */
+        Proposal: {
+            readonly label: number | null;
+            /** Format: double */
+            readonly probability: number;
+        };
         /** @description A capture or project as other records name them. */
         QueueCapture: {
             id: number;
@@ -1698,6 +1707,7 @@ export interface components {
             model_version: number | null;
             /** Format: int64 */
             model_n_takes: number | null;
+            readonly proposals: components["schemas"]["Proposal"][];
         };
         RunRequestRequest: {
             /** @default  */

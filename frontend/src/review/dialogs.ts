@@ -19,8 +19,9 @@ export function showConflict(changes: string[], unsaved: string[]): Promise<void
   ]);
 }
 
-/** Ask before submitting, saying how many pending candidates it keeps as cuts. */
-export function confirmSubmit(review: Review, next: boolean): Promise<boolean> {
+/** Ask before submitting, saying how many pending candidates it keeps as cuts and how many
+ * proposed labels (``proposed``: unlabelled segments with a suggestion) stay unconfirmed. */
+export function confirmSubmit(review: Review, next: boolean, proposed = 0): Promise<boolean> {
   const pending = review.cuts.filter((c) => c.fate === "pending").length;
   const unlabelled = review.segments.filter((seg) => !seg.label).length;
   // Submitting keeps every cut not deleted, pending candidates included: say so, with the count.
@@ -30,6 +31,7 @@ export function confirmSubmit(review: Review, next: boolean): Promise<boolean> {
     pending
       ? h("p", { "data-testid": "submit-pending" }, h("strong", {}, `${candidates} will be kept as cuts.`), ` Accept or delete ${pending === 1 ? "it" : "them"} first to decide each one.`)
       : null,
+    proposed ? h("p", { "data-testid": "submit-proposed" }, `${proposed} proposed label${proposed === 1 ? " is" : "s are"} not confirmed (press S on a segment to accept its proposal).`) : null,
     unlabelled ? h("p", { class: "muted", "data-testid": "submit-unlabelled" }, `${unlabelled} unlabelled segment${unlabelled === 1 ? "" : "s"} will be left out of the library.`) : null,
   ], pending ? `Submit, keeping ${pending}` : "Submit");
 }

@@ -259,7 +259,9 @@ class ReviewPage {
 
   private async submit(next: boolean): Promise<void> {
     const s = this.session;
-    if (s.locked() || s.saver.pending || !(await confirmSubmit(s.review, next))) return;
+    // Proposals the annotator did not accept: unlabelled segments that show a suggested label.
+    const proposed = s.review.segments.filter((seg) => !seg.label && this.suggestions.on(seg)?.suggested_label).length;
+    if (s.locked() || s.saver.pending || !(await confirmSubmit(s.review, next, proposed))) return;
     try {
       await s.submit();
       toast("Review submitted.");

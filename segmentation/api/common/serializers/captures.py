@@ -19,8 +19,17 @@ class CandidatesField(serializers.JSONField):
     """A run's candidates as stored (a one-hour take has thousands: no serializer per item)."""
 
 
+class ProposalSerializer(serializers.Serializer):
+    """The label a project's frame model proposes for one segment between the candidates
+    (``label``: a label id, null when it would most likely stay unlabelled)."""
+
+    label = serializers.IntegerField(allow_null=True, read_only=True)
+    probability = serializers.FloatField(read_only=True)
+
+
 class RunSerializer(serializers.ModelSerializer):
     error = ErrorField()
+    proposals = ProposalSerializer(many=True, read_only=True)
     params = serializers.DictField(read_only=True)
     timings = serializers.DictField(child=serializers.FloatField(), read_only=True)
     candidates = CandidatesField(read_only=True)
@@ -29,7 +38,7 @@ class RunSerializer(serializers.ModelSerializer):
         model = DetectionRun
         fields = [
             "id", "method", "params", "status", "error", "created_at", "finished_at",
-            "timings", "candidates", "model_version", "model_n_takes",
+            "timings", "candidates", "model_version", "model_n_takes", "proposals",
         ]
 
 
