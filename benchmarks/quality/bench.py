@@ -290,7 +290,7 @@ def _ruptures_loo(cache) -> list[dict]:
 def _point_sets(folder: Path, out) -> None:
     """The point sets (markers and tracked joints) beside the rotation sets, each at its
     own tolerance, with ruptures in the same run (``benchmarks.quality.points``)."""
-    from benchmarks import points_quality
+    from benchmarks.quality import points as points_quality
 
     print("\n# Point takes: every set per take and mean, at its tolerance", file=out)
     with contextlib.redirect_stdout(out):

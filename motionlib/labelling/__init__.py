@@ -31,6 +31,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.spatial import cKDTree
 
+from motionlib.errors import InputError
 from motionlib.labelling import _frames
 from motionlib.labelling._frames import UNLABELLED, descriptors, frame_labels
 
@@ -98,11 +99,11 @@ class FrameModel:
 
     @classmethod
     def from_json(cls, text: str) -> FrameModel:
-        """Read :meth:`to_json`'s text back; ValueError naming what is wrong."""
+        """Read :meth:`to_json`'s text back; InputError naming what is wrong."""
         try:
             d = json.loads(text)
             if d.get("format") != FORMAT:
-                raise ValueError(f"frame model format {d.get('format')!r} is not {FORMAT}")
+                raise InputError(f"frame model format {d.get('format')!r} is not {FORMAT}")
             dims, n_in = int(d["dims"]), int(d["in"])
 
             def unpack(key, dtype):
@@ -115,7 +116,7 @@ class FrameModel:
                        unpack("owners", "<i4").astype(np.int64),
                        {k: tuple(v) for k, v in d["lengths"].items()}, int(d["n_takes"]))
         except (KeyError, TypeError, ValueError) as exc:
-            raise ValueError(f"not a stored frame model: {exc}") from None
+            raise InputError(f"not a stored frame model: {exc}") from None
 
 
 def fit_frame_model(examples: Sequence[FrameExample]) -> FrameModel | None:

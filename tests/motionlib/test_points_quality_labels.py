@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from benchmarks import points_quality
+from benchmarks.quality import points as points_quality
 from tests.motionlib.points_data import POINTS, points_file
 
 

@@ -15,4 +15,4 @@ class MigrationTestCase(TransactionTestCase):
         return executor.loader.project_state(targets).apps
 
     def tearDown(self):
-        self.migrate(MigrationExecutor(connection).loader.graph.leaf_nodes("segmentation"))
+        self.migrate(MigrationExecutor(connection).loader.graph.leaf_nodes())

@@ -130,8 +130,9 @@ class ExportTest(CmuLibraryTestCase):
     def test_it_puts_every_matching_segment_in_the_zip(self):
         response = self.client.get(f"/api/segments/export.zip?capture={self.capture.pk}")
         chunks = list(response.streaming_content)
-        # Streamed: a chunk per segment as it is written, then the manifests.
-        assert len(chunks) == 6 + 1 and all(chunks[:6])
+        # Streamed: an empty chunk that sends the headers (the clip count), a chunk per
+        # segment as it is written, then the manifests.
+        assert chunks[0] == b"" and len(chunks) == 1 + 6 + 1 and all(chunks[1:7])
         names = zipfile.ZipFile(io.BytesIO(b"".join(chunks))).namelist()
         assert len(names) == 6 + 2
         assert "13_29_JumpJack_1-469.bvh" in names

@@ -14,7 +14,8 @@ import numpy as np
 import pytest
 from django.core.files.base import ContentFile
 
-from segmentation import services, storage
+from segmentation import services
+from segmentation.files import storage
 from segmentation.models import Capture, SuggestionRequest
 from tests.motionlib.points_data import points_file
 from tests.segmentation.integration.conftest import wait_for
