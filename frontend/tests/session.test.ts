@@ -123,6 +123,22 @@ describe("ReviewSession", () => {
     expect(session.history).toEqual({ past: ["delete frame 500: pending → deleted"], future: [] });
   });
 
+  it("test_it_ignores_a_log_asked_for_before_its_last_undo", async () => {
+    const { session, saved } = open();
+    const at = "2026-01-01T10:00:00Z";
+    const log = [
+      { id: 1, user: "ann", action: "create", cut: null, before: null, after: { candidates: 3 }, created_at: at },
+      { id: 2, user: "ann", action: "delete", cut: 2, before: { frame: 500, fate: "pending" }, after: { frame: 500, fate: "deleted" }, created_at: at },
+    ];
+    session.readHistory(log);
+    const asOf = session.sent; // the page asks for the log now...
+    const done = saved();
+    session.undo(); // ...and the annotator undoes before it arrives
+    await done;
+    session.readHistory(log, asOf);
+    expect(session.history).toEqual({ past: [], future: ["delete frame 500: pending → deleted"] });
+  });
+
   it("test_it_restores_a_point_of_the_log_as_a_step_undo_takes_back", async () => {
     const { session, server, saved } = open();
     const done = saved();

@@ -237,8 +237,9 @@ class ReviewPage {
   /** The own review's activity log; the undo history is read from it (it survives a reload). */
   private async loadEvents(): Promise<void> {
     if (this.session.readOnly) return;
+    const asOf = this.session.sent;
     const events = await this.sidebar.loadEvents(this.session.locked() ? undefined : (e) => void this.askRestore(e));
-    if (events) this.session.readHistory(events);
+    if (events) this.session.readHistory(events, asOf);
   }
 
   private async askRestore(e: ReviewEvent): Promise<void> {

@@ -27,6 +27,7 @@ export class ReviewSession {
   selectedCutId: number | null = null;
   /** Another annotator's review, shown read-only (reviewers), or null for the own one. */
   private other: Review | null = null;
+  private pushes = 0;
   private nextTempId: number;
   private readonly own: Review;
   readonly saver: Saver;
@@ -93,6 +94,7 @@ export class ReviewSession {
       this.history = record(this.history, title);
       if (edit.kind === "insert") this.selectedCutId = edit.tempId;
       this.saver.push([edit], title);
+      this.pushes++;
       return true;
     } catch (err) {
       if (!(err instanceof EditError)) throw err;
@@ -135,6 +137,7 @@ export class ReviewSession {
     if (!step) return this.view.notice(`Nothing to ${which}.`);
     this.history = step.history;
     this.saver.push([{ kind: which }], `${which} ${step.title}`);
+    this.pushes++;
     this.view.notice(`${which === "undo" ? "Undo" : "Redo"}: ${step.title}`);
     this.view.changed();
   }
@@ -153,9 +156,19 @@ export class ReviewSession {
     this.view.notice(`Restoring the review as it was after “${title}”…`);
   }
 
-  /** The undo/redo stacks as the server's log has them, unless edits are still queued. */
-  readHistory(events: readonly ReviewEvent[]): void {
-    if (this.saver.pending || this.other) return;
+  /** How many edits (undo and redo included) this page has sent: a log read while it
+   * changes is out of date by the time it arrives. */
+  get sent(): number {
+    return this.pushes;
+  }
+
+  /**
+   * The undo/redo stacks as the server's log has them, unless edits are still queued or
+   * were sent after the log was asked for (`asOf`: `sent` when it was): a log read before
+   * an undo would give that undo's step back.
+   */
+  readHistory(events: readonly ReviewEvent[], asOf: number = this.pushes): void {
+    if (this.saver.pending || this.other || asOf !== this.pushes) return;
     this.history = historyFromEvents(events);
     this.view.changed();
   }
