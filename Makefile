@@ -54,8 +54,9 @@ lint: install
 vitest: $(FRONT_STAMP)
 	cd frontend && npm test
 
-# Everything but the integration tests on the embedded default (SQLite), then the
-# integration tests against PostgreSQL + Redis + real Celery workers, last so that the
+# The unit tests on the embedded default (SQLite), then the browser tests in a session of
+# their own (its SQLite test database is a file, which the live server's threads need: the
+# first test of a session decides the database for all), then the integration tests against PostgreSQL + Redis + real Celery workers, last so that the
 # final line is that run's summary.
 INTEGRATION_ENV := DATABASE_URL=postgres://postgres@127.0.0.1:5432/test \
 	CELERY_BROKER_URL=redis://127.0.0.1:6379/15
@@ -69,7 +70,8 @@ PYTEST_WORKERS ?= auto
 XDIST := -n $(PYTEST_WORKERS) --dist worksteal
 
 pytest: install
-	$(PY) -m pytest -m "not integration" $(XDIST)
+	$(PY) -m pytest -m "not integration and not e2e" $(XDIST)
+	$(PY) -m pytest -m e2e tests/e2e $(XDIST)
 	$(INTEGRATION_ENV) $(PY) -m pytest -m integration $(XDIST)
 
 # Each benchmark's output goes to benchmarks/results/<name>.md (generated, committed: every

@@ -36,21 +36,3 @@ def _var_of_this_process(tmp_path_factory):
     yield var
     app.conf.broker_transport_options = saved
     isolated.disable()
-
-
-@pytest.fixture(scope="session")
-def django_db_modify_db_settings(django_db_modify_db_settings_parallel_suffix, tmp_path_factory):
-    """On SQLite, a test database in a file rather than in shared-cache memory, for every
-    test of the session (the first test to ask for the database decides it for all, and
-    with one process per core any test may come first).
-
-    The browser tests' live server answers from its own threads while the test writes from
-    this one; in shared-cache memory a second writer (or a writer meeting a reader) fails at once
-    with "table is locked", whereas a file has the WAL and busy timeout the service is
-    configured for, as in production.
-    """
-    from django.conf import settings
-
-    db = settings.DATABASES["default"]
-    if db["ENGINE"].endswith("sqlite3"):
-        db.setdefault("TEST", {})["NAME"] = str(tmp_path_factory.mktemp("test-db") / "cutroom.sqlite3")

@@ -53,6 +53,22 @@ def pytest_collection_modifyitems(items):
 
 
 @pytest.fixture(scope="session")
+def django_db_modify_db_settings(django_db_modify_db_settings_parallel_suffix, tmp_path_factory):
+    """On SQLite, a test database in a file rather than in shared-cache memory.
+
+    The live server answers from its own threads while the test writes from this one;
+    in shared-cache memory a second writer (or a writer meeting a reader) fails at once
+    with "table is locked", whereas a file has the WAL and busy timeout the service is
+    configured for, as in production.
+    """
+    from django.conf import settings
+
+    db = settings.DATABASES["default"]
+    if db["ENGINE"].endswith("sqlite3"):
+        db.setdefault("TEST", {})["NAME"] = str(tmp_path_factory.mktemp("e2e-db") / "cutroom.sqlite3")
+
+
+@pytest.fixture(scope="session")
 def built_frontend():
     if not (DIST / "index.html").is_file():
         message = (
