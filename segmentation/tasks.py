@@ -113,13 +113,35 @@ def limit_job_memory(**kwargs):
     """Give each pool process CUTROOM_JOB_MEMORY_MB of address space beyond what it holds
     now: a job past it meets a MemoryError (and fails) before the OOM killer picks a
     process to end, which may be the worker's main one. Not in the convert worker, whose
-    Blender child would inherit the limit."""
+    Blender child would inherit the limit.
+
+    BLAS and OpenMP run on one thread, and each BLAS library (numpy's, scipy's, faiss's) has
+    done one matrix product, before the limit is measured: OpenBLAS starts its threads and
+    maps its work buffer on a process's first product, and when either fails under the
+    limit it waits for good instead of raising. A pool process runs one job, so the threads
+    bought little."""
     if not settings.CUTROOM_JOB_MEMORY_MB or settings.CUTROOM_CONVERT_WORKER:
         return
+    _warm_blas()
     with open("/proc/self/statm") as statm:
         held = int(statm.read().split()[0]) * resource.getpagesize()
     limit = held + settings.CUTROOM_JOB_MEMORY_MB * 2**20
     resource.setrlimit(resource.RLIMIT_AS, (limit, resource.getrlimit(resource.RLIMIT_AS)[1]))
+
+
+def _warm_blas():
+    import faiss
+    import numpy as np
+    import scipy.linalg.blas
+    from threadpoolctl import threadpool_limits
+
+    threadpool_limits(limits=1)
+    a = np.ones((256, 256))
+    a @ a
+    scipy.linalg.blas.dgemm(1.0, a, a)
+    index = faiss.IndexFlatL2(16)  # at 20 queries and more faiss's search is a product
+    index.add(np.ones((64, 16), dtype="float32"))
+    index.search(np.ones((32, 16), dtype="float32"), 1)
 
 
 @worker_process_init.connect
