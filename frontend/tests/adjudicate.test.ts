@@ -1,5 +1,5 @@
 import { describe, expect, it } from "vitest";
-import { back, cutMarks, forward, labelConflicts, push, snapToCuts, start } from "../src/adjudicate/marks";
+import { back, cutMarks, forward, labelConflicts, push, snapToCuts, start, unlabelledGold } from "../src/adjudicate/marks";
 import { filterLabels } from "../src/review/palette";
 
 describe("cutMarks", () => {
@@ -57,5 +57,16 @@ describe("the label palette filter", () => {
   it("lists names starting with the text first, then names containing it", () => {
     expect(filterLabels(labels, "c").map((l) => l.name)).toEqual(["crawl", "cartwheel", "kick"]);
     expect(filterLabels(labels, "WAL").map((l) => l.name)).toEqual(["walk"]);
+  });
+});
+
+describe("unlabelledGold", () => {
+  const draft = { cuts: [100, 200, 300], labels: ["walk", null, "run", null] };
+  it("finds the next and the previous gold segment without a label", () => {
+    expect(unlabelledGold(draft, 0, 1)).toBe(100);
+    expect(unlabelledGold(draft, 100, 1)).toBe(300);
+    expect(unlabelledGold(draft, 250, -1)).toBe(100);
+    expect(unlabelledGold(draft, 100, -1)).toBeNull();
+    expect(unlabelledGold(draft, 300, 1)).toBeNull();
   });
 });

@@ -232,3 +232,52 @@ def test_it_offers_a_retired_label_only_where_a_segment_already_carries_it(live_
     expect(page.get_by_test_id("gold-status")).to_have_text("Saved")
     saved = Adjudication.objects.get(capture=ingested_capture)
     assert saved.label_names() == ["walk", "punch", "squat", "kick"]
+
+
+def test_the_review_pages_navigation_keys_work_on_gold(live_server, new_page, ingested_capture, studio):
+    """Alt+←/→ nudge the selected gold cut, U goes to the next unlabelled gold segment and G
+    to a typed frame or timecode, as on the review page; the saved gold has the moves."""
+    from segmentation.models import Adjudication
+
+    _, (c0, c1, c2) = two_reviews(ingested_capture, studio)
+    page = new_page("rachel")
+    page.goto(f"{live_server.url}/captures/{ingested_capture.pk}/adjudicate/")
+    page.get_by_test_id("use-ann").click()
+    hud = page.get_by_test_id("hud-frame")
+
+    page.get_by_test_id("gold-cut-handle-1").click()
+    expect(page.get_by_test_id("gold-selected-cut")).to_contain_text(f"at {c1}")
+    page.keyboard.press("Alt+ArrowRight")
+    expect(page.get_by_test_id("gold-selected-cut")).to_contain_text(f"at {c1 + 1}")
+    page.keyboard.press("Alt+Shift+ArrowLeft")
+    expect(page.get_by_test_id("gold-selected-cut")).to_contain_text(f"at {c1 - 9}")
+    expect(hud).to_contain_text(f"Frame {c1 - 9} ")
+
+    # Clear the third segment's label; from the first frame U goes to it.
+    page.keyboard.press("Escape")
+    page.get_by_test_id("track-gold-seg-2").click()
+    page.keyboard.press("0")
+    expect(page.get_by_test_id("track-gold-seg-2")).to_have_text("")
+    page.keyboard.press("Home")
+    expect(hud).to_contain_text("Frame 0 ")
+    page.keyboard.press("u")
+    expect(hud).to_contain_text(f"Frame {c1 - 9} ")
+
+    page.keyboard.press("g")
+    field = page.get_by_test_id("prompt-line")
+    expect(field).to_be_focused()
+    field.fill("00:00:01:00")
+    page.keyboard.press("Enter")
+    expect(hud).to_contain_text(f"Frame {round(ingested_capture.fps)} ")
+    page.keyboard.press("g")
+    page.get_by_test_id("prompt-line").fill("not a frame")
+    page.keyboard.press("Enter")
+    expect(page.locator(".toasts")).to_contain_text("not a frame")
+    expect(hud).to_contain_text(f"Frame {round(ingested_capture.fps)} ")
+
+    page.get_by_test_id("save-gold").click()
+    expect(page.get_by_test_id("gold-status")).to_have_text("Saved")
+    saved = Adjudication.objects.get(capture=ingested_capture)
+    assert saved.cuts == [c0, c1 - 9, c2]
+    assert saved.label_names() == ["walk", "punch", None, "kick"]
+    assert page.errors == []

@@ -4,6 +4,7 @@
 //   (within three tolerances), and "lone" when some tier has no cut near it at all;
 // - label disagreements are the frame ranges where the tiers' labels differ.
 
+import type { Draft } from "../library/gold";
 import type { Span } from "../library/types";
 
 export type CutMark = "agreed" | "shifted" | "lone";
@@ -75,3 +76,14 @@ export const back = <T>(h: Timeline<T>): Timeline<T> =>
   h.past.length ? { past: h.past.slice(0, -1), present: h.past[h.past.length - 1], future: [h.present, ...h.future] } : h;
 export const forward = <T>(h: Timeline<T>): Timeline<T> =>
   h.future.length ? { past: [...h.past, h.present], present: h.future[0], future: h.future.slice(1) } : h;
+
+/** Start of the nearest gold segment without a label after (1) or before (-1) `frame`. */
+export function unlabelledGold(draft: Draft, frame: number, direction: -1 | 1): number | null {
+  const starts = [0, ...draft.cuts];
+  const order = direction > 0 ? starts.map((_, i) => i) : starts.map((_, i) => starts.length - 1 - i);
+  for (const i of order) {
+    if (draft.labels[i] !== null) continue;
+    if (direction > 0 ? starts[i] > frame : starts[i] < frame) return starts[i];
+  }
+  return null;
+}

@@ -13,12 +13,14 @@ import { SkeletonView } from "../player/skeletonView";
 import { helpOverlay } from "../review/commands";
 import { FrameStore, loadFrames } from "../review/frames";
 import { labelForHotkey, pageCommand } from "../review/keys";
-import type { Command } from "../review/keymap";
+import { NUDGE_STEP, type Command } from "../review/keymap";
 import { openPalette } from "../review/palette";
+import { formatTimecode, GotoError, parseGoto } from "../review/timecode";
 import { formatTime } from "../review/timescale";
 import { clear, dialog, h, toast } from "../ui/dom";
+import { promptLine } from "../ui/prompt";
 import { agreementBox } from "./agreement";
-import { back, cutMarks, forward, labelConflicts, push, start, type Timeline } from "./marks";
+import { back, cutMarks, forward, labelConflicts, push, start, unlabelledGold, type Timeline } from "./marks";
 import { Tiers } from "./tiers";
 import "./adjudicate.css";
 
@@ -39,6 +41,11 @@ const ADJ_HELP: [string, string][] = [
   ["← / →, , / .", "1 or 10 frames back / forward"],
   ["Shift + ← / →", "jump to the previous / next cut of any tier"],
   ["Home / End", "first / last frame"],
+  ["U / Shift+U", "next / previous unlabelled gold segment"],
+  ["G", "go to a frame or a timecode (HH:MM:SS:FF), typed"],
+  ["Alt + ← / →", "nudge the selected gold cut one frame earlier / later"],
+  ["Alt + Shift + ← / →", `nudge the selected gold cut ${NUDGE_STEP} frames`],
+  ["[ / ]", "slower / faster"],
   ["I", "insert a gold cut at the playhead"],
   ["D or Delete", "delete the selected gold cut"],
   ["1 – 9, /", "label the gold segment under the playhead (/ opens the palette)"],
@@ -223,7 +230,7 @@ class AdjudicationPage {
       this.el.editor,
       h("div", { "data-testid": "gold-segment" }, h("b", {}, `Gold segment ${index + 1} of ${spans.length}`), ` · frames ${s.start}–${s.stop}`),
       h("div", { class: "filters" }, select),
-      cut !== undefined ? h("div", { class: "muted", "data-testid": "gold-selected-cut" }, `Selected gold cut at ${cut} (D deletes, drag moves)`) : h("div", { class: "muted" }, "I inserts a gold cut at the playhead; 1–9 or / label the gold segment under it."),
+      cut !== undefined ? h("div", { class: "muted", "data-testid": "gold-selected-cut" }, `Selected gold cut at ${cut} (D deletes; drag or Alt+←/→ moves)`) : h("div", { class: "muted" }, "I inserts a gold cut at the playhead; 1–9 or / label the gold segment under it."),
     );
   }
 
@@ -307,6 +314,21 @@ class AdjudicationPage {
     this.refresh();
   }
 
+  /** Ask for a frame or a timecode and go there; a bad answer is named, the playhead stays. */
+  private async askGoto(): Promise<void> {
+    const fps = this.capture.fps!;
+    const last = `${this.n - 1} (${formatTimecode(this.n - 1, fps)})`;
+    const text = await promptLine("Go to", `A frame number (0 to ${last}) or a timecode HH:MM:SS:FF at ${fps} fps.`, "Go", formatTimecode(this.frame(), fps));
+    if (text === null) return;
+    try {
+      this.playback.seekAndPause(parseGoto(text, fps, this.n));
+    } catch (err) {
+      if (!(err instanceof GotoError)) throw err;
+      toast(err.message, "error");
+    }
+    this.refresh();
+  }
+
   private toggleHelp(): void {
     const open = document.querySelector(".adj-help");
     if (open) return open.remove();
@@ -332,6 +354,24 @@ class AdjudicationPage {
         if (target !== undefined) this.seekTo(target);
         return;
       }
+      case "unlabelled": {
+        const target = unlabelledGold(this.draft, frame, c.direction);
+        if (target === null) toast(`No unlabelled gold segment ${c.direction > 0 ? "after" : "before"} frame ${frame}.`);
+        else this.seekTo(target);
+        return;
+      }
+      case "goto":
+        return void this.askGoto();
+      case "nudge": {
+        if (this.selectedCut === null) return void toast("Select a gold cut first: click it on the gold tier.");
+        const index = this.selectedCut;
+        const to = this.draft.cuts[index] + c.frames;
+        this.edit(moveCut(this.draft, index, to, this.n), `the gold cut cannot move past its neighbours`);
+        return this.seekTo(this.draft.cuts[index]);
+      }
+      case "speed":
+        this.playback.nudgeSpeed(c.direction);
+        break;
       case "zoom":
         this.tiers.zoom(c.factor, frame);
         return;
@@ -375,3 +415,4 @@ class AdjudicationPage {
     this.refresh();
   }
 }
+

@@ -169,7 +169,6 @@ class ReviewPage {
         this.refresh();
       },
       selectCut: (id) => s.select(id),
-      acceptCut: (id) => s.perform({ kind: "fate", cutId: id, fate: "accepted" }),
       moveCut: (id, frame) => s.perform({ kind: "move", cutId: id, frame }),
       insertAt: (frame) => s.insertAt(frame),
       restoreCut: (id) => s.perform({ kind: "fate", cutId: id, fate: "pending" }),

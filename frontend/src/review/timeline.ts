@@ -5,31 +5,22 @@
 // it and draws only the playhead, the pointer and the working window on the overview.
 // Where a pointer may do what is decided in hits.ts.
 
-import type { Cut, Label, Segment, Signal } from "../api/types";
+import type { Cut, Signal } from "../api/types";
 import { denseCuts, hitHandle, isDrag, overviewFrame, overviewX, OVERVIEW, RULER, HANDLES, rows, SEGMENTS, zoneAt, type Rows } from "./hits";
 import { isKept } from "./state";
 import { clampView, formatTime, frameToX, fullView, openingView, pageFollow, panBy, resize, snapFrame, zoomAround, type View } from "./timescale";
-import { cutsInView, drawScene, prepareLane, type Lane, type Scene } from "./timelinedraw";
+import { cutsInView, drawScene, prepareLane, type Lane, type Scene, type SceneModel } from "./timelinedraw";
 
 export { readableOn } from "./timelinedraw";
 
-export interface TimelineModel {
-  nFrames: number;
-  fps: number;
-  signals: Signal[];
-  cuts: Cut[];
-  segments: Segment[];
-  labels: Label[];
-  playhead: number;
-  selectedCutId: number | null;
-  loop: { start: number; stop: number } | null;
+/** What the timeline shows (timelinedraw.ts's scene), and whether it may be edited. */
+export interface TimelineModel extends SceneModel {
   readOnly: boolean;
 }
 
 export interface TimelineHandlers {
   seek(frame: number): void;
   selectCut(id: number | null): void;
-  acceptCut(id: number): void;
   moveCut(id: number, frame: number): void;
   insertAt(frame: number): void;
   setLoop(range: { start: number; stop: number } | null): void;
