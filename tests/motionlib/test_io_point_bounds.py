@@ -38,12 +38,17 @@ def qualisys_tsv(tmp_path, names, name="wide.tsv"):
 
 
 def seconds(read, path, **kwargs):
-    started = time.perf_counter()
-    try:
-        read(path, **kwargs)
-    except CaptureError:
-        pass
-    return time.perf_counter() - started
+    """CPU seconds of the fastest of three reads: what the reading costs, not how busy the
+    machine is."""
+    best = float("inf")
+    for _ in range(3):
+        started = time.process_time()
+        try:
+            read(path, **kwargs)
+        except CaptureError:
+            pass
+        best = min(best, time.process_time() - started)
+    return best
 
 
 # ---- points count as joints -----------------------------------------------------------------
@@ -105,7 +110,7 @@ def test_a_csv_header_of_60000_points_costs_about_ten_times_one_of_6000(tmp_path
     small = seconds(read_points_csv, points_csv(tmp_path, 6_000, name="s.csv"), limits=WIDE)
     large = seconds(read_points_csv, points_csv(tmp_path, 60_000, name="l.csv"), limits=WIDE)
     # Linear: about 10 times; the quadratic reading took about 100 times (seconds).
-    assert large < 40 * max(small, 0.005), (small, large)
+    assert large < 40 * max(small, 0.02), (small, large)
 
 
 def test_a_tsv_naming_one_of_60000_markers_twice_is_refused_in_linear_time(tmp_path):
@@ -115,7 +120,7 @@ def test_a_tsv_naming_one_of_60000_markers_twice_is_refused_in_linear_time(tmp_p
     small = seconds(read_qualisys_tsv, qualisys_tsv(tmp_path, names(6_000), "s.tsv"), limits=WIDE)
     path = qualisys_tsv(tmp_path, names(60_000), "l.tsv")
     large = seconds(read_qualisys_tsv, path, limits=WIDE)
-    assert large < 40 * max(small, 0.005), (small, large)
+    assert large < 40 * max(small, 0.02), (small, large)
     with pytest.raises(CaptureError, match=r"l\.tsv:4: MARKER_NAMES: 'm59998' is named twice"):
         read_qualisys_tsv(path, limits=WIDE)
 

@@ -71,4 +71,7 @@ def test_a_product_runs_with_part_of_the_allowance_held(settings, work):
 
 
 def test_past_the_allowance_a_job_meets_a_memory_error(settings):
-    assert in_a_limited_child(settings, 60, numpy_product) == 2
+    # Well past it: a test process may run tests on a thread whose malloc arena has up to
+    # 64 MB of address space reserved already, which a forked child can fill without asking
+    # for more (a pool process runs its jobs on its main thread).
+    assert in_a_limited_child(settings, 200, numpy_product) == 2
