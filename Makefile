@@ -67,7 +67,7 @@ INTEGRATION_ENV := DATABASE_URL=postgres://postgres@127.0.0.1:5432/test \
 # temporary folders and var/ (tests/conftest.py); each integration test's Celery workers
 # read that process's database from a Redis queue of their own.
 PYTEST_WORKERS ?= auto
-XDIST := -n $(PYTEST_WORKERS) --dist worksteal
+XDIST := -n $(PYTEST_WORKERS) --dist worksteal --durations=10
 
 pytest: install
 	$(PY) -m pytest -m "not integration and not e2e" $(XDIST)
