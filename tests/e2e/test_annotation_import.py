@@ -101,3 +101,28 @@ def test_a_file_the_page_cannot_import_is_named_in_the_dialog(live_server, new_p
     expect(page.get_by_test_id("import-ok")).to_be_disabled()
     page.get_by_test_id("import-cancel").click()
     assert screen.review()["id"] is None  # nothing was started, nothing written
+
+
+def test_a_reviewer_imports_a_csv_into_gold_from_the_adjudication_page(live_server, new_page, ingested_capture, studio, tmp_path):
+    from segmentation.models import Adjudication
+    from tests.segmentation.test_library import submit_review
+
+    submit_review(ingested_capture, studio["ann"], [1200], ["walk", "punch"])
+    labels = tmp_path / "gold.csv"
+    labels.write_text("take;start_timecode;end_timecode;label\n"
+                      "warmup_session;00:00:00:000;00:00:10:000;walk\n"
+                      "warmup_session;00:00:10:000;00:00:40:000;squat\n")
+    page = new_page("rachel")
+    page.goto(f"{live_server.url}/captures/{ingested_capture.pk}/adjudicate/")
+    page.get_by_test_id("import-gold").click()
+    expect(page.get_by_role("dialog")).to_contain_text("Import annotations into gold")
+    with page.expect_file_chooser() as chooser:
+        page.get_by_test_id("import-file").click()
+    chooser.value.set_files(str(labels))
+    expect(page.get_by_test_id("import-summary")).to_have_text("2 segments (2 labelled) from gold.csv.")
+    page.get_by_test_id("import-ok").click()
+    expect(page.get_by_role("dialog")).to_have_count(0)
+    expect(page.get_by_test_id("track-gold").locator(".tier-seg")).to_have_count(2)
+    gold = Adjudication.objects.get(capture=ingested_capture)
+    assert (gold.cuts, gold.label_names(), gold.adjudicator.username) == ([1200], ["walk", "squat"], "rachel")
+    assert page.errors == []

@@ -1,23 +1,31 @@
-// The review page's import of existing annotations: a file, then the ELAN tier or Label
-// Studio annotation to take, then a project label for every label the project lacks. The server reads the file (POST …/annotations/
+// Importing existing annotations, into the own review (the review page) or the gold version
+// (the adjudication page): a file, then the ELAN tier or Label Studio annotation to take,
+// then a project label for every label the project lacks. The server reads the file (POST …/annotations/
 // inspect/, which writes nothing) and imports it (…/import/) as one step of the review's
 // history; the page shows the review it answers with.
 
 import { api, ApiError } from "../api/client";
 import type { components } from "../api/schema";
-import type { ApiReview } from "../api/types";
 import { clear, h } from "../ui/dom";
 
 type Inspection = components["schemas"]["Inspection"];
-type Imported = components["schemas"]["Imported"];
+export type Imported = components["schemas"]["Imported"];
 
 export interface ImportTarget {
   captureId: number;
-  /** The version the import is based on (the review's, as the page last saved it). */
+  /** The own review (annotators, everyone) or the gold version (reviewers and admins). */
+  into: "review" | "gold";
+  /** The version the import is based on: the review's as the page last saved it, or the
+   * gold version shown (0 for none). */
   version(): number;
-  /** The review as the server imported it. */
-  imported(review: ApiReview, summary: string): void;
+  /** The server's answer: the review or the gold version as imported. */
+  imported(answer: Imported, summary: string): void;
 }
+
+const INTROS = {
+  review: "Your review becomes the file's segments, as one step you can undo.",
+  gold: "The gold version becomes the file's segments (it needs a submitted review, as any gold version).",
+};
 
 /** Open the import dialog; resolves when it closes (imported or not). */
 export function openImportDialog(target: ImportTarget): Promise<void> {
@@ -27,6 +35,8 @@ export function openImportDialog(target: ImportTarget): Promise<void> {
 class ImportDialog {
   private file: File | null = null;
   private inspection: Inspection | null = null;
+  /** How many times the file was read: only the answer to the latest reading is shown. */
+  private asked = 0;
   private readonly mapping = new Map<string, string>();
   private readonly fileInput = h("input", { type: "file", accept: ".csv,.tsv,.txt,.eaf,.json", "data-testid": "import-file" }) as HTMLInputElement;
   private readonly source = h("select", { class: "input", "data-testid": "import-source" }) as HTMLSelectElement;
@@ -58,11 +68,11 @@ class ImportDialog {
       h(
         "div",
         { class: "modal import-dialog" },
-        h("h2", {}, "Import annotations"),
+        h("h2", {}, target.into === "gold" ? "Import annotations into gold" : "Import annotations"),
         h(
           "div",
           { class: "modal-body" },
-          h("p", { class: "muted" }, "A CSV (take, start, end, label), an ELAN .eaf file or a Label Studio JSON export. Your review becomes the file's segments, as one step you can undo."),
+          h("p", { class: "muted" }, `A CSV (take, start, end, label), an ELAN .eaf file or a Label Studio JSON export. ${INTROS[target.into]}`),
           h("label", { class: "field" }, "File", this.fileInput),
           this.details,
           this.error,
@@ -89,6 +99,7 @@ class ImportDialog {
     if (this.file) data.append("file", this.file);
     if (this.source.value) data.append("source", this.source.value);
     data.append("unit", this.unit.value);
+    data.append("target", this.target.into);
     return data;
   }
 
@@ -103,13 +114,18 @@ class ImportDialog {
     this.showError(null);
     clear(this.details);
     if (!this.file) return;
+    // A tier chosen while the file's first reading is on its way: that answer is stale.
+    const ask = ++this.asked;
+    let found: Inspection;
     try {
-      this.inspection = await api<Inspection>("POST", `/api/captures/${this.target.captureId}/annotations/inspect/`, this.form());
+      found = await api<Inspection>("POST", `/api/captures/${this.target.captureId}/annotations/inspect/`, this.form());
     } catch (err) {
-      this.showError(err instanceof Error ? err.message : String(err));
+      if (ask === this.asked) this.showError(err instanceof Error ? err.message : String(err));
       return;
     }
-    this.render(this.inspection);
+    if (ask !== this.asked) return;
+    this.inspection = found;
+    this.render(found);
   }
 
   private render(found: Inspection): void {
@@ -180,7 +196,7 @@ class ImportDialog {
     this.ok.disabled = true;
     try {
       const answer = await api<Imported>("POST", `/api/captures/${this.target.captureId}/annotations/import/`, data);
-      if (answer.review) this.target.imported(answer.review, `Imported ${found.segments.length} segments from ${found.file}.`);
+      this.target.imported(answer, `Imported ${found.segments.length} segments from ${found.file}.`);
       this.close();
     } catch (err) {
       this.showError(err instanceof ApiError || err instanceof Error ? err.message : String(err));

@@ -269,9 +269,10 @@ class ReviewPage {
     if (s.saver.pending) return toast("Wait until your edits are saved, then import.", "error");
     await openImportDialog({
       captureId: this.capture.id,
+      into: "review",
       version: () => s.saver.server.version,
-      imported: (review, summary) => {
-        s.replaced(withTempIds(review));
+      imported: (answer, summary) => {
+        if (answer.review) s.replaced(withTempIds(answer.review));
         toast(summary);
       },
     });
