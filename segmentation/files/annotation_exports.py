@@ -12,7 +12,7 @@ import itertools
 import zipfile
 from pathlib import PurePath
 
-from motionlib.io import annotations as fmt
+import motionlib.io.annotations as fmt
 from segmentation.files.exports import ZIP_ENTRY_TIME, slug
 
 FORMATS = {"csv": ("text/csv", "csv"), "eaf": ("application/xml", "eaf"),

@@ -21,7 +21,7 @@ import json
 
 from django.db import transaction
 
-from motionlib.io import annotations as fmt
+import motionlib.io.annotations as fmt
 from segmentation.errors import Invalid, NotReady
 from segmentation.models import Cut, ReviewEvent, SegmentLabel
 from segmentation.services.gold import do_save_gold

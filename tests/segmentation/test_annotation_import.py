@@ -206,3 +206,18 @@ class GoldImportTest(ImportBase):
         for step in ("inspect", "import"):
             assert self.send(step, self.CSV, target="gold", version=0).status_code == 404
         assert not Adjudication.objects.filter(capture=self.capture).exists()
+
+
+def test_the_services_read_the_format_package_whatever_was_imported_before():
+    """``motionlib.io`` has ``from __future__ import annotations``: ``from motionlib.io
+    import annotations`` gave that feature object, not the package, unless something had
+    imported the package first. A fresh interpreter imports the services alone."""
+    import subprocess
+    import sys
+
+    code = ("import os, django; os.environ.setdefault('DJANGO_SETTINGS_MODULE', 'cutroom.settings');"
+            "django.setup(); from segmentation.services import annotations;"
+            "from segmentation.files import annotation_exports as exports;"
+            "print(annotations.fmt.Track.__name__, exports.fmt.write_eaf.__name__)")
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert result.stdout.split() == ["Track", "write_eaf"], result.stderr[-500:]
