@@ -242,3 +242,21 @@ def test_a_real_labelling_with_overlapping_intervals_is_refused_by_line():
     with pytest.raises(AnnotationError, match=r"intervals.csv: line 3 \(frames 417..553\) "
                                               r"overlaps line 2 \(frames 28..484\)"):
         check_spans(take, n_frames=10_000, name="intervals.csv")
+
+
+@pytest.mark.parametrize("name, fmt, data, message", [
+    ("deep.json", "labelstudio", b"[" * 100_000 + b"]" * 100_000,
+     "deep.json: nested too deeply to be a Label Studio export"),
+    ("big.csv", "csv", b"start,end,label\n0,10,x\n0,10," + b"x" * 200_000 + b"\n",
+     "big.csv: line 3: field larger than field limit (131072)"),
+    ("nul.csv", "csv", b"start,end,label\n0,10,wa\x00lk\n",
+     r"nul.csv: line 2: the label 'wa\x00lk' is not a name"),
+    ("late.eaf", "eaf", b"<!--" + b"x" * 5000 + b'--><!DOCTYPE a [<!ENTITY e "x">]><ANNOTATION_DOCUMENT/>',
+     "late.eaf: has a DOCTYPE or entity declaration"),
+])
+def test_hostile_files_are_refused_with_their_reason(name, fmt, data, message):
+    """Each of these raised something other than an AnnotationError (a RecursionError, the
+    csv module's error) or passed a NUL into names the database stores."""
+    with pytest.raises(AnnotationError) as caught:
+        read_annotations(data, name, fmt, fps=FPS)
+    assert str(caught.value).startswith(message)

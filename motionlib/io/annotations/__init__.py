@@ -16,6 +16,9 @@ or result; nothing here knows about projects, labels in use or users.
 
 from __future__ import annotations
 
+import re
+
+from motionlib.errors import shorten
 from motionlib.io.annotations.csvfile import read_annotations_csv, write_annotations_csv
 from motionlib.io.annotations.eaf import read_eaf, write_eaf
 from motionlib.io.annotations.labelstudio import read_label_studio, write_label_studio
@@ -26,6 +29,7 @@ from motionlib.io.annotations.model import (
     Span,
     Track,
     check_spans,
+    fail,
     matches_take,
     select,
     sources_of,
@@ -36,6 +40,8 @@ __all__ = ["FORMATS", "AnnotationError", "Record", "Span", "Track", "check_spans
            "read_eaf", "read_label_studio", "select", "sources_of", "write_annotations_csv",
            "write_eaf", "write_label_studio"]
 
+MAX_NAME = 200
+CONTROL = re.compile(r"[\x00-\x1f\x7f]")
 EXTENSIONS = {".csv": "csv", ".tsv": "csv", ".txt": "csv", ".eaf": "eaf", ".json": "labelstudio"}
 
 
@@ -62,10 +68,27 @@ def read_annotations(data: bytes, name: str, fmt: str, *, fps: float,
     """
     text = decode(data, name)
     if fmt == "csv":
-        return read_annotations_csv(text, name=name, fps=fps)
-    if fmt == "eaf":
-        return read_eaf(text, name=name, fps=fps)
-    return read_label_studio(text, name=name, fps=fps, unit=unit)
+        records = read_annotations_csv(text, name=name, fps=fps)
+    elif fmt == "eaf":
+        records = read_eaf(text, name=name, fps=fps)
+    else:
+        records = read_label_studio(text, name=name, fps=fps, unit=unit)
+    return check_names(records, name)
+
+
+def check_names(records: list[Record], name: str) -> list[Record]:
+    """``records`` if every label and source is printable text of at most
+    :data:`MAX_NAME` characters (a label is a name people read, and it is logged);
+    AnnotationError lists the others by their place."""
+    problems = []
+    for r in records:
+        for what, value in (("label", r.label), ("source", r.source)):
+            if value and (len(value) > MAX_NAME or CONTROL.search(value)):
+                problems.append(f"{r.where}: the {what} {shorten(value)} is not a name "
+                                f"(control characters, or more than {MAX_NAME} characters)")
+    if problems:
+        fail(name, problems)
+    return records
 
 
 def decode(data: bytes, name: str) -> str:

@@ -62,6 +62,14 @@ def read_annotations_csv(text: str, *, name: str, fps: float) -> list[Record]:
     header = lines[skip]
     delimiter = max(",;\t", key=header.count)
     reader = csv.reader(io.StringIO("".join(lines[skip:])), delimiter=delimiter)
+    try:
+        return _rows(reader, name, fps, skip)
+    except csv.Error as exc:
+        # A cell over the csv module's size limit, a quote left open at the end…
+        raise AnnotationError(f"{name}: line {reader.line_num + skip}: {exc}") from None
+
+
+def _rows(reader, name, fps, skip):
     columns = [c.strip().lower().replace(" ", "_").replace("-", "_") for c in next(reader)]
     layout = _layout(columns, name, skip + 1)
     records, problems = [], []

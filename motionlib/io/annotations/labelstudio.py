@@ -44,6 +44,8 @@ def read_label_studio(text: str, *, name: str, fps: float, unit: str = "seconds"
         tasks = json.loads(text)
     except ValueError as exc:
         raise AnnotationError(f"{name}: not JSON ({shorten(str(exc), 80)})") from None
+    except RecursionError:
+        raise AnnotationError(f"{name}: nested too deeply to be a Label Studio export") from None
     if isinstance(tasks, dict):
         tasks = [tasks]
     if not isinstance(tasks, list) or not all(isinstance(t, dict) for t in tasks):
