@@ -47,11 +47,13 @@ class Parsed:
                                             fps=capture.fps, unit=unit)
         self.sources = fmt.sources_of(self.records)
         self.source = source if source is not None or len(self.sources) > 1 else None
-        self.spans = None
+        self.spans, self.other_takes = None, 0
         if source is not None or len(self.sources) <= 1:
             chosen = fmt.select(self.records, take=capture.name, source=source, name=self.name)
             self.spans = fmt.check_spans(chosen, n_frames=capture.n_frames, name=self.name)
             self.source = chosen[0].source
+            # Rows of the same source about other takes (a CSV of a whole session).
+            self.other_takes = sum(1 for r in self.records if r.source == self.source) - len(chosen)
 
 
 def label_summary(project, spans):
@@ -79,6 +81,7 @@ def inspect(capture, parsed):
     return {
         "file": parsed.name, "format": parsed.format, "sources": parsed.sources,
         "source": parsed.source, "chosen": parsed.spans is not None,
+        "other_takes": parsed.other_takes,
         "segments": [{"start": s.start, "stop": s.stop, "label": s.label, "where": s.where}
                      for s in spans],
         "labels": label_summary(capture.project, spans),

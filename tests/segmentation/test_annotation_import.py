@@ -54,7 +54,7 @@ class ReviewImportTest(ImportBase):
         r = self.send("inspect", CSV)
         assert r.status_code == 200, r.content
         body = r.json()
-        assert body["format"] == "csv" and body["chosen"]
+        assert body["format"] == "csv" and body["chosen"] and body["other_takes"] == 1
         # Rows of other takes are not this capture's.
         assert [(s["start"], s["stop"], s["label"]) for s in body["segments"]] == [
             (0, 100, "walk"), (150, 250, "Punch"), (250, 400, "jump")]

@@ -1450,6 +1450,8 @@ export interface components {
             source: string | null;
             /** @description false while the file has several sources and none was chosen */
             chosen: boolean;
+            /** @description annotations of the chosen source about other takes, left out */
+            other_takes: number;
             segments: components["schemas"]["FileSegment"][];
             labels: components["schemas"]["FileLabel"][];
             project_labels: string[];

@@ -146,6 +146,7 @@ class ImportDialog {
     if (found.chosen) {
       const labelled = found.segments.filter((s) => s.label).length;
       parts.push(h("p", { "data-testid": "import-summary" }, `${found.segments.length} segment${found.segments.length === 1 ? "" : "s"} (${labelled} labelled) from ${found.file}.`));
+      if (found.other_takes) parts.push(h("p", { class: "muted", "data-testid": "import-other-takes" }, `${found.other_takes} annotation${found.other_takes === 1 ? " is" : "s are"} about other takes and left out.`));
       parts.push(...this.mappingRows(found));
     }
     clear(this.details, ...parts);

@@ -60,6 +60,8 @@ class InspectionSerializer(serializers.Serializer):
     source = serializers.CharField(allow_null=True)
     chosen = serializers.BooleanField(help_text="false while the file has several sources "
                                       "and none was chosen")
+    other_takes = serializers.IntegerField(help_text="annotations of the chosen source about "
+                                           "other takes, left out")
     segments = FileSegmentSerializer(many=True)
     labels = FileLabelSerializer(many=True)
     project_labels = serializers.ListField(child=serializers.CharField())
