@@ -171,17 +171,28 @@ def test_it_reads_label_studio_time_series_regions_of_the_named_take():
     records = read(json.dumps(LABEL_STUDIO_EXPORT), "labelstudio")
     # One task: about any take; the choices result is not a segment.
     assert spans(records) == [(0, 208, "walk"), (803, 1200, "Punch")]
-    assert records[0].source == "task 17, annotation 41"
+    assert records[0].source == "task 17, annotation 41 by user 3"
     assert records[1].where == "task 17, annotation 41, result 'b7Rr0e'"
 
     two = LABEL_STUDIO_EXPORT + [{**LABEL_STUDIO_EXPORT[0], "id": 18,
                                   "data": {"ts": "/data/upload/2/0a1b2c3d-13_29.csv"}}]
     chosen = select(read(json.dumps(two), "labelstudio"), take="13_29.bvh",
-                    source="task 18, annotation 41", name="f")
+                    source="task 18, annotation 41 by user 3", name="f")
     assert spans(chosen) == [(0, 208, "walk"), (803, 1200, "Punch")]
     with pytest.raises(AnnotationError, match="no annotation of f is for take '86_01.bvh'"):
         select(read(json.dumps(two), "labelstudio"), take="86_01.bvh",
-               source="task 18, annotation 41", name="f")
+               source="task 18, annotation 41 by user 3", name="f")
+
+
+def test_a_label_studio_source_names_who_completed_it_when_the_export_says():
+    export = [{"id": 1, "data": {}, "annotations": [
+        {"id": 2, "completed_by": {"id": 3, "email": "ann@studio.org"}, "result": []},
+        {"id": 4, "completed_by": 5, "result": []}, {"id": 6, "result": []}]}]
+    for number in (2, 4, 6):
+        export[0]["annotations"][number // 2 - 1]["result"] = [{"id": "r", "type": "labels", "value": {
+            "start": number, "end": number + 1, "labels": ["walk"]}}]
+    assert [r.source for r in read(json.dumps(export), "labelstudio")] == [
+        "task 1, annotation 2 by ann@studio.org", "task 1, annotation 4 by user 5", "task 1, annotation 6"]
 
 
 def test_it_reads_label_studio_frames_and_video_timeline_ranges():

@@ -18,8 +18,8 @@ The layout Label Studio's "JSON" export writes (and its import reads)::
 - results of other types (choices, text areas, rectangles) are not segments and are passed
   over; a region with more than one label is refused (a segment carries one).
 
-Each annotation of each task is a source, ``"task 12, annotation 40"``; cancelled ones are
-passed over. A task names its take by the file names among its ``data`` values (matched
+Each annotation of each task is a source, ``"task 12, annotation 40 by user 3"`` (who
+completed it, when the export says); cancelled ones are passed over. A task names its take by the file names among its ``data`` values (matched
 by stem, ignoring the ``ab12cd34-`` prefix of an upload); a file of one task is about any
 take.
 """
@@ -62,13 +62,14 @@ def read_label_studio(text: str, *, name: str, fps: float, unit: str = "seconds"
         for a_number, annotation in enumerate(annotations):
             if not isinstance(annotation, dict) or annotation.get("was_cancelled"):
                 continue
-            source = f"task {task_id}, annotation {annotation.get('id', a_number + 1)}"
+            place = f"task {task_id}, annotation {annotation.get('id', a_number + 1)}"
+            source = place + _who(annotation.get("completed_by"))
             results = annotation.get("result")
             if not isinstance(results, list):
-                problems.append(f"{source}: has no result list")
+                problems.append(f"{place}: has no result list")
                 continue
             for r_number, result in enumerate(results):
-                where = f"{source}, result {_result_id(result, r_number)}"
+                where = f"{place}, result {_result_id(result, r_number)}"
                 try:
                     records += _records(result, fps, unit, where, source, takes)
                 except TimeError as exc:
@@ -81,6 +82,16 @@ def read_label_studio(text: str, *, name: str, fps: float, unit: str = "seconds"
 def _result_id(result, number):
     rid = result.get("id") if isinstance(result, dict) else None
     return shorten(rid, 20) if rid is not None else f"#{number + 1}"
+
+
+def _who(completed_by):
+    """" by user 3" (an export's user id) or " by ann@studio.org" (an expanded user), so
+    that the import dialog tells annotators apart; "" when the export does not say."""
+    if isinstance(completed_by, dict):
+        completed_by = completed_by.get("email") or completed_by.get("id")
+    if isinstance(completed_by, bool) or not isinstance(completed_by, int | str) or completed_by == "":
+        return ""
+    return f" by user {completed_by}" if isinstance(completed_by, int) else f" by {completed_by[:60]}"
 
 
 def _takes(data):
