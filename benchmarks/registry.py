@@ -60,6 +60,8 @@ BENCHMARKS = {
     "review-playback": Benchmark("benchmarks.service.review_playback", "the review page's "
                                  "redraw interval and scrub latency on 38-s, 10- and "
                                  "60-minute takes, the old front end against the new"),
+    "annotation-import": Benchmark("benchmarks.service.annotation_import", "an hour-long "
+                                   "take's labels imported, against edit by edit"),
     "retrain": Benchmark("benchmarks.service.retrain", "retraining a project's cut model"),
     "poisoning": Benchmark("benchmarks.service.poisoning", "one annotator against a "
                            "project's model"),

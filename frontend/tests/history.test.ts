@@ -30,6 +30,12 @@ describe("historyFromEvents", () => {
     expect(h).toEqual({ past: ["restore 1 change"], future: [] });
   });
 
+  it("test_it_counts_an_imported_file_as_one_step_named_by_its_file", () => {
+    const imported = event("import", { cuts: [], labels: [] }, { cuts: [[1, 200, "accepted"]], labels: [], file: "take.eaf", source: "moves", segments: 3 });
+    const h = historyFromEvents([event("create"), move(200, 230), imported, restore("undo")]);
+    expect(h).toEqual({ past: ["move frame 200 → 230"], future: ["import 3 segments from take.eaf (moves)"] });
+  });
+
   it("test_it_ignores_an_undo_with_nothing_to_undo", () => {
     expect(historyFromEvents([event("create"), restore("undo")])).toEqual(emptyHistory());
   });

@@ -4,6 +4,8 @@
   (``count`` exact up to 10,000 matches, else 10,000 with ``count_capped``)
 - ``GET /api/segments/{id}/``, ``…/export.bvh``, ``…/export.fbx``, ``…/export.glb``
 - ``GET /api/segments/export.zip?<same filters>&file_format=bvh|fbx|glb`` (streamed)
+- ``GET /api/segments/annotations.{csv|eaf|labelstudio}?<same filters>``: the matching
+  segments' labels as annotation files (``files.annotation_exports``)
 
 Annotators see their own segments and gold segments; reviewers and admins everybody's.
 """
@@ -20,7 +22,7 @@ from rest_framework.views import APIView
 from segmentation.api.common.params import bool_param, float_param, int_param
 from segmentation.api.common.serializers.library import SegmentSerializer
 from segmentation.errors import Invalid
-from segmentation.files import exports
+from segmentation.files import annotation_exports, exports
 from segmentation.files.storage import read_take
 from segmentation.queries.access import segment_for
 from segmentation.queries.library import (
@@ -192,9 +194,33 @@ class SegmentZipView(APIView):
         return response
 
 
+class SegmentAnnotationsView(APIView):
+    @extend_schema(responses={(200, "application/octet-stream"): bytes})
+    def get(self, request, form):
+        """The matching segments as annotations: one CSV or Label Studio file of every
+        take, or a zip of one ELAN document per take (a tier per annotator and gold)."""
+        if form not in annotation_exports.FORMATS:
+            raise NotFound(f"No export as {form!r}; choose csv, eaf or labelstudio.")
+        segments = list_query(request).segments()
+        count = segments.count()
+        if count > annotation_exports.MAX_SEGMENTS:
+            raise Invalid(f"export: the query matches {count} segments; export at most "
+                          f"{annotation_exports.MAX_SEGMENTS} at a time (narrow the filters)")
+        rows = (segments.select_related("capture", "annotator", "label")
+                .defer("descriptor", "profile", "capture__skeleton")
+                .order_by("capture_id", "is_gold", "annotator_id", "start", "id"))
+        data, content_type, name = annotation_exports.render(
+            form, annotation_exports.library_tracks(rows.iterator(chunk_size=500)), "annotations")
+        response = HttpResponse(data, content_type=content_type)
+        response["Content-Disposition"] = f'attachment; filename="{name}"'
+        return response
+
+
 urlpatterns = [
     path("segments/", SegmentListView.as_view(), name="api-segments"),
     path("segments/export.zip", SegmentZipView.as_view(), name="api-segments-zip"),
+    path("segments/annotations.<str:form>", SegmentAnnotationsView.as_view(),
+         name="api-segments-annotations"),
     path("segments/<int:pk>/", SegmentView.as_view(), name="api-segment"),
     path("segments/<int:pk>/export.bvh", SegmentBvhView.as_view(), name="api-segment-bvh"),
     path("segments/<int:pk>/export.<str:fmt>", SegmentClipView.as_view(), name="api-segment-clip"),

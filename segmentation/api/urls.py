@@ -5,6 +5,7 @@ from rest_framework.routers import SimpleRouter
 from segmentation.api import (
     adjudication,
     agreement,
+    annotations,
     assignments,
     dashboard,
     health,
@@ -46,6 +47,7 @@ urlpatterns = [
     *similar.urlpatterns,
     *agreement.urlpatterns,
     *adjudication.urlpatterns,
+    *annotations.urlpatterns,
     *dashboard.urlpatterns,
     *invitations.urlpatterns,
     *assignments.urlpatterns,

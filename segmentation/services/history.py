@@ -20,7 +20,8 @@ from segmentation.models import Cut, SegmentLabel
 from segmentation.services.reviews import _log, _write
 
 #: Events that change cuts or labels and so are steps of the undo history.
-STEP_ACTIONS = frozenset({"insert", "accept", "delete", "reset", "move", "label", "restore"})
+STEP_ACTIONS = frozenset({"insert", "accept", "delete", "reset", "move", "label", "restore",
+                          "import"})
 CUT_ACTIONS = frozenset({"insert", "accept", "delete", "reset", "move"})
 
 
@@ -45,7 +46,8 @@ def _take_back(event, cuts, labels, candidates):
     before, after = event.before or {}, event.after or {}
     if event.action == "label":
         labels[event.cut_id] = before.get("label")
-    elif event.action == "restore":
+    elif event.action in ("restore", "import"):
+        # An import (services.annotations) lists what it changed as a restore does.
         cuts.update({pk: (frame, fate) for pk, frame, fate in before.get("cuts", [])})
         labels.update({cut_id: label for cut_id, label in before.get("labels", [])})
     elif event.action == "candidates":

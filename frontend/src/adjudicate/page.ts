@@ -6,7 +6,9 @@
 import { ApiError, api, get } from "../api/client";
 import type { Capture, LabelChoice } from "../api/types";
 import { addCut, fromSpans, moveCut, removeCut, sameDraft, segmentAt, setLabel, toSpans, type Draft } from "../library/gold";
+import { annotationExportMenu, captureAnnotationsUrl } from "../library/annotationExport";
 import { topbar } from "../library/nav";
+import { openImportDialog } from "../review/annotationsDialog";
 import type { Adjudication, Span } from "../library/types";
 import { PlaybackController } from "../player/playback";
 import { SkeletonView } from "../player/skeletonView";
@@ -171,6 +173,7 @@ class AdjudicationPage {
             "div",
             { class: "adj-panel" },
             h("div", { class: "adj-actions" }, button("play", "Play", "Play / pause (Space)", () => this.command({ kind: "play" })), button("undo", "Undo", "Undo (Z, Ctrl+Z)", () => this.command({ kind: "undo" })), button("redo", "Redo", "Redo (Shift+Z)", () => this.command({ kind: "redo" })), button("save-gold", "Save gold version", "Save the gold version", () => void this.save(), "btn-primary"), el.status),
+            h("div", { class: "adj-actions" }, button("import-gold", "Import into gold…", "Make the gold version a CSV, ELAN or Label Studio file's segments", () => void this.importGold()), annotationExportMenu((f) => captureAnnotationsUrl(this.capture.id, f, "all"), "every review and gold", "Download every review and the gold version for ELAN, Label Studio or a spreadsheet", "export-annotations")),
             el.editor,
             h("div", { class: "adj-uses" }, ...uses),
             legend,
@@ -275,6 +278,27 @@ class AdjudicationPage {
   private labelUnderPlayhead(name: string | null): void {
     const index = segmentAt(this.draft, this.frame());
     this.edit(setLabel(this.draft, index, name), "same label");
+  }
+
+  /** Import a file as the gold version (review/annotationsDialog.ts); the page then shows
+   * the gold version the server saved, as after a save. */
+  private async importGold(): Promise<void> {
+    await openImportDialog({
+      captureId: this.capture.id,
+      into: "gold",
+      version: () => this.data.gold?.version ?? 0,
+      imported: (_answer, summary) => void this.reloadGold(summary),
+    });
+  }
+
+  private async reloadGold(summary: string): Promise<void> {
+    this.data = await get<Adjudication>(`/api/captures/${this.capture.id}/adjudication/`);
+    if (this.data.gold) {
+      this.saved = fromSpans(this.data.gold.segments);
+      this.history = push(this.history, this.saved);
+    }
+    toast(`${summary} Gold version ${this.data.gold?.version ?? ""} saved.`);
+    this.refresh();
   }
 
   private async save(): Promise<void> {

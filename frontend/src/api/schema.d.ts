@@ -166,6 +166,58 @@ export interface paths {
         patch?: never;
         trace?: never;
     };
+    "/api/captures/{id}/annotations/export.{form}": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get: operations["captures_annotations_export._retrieve"];
+        put?: never;
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/captures/{id}/annotations/import/": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /**
+         * @description Import into the caller's review or into the gold version; the answer is the one
+         *     imported into.
+         */
+        post: operations["captures_annotations_import_create"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/captures/{id}/annotations/inspect/": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        post: operations["captures_annotations_inspect_create"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
     "/api/captures/{id}/frames/": {
         parameters: {
             query?: never;
@@ -909,6 +961,26 @@ export interface paths {
         patch?: never;
         trace?: never;
     };
+    "/api/segments/annotations.{form}": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /**
+         * @description The matching segments as annotations: one CSV or Label Studio file of every
+         *     take, or a zip of one ELAN document per take (a tier per annotator and gold).
+         */
+        get: operations["segments_annotations._retrieve"];
+        put?: never;
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
     "/api/segments/export.zip": {
         parameters: {
             query?: never;
@@ -1051,6 +1123,8 @@ export interface components {
             username: string;
             password: string;
         };
+        /** @enum {unknown} */
+        BlankEnum: "";
         Candidate: {
             frame: number;
             /** Format: double */
@@ -1230,6 +1304,27 @@ export interface components {
             /** Format: date-time */
             created_at: string;
         };
+        FileLabel: {
+            name: string;
+            count: number;
+            /** @description a label in use of the project */
+            known: boolean;
+            /** @description the label in use that differs only in case and spaces */
+            suggestion: string | null;
+        };
+        FileSegment: {
+            start: number;
+            stop: number;
+            label: string | null;
+            where: string;
+        };
+        /**
+         * @description * `csv` - csv
+         *     * `eaf` - eaf
+         *     * `labelstudio` - labelstudio
+         * @enum {string}
+         */
+        FormatEnum: "csv" | "eaf" | "labelstudio";
         /**
          * @description Joint positions of frames start, start + step, … before stop (base64 of little-endian
          *     float32, shape (n_frames, n_joints, 3)); the client continues from stop.
@@ -1254,6 +1349,11 @@ export interface components {
             /** Format: date-time */
             updated_at: string;
         };
+        GoldImported: {
+            cuts: number[];
+            labels: (string | null)[];
+            version: number;
+        };
         GoldRequest: {
             cuts: number[];
             labels: (string | null)[];
@@ -1275,9 +1375,86 @@ export interface components {
              */
             f1: number;
         };
+        ImportRequest: {
+            /**
+             * Format: binary
+             * @description CSV, ELAN .eaf or Label Studio JSON export
+             */
+            file: string;
+            /**
+             * @description by the extension when absent
+             *
+             *     * `csv` - csv
+             *     * `eaf` - eaf
+             *     * `labelstudio` - labelstudio
+             */
+            format?: components["schemas"]["FormatEnum"] | components["schemas"]["BlankEnum"];
+            /** @description the tier, annotation or annotator to import */
+            source?: string;
+            /**
+             * @description what Label Studio's start/end count
+             *
+             *     * `seconds` - seconds
+             *     * `frames` - frames
+             * @default seconds
+             */
+            unit: components["schemas"]["UnitEnum"];
+            /** @default review */
+            target: components["schemas"]["TargetEnum"];
+            /** @description JSON object: file label -> project label */
+            mapping?: string;
+            /** @description the review's version, or the gold version (0 when there is none) */
+            version: number;
+        };
+        Imported: {
+            /** @description the review as imported (target review) */
+            review: components["schemas"]["Review"] | null;
+            /** @description the gold version as imported (target gold) */
+            gold: components["schemas"]["GoldImported"] | null;
+        };
         InsertCutRequest: {
             version: number;
             frame: number;
+        };
+        InspectRequest: {
+            /**
+             * Format: binary
+             * @description CSV, ELAN .eaf or Label Studio JSON export
+             */
+            file: string;
+            /**
+             * @description by the extension when absent
+             *
+             *     * `csv` - csv
+             *     * `eaf` - eaf
+             *     * `labelstudio` - labelstudio
+             */
+            format?: components["schemas"]["FormatEnum"] | components["schemas"]["BlankEnum"];
+            /** @description the tier, annotation or annotator to import */
+            source?: string;
+            /**
+             * @description what Label Studio's start/end count
+             *
+             *     * `seconds` - seconds
+             *     * `frames` - frames
+             * @default seconds
+             */
+            unit: components["schemas"]["UnitEnum"];
+            /** @default review */
+            target: components["schemas"]["TargetEnum"];
+        };
+        Inspection: {
+            file: string;
+            format: string;
+            sources: string[];
+            source: string | null;
+            /** @description false while the file has several sources and none was chosen */
+            chosen: boolean;
+            /** @description annotations of the chosen source about other takes, left out */
+            other_takes: number;
+            segments: components["schemas"]["FileSegment"][];
+            labels: components["schemas"]["FileLabel"][];
+            project_labels: string[];
         };
         /** @description An invitation as the project's admins see it (the invitee's username as typed). */
         Invitation: {
@@ -1832,6 +2009,12 @@ export interface components {
             pending: boolean;
             suggestions: components["schemas"]["Suggestion"][];
         };
+        /**
+         * @description * `review` - review
+         *     * `gold` - gold
+         * @enum {string}
+         */
+        TargetEnum: "review" | "gold";
         /** @description Who is assigned a capture, and each review's annotator and state. */
         Team: {
             assigned: string[];
@@ -1842,6 +2025,12 @@ export interface components {
             annotator: string;
             status: components["schemas"]["ReviewStatusEnum"];
         };
+        /**
+         * @description * `seconds` - seconds
+         *     * `frames` - frames
+         * @enum {string}
+         */
+        UnitEnum: "seconds" | "frames";
         UploadRequest: {
             /** Format: binary */
             file: string;
@@ -2195,6 +2384,81 @@ export interface operations {
                 };
                 content: {
                     "application/json": components["schemas"]["Agreement"];
+                };
+            };
+        };
+    };
+    "captures_annotations_export._retrieve": {
+        parameters: {
+            query?: {
+                /** @description mine (default), gold, all (reviewers and admins) or a review id */
+                source?: string;
+            };
+            header?: never;
+            path: {
+                form: string;
+                id: number;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/octet-stream": string;
+                };
+            };
+        };
+    };
+    captures_annotations_import_create: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path: {
+                id: number;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "multipart/form-data": components["schemas"]["ImportRequest"];
+            };
+        };
+        responses: {
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["Imported"];
+                };
+            };
+        };
+    };
+    captures_annotations_inspect_create: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path: {
+                id: number;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "multipart/form-data": components["schemas"]["InspectRequest"];
+            };
+        };
+        responses: {
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["Inspection"];
                 };
             };
         };
@@ -3441,6 +3705,27 @@ export interface operations {
                 };
                 content: {
                     "application/json": components["schemas"]["Similar"];
+                };
+            };
+        };
+    };
+    "segments_annotations._retrieve": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path: {
+                form: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/octet-stream": string;
                 };
             };
         };

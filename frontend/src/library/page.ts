@@ -5,6 +5,7 @@ import { get } from "../api/client";
 import type { Me, Page, Project } from "../api/types";
 import type { Member } from "../queue/api";
 import { clear, clip, formatDuration, h, toast } from "../ui/dom";
+import { annotationExportMenu } from "./annotationExport";
 import { clipsWhat, downloadWithProgress } from "./download";
 import { topbar } from "./nav";
 import { GlbPreview } from "./gltfPreview";
@@ -129,6 +130,7 @@ export async function renderLibrary(root: HTMLElement): Promise<() => void> {
     field("ordering", h("select", { class: "select" }, ...options(ORDERINGS))),
     zipFormat,
     exportZip,
+    annotationExportMenu((f) => `/api/segments/annotations.${f}?${libraryQuery(filters, false)}`, "these segments' labels", "Download these segments' labels for ELAN, Label Studio or a spreadsheet", "export-annotations"),
   );
 
   // The list shows agreement; "Similar" shows motion distance in the same column.

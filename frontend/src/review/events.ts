@@ -10,6 +10,8 @@ export function eventDetail(e: Pick<ReviewEvent, "action" | "before" | "after">)
   // A review opened before detection finished takes the run's candidates in afterwards.
   if (e.action === "candidates") return `${after.candidates ?? 0} candidates arrived`;
   if (e.action === "restore") return restoreDetail(after);
+  // An imported file (services/annotations.py): how many segments, from which file and tier.
+  if (e.action === "import") return `${after.segments ?? 0} segments from ${after.file ?? "a file"}${after.source ? ` (${after.source})` : ""}`;
   if ("index" in after || "index" in before) {
     const index = Number(after.index ?? before.index);
     return `segment ${index + 1}: ${before.label ?? "—"} → ${after.label ?? "—"}`;

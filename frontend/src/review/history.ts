@@ -17,7 +17,7 @@ export interface History {
 }
 
 /** Events that change cuts or labels: the steps of the history. */
-const STEP_ACTIONS = new Set(["insert", "accept", "delete", "reset", "move", "label", "restore"]);
+const STEP_ACTIONS = new Set(["insert", "accept", "delete", "reset", "move", "label", "restore", "import"]);
 
 export const emptyHistory = (): History => ({ past: [], future: [] });
 

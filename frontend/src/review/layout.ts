@@ -6,6 +6,7 @@ import { SPEEDS } from "../player/clock";
 import { clip, formatDuration, h } from "../ui/dom";
 import { accountLinks, appLinks } from "../ui/appnav";
 import { icon } from "../ui/icons";
+import { annotationExportMenu, captureAnnotationsUrl } from "../library/annotationExport";
 import type { Command } from "./keymap";
 
 export interface LayoutActions {
@@ -16,6 +17,7 @@ export interface LayoutActions {
   follow(): void;
   speed(value: number): void;
   zoom(factor: number): void;
+  importAnnotations(): void;
 }
 
 export type Elements = Record<string, HTMLElement>;
@@ -65,6 +67,8 @@ function topbar(c: ReadyCapture, me: Me, el: Elements, button: ButtonMaker, acti
     h("span", { class: "spacer" }),
     (el.reviewPicker = h("span", { class: "review-picker" })),
     (el.saveState = h("span", { class: "save-state", "data-testid": "save-state" }, "Saved")),
+    button("import-annotations", "Import…", "Import segments from a CSV, ELAN or Label Studio file into your review", actions.importAnnotations),
+    annotationExportMenu((f) => captureAnnotationsUrl(c.id, f), "your review", "Download your review's segments for ELAN, Label Studio or a spreadsheet", "export-annotations"),
     button("submit", "Submit review", "Mark this review finished; it can no longer be edited", actions.submit, "btn-primary"),
     button("submit-next", "Submit & next", "Submit, then open the oldest open capture of your queue", actions.submitNext),
     ...appLinks(c.project, me.projects.find((p) => p.id === c.project)?.role ?? null),

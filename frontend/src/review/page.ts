@@ -13,6 +13,7 @@ import { PlaybackController } from "../player/playback";
 import { clear, h, toast } from "../ui/dom";
 import { icon } from "../ui/icons";
 import { Commands } from "./commands";
+import { openImportDialog } from "./annotationsDialog";
 import { confirmSubmit, openNext, showConflict } from "./dialogs";
 import { eventDetail } from "./events";
 import { pageCommand } from "./keys";
@@ -121,6 +122,7 @@ class ReviewPage {
       follow: () => this.el.follow.classList.toggle("active", this.stage.toggleFollow()),
       speed: (v) => this.setSpeed(v),
       zoom: (factor) => this.timeline.zoom(factor, this.playback.frame),
+      importAnnotations: () => void this.importAnnotations(),
     });
     this.el = layout.el;
     clear(root, layout.root);
@@ -257,6 +259,24 @@ class ReviewPage {
     requestAnimationFrame(() => (this.el.timeline.dataset.lanesMs = String(Math.round(performance.now()))));
   }
 
+  /** Import a file's segments into the own review (annotationsDialog.ts); the review the
+   * server answers with replaces the one shown, and the history is read from its log. */
+  private async importAnnotations(): Promise<void> {
+    const s = this.session;
+    const locked = s.locked();
+    if (locked) return toast(locked, "error");
+    if (s.saver.pending) return toast("Wait until your edits are saved, then import.", "error");
+    await openImportDialog({
+      captureId: this.capture.id,
+      into: "review",
+      version: () => s.saver.server.version,
+      imported: (answer, summary) => {
+        if (answer.review) s.replaced(withTempIds(answer.review));
+        toast(summary);
+      },
+    });
+  }
+
   private async submit(next: boolean): Promise<void> {
     const s = this.session;
     // Proposals the annotator did not accept: unlabelled segments that show a suggested label.
@@ -285,7 +305,7 @@ function showControls(el: Elements, session: ReviewSession, playback: PlaybackCo
   const locked = session.locked() !== null;
   el.undo.toggleAttribute("disabled", locked || session.history.past.length === 0);
   el.redo.toggleAttribute("disabled", locked || session.history.future.length === 0);
-  for (const id of ["accept", "delete", "insert", "submit", "submit-next"]) el[id].toggleAttribute("disabled", locked);
+  for (const id of ["accept", "delete", "insert", "submit", "submit-next", "import-annotations"]) el[id].toggleAttribute("disabled", locked);
   el.submit.textContent = review.status === "submitted" ? "Submitted" : review.status === "returned" ? "Resubmit" : "Submit review";
   const returned = review.status === "returned" ? `Returned by a reviewer: “${review.return_comment ?? ""}” — edit and resubmit.` : "";
   const banner = session.readOnly ? `Viewing ${review.annotator.username}'s review — read-only.` : locked ? "You submitted this review — read-only." : returned;

@@ -29,7 +29,7 @@ export class ReviewSession {
   private other: Review | null = null;
   private pushes = 0;
   private nextTempId: number;
-  private readonly own: Review;
+  private own: Review;
   readonly saver: Saver;
 
   constructor(
@@ -171,6 +171,16 @@ export class ReviewSession {
     if (this.saver.pending || this.other || asOf !== this.pushes) return;
     this.history = historyFromEvents(events);
     this.view.changed();
+  }
+
+  /** The review as the server changed it outside the edit queue (an import): shown now;
+   * the undo history is read from its log again (`settled`). */
+  replaced(review: Review): void {
+    this.saver.server = this.own = review;
+    if (!this.other) this.review = review;
+    this.selectedCutId = null;
+    this.view.changed();
+    this.view.settled(review);
   }
 
   /** Submit the review as the server holds it; throws the server's refusal. */
