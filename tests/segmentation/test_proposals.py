@@ -13,7 +13,9 @@ from tests.segmentation.test_adaptation_detect import SECONDS, ReviewedTakesTest
 TRUE = set(synth.ACTIONS)
 
 
-class ProposalsTestCase(ReviewedTakesTestCase):
+class ProposalsBase(ReviewedTakesTestCase):
+    """bob and dora annotate; helpers to review, train and read what the page is offered."""
+
     @classmethod
     def setUpTestData(cls):
         super().setUpTestData()
@@ -70,6 +72,8 @@ class ProposalsTestCase(ReviewedTakesTestCase):
     def proposed_labels(self, capture, user):
         return {s["label"] for s in self.offered(capture, user) if s["proposed"]}
 
+
+class ProposalsTestCase(ProposalsBase):
     def test_another_annotators_labels_are_never_proposed_to_an_annotator(self):
         self.trained_by_bob()
         capture = self.ingested(seed=94)
