@@ -38,6 +38,11 @@ log = logging.getLogger(__name__)
 HELD_OUT_TAKES = 10
 # Fewer reviewed takes than this leave nothing to hold out: no proposal.
 MIN_TAKES = 2
+# A proposal less likely than this is not shown (the library's suggestion is, if any): the
+# frame model's nearest references then disagree, and on the vMCI point takes, whose
+# one-second actions its 5 Hz windows blur, every proposal below it was wrong while the
+# library's suggestions were right (tests/segmentation/test_point_takes.py).
+MIN_PROBABILITY = 0.6
 FRAMES_KEY = "frames-v1"
 PREFIX = "p:"
 

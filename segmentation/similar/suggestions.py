@@ -116,8 +116,8 @@ def for_review(capture, annotator):
     "probability", "proposed"}]}`` for the unlabelled segments, sending the job for any span
     not computed yet.
 
-    A span's proposed label (``proposals``, with its probability) comes first; else the
-    label the library suggests (``probability`` None, ``proposed`` false). An annotator's
+    A span's proposed label (``proposals``, with its probability) comes first when it is at
+    least ``proposals.MIN_PROBABILITY`` likely; else the label the library suggests (``probability`` None, ``proposed`` false). An annotator's
     proposals are their own pool's (``proposals.propose_spans``, computed by the job); a
     reviewer's or admin's are the detection run's (``proposed``), learnt from all reviews,
     which they may see. ``pending`` is true while some span still waits for the worker.
@@ -138,7 +138,7 @@ def for_review(capture, annotator):
     out = []
     for span in sorted(set(found) | set(offered)):
         label, probability = offered.get(span) or (None, None)
-        if label is not None:
+        if label is not None and (probability or 0.0) >= proposals.MIN_PROBABILITY:
             out.append({"start": span[0], "stop": span[1], "label": label,
                         "probability": probability, "proposed": True})
         else:

@@ -140,3 +140,17 @@ class ProposalsTestCase(ProposalsBase):
         tasks.suggest(capture.pk, self.dora.pk)  # the spans have theirs: nothing recomputed
         self.assertEqual(list(LabelSuggestion.objects.filter(
             capture=capture, pool__startswith=proposals.PREFIX).values_list("pk", flat=True)), rows)
+
+    def test_a_proposal_below_the_probability_floor_is_not_shown(self):
+        for seed in (95, 96):
+            self.review(self.ingested(seed), self.dora, seed)
+        capture = self.ingested(seed=94)
+        offered = [s for s in self.offered(capture, self.dora) if s["proposed"]]
+        doubtful = offered[0]
+        LabelSuggestion.objects.filter(
+            capture=capture, pool__startswith=proposals.PREFIX, start=doubtful["start"],
+            stop=doubtful["stop"]).update(probability=proposals.MIN_PROBABILITY - 0.01)
+        again = {(s["start"], s["stop"]): s for s in self.offered(capture, self.dora)}
+        shown = again[(doubtful["start"], doubtful["stop"])]
+        self.assertFalse(shown["proposed"])
+        self.assertIsNone(shown["probability"])
