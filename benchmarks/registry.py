@@ -61,6 +61,8 @@ BENCHMARKS = {
                                  "redraw interval and scrub latency on 38-s, 10- and "
                                  "60-minute takes, the old front end against the new"),
     "retrain": Benchmark("benchmarks.service.retrain", "retraining a project's cut model"),
+    "proposals-cost": Benchmark("benchmarks.service.proposals_cost", "an annotator's own "
+                                "proposed labels for a 60-minute take"),
     "poisoning": Benchmark("benchmarks.service.poisoning", "one annotator against a "
                            "project's model"),
     "soak": Benchmark("benchmarks.service.soak", "the embedded default under mixed load "
