@@ -21,6 +21,7 @@ proposals match more of the reviewed frames than the best constant proposal
 (unlabelled everywhere, or the commonest label everywhere) would.
 """
 
+import bisect
 import dataclasses
 import logging
 from collections import defaultdict
@@ -118,11 +119,15 @@ def _bounds(segments, n_frames):
 
 
 def _truth(segments, bounds):
-    """The reviewed label ("" for none) of each stretch between ``bounds``."""
+    """The reviewed label ("" for none) of each stretch between ``bounds``, which hold every
+    segment's start and end: a stretch lies within one segment or between segments, so its
+    first frame's label is its own."""
+    labelled = sorted((a, b, str(lab)) for a, b, lab in segments if lab and b > a)
+    starts = [a for a, _b, _lab in labelled]
     out = []
-    for a, b in zip(bounds[:-1], bounds[1:], strict=True):
-        label = next((str(lab) for s, e, lab in segments if lab and s <= a and b <= e), "")
-        out.append(label)
+    for a in bounds[:-1]:
+        i = bisect.bisect_right(starts, a) - 1
+        out.append(labelled[i][2] if i >= 0 and a < labelled[i][1] else "")
     return out
 
 

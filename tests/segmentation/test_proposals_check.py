@@ -41,3 +41,18 @@ def test_a_model_whose_labels_say_nothing_of_the_motion_is_refused():
 
 def test_a_single_reviewed_take_leaves_nothing_to_hold_out_and_proposes_nothing():
     assert proposals.checked_fit(examples()[:1]) is None
+
+
+def test_the_reviewed_label_of_each_stretch_matches_the_obvious_reading():
+    import numpy as np
+
+    rng = np.random.default_rng(3)
+    for _ in range(50):
+        edges = sorted({int(x) for x in rng.integers(1, 999, size=12)})
+        bounds = [0, *edges, 1000]
+        segments = [(a, b, str(rng.integers(1, 4)) if rng.random() < 0.7 else "")
+                    for a, b in zip(bounds[:-1], bounds[1:], strict=True) if rng.random() < 0.8]
+        stretches = sorted(proposals._bounds(segments, 1000))
+        obvious = [next((lab for s, e, lab in segments if lab and s <= a and b <= e), "")
+                   for a, b in zip(stretches[:-1], stretches[1:], strict=True)]
+        assert proposals._truth(segments, stretches) == obvious
