@@ -63,6 +63,8 @@ BENCHMARKS = {
     "annotation-import": Benchmark("benchmarks.service.annotation_import", "an hour-long "
                                    "take's labels imported, against edit by edit"),
     "retrain": Benchmark("benchmarks.service.retrain", "retraining a project's cut model"),
+    "proposals-cost": Benchmark("benchmarks.service.proposals_cost", "an annotator's own "
+                                "proposed labels for a 60-minute take"),
     "poisoning": Benchmark("benchmarks.service.poisoning", "one annotator against a "
                            "project's model"),
     "soak": Benchmark("benchmarks.service.soak", "the embedded default under mixed load "

@@ -173,7 +173,8 @@ class CaptureViewSet(
     def runs(self, request, pk=None):
         capture = self.get_object()
         if request.method == "GET":
-            return Response(RunSerializer(capture.runs.all(), many=True).data)
+            staff = {"sees_all_reviews": capture.project.can_see_all_reviews(request.user)}
+            return Response(RunSerializer(capture.runs.all(), many=True, context=staff).data)
         run = services.do_start_run(capture, request.user, **body(request, RunRequestSerializer))
         return Response(RunSerializer(run).data, status=202)
 

@@ -1,5 +1,6 @@
 """Team management and the label taxonomy, for a project's admins: change a member's
-role, remove a member, create an account (site admins only), edit and reorder labels.
+role, remove a member, create an account (site admins only), edit, reorder and merge
+labels.
 
 Adding an existing user is ``POST /api/projects/{id}/members/`` (an invitation, see
 ``segmentation.api.invitations``).
@@ -16,6 +17,7 @@ from rest_framework.views import APIView
 from segmentation.api.common.params import body
 from segmentation.api.common.serializers.base import Text
 from segmentation.api.common.serializers.projects import LabelSerializer, MemberSerializer
+from segmentation.errors import Invalid
 from segmentation.limits import USERNAME_LENGTH, text_limit
 from segmentation.models import ROLES, Label
 from segmentation.queries.access import project_for
@@ -47,6 +49,10 @@ class LabelChange(serializers.Serializer):
     color = Text(text_limit(Label, "color"), required=False)
     hotkey = Text(text_limit(Label, "hotkey"), required=False, allow_null=True, allow_blank=True)
     retired = serializers.BooleanField(required=False)
+
+
+class LabelMerge(serializers.Serializer):
+    into = serializers.IntegerField(help_text="The id of the project's label that takes its place.")
 
 
 class LabelOrder(serializers.Serializer):
@@ -96,6 +102,20 @@ class LabelView(APIView):
         return Response(LabelSerializer(taxonomy.do_change_label(label, **data)).data)
 
 
+class LabelMergeView(APIView):
+    @extend_schema(request=LabelMerge, responses=LabelSerializer)
+    def post(self, request, pk, label_id):
+        """Merge a label into another of the project's: every segment, gold version and
+        proposal that carries it carries the other instead, and it is deleted."""
+        project = admin_project(request, pk)
+        label = get_object_or_404(project.labels, pk=label_id)
+        data = body(request, LabelMerge)
+        into = project.labels.filter(pk=data["into"]).first()
+        if into is None:
+            raise Invalid(f"into: the project has no label {data['into']}")
+        return Response(LabelSerializer(taxonomy.do_merge_labels(label, into)).data)
+
+
 class LabelOrderView(APIView):
     @extend_schema(request=LabelOrder, responses=LabelSerializer(many=True))
     def post(self, request, pk):
@@ -108,5 +128,6 @@ urlpatterns = [
     path("projects/<int:pk>/members/<int:user_id>/", MemberView.as_view(), name="api-member"),
     path("projects/<int:pk>/members/new-account/", NewAccountView.as_view(), name="api-member-new-account"),
     path("projects/<int:pk>/labels/<int:label_id>/", LabelView.as_view(), name="api-label"),
+    path("projects/<int:pk>/labels/<int:label_id>/merge/", LabelMergeView.as_view(), name="api-label-merge"),
     path("projects/<int:pk>/labels/order/", LabelOrderView.as_view(), name="api-label-order"),
 ]

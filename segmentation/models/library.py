@@ -262,6 +262,9 @@ class LabelSuggestion(models.Model):
     stop = models.PositiveIntegerField()
     # Null when nothing in the pool can name the span (no descriptor, empty pool).
     label = models.ForeignKey(Label, models.CASCADE, null=True, blank=True, related_name="+")
+    # A frame model's proposal (pool ``p:<pool key>``, ``similar.proposals``): the mean
+    # probability of ``label`` over the span; null for a library suggestion.
+    probability = models.FloatField(null=True, blank=True)
 
     class Meta:
         constraints = [

@@ -142,12 +142,14 @@ def example_segments(capture, cuts):
 
 def fit_labels(examples):
     """The project's frame model (``motionlib.labelling``) as stored text; "" when no
-    reviewed take carries a label. Each take is read (from ``takecache``) once."""
-    from motionlib import labelling
+    reviewed take carries a label, or when the model fails its held-out check
+    (``proposals.checked_fit``: its proposals must match more reviewed frames than a
+    constant proposal would). Each take's descriptors are read from storage once stored."""
+    from segmentation.similar import proposals as proposed
 
-    chosen = [labelling.frame_example(example_take(capture), example_segments(capture, cuts))
+    chosen = [proposed.frames_of(capture, example_segments(capture, cuts), example_take)
               for capture, cuts in examples]
-    model = labelling.fit_frame_model(chosen)
+    model = proposed.checked_fit(chosen)
     return model.to_json() if model is not None else ""
 
 

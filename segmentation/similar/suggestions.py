@@ -41,6 +41,7 @@ from segmentation.models import (
     Review,
     SuggestionRequest,
 )
+from segmentation.similar import proposals
 from segmentation.similar.descriptors import Describer, load_descriptors, profile_pool, same_kind
 from segmentation.similar.search import SHORTLIST, SIMILAR_POOL
 
@@ -111,32 +112,53 @@ def stored(capture, key, spans):
 
 
 def for_review(capture, annotator):
-    """What the review page shows: ``{"pending", "suggestions": [{"start", "stop", "label"}]}``
-    for the unlabelled segments, sending the job for any span not computed yet.
+    """What the review page shows: ``{"pending", "suggestions": [{"start", "stop", "label",
+    "probability", "proposed"}]}`` for the unlabelled segments, sending the job for any span
+    not computed yet.
 
-    ``pending`` is true while some span still waits for the worker.
+    A span's proposed label (``proposals``, with its probability) comes first when it is at
+    least ``proposals.MIN_PROBABILITY`` likely; else the label the library suggests (``probability`` None, ``proposed`` false). An annotator's
+    proposals are their own pool's (``proposals.propose_spans``, computed by the job); a
+    reviewer's or admin's are the detection run's (``proposed``), learnt from all reviews,
+    which they may see. ``pending`` is true while some span still waits for the worker.
     """
     spans = unlabelled_spans(capture, annotator)
     key = pool_key(capture, annotator) if spans else None
     found = stored(capture, key, spans) if key else {}
-    pending = bool(key) and len(found) < len(spans)
+    staff = capture.project.can_see_all_reviews(annotator)
+    if staff:
+        offered = proposed(capture, spans)
+        missing = len(found) < len(spans)
+    else:
+        offered = stored_proposals(capture, key, spans) if key else {}
+        missing = len(found) < len(spans) or len(offered) < len(spans)
+    pending = bool(key) and missing
     if pending:
         pending = ask(capture, annotator) or not recently_failed(capture, annotator)
-    # Where the annotator's own pool suggests nothing, the label the detection proposed
-    # for a segment it left as it was.
-    found = dict(found)
-    for span, label in proposed(capture, spans).items():
-        if found.get(span) is None:
-            found[span] = label
-    return {
-        "pending": pending,
-        "suggestions": [{"start": s, "stop": e, "label": label}
-                        for (s, e), label in sorted(found.items())],
-    }
+    out = []
+    for span in sorted(set(found) | set(offered)):
+        label, probability = offered.get(span) or (None, None)
+        if label is not None and (probability or 0.0) >= proposals.MIN_PROBABILITY:
+            out.append({"start": span[0], "stop": span[1], "label": label,
+                        "probability": probability, "proposed": True})
+        else:
+            out.append({"start": span[0], "stop": span[1], "label": found.get(span),
+                        "probability": None, "proposed": False})
+    return {"pending": pending, "suggestions": out}
+
+
+def stored_proposals(capture, key, spans):
+    """{(start, stop): (label name or None, probability or None)} of ``spans`` proposed
+    for the pool ``key`` (rows of the pool ``proposals.PREFIX + key``)."""
+    rows = LabelSuggestion.objects.filter(capture=capture, pool=proposals.PREFIX + key)
+    # A label retired since is proposed no more.
+    found = {(s, e): (None, None) if retired else (name, p) for s, e, name, retired, p in
+             rows.values_list("start", "stop", "label__name", "label__retired", "probability")}
+    return {span: found[span] for span in spans if span in found}
 
 
 def proposed(capture, spans):
-    """``{(start, stop): label name}`` of the latest finished run's proposals
+    """``{(start, stop): (label name, probability)}`` of the latest finished run's proposals
     (``DetectionRun.proposals``) for the ``spans`` that are still one of its segments;
     labels retired since are left out."""
     run = capture.latest_finished_run()
@@ -147,7 +169,7 @@ def proposed(capture, spans):
     names = dict(Label.objects.filter(project_id=capture.project_id, retired=False)
                  .values_list("id", "name"))
     wanted = set(spans)
-    return {(a, b): names[p["label"]]
+    return {(a, b): (names[p["label"]], p.get("probability"))
             for a, b, p in zip(bounds[:-1], bounds[1:], run.proposals, strict=False)
             if (a, b) in wanted and p["label"] in names}
 
@@ -181,9 +203,12 @@ def fill(capture, annotator):
     key = pool_key(capture, annotator)
     if key is not None:
         name = key.split(":")[0]
-        (LabelSuggestion.objects.filter(capture=capture, pool__startswith=f"{name}:")
-         .exclude(pool=key).delete())
+        for prefix in ("", proposals.PREFIX):
+            (LabelSuggestion.objects.filter(capture=capture, pool__startswith=f"{prefix}{name}:")
+             .exclude(pool=prefix + key).delete())
     spans = unlabelled_spans(capture, annotator) if key else []
+    if spans and not capture.project.can_see_all_reviews(annotator):
+        fill_proposals(capture, annotator, key, spans)
     have = stored(capture, key, spans) if key else {}
     missing = [span for span in spans if span not in have]
     random.Random(annotator.pk).shuffle(missing)
@@ -207,6 +232,22 @@ def fill(capture, annotator):
         request.update(asked_at=timezone.now())
     request.update(done_at=timezone.now())
     return computed
+
+
+def fill_proposals(capture, annotator, key, spans):
+    """Store the annotator's own proposals (``proposals.propose_spans`` over their pool)
+    for the ``spans`` that have none for the pool ``key``. One fit serves all the spans:
+    a 60-minute take's take as many seconds as its pool's fit and one posterior."""
+    have = stored_proposals(capture, key, spans)
+    missing = sorted(span for span in spans if span not in have)
+    if not missing:
+        return
+    found = at_low_priority(proposals.propose_spans, capture, pool(capture, annotator), missing)
+    LabelSuggestion.objects.bulk_create(
+        [LabelSuggestion(capture=capture, pool=proposals.PREFIX + key, start=s, stop=e,
+                         label_id=label, probability=p)
+         for (s, e), (label, p) in zip(missing, found, strict=True)],
+        ignore_conflicts=True)
 
 
 def fill_by_id(capture_id, annotator_id):

@@ -7,6 +7,7 @@ from motionlib import synth
 from segmentation import services, tasks
 from segmentation.models import ProjectCutModel
 from segmentation.services import taxonomy
+from segmentation.similar.proposals import MIN_PROBABILITY
 from tests.segmentation.test_adaptation_detect import SECONDS, ReviewedTakesTestCase
 
 
@@ -74,11 +75,13 @@ class LabelledDetectionTestCase(ReviewedTakesTestCase):
         names = dict(self.project.labels.values_list("id", "name"))
         frames = [c["frame"] for c in run.candidates]
         bounds = [0, *frames, capture.n_frames]
-        expected = {(a, b): names[p["label"]] for a, b, p in
-                    zip(bounds[:-1], bounds[1:], run.proposals, strict=True) if p["label"]}
+        expected = {(a, b): (names[p["label"]], p["probability"]) for a, b, p in
+                    zip(bounds[:-1], bounds[1:], run.proposals, strict=True)
+                    if p["label"] and p["probability"] >= MIN_PROBABILITY}
         self.assertTrue(expected)
-        self.login(self.rachel)  # no review in the project: her own pool is empty
+        self.login(self.rachel)  # a reviewer: she sees every review, so the run's proposals
         body = self.client.get(f"/api/captures/{capture.pk}/review/suggestions/").json()
-        got = {(s["start"], s["stop"]): s["label"] for s in body["suggestions"]}
+        got = {(s["start"], s["stop"]): (s["label"], s["probability"])
+               for s in body["suggestions"] if s["proposed"]}
         for span, label in expected.items():
             self.assertEqual(got.get(span), label)

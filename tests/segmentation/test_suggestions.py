@@ -20,7 +20,7 @@ from segmentation.files import storage
 from segmentation.models import Capture, LabelSuggestion
 from segmentation.services import gold
 from segmentation.services.taxonomy import do_change_label
-from segmentation.similar import suggestions
+from segmentation.similar import proposals, suggestions
 from tests.segmentation.test_library import LibraryTestCase, submit_review
 
 
@@ -186,7 +186,10 @@ class SuggestionStoreTest(SuggestionsTestCase):
                       [label for _, _, label in truth_c])
         assert suggestions.for_review(self.take_b, self.bob)["pending"] is True
         assert tasks.suggest(self.take_b.pk, self.bob.pk) == len(self.truth_b)
-        assert LabelSuggestion.objects.count() == len(self.truth_b)
+        # the old pool's suggestions and its proposals (``similar.proposals``) are gone
+        library = LabelSuggestion.objects.exclude(pool__startswith=proposals.PREFIX)
+        assert library.count() == len(self.truth_b)
+        assert LabelSuggestion.objects.count() - library.count() == len(self.truth_b)
 
 
 class LowPriorityTest(TransactionTestCase):

@@ -788,6 +788,26 @@ export interface paths {
         patch: operations["projects_labels_partial_update"];
         trace?: never;
     };
+    "/api/projects/{id}/labels/{label_id}/merge/": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /**
+         * @description Merge a label into another of the project's: every segment, gold version and
+         *     proposal that carries it carries the other instead, and it is deleted.
+         */
+        post: operations["projects_labels_merge_create"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
     "/api/projects/{id}/labels/order/": {
         parameters: {
             query?: never;
@@ -1500,6 +1520,10 @@ export interface components {
             /** Format: double */
             value: number | null;
         };
+        LabelMergeRequest: {
+            /** @description The id of the project's label that takes its place. */
+            into: number;
+        };
         LabelOrderRequest: {
             order: number[];
         };
@@ -1864,6 +1888,11 @@ export interface components {
          * @enum {string}
          */
         RoleEnum: "annotator" | "reviewer" | "admin";
+        /**
+         * @description A detection run. Its ``proposals`` were learnt from every annotator's reviews, so
+         *     they are given only with ``context["sees_all_reviews"]`` (the project's reviewers and
+         *     admins); anyone else gets [] (an annotator's own proposals: the review's suggestions).
+         */
         Run: {
             readonly id: number;
             method: string;
@@ -2004,6 +2033,13 @@ export interface components {
             start: number;
             stop: number;
             label: string | null;
+            /**
+             * Format: double
+             * @description A proposal's mean probability over the span; null for a label the library suggests.
+             */
+            probability: number | null;
+            /** @description True: a frame model's proposed label (learnt from what the caller may see); false: the label the library's most similar segments suggest. */
+            proposed: boolean;
         };
         Suggestions: {
             pending: boolean;
@@ -3400,6 +3436,34 @@ export interface operations {
                 "application/json": components["schemas"]["PatchedLabelChangeRequest"];
                 "application/x-www-form-urlencoded": components["schemas"]["PatchedLabelChangeRequest"];
                 "multipart/form-data": components["schemas"]["PatchedLabelChangeRequest"];
+            };
+        };
+        responses: {
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["Label"];
+                };
+            };
+        };
+    };
+    projects_labels_merge_create: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path: {
+                id: number;
+                label_id: number;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["LabelMergeRequest"];
+                "application/x-www-form-urlencoded": components["schemas"]["LabelMergeRequest"];
+                "multipart/form-data": components["schemas"]["LabelMergeRequest"];
             };
         };
         responses: {

@@ -44,8 +44,9 @@ export type ApiCut = Schemas["Cut"];
 export type Cut = ApiCut & { id: number };
 
 /** A review's segment; `suggested_label` is not sent with the review: the page fills it in
- * from `Suggestions` for an unlabelled segment. */
-export type Segment = Schemas["ReviewSegment"] & { suggested_label?: string | null };
+ * from `Suggestions` for an unlabelled segment, with `proposed_probability` when it is a
+ * frame model's proposal (null: a label the library suggests). */
+export type Segment = Schemas["ReviewSegment"] & { suggested_label?: string | null; proposed_probability?: number | null };
 
 /** `GET /api/captures/{id}/review/suggestions/`: computed by a worker, `pending` until all are. */
 export type Suggestions = Schemas["Suggestions"];

@@ -31,7 +31,7 @@ export function confirmSubmit(review: Review, next: boolean, proposed = 0): Prom
     pending
       ? h("p", { "data-testid": "submit-pending" }, h("strong", {}, `${candidates} will be kept as cuts.`), ` Accept or delete ${pending === 1 ? "it" : "them"} first to decide each one.`)
       : null,
-    proposed ? h("p", { "data-testid": "submit-proposed" }, `${proposed} proposed label${proposed === 1 ? " is" : "s are"} not confirmed (press S on a segment to accept its proposal).`) : null,
+    proposed ? h("p", { "data-testid": "submit-proposed" }, `${proposed} proposed label${proposed === 1 ? " is" : "s are"} not confirmed and will not be saved (press S on a segment to accept its proposal).`) : null,
     unlabelled ? h("p", { class: "muted", "data-testid": "submit-unlabelled" }, `${unlabelled} unlabelled segment${unlabelled === 1 ? "" : "s"} will be left out of the library.`) : null,
   ], pending ? `Submit, keeping ${pending}` : "Submit");
 }

@@ -144,7 +144,8 @@ class ReviewPage {
       notice: (text, error) => toast(text, error ? "error" : "info"),
       refresh: () => this.refresh(),
     });
-    this.suggestions = new Suggestions(capture.id, () => this.renderSide());
+    // Arrived suggestions show in the side panel and in the timeline's segments.
+    this.suggestions = new Suggestions(capture.id, () => this.refresh());
     frames.onChunk = () => this.stage.loaded(this.playback.frame);
     if (frames.store.loadedFrames) this.stage.loaded(this.playback.frame);
     void signalsWait(frames).then(() => this.loadFullSignals()).finally(frames.resume);
@@ -210,7 +211,8 @@ class ReviewPage {
     const s = this.session;
     return {
       nFrames: this.capture.n_frames, fps: this.capture.fps, signals: this.signals, cuts: s.review.cuts,
-      segments: s.review.segments, labels: this.project?.labels ?? [], playhead,
+      segments: s.readOnly ? s.review.segments : this.suggestions.all(s.review.segments),
+      labels: this.project?.labels ?? [], playhead,
       selectedCutId: s.selectedCutId, loop: this.playback.loop, readOnly: s.locked() !== null,
     };
   }

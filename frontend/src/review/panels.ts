@@ -6,7 +6,7 @@ import { eventDetail } from "./events";
 import { FATE_TEXT } from "./state";
 import { formatTime } from "./timescale";
 
-export function renderLabels(el: HTMLElement, labels: Label[], current: string | null, disabled: boolean, pick: (name: string) => void): void {
+export function renderLabels(el: HTMLElement, labels: Label[], current: string | null, disabled: boolean, pick: (name: string) => void, proposed: string | null = null): void {
   if (!labels.length) {
     clear(el, h("p", { class: "muted" }, "This project has no labels yet."));
     return;
@@ -15,7 +15,7 @@ export function renderLabels(el: HTMLElement, labels: Label[], current: string |
     h(
       "button",
       {
-        class: `label-chip${current === label.name ? " current" : ""}`,
+        class: `label-chip${current === label.name ? " current" : ""}${!current && proposed === label.name ? " proposed" : ""}`,
         "data-testid": `label-${label.name}`,
         disabled,
         title: `${label.name}: label the segment under the playhead${label.hotkey ? ` (${label.hotkey})` : ""}`,
@@ -57,11 +57,21 @@ function segmentPanel(segment: Segment, fps: number): HTMLElement {
     h("b", {}, `Segment ${segment.index + 1}`),
     ` · ${segment.start}–${segment.stop} · ${formatDuration((segment.stop - segment.start) / fps)}`,
     h("div", {}, segment.label ? `labelled ${segment.label}` : h("span", { class: "muted" }, "unlabelled")),
-    !segment.label && segment.suggested_label
-      ? h("div", { class: "muted", "data-testid": "suggested-label" }, `suggested: ${segment.suggested_label} (S accepts)`)
-      : null,
+    !segment.label && segment.suggested_label ? suggestion(segment, segment.suggested_label) : null,
   );
 }
+
+/** A proposal (a frame model's, with its probability) or a library suggestion: not the
+ * segment's label until accepted. */
+function suggestion(segment: Segment, label: string): HTMLElement {
+  const p = segment.proposed_probability;
+  if (p === null || p === undefined)
+    return h("div", { class: "muted", "data-testid": "suggested-label" }, `suggested: ${label} (S accepts)`);
+  return h("div", { class: "proposed-label", "data-testid": "proposed-label" },
+    h("i", {}, label), ` proposed, ${percent(p)} (S accepts)`);
+}
+
+export const percent = (p: number) => `${Math.round(p * 100)} %`;
 
 /** Cut counts by fate (inserted cuts counted apart) and how much is labelled. */
 export function renderStats(el: HTMLElement, review: Review): void {

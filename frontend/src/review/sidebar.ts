@@ -32,7 +32,8 @@ export class Sidebar {
 
   render(session: ReviewSession, segment: Segment | undefined): void {
     this.shownSegment = segment;
-    renderLabels(this.el.labels, this.labels, segment?.label ?? null, session.locked() !== null, this.actions.label);
+    renderLabels(this.el.labels, this.labels, segment?.label ?? null, session.locked() !== null, this.actions.label,
+      segment?.suggested_label ?? null);
     renderSelection(this.el.selection, session.selectedCut(), segment, this.capture.fps);
     renderStats(this.el.stats, session.review);
     renderAdaptation(this.el.adaptation, this.adaptation);

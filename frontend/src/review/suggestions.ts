@@ -1,13 +1,17 @@
-// Suggested labels of the own review's unlabelled segments. A worker computes them after
-// the page opens, so they are asked for until none is pending, less often the longer it
-// takes (a busy or stopped worker).
+// Suggested labels of the own review's unlabelled segments: a frame model's proposal (with
+// its probability) or, without one, the label the library suggests. A worker computes them
+// after the page opens, so they are asked for until none is pending, less often the longer
+// it takes (a busy or stopped worker). Nothing here writes: a suggestion becomes the
+// segment's label only when the annotator accepts it (S, commands.ts).
 
 import { get } from "../api/client";
 import type { Segment, Suggestions as SuggestionsBody } from "../api/types";
 
 export class Suggestions {
-  /** Suggested label by "start-stop". */
-  private readonly byspan = new Map<string, string | null>();
+  /** Suggested label and a proposal's probability by "start-stop". */
+  private readonly byspan = new Map<string, { label: string | null; probability: number | null }>();
+  private decorated: { from: readonly Segment[]; version: number; out: Segment[] } | null = null;
+  private version = 0;
   private timer = 0;
   private delay = 2000;
   private stopped = false;
@@ -17,7 +21,18 @@ export class Suggestions {
   /** `segment` with the suggested label of the own review's segment of the same span. */
   on(segment: Segment | undefined): Segment | undefined {
     if (!segment || segment.label) return segment;
-    return { ...segment, suggested_label: this.byspan.get(key(segment)) ?? null };
+    const found = this.byspan.get(key(segment));
+    return { ...segment, suggested_label: found?.label ?? null, proposed_probability: found?.label ? found.probability : null };
+  }
+
+  /** `segments` with their suggestions; the same array until the segments or the
+   * suggestions change (the timeline redraws when its segments are another array). */
+  all(segments: readonly Segment[]): Segment[] {
+    const d = this.decorated;
+    if (d && d.from === segments && d.version === this.version) return d.out;
+    const out = segments.map((s) => this.on(s) as Segment);
+    this.decorated = { from: segments, version: this.version, out };
+    return out;
   }
 
   /** An edit made new segments: ask for theirs once the edits settle. */
@@ -33,7 +48,8 @@ export class Suggestions {
   async load(): Promise<void> {
     const body = await get<SuggestionsBody>(`/api/captures/${this.captureId}/review/suggestions/`).catch(() => null);
     if (!body || this.stopped) return;
-    for (const s of body.suggestions) this.byspan.set(`${s.start}-${s.stop}`, s.label);
+    for (const s of body.suggestions) this.byspan.set(`${s.start}-${s.stop}`, { label: s.label, probability: s.probability });
+    this.version++;
     this.arrived();
     if (!body.pending) {
       this.delay = 2000;

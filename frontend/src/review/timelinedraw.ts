@@ -195,11 +195,37 @@ function drawSegments(s: Scene): void {
     ctx.globalAlpha = colour ? 0.85 : 1;
     ctx.fillRect(x0 + 1, top, Math.max(x1 - x0 - 2, 1), SEGMENTS);
     ctx.globalAlpha = 1;
+    if (!seg.label && seg.suggested_label) {
+      drawProposal(s, seg, seg.suggested_label, colours.get(seg.suggested_label) ?? "#8a93a3", x0, x1);
+      ctx.font = "600 12px system-ui, sans-serif";
+      continue;
+    }
     const text = seg.label ?? "unlabelled";
     if (x1 - x0 > ctx.measureText(text).width + 12) {
       ctx.fillStyle = colour ? readableOn(colour) : "#6b7687";
       ctx.fillText(text, Math.max(x0, 0) + 6, top + SEGMENTS / 2);
     }
+  }
+}
+
+/** An unlabelled segment's proposed label, not confirmed: a dashed outline in the label's
+ * colour and its name in italics with the proposal's probability, so that it never looks
+ * like a label the annotator gave. */
+export function drawProposal(s: Scene, seg: Segment, label: string, colour: string, x0: number, x1: number): void {
+  const { ctx } = s;
+  const top = s.rows.segTop;
+  ctx.save();
+  ctx.strokeStyle = colour;
+  ctx.lineWidth = 1.5;
+  ctx.setLineDash([5, 3]);
+  ctx.strokeRect(x0 + 1.75, top + 0.75, Math.max(x1 - x0 - 3.5, 1), SEGMENTS - 1.5);
+  ctx.restore();
+  ctx.font = "italic 12px system-ui, sans-serif";
+  const p = seg.proposed_probability;
+  const text = p === null || p === undefined ? `${label}?` : `${label}? ${Math.round(p * 100)} %`;
+  if (x1 - x0 > ctx.measureText(text).width + 12) {
+    ctx.fillStyle = colour;
+    ctx.fillText(text, Math.max(x0, 0) + 6, top + SEGMENTS / 2);
   }
 }
 

@@ -28,8 +28,12 @@ class ProposalSerializer(serializers.Serializer):
 
 
 class RunSerializer(serializers.ModelSerializer):
+    """A detection run. Its ``proposals`` were learnt from every annotator's reviews, so
+    they are given only with ``context["sees_all_reviews"]`` (the project's reviewers and
+    admins); anyone else gets [] (an annotator's own proposals: the review's suggestions)."""
+
     error = ErrorField()
-    proposals = ProposalSerializer(many=True, read_only=True)
+    proposals = serializers.SerializerMethodField()
     params = serializers.DictField(read_only=True)
     timings = serializers.DictField(child=serializers.FloatField(), read_only=True)
     candidates = CandidatesField(read_only=True)
@@ -40,6 +44,10 @@ class RunSerializer(serializers.ModelSerializer):
             "id", "method", "params", "status", "error", "created_at", "finished_at",
             "timings", "candidates", "model_version", "model_n_takes", "proposals",
         ]
+
+    @extend_schema_field(ProposalSerializer(many=True))
+    def get_proposals(self, run):
+        return run.proposals if self.context.get("sees_all_reviews") else []
 
 
 class CutModelSerializer(serializers.ModelSerializer):

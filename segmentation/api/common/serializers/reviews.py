@@ -98,6 +98,12 @@ class SuggestionSerializer(serializers.Serializer):
     start = serializers.IntegerField()
     stop = serializers.IntegerField()
     label = serializers.CharField(allow_null=True)
+    probability = serializers.FloatField(
+        allow_null=True, help_text="A proposal's mean probability over the span; null for a "
+        "label the library suggests.")
+    proposed = serializers.BooleanField(
+        help_text="True: a frame model's proposed label (learnt from what the caller may "
+        "see); false: the label the library's most similar segments suggest.")
 
 
 class SuggestionsSerializer(serializers.Serializer):
