@@ -152,8 +152,8 @@ class SegmentListTest(LibraryTestCase):
                 self.get(f"?page_size={size}")
             counts.append(len(queries))
         # Memberships, the page's ids, its rows (with capture, annotator and label
-        # joined), and a count unless the page is the last one.
-        assert counts == [4, 3]
+        # joined), their attribute values, and a count unless the page is the last one.
+        assert counts == [5, 4]
 
     def test_it_requires_login(self):
         assert self.client.get("/api/segments/").status_code in (401, 403)
