@@ -3,7 +3,6 @@ apart from the schema (``services.attributes``), which the library and gold work
 
 from django.db import transaction
 
-from motionlib.errors import shorten
 from segmentation.errors import Invalid
 from segmentation.models import SegmentAttributeValue
 from segmentation.services.reviews import _log, _write
@@ -13,7 +12,7 @@ def find_attribute(project, name):
     attribute = project.attributes.filter(name=name).first()
     if attribute is None:
         names = ", ".join(project.attributes.values_list("name", flat=True)) or "none defined"
-        raise Invalid(f"attribute: {shorten(repr(name))} is not an attribute of this project ({names})")
+        raise Invalid(f"attribute: {str(name)[:100]!r} is not an attribute of this project ({names})")
     return attribute
 
 
