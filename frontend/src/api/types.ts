@@ -45,7 +45,14 @@ export type Cut = ApiCut & { id: number };
 
 /** A review's segment; `suggested_label` is not sent with the review: the page fills it in
  * from `Suggestions` for an unlabelled segment. */
-export type Segment = Schemas["ReviewSegment"] & { suggested_label?: string | null };
+export type Segment = Omit<Schemas["ReviewSegment"], "attributes"> & { attributes?: Schemas["ReviewSegment"]["attributes"]; suggested_label?: string | null };
+/** A segment's attribute values by attribute name: an option, a note or true/false. Absent
+ * on a segment the page derived itself until the server answers. */
+export type AttributeValues = NonNullable<Segment["attributes"]>;
+/** One attribute of a project's segment schema. */
+export type SegmentAttribute = Schemas["Attribute"];
+/** A comment on a review, or a reply (`parent`). */
+export type ReviewComment = Schemas["Comment"];
 
 /** `GET /api/captures/{id}/review/suggestions/`: computed by a worker, `pending` until all are. */
 export type Suggestions = Schemas["Suggestions"];

@@ -27,7 +27,7 @@ class ReviewSegmentSerializer(serializers.Serializer):
     stop = serializers.IntegerField()
     label = serializers.CharField(allow_null=True)
     attributes = serializers.DictField(
-        help_text="the segment's attribute values by attribute name (the project's schema: "
+        required=False, help_text="the segment's attribute values by attribute name (the project's schema: "
                   "GET /api/projects/{id}/attributes/)")
 
 
