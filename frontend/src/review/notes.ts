@@ -125,8 +125,8 @@ export class Notes {
     if (!segment) return toast("No segment under the playhead.");
     const current = segment.attributes?.[attribute.name];
     if (attribute.kind !== "text") return this.set(segment, attribute, nextValue(attribute, current, back));
-    const text = await promptLine(attribute.name, `The ${attribute.name} of segment ${segment.start}–${segment.stop - 1} (empty clears it).`, "Set", typeof current === "string" ? current : "");
-    if (text !== null) this.set(segment, attribute, text.trim() || null);
+    const text = await promptLine(attribute.name, `The ${attribute.name} of segment ${segment.start}–${segment.stop - 1} (a single - clears it).`, "Set", typeof current === "string" ? current : "");
+    if (text !== null) this.set(segment, attribute, text.trim() === "-" ? null : text.trim());
   }
 
   private set(segment: Segment, attribute: SegmentAttribute, value: string | boolean | null): void {
