@@ -96,4 +96,20 @@ def test_comments_and_attributes_from_the_keyboard(live_server, new_page, ingest
     actions = [(e["action"], e["after"]) for e in screen.events() if e["action"] == "attribute"]
     assert actions[0] == ("attribute", {"index": 0, "attribute": "quality", "value": "good"})
     assert len(actions) == 4
+
+    # Labelled and submitted, the segment is in the library: the attribute filter finds it
+    # and its row shows its values.
+    ann.keyboard.press("Home")
+    ann.keyboard.press("1")
+    screen.saved()
+    ann.get_by_test_id("submit").click()
+    ann.get_by_test_id("confirm-ok").click()
+    expect(ann.get_by_test_id("readonly-banner")).to_contain_text("You submitted this review")
+    ann.goto(f"{base}/library/")
+    ann.get_by_test_id("lib-attribute").fill("quality:usable")
+    ann.get_by_test_id("lib-attribute").press("Enter")
+    expect(ann.get_by_test_id("segment-attributes")).to_have_text("quality: usable · needs cleanup")
+    assert "attribute=quality%3Ausable" in ann.url
+    found = ann.request.get(f"{base}/api/segments/?attribute=quality:usable").json()
+    assert [(r["start"], r["label"]) for r in found["results"]] == [(0, "walk")]
     assert ann.errors == [] and rachel.errors == []
