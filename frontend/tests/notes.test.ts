@@ -30,7 +30,7 @@ describe("comments", () => {
   });
 
   it("test_c_and_m_are_the_comment_keys", () => {
-    expect(commandFor(key("c"))).toEqual({ kind: "comment" });
+    expect(commandFor(key("c"))).toEqual({ kind: "comment", on: "playhead" });
     expect(commandFor(key("m"))).toEqual({ kind: "commentJump", direction: 1 });
     expect(commandFor(key("M", { shiftKey: true }))).toEqual({ kind: "commentJump", direction: -1 });
     expect(HELP.some(([keys]) => keys.startsWith("M / Shift+M"))).toBe(true);
@@ -64,5 +64,19 @@ describe("attributes", () => {
     });
     const cleared = applyEdit(after, { ...edit, value: null }, 1000);
     expect(cleared.segments[1].attributes).toEqual({});
+  });
+});
+
+describe("attributes on screen", () => {
+  it("test_a_value_follows_its_segment_when_a_cut_moves_before_the_server_answers", () => {
+    const r = review();
+    r.segments[1] = { ...r.segments[1], attributes: { quality: "good" } };
+    const moved = applyEdit(r, { kind: "move", cutId: 1, frame: 250 }, 1000);
+    expect(moved.segments[1]).toMatchObject({ start: 250, attributes: { quality: "good" } });
+    expect(moved.segments[0].attributes).toEqual({});
+  });
+
+  it("test_shift_c_comments_on_the_segment", () => {
+    expect(commandFor(key("C", { shiftKey: true }))).toEqual({ kind: "comment", on: "segment" });
   });
 });

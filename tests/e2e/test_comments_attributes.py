@@ -93,6 +93,12 @@ def test_comments_and_attributes_from_the_keyboard(live_server, new_page, ingest
     screen.saved()
     last = screen.review()["segments"][-1]
     assert last["attributes"] == {"quality": "unusable"}
+    # Shift+C comments on the segment under the playhead: pinned to its start.
+    ann.keyboard.press("Shift+C")
+    write_in_prompt(ann, "whole segment is noisy", "Comment")
+    expect(ann.get_by_test_id(f"thread-{last['start']}")).to_contain_text("(segment)")
+    on_segment = [c for c in ann.request.get(comments_url).json() if c["anchor"] == "segment"]
+    assert [(c["frame"], c["text"]) for c in on_segment] == [(last["start"], "whole segment is noisy")]
     actions = [(e["action"], e["after"]) for e in screen.events() if e["action"] == "attribute"]
     assert actions[0] == ("attribute", {"index": 0, "attribute": "quality", "value": "good"})
     assert len(actions) == 4

@@ -10,6 +10,10 @@ export function eventDetail(e: Pick<ReviewEvent, "action" | "before" | "after">)
   // A review opened before detection finished takes the run's candidates in afterwards.
   if (e.action === "candidates") return `${after.candidates ?? 0} candidates arrived`;
   if (e.action === "restore") return restoreDetail(after);
+  if (e.action === "attribute") {
+    const shown = (v: unknown) => (v === null || v === undefined ? "—" : v === true ? "yes" : v === false ? "no" : String(v));
+    return `segment ${Number(after.index ?? before.index) + 1} ${String(after.attribute ?? "")}: ${shown(before.value)} → ${shown(after.value)}`;
+  }
   if ("index" in after || "index" in before) {
     const index = Number(after.index ?? before.index);
     return `segment ${index + 1}: ${before.label ?? "—"} → ${after.label ?? "—"}`;

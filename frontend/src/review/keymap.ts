@@ -26,7 +26,7 @@ export type Command =
   | { kind: "end" }
   | { kind: "help" }
   | { kind: "escape" }
-  | { kind: "comment" }
+  | { kind: "comment"; on: "playhead" | "segment" }
   | { kind: "commentJump"; direction: -1 | 1 }
   | { kind: "attribute"; hotkey: string; back: boolean };
 
@@ -96,7 +96,8 @@ const SIMPLE: Record<string, Command> = {
   End: { kind: "end" },
   "?": { kind: "help" },
   Escape: { kind: "escape" },
-  c: { kind: "comment" },
+  c: { kind: "comment", on: "playhead" },
+  "shift+c": { kind: "comment", on: "segment" },
   m: { kind: "commentJump", direction: 1 },
   "shift+m": { kind: "commentJump", direction: -1 },
 };
@@ -134,6 +135,7 @@ export const HELP: [string, string][] = [
   ["Click a grey × under the ruler", "restore that deleted candidate"],
   ["Click the overview strip", "seek anywhere in the take; the working window follows"],
   ["C", "comment at the playhead (on the selected cut when one is selected)"],
+  ["Shift+C", "comment on the segment under the playhead (it follows the segment's start)"],
   ["M / Shift+M", "next / previous comment (the playhead moves to its frame)"],
   ["An attribute's letter (Shift: backwards)", "set that attribute of the segment under the playhead: next option, yes/no, or type a note"],
   ["?", "show / hide this help"],

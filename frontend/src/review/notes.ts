@@ -70,15 +70,15 @@ export class Notes {
     this.ctx.goTo(next.frame);
   }
 
-  /** A new thread at the playhead, or on the selected cut. */
-  async add(): Promise<void> {
+  /** A new thread on `segment` when given, else on the selected cut, else at the playhead. */
+  async add(segment?: Segment): Promise<void> {
     const s = this.ctx.session;
-    const cut = s.selectedCut();
+    const cut = segment ? undefined : s.selectedCut();
     const frame = this.ctx.frame();
-    const where = cut && cut.id > 0 ? `the cut at frame ${cut.frame}` : `frame ${frame}`;
+    const where = segment ? `segment ${segment.start}–${segment.stop - 1}` : cut && cut.id > 0 ? `the cut at frame ${cut.frame}` : `frame ${frame}`;
     const text = await promptDialog(`Comment on ${where}`, s.readOnly ? `On ${s.review.annotator.username}'s review: they and the project's reviewers read it.` : "The project's reviewers and admins read it; other annotators do not.", "Comment");
     if (!text) return;
-    const anchor = cut && cut.id > 0 ? { cut: cut.id } : { frame };
+    const anchor = segment ? { segment: segment.index } : cut && cut.id > 0 ? { cut: cut.id } : { frame };
     await this.send(s.review.id === null ? `/api/captures/${this.ctx.captureId}/review/comments/` : this.url(s.review.id), { text, ...anchor }, "Comment added.");
   }
 

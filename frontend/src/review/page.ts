@@ -195,7 +195,7 @@ class ReviewPage {
   // ---- state → screen ------------------------------------------------------------------
 
   private command(c: Command): void {
-    if (c.kind === "comment") void this.notes.add();
+    if (c.kind === "comment") void this.notes.add(c.on === "segment" ? this.segmentHere() : undefined);
     else if (c.kind === "commentJump") this.notes.jump(c.direction);
     else if (c.kind === "attribute") void this.notes.attributeKey(c.hotkey, c.back, this.segmentHere());
     else this.commands.run(c);

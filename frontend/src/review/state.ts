@@ -136,7 +136,20 @@ export function applyEdit(review: Review, edit: Edit, nFrames: number): Review {
     else moveCut(cut, cuts, edit.frame, nFrames);
   }
   const labels = labelsByStartCut(review);
-  return { ...review, cuts, segments: deriveSegments(cuts, nFrames, (id) => labels.get(id) ?? null) };
+  const segments = deriveSegments(cuts, nFrames, (id) => labels.get(id) ?? null);
+  return { ...review, cuts, segments: withAttributes(review, cuts, segments) };
+}
+
+/** `segments` (derived after a cut edit) with the attribute values of the segment that
+ * started at the same cut before it, as the server keys them. */
+function withAttributes(review: Review, cuts: readonly Cut[], segments: Segment[]): Segment[] {
+  const startCut = (kept: Cut[], index: number) => (index === 0 ? null : (kept[index - 1]?.id ?? NaN));
+  const before = sortedCuts(review.cuts);
+  const byCut = new Map<number | null, Segment["attributes"]>();
+  for (const s of review.segments) if (s.attributes) byCut.set(startCut(before, s.index), s.attributes);
+  if (!byCut.size) return segments;
+  const after = sortedCuts(cuts);
+  return segments.map((s) => ({ ...s, attributes: byCut.get(startCut(after, s.index)) ?? {} }));
 }
 
 function withValue(values: AttributeValues | undefined, name: string, value: string | boolean | null): AttributeValues {
