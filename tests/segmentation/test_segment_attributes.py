@@ -180,3 +180,16 @@ class AttributesTestCase(BaseTestCase):
                              "attributes": [{}, {"quality": "superb"}, {}]}, format="json")
         self.assertEqual(r.status_code, 400)
         self.assertIn("attributes: segment 1: 'superb' is not an option of 'quality'", r.json()["detail"])
+
+    def test_a_capture_and_a_project_whose_segments_carry_values_can_still_be_deleted(self):
+        self.label_and_submit(self.bob)
+        self.set(1, "quality", "good")
+        self.submit()
+        other = self.ready_capture(candidates=(50,), n_frames=100, name="d.bvh")
+        self.client.post(f"/api/captures/{other.pk}/review/")
+        self.client.patch(f"/api/captures/{other.pk}/review/segments/0/attributes/",
+                          {"name": "quality", "value": "usable", "version": 1}, format="json")
+        self.capture.delete()
+        self.assertEqual(list(SegmentAttributeValue.objects.values_list("value", flat=True)), ["usable"])
+        self.project.delete()
+        self.assertFalse(SegmentAttributeValue.objects.exists())
