@@ -219,10 +219,12 @@ def check_gold_attributes(capture, n_segments, attributes):
 def store_gold_values(capture, previous_spans, cuts, attributes=None, source_review=None):
     """Replace the gold version's attribute values (inside the gold workflow).
 
-    ``attributes`` given: those. Else each gold segment keeps the values of the same span
-    (start and stop) in the previous gold version (``previous_spans``: its ``(start,
-    stop)``s), or else takes those of the same span in ``source_review``, the review
-    the reviewer copied: values travel with the segments they were set on.
+    ``attributes`` given: those. Else values travel with the segments they were set on:
+    each gold segment keeps the values of the same span (start and stop) in the previous
+    gold version (``previous_spans``: its ``(start, stop)``s); else takes those of the same
+    span in ``source_review``, the review the reviewer copied; else, attribute by
+    attribute, the value the capture's submitted reviews with that span agree on (a segment
+    taken from one tier on the adjudication page; reviews that differ give none).
     """
     bounds = [0, *cuts, capture.n_frames]
     spans = list(zip(bounds[:-1], bounds[1:], strict=True))
@@ -231,13 +233,27 @@ def store_gold_values(capture, previous_spans, cuts, attributes=None, source_rev
     else:
         previous, kept = gold_by_start(capture), set(previous_spans)
         source = _review_spans(source_review) if source_review is not None else {}
-        chosen = [previous.get(start, {}) if (start, stop) in kept else source.get((start, stop), {})
+        agreed = _agreed_spans(capture)
+        chosen = [previous.get(start, {}) if (start, stop) in kept
+                  else source.get((start, stop)) or agreed.get((start, stop), {})
                   for start, stop in spans]
     GoldAttributeValue.objects.filter(capture=capture).delete()
     GoldAttributeValue.objects.bulk_create(
         GoldAttributeValue(capture=capture, start=start, attribute_id=attribute_id, value=text)
         for (start, _), values in zip(spans, chosen, strict=True)
         for attribute_id, text in values.items())
+
+
+def _agreed_spans(capture):
+    """``{(start, stop): {attribute id: text}}``: per span of the capture's submitted
+    reviews, the values every review with that span that sets the attribute agrees on."""
+    seen = {}
+    for review in capture.reviews.filter(status="submitted"):
+        for span, values in _review_spans(review).items():
+            for attribute_id, text in values.items():
+                seen.setdefault(span, {}).setdefault(attribute_id, set()).add(text)
+    return {span: {a: next(iter(texts)) for a, texts in values.items() if len(texts) == 1}
+            for span, values in seen.items()}
 
 
 def _review_spans(review):

@@ -193,3 +193,22 @@ class AttributesTestCase(BaseTestCase):
         self.assertEqual(list(SegmentAttributeValue.objects.values_list("value", flat=True)), ["usable"])
         self.project.delete()
         self.assertFalse(SegmentAttributeValue.objects.exists())
+
+    def test_gold_takes_a_segment_the_reviews_agree_on_and_none_where_they_differ(self):
+        from django.contrib.auth import get_user_model
+
+        from segmentation import services
+        get_user_model().objects.create_user("dora")
+        services.do_set_member(self.project, "dora", "annotator")
+        dora = get_user_model().objects.get(username="dora")
+        for user, quality in ((self.bob, "good"), (dora, "usable")):
+            self.label_and_submit(user)
+            self.set(0, "needs cleanup", True)
+            self.set(1, "quality", quality)
+            self.submit()
+        self.login(self.rachel)
+        r = self.client.put(f"/api/captures/{self.capture.pk}/adjudication/",
+                            {"cuts": [100, 200], "labels": ["walk", "punch", "walk"], "version": 0},
+                            format="json")
+        self.assertEqual(r.status_code, 200, r.content)
+        self.assertEqual(list(GoldAttributeValue.objects.values_list("start", "value")), [(0, "true")])
