@@ -11,6 +11,7 @@ that values carry cannot be taken away (``services.attributes``): nothing stored
 from django.db import models
 from django.db.models import Q
 
+from motionlib.errors import shorten
 from segmentation.errors import Invalid
 from segmentation.models.captures import Capture
 from segmentation.models.library import LibrarySegment
@@ -55,12 +56,12 @@ class SegmentAttribute(models.Model):
                 return "true"
             if text in FALSE:
                 return "false"
-            raise Invalid(f"{where}: {self.name!r} is yes or no (true/false), got {value!r}")
+            raise Invalid(f"{where}: {self.name!r} is yes or no (true/false), got {shorten(value)}")
         if not isinstance(value, str):
-            raise Invalid(f"{where}: {self.name!r} takes text, got {value!r}")
+            raise Invalid(f"{where}: {self.name!r} takes text, got {shorten(value)}")
         if self.kind == "choice":
             if value not in self.options:
-                raise Invalid(f"{where}: {value!r} is not an option of {self.name!r} "
+                raise Invalid(f"{where}: {shorten(value)} is not an option of {self.name!r} "
                               f"({', '.join(self.options)})")
             return value
         value = value.strip()

@@ -212,3 +212,12 @@ class AttributesTestCase(BaseTestCase):
                             format="json")
         self.assertEqual(r.status_code, 200, r.content)
         self.assertEqual(list(GoldAttributeValue.objects.values_list("start", "value")), [(0, "true")])
+
+    def test_a_huge_or_odd_value_is_named_short_never_echoed_whole(self):
+        self.login(self.bob)
+        self.client.post(self.base)
+        for name, value in (("quality", "x" * 100_000), ("note", {"a": ["b"] * 10_000}), ("needs cleanup", [1] * 10_000)):
+            r = self.set(0, name, value)
+            self.assertEqual(r.status_code, 400, name)
+            self.assertLess(len(r.json()["detail"]), 300)
+            self.assertIn(name, r.json()["detail"])
