@@ -75,7 +75,9 @@ class ListQuery:
             v["label_projects"] = tuple(p for _, _, p in labels)
             self.empty = self.empty or not labels
         for i, (ids, text) in enumerate(attributes):
-            v[f"attribute{i}"], v[f"attribute{i}_value"] = tuple(ids), text
+            # How the filter reads (``segment_filters``) is part of the shape: by the key.
+            how = "walk" if common_value(ids, text) else "seek"
+            v[f"attribute{i}"], v[f"attribute{i}_{how}"] = tuple(ids), text
             self.empty = self.empty or not ids
         groups = ()
         if self.ordering == "label":
@@ -248,12 +250,33 @@ def segment_filters(gold, values):
             filters.append(Q(**{lookup: values[name]}))
     i = 0
     while f"attribute{i}" in values:
-        carried = LibraryAttributeValue.objects.filter(
-            segment_id=OuterRef("id"), value=values[f"attribute{i}_value"],
-            **one_of("attribute_id", list(values[f"attribute{i}"])))
-        filters.append(Exists(carried))
+        filters.append(attribute_q(values, i))
         i += 1
     return filters
+
+
+# A value carried by at least this many library rows is read by walking the list and
+# probing each row (``EXISTS``): the page and the capped count find their rows soon. A
+# rarer one is sought in the value index first (``id IN``): walking would probe every
+# row of the list to find 50 (``benchmarks/results/library-attribute-filter.md``).
+COMMON_VALUE_ROWS = 10_000
+
+
+def common_value(ids, text):
+    """Whether attributes ``ids`` carry ``text`` on at least ``COMMON_VALUE_ROWS`` library
+    rows (counted from the value index, no further than that)."""
+    rows = LibraryAttributeValue.objects.filter(value=text, **one_of("attribute_id", list(ids)))
+    return rows[:COMMON_VALUE_ROWS].count() >= COMMON_VALUE_ROWS
+
+
+def attribute_q(values, i):
+    """The filter of the ``i``th attribute of a ``ListQuery``'s ``values``."""
+    walk = f"attribute{i}_walk" in values
+    text = values[f"attribute{i}_walk" if walk else f"attribute{i}_seek"]
+    carried = LibraryAttributeValue.objects.filter(value=text, **one_of("attribute_id", list(values[f"attribute{i}"])))
+    if walk:
+        return Exists(carried.filter(segment_id=OuterRef("id")))
+    return Q(id__in=carried.values("segment_id"))
 
 
 def one_of(field, values):

@@ -221,3 +221,19 @@ class AttributesTestCase(BaseTestCase):
             self.assertEqual(r.status_code, 400, name)
             self.assertLess(len(r.json()["detail"]), 300)
             self.assertIn(name, r.json()["detail"])
+
+    def test_a_common_value_and_a_rare_one_filter_the_same_way(self):
+        from unittest import mock
+
+        from segmentation.queries import library
+        self.label_and_submit(self.bob)
+        self.set(0, "quality", "good")
+        self.set(2, "quality", "good")
+        self.submit()
+        self.login(self.alice)
+        url = "/api/segments/?attribute=quality:good&page_size=1"
+        rare = [self.client.get(f"{url}&page={n}").json()["results"][0]["start"] for n in (1, 2)]
+        with mock.patch.object(library, "COMMON_VALUE_ROWS", 1):
+            common = [self.client.get(f"{url}&page={n}").json()["results"][0]["start"] for n in (1, 2)]
+        self.assertEqual(rare, common)
+        self.assertEqual(sorted(rare), [0, 200])
