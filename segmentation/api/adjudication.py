@@ -64,6 +64,10 @@ class GoldSerializer(serializers.Serializer):
     labels = serializers.ListField(child=Text(text_limit(Label, "name"), allow_null=True))
     version = serializers.IntegerField(min_value=0)
     source_review = serializers.IntegerField(required=False, allow_null=True)
+    attributes = serializers.ListField(
+        child=serializers.DictField(), required=False, allow_null=True,
+        help_text="one {attribute name: value} per segment; when omitted, unchanged segments "
+                  "keep theirs and segments copied from source_review bring theirs")
 
 
 def adjudication_body(capture):
@@ -103,7 +107,8 @@ class AdjudicationView(APIView):
             if source is None:
                 raise Invalid(f"source_review: review {data['source_review']} is not a "
                               "submitted review of this capture")
-        do_save_gold(capture, request.user, data["cuts"], data["labels"], data["version"], source)
+        do_save_gold(capture, request.user, data["cuts"], data["labels"], data["version"], source,
+                     data.get("attributes"))
         return Response(AdjudicationSerializer(adjudication_body(capture)).data)
 
 

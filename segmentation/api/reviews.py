@@ -76,7 +76,7 @@ def unstarted_review(capture, user):
         "id": None, "capture": capture.pk, "annotator": {"id": user.pk, "username": user.username},
         "run": run.pk if run else None, "status": "not_started", "version": 1,
         "return_comment": "", "cuts": cuts,
-        "segments": [{"index": i, "start": a, "stop": b, "label": None}
+        "segments": [{"index": i, "start": a, "stop": b, "label": None, "attributes": {}}
                      for i, (a, b) in enumerate(zip(bounds[:-1], bounds[1:], strict=True))],
         "adaptation": adaptation_summary(run, capture.project_id, user),
     }

@@ -1,6 +1,7 @@
 """The clip library's segments: the filtered, paged list, one segment, and its exports.
 
-- ``GET /api/segments/?project=&label=&capture=&annotator=<username or id>&min_duration=&max_duration=&min_agreement=&gold=&ordering=&page=``
+- ``GET /api/segments/?project=&label=&capture=&annotator=<username or id>&min_duration=&max_duration=&min_agreement=&gold=&attribute=<name:value>&ordering=&page=``
+  (``attribute`` repeatable: every one must hold)
   (``count`` exact up to 10,000 matches, else 10,000 with ``count_capped``)
 - ``GET /api/segments/{id}/``, ``…/export.bvh``, ``…/export.fbx``, ``…/export.glb``
 - ``GET /api/segments/export.zip?<same filters>&file_format=bvh|fbx|glb`` (streamed)
@@ -27,12 +28,14 @@ from segmentation.files.storage import read_take
 from segmentation.queries.access import segment_for
 from segmentation.queries.library import (
     ListQuery,
+    attribute_filter,
     capped_count,
     check_ordering,
     page_ids,
     page_rows,
     user_named,
 )
+from segmentation.services.attributes import shown_library_values
 
 
 class SegmentPagination(PageNumberPagination):
@@ -122,16 +125,23 @@ def list_query(request):
         asked["annotator"] = user_named(annotator)
     for name, high in (("min_duration", None), ("max_duration", None), ("min_agreement", 1)):
         asked[name] = float_param(request, name, 0, high)
-    return ListQuery(request.user, label=params.get("label"), **asked)
+    attributes = [attribute_filter(request.user, asked["project"], raw)
+                  for raw in params.getlist("attribute") if raw]
+    return ListQuery(request.user, label=params.get("label"), attributes=attributes, **asked)
 
 
 class SegmentListView(APIView):
     pagination_class = SegmentPagination
 
-    @extend_schema(responses=SegmentSerializer(many=True))
+    @extend_schema(responses=SegmentSerializer(many=True), parameters=[OpenApiParameter(
+        "attribute", str, many=True, description="name:value of a segment attribute "
+        "(e.g. quality:good, needs cleanup:true); repeat it to ask for several")])
     def get(self, request):
         paginator = self.pagination_class()
         page = paginator.paginate_queryset(list_query(request).parts(), request, view=self)
+        values = shown_library_values([row["id"] for row in page])
+        for row in page:
+            row["attributes"] = values[row["id"]]
         return paginator.get_paginated_response(page)
 
 
@@ -186,6 +196,7 @@ class SegmentZipView(APIView):
                           f"{exports.MAX_EXPORT_SEGMENTS} at a time (narrow the filters)")
         left_out = matching.count() - count
         rows = (segments.select_related("capture", "annotator", "label").defer("descriptor", "profile")
+                .prefetch_related("attribute_values__attribute")
                 .order_by("capture_id", "start", "id").iterator(chunk_size=200))
         response = StreamingHttpResponse(exports.stream_zip(rows, fmt, left_out),
                                          content_type="application/zip")

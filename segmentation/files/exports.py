@@ -178,6 +178,10 @@ def manifest_row(segment, name, fmt, take, unit):
         "unit": unit, "label": segment.label.name, "gold": segment.is_gold,
         "annotator": segment.annotator.username if segment.annotator else None,
         "agreement": segment.agreement,
+        # The segment's attribute values by name (the list prefetches them).
+        "attributes": {v.attribute.name: v.attribute.shown(v.value)
+                       for v in sorted(segment.attribute_values.all(),
+                                       key=lambda v: (v.attribute.position, v.attribute_id))},
     }
 
 
@@ -253,12 +257,22 @@ def _clips(capture, take, segments, fmt):
 
 
 def _csv(rows):
+    """The manifest as CSV: one ``attribute:<name>`` column per segment attribute any row
+    carries (a boolean as true/false, an unset value empty)."""
     out = io.StringIO()
     fields = ["file", "format", "segment", "capture", "capture_id", "start", "stop", "frames",
               "unit", "label", "gold", "annotator", "agreement"]
-    writer = csv.DictWriter(out, fieldnames=fields)
-    writer.writeheader()
-    # Names typed by people (capture, label, annotator) open as text, never as formulas.
-    writer.writerows({k: spreadsheet_safe(v) if isinstance(v, str) else v for k, v in row.items()}
-                     for row in rows)
+    names = list(dict.fromkeys(name for row in rows for name in row.get("attributes", {})))
+    writer = csv.DictWriter(out, fieldnames=fields + [f"attribute:{n}" for n in names])
+    # Names and values typed by people (capture, label, annotator, attribute names, options
+    # and notes) open as text, never as formulas.
+    writer.writerow({k: spreadsheet_safe(k) for k in writer.fieldnames})
+    for row in rows:
+        flat = {k: v for k, v in row.items() if k != "attributes"}
+        flat.update({f"attribute:{n}": _cell(v) for n, v in row.get("attributes", {}).items()})
+        writer.writerow({k: spreadsheet_safe(v) if isinstance(v, str) else v for k, v in flat.items()})
     return out.getvalue()
+
+
+def _cell(value):
+    return str(value).lower() if isinstance(value, bool) else value

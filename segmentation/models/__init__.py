@@ -6,12 +6,20 @@
 - ``reviews``: reviews, cuts, segment labels, the review audit log;
 - ``library``: library segments, gold versions, agreement, label suggestions;
 - ``workers``: the Celery workers' heartbeats;
+- ``comments``: threads of comments pinned to a frame, cut or segment of a review;
+- ``attributes``: a project's segment attribute schema and the values segments carry;
 
 Rules about one record live on the models; lookups live on the managers
 (``Capture.objects.visible_to(user)``). Workflows that touch several records are the
 ``do_*`` functions in ``segmentation.services``.
 """
 
+from segmentation.models.attributes import (
+    GoldAttributeValue,
+    LibraryAttributeValue,
+    SegmentAttribute,
+    SegmentAttributeValue,
+)
 from segmentation.models.captures import (
     Assignment,
     Capture,
@@ -20,6 +28,7 @@ from segmentation.models.captures import (
     derived_path,
     original_path,
 )
+from segmentation.models.comments import Comment
 from segmentation.models.jobs import JOB_STATUSES, ClaimQuerySet, Job, JSONArrayLength
 from segmentation.models.library import (
     AGREED_BOUNDARY_F1,
@@ -51,20 +60,25 @@ __all__ = [
     "Capture",
     "CaptureAgreement",
     "CaptureQuerySet",
+    "Comment",
     "ClaimQuerySet",
     "Cut",
     "DetectionRun",
+    "GoldAttributeValue",
     "Invitation",
     "JSONArrayLength",
     "Job",
     "Label",
     "LabelSuggestion",
+    "LibraryAttributeValue",
     "LibrarySegment",
     "Membership",
     "Project",
     "ProjectCutModel",
     "Review",
     "ReviewEvent",
+    "SegmentAttribute",
+    "SegmentAttributeValue",
     "SegmentLabel",
     "SuggestionRequest",
     "derived_path",

@@ -15,12 +15,18 @@ import operator
 
 from django.contrib.auth import get_user_model
 from django.db import connections
-from django.db.models import Q
+from django.db.models import Exists, OuterRef, Q
 
 from segmentation.db import statements
 from segmentation.db.statements import Statement
 from segmentation.errors import Invalid
-from segmentation.models import Label, LibrarySegment, Membership
+from segmentation.models import (
+    Label,
+    LibraryAttributeValue,
+    LibrarySegment,
+    Membership,
+    SegmentAttribute,
+)
 from segmentation.models.library import projects_by_role
 from segmentation.similar import candidates, search
 
@@ -44,9 +50,10 @@ class ListQuery:
 
     def __init__(self, user, ordering="recent", gold=None, project=None, capture=None,
                  annotator=None, min_duration=None, max_duration=None, min_agreement=None,
-                 label=None):
+                 label=None, attributes=()):
         """``annotator`` a user id (``user_named`` finds it from a name); ``label`` a label
-        name; ``None`` leaves a filter out."""
+        name; ``attributes`` ``(attribute ids, stored text)`` pairs (``attribute_filter``);
+        ``None`` leaves a filter out."""
         self.ordering, self.gold = ordering, gold
         v = {"user": user.pk}
         for name, value in (("project", project), ("capture", capture), ("annotator", annotator),
@@ -67,6 +74,11 @@ class ListQuery:
             v["labels"] = tuple(pk for _, pk, _ in labels)
             v["label_projects"] = tuple(p for _, _, p in labels)
             self.empty = self.empty or not labels
+        for i, (ids, text) in enumerate(attributes):
+            # How the filter reads (``segment_filters``) is part of the shape: by the key.
+            how = "walk" if common_value(ids, text) else "seek"
+            v[f"attribute{i}"], v[f"attribute{i}_{how}"] = tuple(ids), text
+            self.empty = self.empty or not ids
         groups = ()
         if self.ordering == "label":
             labels = label_rows(user, project)
@@ -236,7 +248,35 @@ def segment_filters(gold, values):
                          ("min_agreement", "agreement__gte")):
         if name in values:
             filters.append(Q(**{lookup: values[name]}))
+    i = 0
+    while f"attribute{i}" in values:
+        filters.append(attribute_q(values, i))
+        i += 1
     return filters
+
+
+# A value carried by at least this many library rows is read by walking the list and
+# probing each row (``EXISTS``): the page and the capped count find their rows soon. A
+# rarer one is sought in the value index first (``id IN``): walking would probe every
+# row of the list to find 50 (``benchmarks/results/library-attribute-filter.md``).
+COMMON_VALUE_ROWS = 10_000
+
+
+def common_value(ids, text):
+    """Whether attributes ``ids`` carry ``text`` on at least ``COMMON_VALUE_ROWS`` library
+    rows (counted from the value index, no further than that)."""
+    rows = LibraryAttributeValue.objects.filter(value=text, **one_of("attribute_id", list(ids)))
+    return rows[:COMMON_VALUE_ROWS].count() >= COMMON_VALUE_ROWS
+
+
+def attribute_q(values, i):
+    """The filter of the ``i``th attribute of a ``ListQuery``'s ``values``."""
+    walk = f"attribute{i}_walk" in values
+    text = values[f"attribute{i}_walk" if walk else f"attribute{i}_seek"]
+    carried = LibraryAttributeValue.objects.filter(value=text, **one_of("attribute_id", list(values[f"attribute{i}"])))
+    if walk:
+        return Exists(carried.filter(segment_id=OuterRef("id")))
+    return Q(id__in=carried.values("segment_id"))
 
 
 def one_of(field, values):
@@ -368,6 +408,32 @@ def user_named(username):
     if not found:
         raise Invalid(f"annotator: no user named {username[:150]!r}")
     return found[0][0]
+
+
+def attribute_filter(user, project, raw):
+    """``(attribute ids, stored text)`` of a list filter ``name:value`` over the attributes
+    of that name in ``user``'s projects (or ``project``); Invalid names what is wrong."""
+    name, colon, value = raw.partition(":")
+    name = name.strip()
+    if not colon or not name:
+        raise Invalid(f"attribute: write name:value (e.g. quality:good), got {raw[:100]!r}")
+    found = SegmentAttribute.objects.filter(
+        name=name, project_id__in=Membership.objects.filter(user_id=user.pk).values("project_id"))
+    if project is not None:
+        found = found.filter(project_id=project)
+    found = list(found)
+    if not found:
+        raise Invalid(f"attribute: no attribute named {name[:100]!r} in your projects")
+    text, error = None, None
+    for attribute in found:
+        try:
+            text = attribute.parse(value.strip(), "attribute")
+            break
+        except Invalid as exc:
+            error = error or exc
+    if text is None:
+        raise error or Invalid(f"attribute: {name[:100]!r} needs a value after the ':'")
+    return [a.pk for a in found], text
 
 
 def check_ordering(ordering):

@@ -6,6 +6,7 @@ from django.utils import timezone
 from segmentation.errors import Invalid, StaleGold
 from segmentation.models import Adjudication
 from segmentation.services.adaptation import on_examples_changed
+from segmentation.services.attributes import store_gold_values
 from segmentation.services.library import refresh_capture_library
 
 
@@ -64,12 +65,14 @@ def gold_label_ids(capture, cuts, names, current):
     return ids
 
 
-def do_save_gold(capture, user, cuts, labels, version, source_review=None):
+def do_save_gold(capture, user, cuts, labels, version, source_review=None, attributes=None):
     """Create or replace the capture's gold version and rebuild its library rows.
 
     ``labels`` are the segments' label names (or null), stored as label ids.
     ``version`` is the gold version the reviewer started from (0 when there was none);
-    anything else than the current version is refused with ``StaleGold``.
+    anything else than the current version is refused with ``StaleGold``. ``attributes``:
+    the segments' attribute values (``services.attributes.store_gold_values``; when
+    omitted they travel with unchanged segments and from ``source_review``).
     """
     cuts, labels = check_gold(capture, cuts, labels)
     if not capture.reviews.filter(status="submitted").exists():
@@ -82,6 +85,8 @@ def do_save_gold(capture, user, cuts, labels, version, source_review=None):
             raise StaleGold(current) if current else Invalid(
                 f"version: there is no gold version yet; send 0, got {version}")
         label_ids = gold_label_ids(capture, cuts, labels, current)
+        previous = [(start, stop) for start, stop, _ in current.label_segments()] if current else []
+        store_gold_values(capture, previous, cuts, attributes, source_review)
         gold = current or Adjudication(capture=capture, version=0)
         gold.adjudicator, gold.source_review = user, source_review
         gold.cuts, gold.labels = cuts, label_ids

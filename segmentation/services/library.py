@@ -15,7 +15,7 @@ from django.db import transaction
 from motionlib.agreement import label_codes, segment_support
 from segmentation import workers
 from segmentation.models import Adjudication, Capture, LibrarySegment
-from segmentation.services import agreement
+from segmentation.services import agreement, attributes
 from segmentation.similar import updates
 from segmentation.similar.descriptors import descriptors, store_descriptor
 
@@ -56,6 +56,7 @@ def refresh_capture_library(capture):
     with transaction.atomic():
         LibrarySegment.objects.filter(capture=capture).delete()
         LibrarySegment.objects.bulk_create(rows, batch_size=500)
+        attributes.store_library_values(capture, rows)
         updates.schedule_update(capture.project_id)
         if rows and not described_inline(capture):
             transaction.on_commit(lambda: workers.send(
@@ -91,9 +92,11 @@ def describe_library(capture_id):
         ids = [r.pk for r in rows]
         if LibrarySegment.objects.filter(pk__in=ids).delete()[0] != len(ids):
             return 0  # replaced meanwhile; the newer refresh's job describes the new rows
+        carried = attributes.library_values(ids)
         for row in rows:
             row.pk = None
         LibrarySegment.objects.bulk_create(rows, batch_size=500)
+        attributes.copy_library_values(carried, {old: row.pk for old, row in zip(ids, rows, strict=True)})
         updates.schedule_update(capture.project_id)
     return len(rows)
 

@@ -152,8 +152,8 @@ class SegmentListTest(LibraryTestCase):
                 self.get(f"?page_size={size}")
             counts.append(len(queries))
         # Memberships, the page's ids, its rows (with capture, annotator and label
-        # joined), and a count unless the page is the last one.
-        assert counts == [4, 3]
+        # joined), their attribute values, and a count unless the page is the last one.
+        assert counts == [5, 4]
 
     def test_it_requires_login(self):
         assert self.client.get("/api/segments/").status_code in (401, 403)
@@ -235,7 +235,7 @@ class PostgresSegmentListTest(LibraryTestCase):
     """The same query count on PostgreSQL, where the library lives in production
     (``make pytest`` runs the integration tests there)."""
 
-    def test_it_answers_with_four_queries_on_postgresql(self):
+    def test_it_answers_with_five_queries_on_postgresql(self):
         if connection.vendor != "postgresql":
             pytest.skip("needs PostgreSQL: DATABASE_URL=postgres://… (make pytest sets it)")
         self.two_reviews()
@@ -245,9 +245,9 @@ class PostgresSegmentListTest(LibraryTestCase):
                 response = self.client.get(f"/api/segments/?page_size={size}&label=walk&min_agreement=0")
             assert response.status_code == 200
             assert response.json()["count"] == 3
-            # Memberships, the label's ids, the page's ids, its rows; and the count when
-            # the page is not the last.
-            assert len(queries) == (5 if size < 3 else 4)
+            # Memberships, the label's ids, the page's ids, its rows, their attribute
+            # values; and the count when the page is not the last.
+            assert len(queries) == (6 if size < 3 else 5)
 
 
 class LostPositionsTest(LibraryTestCase):

@@ -218,6 +218,22 @@ export interface paths {
         patch?: never;
         trace?: never;
     };
+    "/api/captures/{id}/comments/": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get: operations["captures_comments_list"];
+        put?: never;
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
     "/api/captures/{id}/frames/": {
         parameters: {
             query?: never;
@@ -288,6 +304,23 @@ export interface paths {
         put?: never;
         /** @description Start the caller's review (or return it if started). */
         post: operations["captures_review_create"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/captures/{id}/review/comments/": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /** @description A comment on the caller's own review, which it starts if they had not. */
+        post: operations["captures_review_comments_create"];
         delete?: never;
         options?: never;
         head?: never;
@@ -382,6 +415,22 @@ export interface paths {
         patch: operations["captures_review_segments_partial_update"];
         trace?: never;
     };
+    "/api/captures/{id}/review/segments/{index}/attributes/": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch: operations["captures_review_segments_attributes_partial_update"];
+        trace?: never;
+    };
     "/api/captures/{id}/review/submit/": {
         parameters: {
             query?: never;
@@ -450,6 +499,38 @@ export interface paths {
         options?: never;
         head?: never;
         patch?: never;
+        trace?: never;
+    };
+    "/api/captures/{id}/reviews/{review_id}/comments/": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get: operations["captures_reviews_comments_list"];
+        put?: never;
+        post: operations["captures_reviews_comments_create"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/captures/{id}/reviews/{review_id}/comments/{comment_id}/": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch: operations["captures_reviews_comments_partial_update"];
         trace?: never;
     };
     "/api/captures/{id}/reviews/{review_id}/events/": {
@@ -684,6 +765,38 @@ export interface paths {
         head?: never;
         /** @description Reassign: give the capture to another member instead. */
         patch: operations["projects_assignments_partial_update"];
+        trace?: never;
+    };
+    "/api/projects/{id}/attributes/": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get: operations["projects_attributes_list"];
+        put?: never;
+        post: operations["projects_attributes_create"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/projects/{id}/attributes/{attribute_id}/": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        post?: never;
+        delete: operations["projects_attributes_destroy"];
+        options?: never;
+        head?: never;
+        patch: operations["projects_attributes_partial_update"];
         trace?: never;
     };
     "/api/projects/{id}/cut-models/": {
@@ -1098,6 +1211,13 @@ export interface components {
             /** Format: date-time */
             submitted_at: string | null;
         };
+        /**
+         * @description * `frame` - Frame
+         *     * `cut` - Cut
+         *     * `segment` - Segment
+         * @enum {string}
+         */
+        AnchorEnum: "frame" | "cut" | "segment";
         Annotator: {
             id: number;
             username: string;
@@ -1138,6 +1258,24 @@ export interface components {
             /** Format: date-time */
             created_at: string;
             readonly state: components["schemas"]["QueueStateEnum"];
+        };
+        Attribute: {
+            readonly id: number;
+            name: string;
+            kind: components["schemas"]["KindEnum"];
+            /** @description a choice's options in order */
+            options: string[];
+            hotkey: string | null;
+            readonly position: number;
+            /** @description segments of reviews and gold versions carrying it */
+            readonly in_use: number;
+        };
+        AttributeRequest: {
+            name: string;
+            kind: components["schemas"]["KindEnum"];
+            /** @description a choice's options in order */
+            options?: string[];
+            hotkey?: string | null;
         };
         AuthTokenRequest: {
             username: string;
@@ -1232,6 +1370,23 @@ export interface components {
          * @enum {string}
          */
         ChangeCutFateEnum: "accepted" | "deleted" | "pending";
+        Comment: {
+            id: number;
+            review: number;
+            /** @description whose review the thread is on */
+            annotator: string;
+            readonly author: string | null;
+            parent: number | null;
+            anchor: components["schemas"]["AnchorEnum"];
+            cut: number | null;
+            /** @description where the thread is now: its cut's frame, or the frame it was written at */
+            readonly frame: number;
+            text: string;
+            /** Format: date-time */
+            created_at: string;
+            readonly resolved: boolean;
+            readonly resolved_by: string | null;
+        };
         Cut: {
             /** @description null in a review not started yet */
             id: number | null;
@@ -1379,6 +1534,10 @@ export interface components {
             labels: (string | null)[];
             version: number;
             source_review?: number | null;
+            /** @description one {attribute name: value} per segment; when omitted, unchanged segments keep theirs and segments copied from source_review bring theirs */
+            attributes?: {
+                [key: string]: unknown;
+            }[] | null;
         };
         /** @description A model's own figure: each reviewed take scored by a model fitted without it. */
         HeldOut: {
@@ -1506,6 +1665,13 @@ export interface components {
          * @enum {string}
          */
         JobStatusEnum: "queued" | "processing" | "ready" | "failed";
+        /**
+         * @description * `choice` - Choice
+         *     * `text` - Free text
+         *     * `boolean` - Yes / no
+         * @enum {string}
+         */
+        KindEnum: "choice" | "text" | "boolean";
         Label: {
             readonly id: number;
             name: string;
@@ -1612,6 +1778,17 @@ export interface components {
             /** @description The one-time password; shown only in this answer. */
             password: string;
         };
+        /**
+         * @description A thread on one of ``frame``, ``cut`` (a cut id) or ``segment`` (an index), or a
+         *     reply (``parent``).
+         */
+        NewCommentRequest: {
+            text: string;
+            frame?: number | null;
+            cut?: number | null;
+            segment?: number | null;
+            parent?: number | null;
+        };
         /** @enum {unknown} */
         NullEnum: null;
         /**
@@ -1709,6 +1886,12 @@ export interface components {
             /** @description The one-time password; shown only in this answer. */
             password: string;
         };
+        PatchedAttributeChangeRequest: {
+            name?: string;
+            kind?: components["schemas"]["KindEnum"];
+            options?: string[];
+            hotkey?: string | null;
+        };
         PatchedChangeCutRequest: {
             version?: number;
             fate?: components["schemas"]["ChangeCutFateEnum"];
@@ -1737,8 +1920,17 @@ export interface components {
         PatchedReassignRequestRequest: {
             annotator?: string;
         };
+        PatchedResolveRequest: {
+            resolved?: boolean;
+        };
         PatchedRoleRequestRequest: {
             role?: components["schemas"]["RoleEnum"];
+        };
+        PatchedSetAttributeRequest: {
+            version?: number;
+            name?: string;
+            /** @description an option, text (at most 500 characters) or true/false as the attribute's kind; null clears */
+            value?: unknown;
         };
         Project: {
             readonly id: number;
@@ -1865,6 +2057,10 @@ export interface components {
             start: number;
             stop: number;
             label: string | null;
+            /** @description the segment's attribute values by attribute name (the project's schema: GET /api/projects/{id}/attributes/) */
+            attributes: {
+                [key: string]: unknown;
+            };
         };
         /**
          * @description * `in_progress` - In progress
@@ -1959,6 +2155,10 @@ export interface components {
             /** Format: double */
             agreement: number | null;
             readonly export_formats: string[];
+            /** @description The segment's attribute values by attribute name. */
+            readonly attributes: {
+                [key: string]: unknown;
+            };
         };
         /** @description A feature signal, sampled: value i is at frame start + i * step. */
         Signal: {
@@ -2002,6 +2202,10 @@ export interface components {
             /** Format: double */
             agreement: number | null;
             readonly export_formats: string[];
+            /** @description The segment's attribute values by attribute name. */
+            readonly attributes: {
+                [key: string]: unknown;
+            };
             /**
              * Format: double
              * @description Descriptor distance to the segment
@@ -2499,6 +2703,27 @@ export interface operations {
             };
         };
     };
+    captures_comments_list: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path: {
+                id: number;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["Comment"][];
+                };
+            };
+        };
+    };
     captures_frames_retrieve: {
         parameters: {
             query?: {
@@ -2607,6 +2832,33 @@ export interface operations {
                 };
                 content: {
                     "application/json": components["schemas"]["Review"];
+                };
+            };
+        };
+    };
+    captures_review_comments_create: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path: {
+                id: number;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["NewCommentRequest"];
+                "application/x-www-form-urlencoded": components["schemas"]["NewCommentRequest"];
+                "multipart/form-data": components["schemas"]["NewCommentRequest"];
+            };
+        };
+        responses: {
+            201: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["Comment"];
                 };
             };
         };
@@ -2742,6 +2994,34 @@ export interface operations {
             };
         };
     };
+    captures_review_segments_attributes_partial_update: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path: {
+                id: number;
+                index: number;
+            };
+            cookie?: never;
+        };
+        requestBody?: {
+            content: {
+                "application/json": components["schemas"]["PatchedSetAttributeRequest"];
+                "application/x-www-form-urlencoded": components["schemas"]["PatchedSetAttributeRequest"];
+                "multipart/form-data": components["schemas"]["PatchedSetAttributeRequest"];
+            };
+        };
+        responses: {
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["Review"];
+                };
+            };
+        };
+    };
     captures_review_submit_create: {
         parameters: {
             query?: never;
@@ -2834,6 +3114,85 @@ export interface operations {
                 };
                 content: {
                     "application/json": components["schemas"]["Review"][];
+                };
+            };
+        };
+    };
+    captures_reviews_comments_list: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path: {
+                id: number;
+                review_id: number;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["Comment"][];
+                };
+            };
+        };
+    };
+    captures_reviews_comments_create: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path: {
+                id: number;
+                review_id: number;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["NewCommentRequest"];
+                "application/x-www-form-urlencoded": components["schemas"]["NewCommentRequest"];
+                "multipart/form-data": components["schemas"]["NewCommentRequest"];
+            };
+        };
+        responses: {
+            201: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["Comment"];
+                };
+            };
+        };
+    };
+    captures_reviews_comments_partial_update: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path: {
+                comment_id: number;
+                id: number;
+                review_id: number;
+            };
+            cookie?: never;
+        };
+        requestBody?: {
+            content: {
+                "application/json": components["schemas"]["PatchedResolveRequest"];
+                "application/x-www-form-urlencoded": components["schemas"]["PatchedResolveRequest"];
+                "multipart/form-data": components["schemas"]["PatchedResolveRequest"];
+            };
+        };
+        responses: {
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["Comment"];
                 };
             };
         };
@@ -3284,6 +3643,103 @@ export interface operations {
             };
         };
     };
+    projects_attributes_list: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path: {
+                id: number;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["Attribute"][];
+                };
+            };
+        };
+    };
+    projects_attributes_create: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path: {
+                id: number;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["AttributeRequest"];
+                "application/x-www-form-urlencoded": components["schemas"]["AttributeRequest"];
+                "multipart/form-data": components["schemas"]["AttributeRequest"];
+            };
+        };
+        responses: {
+            201: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["Attribute"];
+                };
+            };
+        };
+    };
+    projects_attributes_destroy: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path: {
+                attribute_id: number;
+                id: number;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description No response body */
+            204: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content?: never;
+            };
+        };
+    };
+    projects_attributes_partial_update: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path: {
+                attribute_id: number;
+                id: number;
+            };
+            cookie?: never;
+        };
+        requestBody?: {
+            content: {
+                "application/json": components["schemas"]["PatchedAttributeChangeRequest"];
+                "application/x-www-form-urlencoded": components["schemas"]["PatchedAttributeChangeRequest"];
+                "multipart/form-data": components["schemas"]["PatchedAttributeChangeRequest"];
+            };
+        };
+        responses: {
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["Attribute"];
+                };
+            };
+        };
+    };
     projects_cut_models_list: {
         parameters: {
             query?: never;
@@ -3665,6 +4121,8 @@ export interface operations {
     segments_list: {
         parameters: {
             query?: {
+                /** @description name:value of a segment attribute (e.g. quality:good, needs cleanup:true); repeat it to ask for several */
+                attribute?: string[];
                 /** @description A page number within the paginated result set. */
                 page?: number;
                 /** @description Number of results to return per page. */

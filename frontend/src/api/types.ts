@@ -46,7 +46,14 @@ export type Cut = ApiCut & { id: number };
 /** A review's segment; `suggested_label` is not sent with the review: the page fills it in
  * from `Suggestions` for an unlabelled segment, with `proposed_probability` when it is a
  * frame model's proposal (null: a label the library suggests). */
-export type Segment = Schemas["ReviewSegment"] & { suggested_label?: string | null; proposed_probability?: number | null };
+export type Segment = Omit<Schemas["ReviewSegment"], "attributes"> & { attributes?: Schemas["ReviewSegment"]["attributes"]; suggested_label?: string | null; proposed_probability?: number | null };
+/** A segment's attribute values by attribute name: an option, a note or true/false. Absent
+ * on a segment the page derived itself until the server answers. */
+export type AttributeValues = NonNullable<Segment["attributes"]>;
+/** One attribute of a project's segment schema. */
+export type SegmentAttribute = Schemas["Attribute"];
+/** A comment on a review, or a reply (`parent`). */
+export type ReviewComment = Schemas["Comment"];
 
 /** `GET /api/captures/{id}/review/suggestions/`: computed by a worker, `pending` until all are. */
 export type Suggestions = Schemas["Suggestions"];

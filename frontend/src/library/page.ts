@@ -20,11 +20,13 @@ export interface LibraryFilters {
   max_duration: string;
   min_agreement: string;
   gold: string;
+  /** A segment attribute as name:value (quality:good, needs cleanup:true). */
+  attribute: string;
   ordering: string;
   page: number;
 }
 
-const KEYS = ["project", "label", "annotator", "min_duration", "max_duration", "min_agreement", "gold", "ordering"] as const;
+const KEYS = ["project", "label", "annotator", "min_duration", "max_duration", "min_agreement", "gold", "attribute", "ordering"] as const;
 export const ORDERINGS: [string, string][] = [["recent", "Newest"], ["-duration", "Longest"], ["duration", "Shortest"], ["-agreement", "Most agreed"], ["agreement", "Least agreed"], ["label", "Label"], ["capture", "Capture"]];
 
 export function libraryFiltersFrom(search: string): LibraryFilters {
@@ -39,6 +41,14 @@ export function libraryQuery(f: LibraryFilters, withPage = true): string {
   for (const k of KEYS) if (f[k]) q.set(k, f[k]);
   if (withPage && f.page > 1) q.set("page", String(f.page));
   return q.toString();
+}
+
+/** A segment's attribute values as one muted line (none: nothing). */
+export function attributeText(s: { attributes?: Record<string, unknown> }): HTMLElement | null {
+  const values = Object.entries(s.attributes ?? {});
+  if (!values.length) return null;
+  const text = values.map(([name, value]) => (value === true ? name : value === false ? `not ${name}` : `${name}: ${String(value)}`)).join(" · ");
+  return h("div", { class: "muted lib-attributes", "data-testid": "segment-attributes" }, text);
 }
 
 /** "1 segment", "7 segments", or "10,000+ segments" when the server stopped counting. */
@@ -127,6 +137,7 @@ export async function renderLibrary(root: HTMLElement): Promise<() => void> {
     field("max_duration", h("input", { class: "input num-input", type: "number", step: "0.1", min: "0", placeholder: "max s" })),
     field("min_agreement", h("input", { class: "input num-input", type: "number", step: "0.05", min: "0", max: "1", placeholder: "min agreement" })),
     field("gold", h("select", { class: "select" }, ...options([["", "Gold where made"], ["true", "Gold only"], ["false", "Annotators' versions"]]))),
+    field("attribute", h("input", { class: "input", placeholder: "attribute name:value", title: "A segment attribute, e.g. quality:good or needs cleanup:true" })),
     field("ordering", h("select", { class: "select" }, ...options(ORDERINGS))),
     zipFormat,
     exportZip,
@@ -173,7 +184,7 @@ export async function renderLibrary(root: HTMLElement): Promise<() => void> {
     return h(
       "tr",
       { "data-testid": `segment-${s.id}` },
-      h("td", {}, h("span", { class: "label-dot", style: `background:${s.color}` }), clip(s.label), s.gold ? h("span", { class: "badge badge-ready gold-badge" }, "gold") : null),
+      h("td", {}, h("span", { class: "label-dot", style: `background:${s.color}` }), clip(s.label), s.gold ? h("span", { class: "badge badge-ready gold-badge" }, "gold") : null, attributeText(s)),
       h("td", {}, clip(s.capture.name, { href: `/captures/${s.capture.id}/?frame=${s.start}` })),
       h("td", { class: "num" }, `${s.start}–${s.stop}`),
       h("td", { class: "num" }, formatDuration(s.duration)),

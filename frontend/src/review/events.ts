@@ -12,6 +12,10 @@ export function eventDetail(e: Pick<ReviewEvent, "action" | "before" | "after">)
   if (e.action === "restore") return restoreDetail(after);
   // An imported file (services/annotations.py): how many segments, from which file and tier.
   if (e.action === "import") return `${after.segments ?? 0} segments from ${after.file ?? "a file"}${after.source ? ` (${after.source})` : ""}`;
+  if (e.action === "attribute") {
+    const shown = (v: unknown) => (v === null || v === undefined ? "—" : v === true ? "yes" : v === false ? "no" : String(v));
+    return `segment ${Number(after.index ?? before.index) + 1} ${String(after.attribute ?? "")}: ${shown(before.value)} → ${shown(after.value)}`;
+  }
   if ("index" in after || "index" in before) {
     const index = Number(after.index ?? before.index);
     return `segment ${index + 1}: ${before.label ?? "—"} → ${after.label ?? "—"}`;

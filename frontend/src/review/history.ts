@@ -53,6 +53,7 @@ function eventTitle(e: ReviewEvent): string {
 /** What `edit` does in words, measured on the review before it is applied. */
 export function editTitle(review: Review, edit: Edit): string {
   if (edit.kind === "label") return edit.label ? `label ${edit.label}` : "clear label";
+  if (edit.kind === "attribute") return edit.value === null ? `clear ${edit.name}` : `${edit.name}: ${String(edit.value)}`;
   if (edit.kind === "insert") return `insert cut at ${edit.frame}`;
   if (edit.kind === "undo" || edit.kind === "redo") return edit.kind;
   if (edit.kind === "restore") return "restore an earlier point";

@@ -25,7 +25,14 @@ export type Command =
   | { kind: "home" }
   | { kind: "end" }
   | { kind: "help" }
-  | { kind: "escape" };
+  | { kind: "escape" }
+  | { kind: "comment"; on: "playhead" | "segment" }
+  | { kind: "commentJump"; direction: -1 | 1 }
+  | { kind: "attribute"; hotkey: string; back: boolean };
+
+/** Letters no other command uses: a segment attribute's hotkey is one of them (the server
+ * holds the same list, segmentation/models/attributes.py). */
+export const ATTRIBUTE_KEYS = "befhjkopqtvwxy";
 
 export interface KeyInput {
   key: string;
@@ -35,7 +42,9 @@ export interface KeyInput {
   altKey: boolean;
 }
 
-export function commandFor(e: KeyInput): Command | null {
+/** The command of a key press; `attributeKeys`: the hotkeys of the project's segment
+ * attributes (any other letter of ATTRIBUTE_KEYS is left to the browser). */
+export function commandFor(e: KeyInput, attributeKeys = ""): Command | null {
   const mod = e.ctrlKey || e.metaKey;
   const key = e.key.length === 1 ? e.key.toLowerCase() : e.key;
   if (mod && key === "z") return e.shiftKey ? { kind: "redo" } : { kind: "undo" };
@@ -46,6 +55,7 @@ export function commandFor(e: KeyInput): Command | null {
   if (key === "ArrowRight") return e.shiftKey ? { kind: "jump", direction: 1 } : { kind: "step", frames: 1 };
   if (/^[1-9]$/.test(key)) return { kind: "label", hotkey: key };
   if (key === "0" || key === "Backspace") return { kind: "clearLabel" };
+  if (key.length === 1 && ATTRIBUTE_KEYS.includes(key) && attributeKeys.includes(key)) return { kind: "attribute", hotkey: key, back: e.shiftKey };
   return SIMPLE[e.shiftKey ? `shift+${key}` : key] ?? SIMPLE[key] ?? null;
 }
 
@@ -86,6 +96,10 @@ const SIMPLE: Record<string, Command> = {
   End: { kind: "end" },
   "?": { kind: "help" },
   Escape: { kind: "escape" },
+  c: { kind: "comment", on: "playhead" },
+  "shift+c": { kind: "comment", on: "segment" },
+  m: { kind: "commentJump", direction: 1 },
+  "shift+m": { kind: "commentJump", direction: -1 },
 };
 
 /** Rows of the "?" overlay: keys, then what they do. */
@@ -120,6 +134,10 @@ export const HELP: [string, string][] = [
   ["Double-click a lane", "insert a cut there"],
   ["Click a grey × under the ruler", "restore that deleted candidate"],
   ["Click the overview strip", "seek anywhere in the take; the working window follows"],
+  ["C", "comment at the playhead (on the selected cut when one is selected)"],
+  ["Shift+C", "comment on the segment under the playhead (it follows the segment's start)"],
+  ["M / Shift+M", "next / previous comment (the playhead moves to its frame)"],
+  ["An attribute's letter (Shift: backwards)", "set that attribute of the segment under the playhead: next option, yes/no, or type a note"],
   ["?", "show / hide this help"],
 ];
 

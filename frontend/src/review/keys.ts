@@ -18,9 +18,9 @@ function dialogOpen(): boolean {
  * person is typing in a field, or a dialog is open. A press that is a command has its
  * default action (scrolling, the browser's own shortcut) prevented.
  */
-export function pageCommand(e: PageKey, isDialogOpen: () => boolean = dialogOpen): Command | null {
+export function pageCommand(e: PageKey, isDialogOpen: () => boolean = dialogOpen, attributeKeys = ""): Command | null {
   if (isTypingTarget(e.target) || isDialogOpen()) return null;
-  const command = commandFor(e);
+  const command = commandFor(e, attributeKeys);
   if (command) e.preventDefault();
   return command;
 }

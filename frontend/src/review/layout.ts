@@ -97,6 +97,8 @@ function side(el: Elements): HTMLElement {
     { class: "side" },
     h("section", {}, h("h3", {}, "Labels"), (el.labels = h("div", { class: "label-list", "data-testid": "labels" }))),
     h("section", {}, h("h3", {}, "Selection"), (el.selection = h("div", { class: "selection", "data-testid": "selection" }))),
+    (el.attributesSection = h("section", { hidden: true }, h("h3", {}, "Attributes"), (el.attributes = h("div", { class: "attributes", "data-testid": "attributes" })))),
+    h("section", {}, h("h3", {}, "Comments"), (el.comments = h("div", { class: "comments", "data-testid": "comments" }))),
     h(
       "section",
       {},

@@ -19,6 +19,7 @@ import { eventDetail } from "./events";
 import { pageCommand } from "./keys";
 import type { Command } from "./keymap";
 import { buildLayout, type Elements } from "./layout";
+import { Notes } from "./notes";
 import { ReviewSession } from "./session";
 import { confirmRestore, listOf, Sidebar } from "./sidebar";
 import { FrameFeed, frameFromUrl, fullSignals, maxJoints, signalsAfterPoses, signalsWait, Stage } from "./stage";
@@ -83,10 +84,11 @@ class ReviewPage {
   private readonly sidebar: Sidebar;
   private readonly commands: Commands;
   private readonly suggestions: Suggestions;
+  private readonly notes: Notes;
   private readonly labels: Label[];
   private readonly el: Elements;
   private readonly onKey = (e: KeyboardEvent) => {
-    const command = pageCommand(e);
+    const command = pageCommand(e, undefined, this.notes?.hotkeys() ?? "");
     if (command) this.command(command);
   };
 
@@ -146,6 +148,15 @@ class ReviewPage {
     });
     // Arrived suggestions show in the side panel and in the timeline's segments.
     this.suggestions = new Suggestions(capture.id, () => this.refresh());
+    this.notes = new Notes({
+      session: this.session, captureId: capture.id, frame: () => this.playback.frame,
+      goTo: (f) => {
+        this.playback.seekAndPause(f);
+        this.timeline.reveal(this.playback.frame);
+        this.refresh();
+      },
+      refresh: () => this.refresh(),
+    });
     frames.onChunk = () => this.stage.loaded(this.playback.frame);
     if (frames.store.loadedFrames) this.stage.loaded(this.playback.frame);
     void signalsWait(frames).then(() => this.loadFullSignals()).finally(frames.resume);
@@ -154,6 +165,7 @@ class ReviewPage {
     void this.loadEvents();
     void this.sidebar.loadOtherReviews(project, me);
     void this.suggestions.load();
+    void this.notes.load(project?.id ?? null);
   }
 
   dispose(): void {
@@ -185,7 +197,10 @@ class ReviewPage {
   // ---- state → screen ------------------------------------------------------------------
 
   private command(c: Command): void {
-    this.commands.run(c);
+    if (c.kind === "comment") void this.notes.add(c.on === "segment" ? this.segmentHere() : undefined);
+    else if (c.kind === "commentJump") this.notes.jump(c.direction);
+    else if (c.kind === "attribute") void this.notes.attributeKey(c.hotkey, c.back, this.segmentHere());
+    else this.commands.run(c);
     this.refresh();
   }
 
@@ -224,7 +239,9 @@ class ReviewPage {
   }
 
   private renderSide(): void {
-    this.sidebar.render(this.session, this.segmentHere());
+    const segment = this.segmentHere();
+    this.sidebar.render(this.session, segment);
+    this.notes?.render(this.el.comments, this.el.attributes, this.el.attributesSection, segment);
   }
 
   private setSpeed(speed: number): void {

@@ -56,7 +56,7 @@ export class Saver {
       try {
         if (this.server.id === null) await this.start();
         const request =
-          edit.kind === "label"
+          edit.kind === "label" || edit.kind === "attribute"
             ? labelRequest(this.captureId, this.server, edit, this.server.version)
             : editRequest(this.captureId, edit, this.server.version, this.resolve, this.server.id);
         const next = await this.send<Review>(request.method, request.url, request.body);

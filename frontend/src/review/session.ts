@@ -91,7 +91,8 @@ export class ReviewSession {
     try {
       const title = editTitle(this.review, edit);
       this.review = applyEdit(this.review, edit, this.nFrames);
-      this.history = record(this.history, title);
+      // An attribute is logged but is no step of the server's undo history.
+      if (edit.kind !== "attribute") this.history = record(this.history, title);
       if (edit.kind === "insert") this.selectedCutId = edit.tempId;
       this.saver.push([edit], title);
       this.pushes++;

@@ -2,13 +2,15 @@
 // The page applies an edit here at once (so the screen answers immediately) and sends the
 // same edit to the server; the server's answer then replaces the prediction.
 
-import type { ApiReview, Cut, Fate, Review, Segment } from "../api/types";
+import type { ApiReview, AttributeValues, Cut, Fate, Review, Segment } from "../api/types";
 
 export type Edit =
   | { kind: "fate"; cutId: number; fate: "accepted" | "deleted" | "pending" }
   | { kind: "move"; cutId: number; frame: number }
   | { kind: "insert"; frame: number; tempId: number }
   | { kind: "label"; start: number; stop: number; label: string | null }
+  // A segment attribute (review/notes.ts); not a step of the undo history.
+  | { kind: "attribute"; start: number; stop: number; name: string; value: string | boolean | null }
   // Made by the server from the review's log (history.ts): the page cannot predict them.
   | { kind: "undo" }
   | { kind: "redo" }
@@ -90,7 +92,7 @@ export function nearestDeleted(cuts: readonly Cut[], frame: number): Cut | undef
  * on its candidate cuts, so they can be selected and edited before the first save
  * starts the review.
  */
-export function withTempIds(review: ApiReview): Review {
+export function withTempIds(review: Omit<ApiReview, "segments"> & { segments: Segment[] }): Review {
   // A started review's cuts all have ids; an unstarted one's have none.
   return { ...review, cuts: review.cuts.map((c, i) => ({ ...c, id: c.id ?? -1 - i })) };
 }
@@ -119,6 +121,11 @@ export function applyEdit(review: Review, edit: Edit, nFrames: number): Review {
     }
     return { ...review, segments };
   }
+  if (edit.kind === "attribute") {
+    const found = review.segments.some((s) => s.start === edit.start && s.stop === edit.stop);
+    if (!found) throw new EditError(`No segment ${edit.start}–${edit.stop} to set ${edit.name} on.`);
+    return { ...review, segments: review.segments.map((s) => (s.start === edit.start && s.stop === edit.stop ? { ...s, attributes: withValue(s.attributes, edit.name, edit.value) } : s)) };
+  }
   if (edit.kind === "insert") {
     checkInsert(review.cuts, edit.frame, nFrames);
     cuts.push({ id: edit.tempId, origin: "inserted", fate: "accepted", candidate_frame: null, frame: edit.frame, confidence: null });
@@ -129,7 +136,27 @@ export function applyEdit(review: Review, edit: Edit, nFrames: number): Review {
     else moveCut(cut, cuts, edit.frame, nFrames);
   }
   const labels = labelsByStartCut(review);
-  return { ...review, cuts, segments: deriveSegments(cuts, nFrames, (id) => labels.get(id) ?? null) };
+  const segments = deriveSegments(cuts, nFrames, (id) => labels.get(id) ?? null);
+  return { ...review, cuts, segments: withAttributes(review, cuts, segments) };
+}
+
+/** `segments` (derived after a cut edit) with the attribute values of the segment that
+ * started at the same cut before it, as the server keys them. */
+function withAttributes(review: Review, cuts: readonly Cut[], segments: Segment[]): Segment[] {
+  const startCut = (kept: Cut[], index: number) => (index === 0 ? null : (kept[index - 1]?.id ?? NaN));
+  const before = sortedCuts(review.cuts);
+  const byCut = new Map<number | null, Segment["attributes"]>();
+  for (const s of review.segments) if (s.attributes) byCut.set(startCut(before, s.index), s.attributes);
+  if (!byCut.size) return segments;
+  const after = sortedCuts(cuts);
+  return segments.map((s) => ({ ...s, attributes: byCut.get(startCut(after, s.index)) ?? {} }));
+}
+
+function withValue(values: AttributeValues | undefined, name: string, value: string | boolean | null): AttributeValues {
+  const next: AttributeValues = { ...(values ?? {}) };
+  if (value === null) delete next[name];
+  else next[name] = value;
+  return next;
 }
 
 function checkInsert(cuts: readonly Cut[], frame: number, nFrames: number): void {
@@ -190,14 +217,19 @@ export function editRequest(captureId: number, edit: Edit, version: number, reso
     case "move":
       return { method: "PATCH", url: `${base}/cuts/${resolveId(edit.cutId)}/`, body: { frame: edit.frame, version } };
     case "label":
-      throw new EditError("A label edit needs the segment index: use labelRequest.");
+    case "attribute":
+      throw new EditError("A segment edit needs the segment index: use labelRequest.");
   }
 }
 
 /** Label requests name the segment by its index in the review the server holds now. */
-export function labelRequest(captureId: number, review: Review, edit: Extract<Edit, { kind: "label" }>, version: number): Request {
+export function labelRequest(captureId: number, review: Review, edit: Extract<Edit, { kind: "label" | "attribute" }>, version: number): Request {
   const segment = review.segments.find((s) => s.start === edit.start && s.stop === edit.stop);
   if (!segment) throw new EditError(`Segment ${edit.start}–${edit.stop} no longer exists.`);
+  if (edit.kind === "attribute") {
+    const url = `/api/captures/${captureId}/review/segments/${segment.index}/attributes/`;
+    return { method: "PATCH", url, body: { name: edit.name, value: edit.value, version } };
+  }
   return {
     method: "PATCH",
     url: `/api/captures/${captureId}/review/segments/${segment.index}/`,

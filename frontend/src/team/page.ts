@@ -7,6 +7,7 @@ import type { Invitation, Label, Me, Project, Role } from "../api/types";
 import type { Member } from "../queue/api";
 import { accountLinks, appLinks } from "../ui/appnav";
 import { clear, clip, confirmDialog, dialog, h, toast } from "../ui/dom";
+import { attributeEditor } from "./attributes";
 import { taxonomyEditor } from "./taxonomy";
 import "./team.css";
 
@@ -165,6 +166,7 @@ export async function renderTeam(root: HTMLElement, projectId: number): Promise<
       : null,
     h("section", { class: "team-section" }, h("h2", {}, "Assignments"), h("label", { class: "check" }, pick, " Annotators may also pick captures nobody assigned to them")),
     isAdmin ? taxonomyEditor(project) : null,
+    isAdmin ? attributeEditor(project) : null,
   ]);
   await loadMembers();
   if (isAdmin) await loadInvitations();

@@ -6,6 +6,7 @@ from rest_framework import serializers
 from segmentation.api.common.serializers.base import NamedRefSerializer, UserRefSerializer
 from segmentation.files import exports
 from segmentation.models import LibrarySegment
+from segmentation.services.attributes import shown_library_values
 
 
 class SegmentSerializer(serializers.ModelSerializer):
@@ -16,12 +17,13 @@ class SegmentSerializer(serializers.ModelSerializer):
     gold = serializers.BooleanField(source="is_gold")
     fps = serializers.FloatField(source="capture.fps")
     export_formats = serializers.SerializerMethodField()
+    attributes = serializers.SerializerMethodField()
 
     class Meta:
         model = LibrarySegment
         fields = ["id", "project", "capture", "review", "annotator", "gold", "superseded",
                   "label", "color", "start", "stop", "fps", "duration", "agreement",
-                  "export_formats"]
+                  "export_formats", "attributes"]
 
     @extend_schema_field(NamedRefSerializer)
     def get_capture(self, s):
@@ -33,6 +35,10 @@ class SegmentSerializer(serializers.ModelSerializer):
 
     def get_export_formats(self, s) -> list[str]:
         return exports.formats_for(s.capture)
+
+    def get_attributes(self, s) -> dict:
+        """The segment's attribute values by attribute name."""
+        return shown_library_values([s.pk])[s.pk]
 
     def get_color(self, s) -> str:
         return s.label.color if s.label_id else "#888888"

@@ -9,6 +9,7 @@ from segmentation.api.common.serializers.captures import AdaptationSerializer
 from segmentation.limits import text_limit
 from segmentation.models import Cut, Label, Review, ReviewEvent
 from segmentation.services.adaptation import adaptation_summary
+from segmentation.services.attributes import review_values
 
 
 class CutSerializer(serializers.Serializer):
@@ -25,6 +26,9 @@ class ReviewSegmentSerializer(serializers.Serializer):
     start = serializers.IntegerField()
     stop = serializers.IntegerField()
     label = serializers.CharField(allow_null=True)
+    attributes = serializers.DictField(
+        required=False, help_text="the segment's attribute values by attribute name (the project's schema: "
+                  "GET /api/projects/{id}/attributes/)")
 
 
 # A review's statuses, and that of the review a caller has not started yet (the schema's
@@ -73,7 +77,9 @@ class ReviewSerializer(serializers.ModelSerializer):
         # Label suggestions are not part of a review: they are computed by a worker and
         # read from …/review/suggestions/ (segmentation.similar.suggestions).
         kept = [(cut["id"], cut["frame"]) for cut in self._cuts(review) if cut["fate"] != "deleted"]
-        return [{"index": index, "start": start, "stop": stop, "label": label}
+        values, starts = review_values(review), [None] + [cut_id for cut_id, _ in kept]
+        return [{"index": index, "start": start, "stop": stop, "label": label,
+                 "attributes": values.get(starts[index], {})}
                 for index, start, stop, label in review.segments(kept=kept)]
 
 
