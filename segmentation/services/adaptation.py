@@ -280,18 +280,28 @@ def _train(job):
         raise Invalid("no reviewed take can be learnt from: " + "; ".join(skipped))
     zero = {capture.pk: len(_candidates(capture, None, stored)) for capture, _cuts in examples
             if sources[capture.pk] not in (model_gate.GOLD, model_gate.SHARED)}
-    sources = {**sources, model_gate.IMPLAUSIBLE: implausible(examples, sources, zero)}
+    odd = implausible(examples, sources, zero)
+    sources = {**sources, model_gate.IMPLAUSIBLE: odd}
+    # An implausible annotator's takes are not learnt from while there is anything else:
+    # the learner's medians and outlier test count takes, and four takes without a cut
+    # would outnumber two honest ones there. The gate still scores the model on them.
+    pool = [e for e in examples if sources[e[0].pk] not in odd] or examples
     # The full fit first, with the stored studies: they stay those of the examples as they
     # are, which the next training reads (the gate's refits keep theirs in memory).
-    candidate = fit_examples(examples, stored, refits=True, sources=sources)
+    candidate = fit_examples(pool, stored, refits=True, sources=sources)
     model = candidate.model
     learnt = set(current.trained_on) if current is not None else set()
     own = [e for e in examples if e[0].pk in learnt]
     # The current model's own examples, refitted only when a take it learnt from is scored.
     own_refits = functools.cache(lambda: fit_examples(own, in_memory, refits=True, sources=sources))
+    pooled = {capture.pk for capture, _cuts in pool}
+
+    def candidate_without(capture):
+        return candidate.without(_position(pool, capture)) if capture.pk in pooled else model
+
     verdict = model_gate.judge(
         examples, current, current_model, sources=sources,
-        candidate_without=lambda capture: candidate.without(_position(examples, capture)),
+        candidate_without=candidate_without,
         current_without=lambda capture: own_refits().without(_position(own, capture)),
         detect=lambda capture, cut_model: _candidates(capture, cut_model, in_memory),
     )
@@ -302,10 +312,10 @@ def _train(job):
             refused=verdict.refused,
             skipped="\n".join(skipped),
             model=model.to_json(),
-            labels_model=fit_labels(examples),
+            labels_model=fit_labels(pool),
             n_takes=model.n_takes,
             n_cuts=model.n_cuts,
-            trained_on=[capture.pk for capture, _cuts in examples],
+            trained_on=[capture.pk for capture, _cuts in pool],
             held_out_takes=verdict.figure.takes,
             held_out_edits_per_cut=round(verdict.figure.edits_per_cut, 4),
             held_out_f1=round(verdict.figure.f1, 4),
