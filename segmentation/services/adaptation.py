@@ -1,16 +1,24 @@
 """Learning each project's cutting from its own reviews.
 
 A project's examples are its reviewed takes: the gold version of a capture where one was
-saved, else the consensus of all its submitted reviews (``consensus.consensus_cuts``: one
-example per take, so every take weighs the same and "learnt from N reviewed takes" counts
-takes, and no single annotator decides a take's cuts). After a submit or a gold save,
-``request_training`` queues one training per project (requests made while one waits join
-it); a worker trains with ``motionlib.adapt.fit_cut_model``, scores the new model against
-the current one on reviewed takes each did not learn from (``model_gate``) and stores it
-as the project's next version only if it is not worse; a refused model is stored with the
-reason and no version. Runs of the ``default`` method detect with the newest version; a
-project without one uses the zero-shot detector. A failed training stores its reason and
-leaves the newest version in use.
+saved, else the consensus of all its submitted reviews (``consensus.consensus_cuts``, a
+tie between annotators settled by the project's current model as a half-vote referee:
+one example per take, so every take weighs the same and "learnt from N reviewed takes"
+counts takes). Each example knows its source (gold, shared, or one annotator alone):
+one annotator's own takes weigh together at most what the rest of the project does
+(``annotator_weights``), and an annotator whose takes keep far fewer or far more cuts
+than the zero-shot detector proposes there is not learnt from (``implausible``). A take
+that cannot be read or is too short is left out with a note (``learnable``), never
+failing the training.
+
+After a submit or a gold save, ``request_training`` queues one training per project
+(requests made while one waits join it); a worker trains with
+``motionlib.adapt.fit_cut_model``, scores the new model against the current one on
+reviewed takes each did not learn from, by source (``model_gate``), and stores it as the
+project's next version only if it is accepted; a refused model is stored with the reason
+and no version. Runs of the ``default`` method detect with the newest version; a project
+without one uses the zero-shot detector. A failed training stores its reason and leaves
+the newest version in use. The rules and their reasons: docs/learning.md.
 
 What the fit learnt from each reviewed take (its study) is stored beside the parsed take
 (``takecache.StoredStudies``), so a retraining after one more submit reads and analyses

@@ -4,10 +4,11 @@ Both models are scored out of sample on the same reviewed takes: the candidate o
 scored take by a model refitted on the project's other examples (leave-one-take-out,
 ``motionlib.adapt.Refits``); the current model on a take it did not learn from as it is,
 and on a take it learnt from by a refit of its own examples without that take (zero-shot,
-the model of a project without one, learnt from nothing). The scored takes fall in two groups, those the
-current model learnt from and the others, and the candidate must be not worse in each:
-an annotator whose new reviews cut differently from everyone before makes a candidate
-that wins on their own takes and loses on the others', and such a model is refused.
+the model of a project without one, learnt from nothing). The candidate must propose a
+plausible number of cuts beside the zero-shot detector (``Count``), and the scored takes
+are compared by source (``_source_reasons``): worse on gold versions or on takes several
+annotators reviewed refuses it; one annotator's own takes are one capped vote, so a lone
+annotator can neither get a model accepted nor refused against the rest of the project.
 The rule and its reasons: docs/learning.md.
 """
 
