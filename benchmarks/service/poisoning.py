@@ -5,7 +5,8 @@ or 5 of 7 (a young project, where one annotator is most of the reviews).
 Real service code on the embedded default (a temporary SQLite database and media folder),
 synthetic takes with known boundaries (``motionlib.synth``) stored as BVH captures. An
 honest annotator reviews takes to their true cuts; the poisoner's reviews either keep no
-cut (under-cut) or add a cut in the middle of every true segment (over-cut). Two ways the
+cut (under-cut) or add, in every true segment, the detector's candidate nearest its middle
+(over-cut: about twice the true cuts, at frames the learner can learn). Two ways the
 poisoner's takes reach the project:
 
 - *shared*: every take was reviewed honestly, then the poisoner re-reviews theirs;
@@ -62,11 +63,22 @@ def truth(seed, minutes):
     return take, [start for start, _stop, _label in segments[1:]]
 
 
-def poisoned_cuts(kind, cuts, n_frames):
+def poisoned_cuts(kind, cuts, take):
+    """The poisoner's cuts: none (under-cut), or the true ones plus, in every true segment,
+    the detector's candidate nearest its middle (over-cut: a cut the learner can learn,
+    as an annotator who keeps weak candidates would), about twice the true count."""
     if kind == "under-cut":
         return []
-    bounds = [0, *cuts, n_frames]
-    return sorted({*cuts, *[(a + b) // 2 for a, b in zip(bounds[:-1], bounds[1:], strict=True)]})
+    from motionlib import adapt
+
+    candidates = adapt.placed(adapt.CutModel.zero_shot(), adapt.study(take))
+    bounds = [0, *cuts, take.n_frames]
+    extra = set()
+    for a, b in zip(bounds[:-1], bounds[1:], strict=True):
+        inside = [int(f) for f in candidates if a + FPS <= f <= b - FPS]
+        if inside:
+            extra.add(min(inside, key=lambda f: abs(f - (a + b) // 2)))
+    return sorted({*cuts, *extra})
 
 
 class Project:
@@ -97,7 +109,7 @@ class Project:
                           fps=FPS, n_frames=take.n_frames, n_joints=len(take.skeleton.names))
         capture.original.save(capture.name, ContentFile(text.getvalue().encode()), save=False)
         capture.save()
-        capture.truth = cuts
+        capture.truth, capture.take = cuts, take
         return capture
 
     def review(self, capture, user, cuts):
@@ -153,7 +165,7 @@ def build(kind, where, minutes, n_takes, which):
     honest = p.captures if where == "shared" else [c for c in p.captures if c not in poisoned]
     if where == "first":
         for capture in poisoned:
-            p.review(capture, p.poisoner, poisoned_cuts(kind, capture.truth, capture.n_frames))
+            p.review(capture, p.poisoner, poisoned_cuts(kind, capture.truth, capture.take))
         p.train()
         for capture in honest:
             p.review(capture, p.honest, capture.truth)
@@ -163,7 +175,7 @@ def build(kind, where, minutes, n_takes, which):
             p.review(capture, p.honest, capture.truth)
         p.train()
         for capture in poisoned:
-            p.review(capture, p.poisoner, poisoned_cuts(kind, capture.truth, capture.n_frames))
+            p.review(capture, p.poisoner, poisoned_cuts(kind, capture.truth, capture.take))
         job = p.train()
     old = adaptation.fit_examples(latest_review_examples(p.project), None)
     outcome = job.refused.split(":")[0] if job.refused else f"accepted v{job.version}"

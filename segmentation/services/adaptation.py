@@ -192,7 +192,9 @@ def learnable(examples, studies):
                 raise Invalid(f"cut {outside[0]} is outside the take ({n} frames)")
             adapt.example_study(example(capture, cuts), studies=studies)
         except (CutroomError, MotionlibError, ValueError, FloatingPointError) as exc:
-            reason = str(exc).removeprefix(f"{example_name(capture)}: ")
+            # The note names the capture once; the errors name it in their own words.
+            reason = str(exc).removeprefix(f"{example_name(capture)}: ").removeprefix(
+                f"reviewed capture {capture.pk} ({capture.name!r}) ")
             notes.append(f"capture {capture.pk} ({capture.name!r}) skipped: {reason}")
             continue
         kept.append((capture, cuts))
