@@ -8,14 +8,23 @@ The rule and why it was chosen: docs/learning.md.
 import bisect
 import heapq
 
+# A referee's vote: less than one annotator's, so it only settles ties between them.
+REFEREE_VOTE = 0.5
 
-def consensus_cuts(reviews, tolerance):
+
+def consensus_cuts(reviews, tolerance, referee=None):
     """Cuts supported by at least half of ``reviews``, each at the median of its support.
 
     Parameters
     ----------
     reviews : sequence of sequences of int, each review's kept cut frames (0-based).
     tolerance : frames two annotators' cuts may lie apart and still mean the same cut.
+    referee : sequence of int or None, cut frames of a voter that belongs to no annotator
+        (the service passes what the project's current model, or the zero-shot detector,
+        proposes on the take). It has REFEREE_VOTE, half an annotator's: it never outvotes
+        an annotator, and it settles a tie between them (two annotators, one of whom
+        under- or over-cut the take) for whichever side the project agreed on before. Its
+        cuts seed nothing and never place a cut; ignored with fewer than two reviews.
 
     Returns
     -------
@@ -33,19 +42,25 @@ def consensus_cuts(reviews, tolerance):
     if len(cuts) <= 1:
         return cuts[0] if cuts else []
     free = [list(c) for c in cuts]  # each review's cuts not yet used, sorted
-    heap = [(-_support(free, seed, tolerance), seed) for seed in sorted({f for c in cuts for f in c})]
+    votes = [1.0] * len(cuts)
+    if referee is not None:
+        free.append(sorted({int(f) for f in referee}))
+        votes.append(REFEREE_VOTE)
+    total = sum(votes)
+    heap = [(-_support(free, votes, seed, tolerance), seed) for seed in sorted({f for c in cuts for f in c})]
     heapq.heapify(heap)
     kept = set()
     while heap:
         negative, seed = heapq.heappop(heap)
-        support = _support(free, seed, tolerance)
+        support = _support(free, votes, seed, tolerance)
         if support != -negative:  # cuts were used since: look again at its true place
             heapq.heappush(heap, (-support, seed))
             continue
-        if 2 * support < len(cuts):
+        if 2 * support < total:
             break  # supports only shrink: nothing after this one reaches half either
         chosen = [_take_nearest(review, seed, tolerance) for review in free]
-        chosen = sorted(f for f in chosen if f is not None)
+        # The referee's cut is used up, but the cut is placed among the annotators' own.
+        chosen = sorted(f for f in chosen[:len(cuts)] if f is not None)
         kept.add(chosen[(len(chosen) - 1) // 2])
     return sorted(kept)
 
@@ -62,9 +77,10 @@ def _nearest(review, seed, tolerance):
     return best
 
 
-def _support(free, seed, tolerance):
-    """How many reviews still have a free cut within ``tolerance`` of ``seed``."""
-    return sum(_nearest(review, seed, tolerance) is not None for review in free)
+def _support(free, votes, seed, tolerance):
+    """The votes of the reviews that still have a free cut within ``tolerance`` of ``seed``."""
+    return sum(vote for review, vote in zip(free, votes, strict=True)
+               if _nearest(review, seed, tolerance) is not None)
 
 
 def _take_nearest(review, seed, tolerance):

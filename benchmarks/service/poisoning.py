@@ -1,15 +1,18 @@
 """One annotator against a project's model: how the model in use cuts the next takes when
-one annotator under-cuts or over-cuts 3 of a project's 10 reviewed takes (the issue's
-target), or 5 of 7 (a young project, where one annotator is most of the reviews).
+one annotator under-cuts or over-cuts 3 of a project's 10 reviewed takes (the target),
+or 5 of 7 (a young project, where one annotator is most of the reviews).
 
 Real service code on the embedded default (a temporary SQLite database and media folder),
 synthetic takes with known boundaries (``motionlib.synth``) stored as BVH captures. An
 honest annotator reviews takes to their true cuts; the poisoner's reviews either keep no
-cut (under-cut) or add a cut in the middle of every true segment (over-cut). Two ways the
+cut (under-cut) or add, in every true segment, the detector's candidate nearest its middle
+(over-cut: about twice the true cuts, at frames the learner can learn). Two ways the
 poisoner's takes reach the project:
 
 - *shared*: every take was reviewed honestly, then the poisoner re-reviews theirs;
-- *alone*: the poisoner is the only reviewer of their takes, reviewed after the others.
+- *alone*: the poisoner is the only reviewer of their takes, reviewed after the others;
+- *first*: the poisoner is the only reviewer of their takes and reviews them before anyone
+  else (the project trains on them alone first), then the honest annotator reviews the rest.
 
 Both paths in the same run, on the same reviews:
 
@@ -25,7 +28,11 @@ true cut, pooled); "clean" is the model learnt from honest reviews of the same t
 
     .venv/bin/python -m benchmarks poisoning -- [--minutes 1] [--next 5]
 
-Target (issue 34): the poisoner moves the F1 on the next takes by < 0.05.
+Target: the poisoner moves the F1 on the next takes by < 0.05. ``cuts`` is what the model
+in use proposes on the held-out takes against their true cuts (an under-cut model proposes
+few, an over-cut one many). To compare with the service of another revision in the same
+run: ``python -m benchmarks poisoning --against REV`` (that revision's *new* path is its
+service as it was).
 """
 
 import argparse
@@ -56,11 +63,22 @@ def truth(seed, minutes):
     return take, [start for start, _stop, _label in segments[1:]]
 
 
-def poisoned_cuts(kind, cuts, n_frames):
+def poisoned_cuts(kind, cuts, take):
+    """The poisoner's cuts: none (under-cut), or the true ones plus, in every true segment,
+    the detector's candidate nearest its middle (over-cut: a cut the learner can learn,
+    as an annotator who keeps weak candidates would), about twice the true count."""
     if kind == "under-cut":
         return []
-    bounds = [0, *cuts, n_frames]
-    return sorted({*cuts, *[(a + b) // 2 for a, b in zip(bounds[:-1], bounds[1:], strict=True)]})
+    from motionlib import adapt
+
+    candidates = adapt.placed(adapt.CutModel.zero_shot(), adapt.study(take))
+    bounds = [0, *cuts, take.n_frames]
+    extra = set()
+    for a, b in zip(bounds[:-1], bounds[1:], strict=True):
+        inside = [int(f) for f in candidates if a + FPS <= f <= b - FPS]
+        if inside:
+            extra.add(min(inside, key=lambda f: abs(f - (a + b) // 2)))
+    return sorted({*cuts, *extra})
 
 
 class Project:
@@ -91,7 +109,7 @@ class Project:
                           fps=FPS, n_frames=take.n_frames, n_joints=len(take.skeleton.names))
         capture.original.save(capture.name, ContentFile(text.getvalue().encode()), save=False)
         capture.save()
-        capture.truth = cuts
+        capture.truth, capture.take = cuts, take
         return capture
 
     def review(self, capture, user, cuts):
@@ -144,19 +162,29 @@ def build(kind, where, minutes, n_takes, which):
 
     p = Project(f"{kind} {where} {n_takes}", minutes, n_takes)
     poisoned = [p.captures[i] for i in which]
-    first = p.captures if where == "shared" else [c for c in p.captures if c not in poisoned]
-    for capture in first:
-        p.review(capture, p.honest, capture.truth)
-    p.train()
-    for capture in poisoned:
-        p.review(capture, p.poisoner, poisoned_cuts(kind, capture.truth, capture.n_frames))
-    job = p.train()
+    honest = p.captures if where == "shared" else [c for c in p.captures if c not in poisoned]
+    if where == "first":
+        for capture in poisoned:
+            p.review(capture, p.poisoner, poisoned_cuts(kind, capture.truth, capture.take))
+        p.train()
+        for capture in honest:
+            p.review(capture, p.honest, capture.truth)
+        job = p.train()
+    else:
+        for capture in honest:
+            p.review(capture, p.honest, capture.truth)
+        p.train()
+        for capture in poisoned:
+            p.review(capture, p.poisoner, poisoned_cuts(kind, capture.truth, capture.take))
+        job = p.train()
     old = adaptation.fit_examples(latest_review_examples(p.project), None)
     outcome = job.refused.split(":")[0] if job.refused else f"accepted v{job.version}"
     return old, in_use(p.project), outcome
 
 
 def score(model, held_out):
+    """The model's pooled Figure on the held-out takes (its ``candidates`` are what it
+    proposes there)."""
     from motionlib import adapt
     from segmentation.services.model_gate import Figure
 
@@ -164,6 +192,11 @@ def score(model, held_out):
     for take, cuts in held_out:
         figure.add(adapt.detect(take, model).cuts.tolist(), cuts, FPS)
     return figure
+
+
+def cuts(figure):
+    """"proposed/true" over the held-out takes."""
+    return f"{figure.candidates}/{figure.true_cuts}"
 
 
 def main():
@@ -179,10 +212,12 @@ def run(args, var):
     print(f"load: synthetic takes of {args.minutes:g} min at {FPS:g} fps; scored on {args.next} "
           f"held-out takes ({sum(len(c) for _, c in held_out)} true cuts); {os.cpu_count()} cores, "
           f"load average {os.getloadavg()[0]:.1f}")
-    print(f"zero-shot: F1 {zero.f1:.3f}, {zero.edits_per_cut:.2f} edits per true cut\n")
+    print(f"zero-shot: F1 {zero.f1:.3f}, {zero.edits_per_cut:.2f} edits per true cut, "
+          f"{zero.candidates} cuts\n")
     print(f"| {'project':<14} | {'poisoner':<10} | {'their takes':<11} | {'path':<4} | {'last training':<14} "
-          f"| {'F1':>6} | {'F1 - clean':>10} | {'edits/cut':>9} | {'< 0.05':<6} |")
-    print(f"|{'-' * 16}|{'-' * 12}|{'-' * 13}|{'-' * 6}|{'-' * 16}|{'-' * 8}|{'-' * 12}|{'-' * 11}|{'-' * 8}|")
+          f"| {'F1':>6} | {'F1 - clean':>10} | {'edits/cut':>9} | {'cuts':>7} | {'< 0.05':<6} |")
+    print(f"|{'-' * 16}|{'-' * 12}|{'-' * 13}|{'-' * 6}|{'-' * 16}|{'-' * 8}|{'-' * 12}|{'-' * 11}"
+          f"|{'-' * 9}|{'-' * 8}|")
     worst = {"old": 0.0, "new": 0.0}
     for n_takes, which in PROJECTS:
         clean_project = Project(f"clean {n_takes}", args.minutes, n_takes)
@@ -192,9 +227,9 @@ def run(args, var):
         clean = score(adaptation.fit_examples(examples, None), held_out)
         label = f"{len(which)} of {n_takes} bad"
         print(f"| {label:<14} | {'(none)':<10} | {'':<11} | {'':<4} | {'clean':<14} | {clean.f1:>6.3f} "
-              f"| {0.0:>+10.3f} | {clean.edits_per_cut:>9.2f} | {'':<6} |")
+              f"| {0.0:>+10.3f} | {clean.edits_per_cut:>9.2f} | {cuts(clean):>7} | {'':<6} |")
         for kind in ("under-cut", "over-cut"):
-            for where in ("shared", "alone"):
+            for where in ("shared", "alone", "first"):
                 old, new, outcome = build(kind, where, args.minutes, n_takes, which)
                 for path, model, last in (("old", old, "accepted"), ("new", new, outcome)):
                     figure = score(model, held_out)
@@ -202,7 +237,7 @@ def run(args, var):
                     worst[path] = max(worst[path], abs(move))
                     print(f"| {label:<14} | {kind:<10} | {where:<11} | {path:<4} | {last:<14} "
                           f"| {figure.f1:>6.3f} | {move:>+10.3f} | {figure.edits_per_cut:>9.2f} | "
-                          f"{'yes' if abs(move) < TARGET_F1_MOVE else 'NO':<6} |", flush=True)
+                          f"{cuts(figure):>7} | {'yes' if abs(move) < TARGET_F1_MOVE else 'NO':<6} |", flush=True)
     print(f"\ntarget: the poisoner moves F1 on the next takes by < {TARGET_F1_MOVE} -> largest move: "
           f"old path {worst['old']:.3f}, new path {worst['new']:.3f} "
           f"({'meets' if worst['new'] < TARGET_F1_MOVE else 'MISSES'} it); "

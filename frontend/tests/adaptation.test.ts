@@ -3,8 +3,9 @@ import type { Adaptation, CaptureSummary } from "../src/api/types";
 import { canRedetect } from "../src/captures/list";
 import { adaptationLines } from "../src/review/panels";
 
-const zeroShot: Adaptation = { model_version: null, n_takes: null, held_out: null, project_model: null, training: false, training_error: null, training_refused: null };
-const figure = { n_takes: 5, edits_per_cut: 0.3, f1: 0.912 };
+const zeroShot: Adaptation = { model_version: null, n_takes: null, held_out: null, project_model: null, training: false, training_error: null, training_refused: null, training_skipped: null };
+// A model trained before the figure's basis was kept.
+const figure = { n_takes: 5, edits_per_cut: 0.3, f1: 0.912, gold: null, shared: null, single: null, annotators: null, true_cuts: null };
 
 describe("adaptation line of the review page", () => {
   it("test_it_says_candidates_are_not_adapted_yet", () => {
@@ -45,6 +46,31 @@ describe("adaptation line of the review page", () => {
     // The project's news for its reviewers and admins, not a failure: drawn neutral.
     expect(adaptationLines(a).notes).toEqual([`Last retraining ${refused}. The project keeps model v1.`]);
     expect(adaptationLines(a).failure).toBe("");
+  });
+
+  it("test_it_says_what_the_figure_was_measured_on", () => {
+    const basis = { ...figure, gold: 2, shared: 1, single: 2, annotators: 2, true_cuts: 40 };
+    const a = { ...zeroShot, model_version: 2, n_takes: 5, held_out: basis };
+    expect(adaptationLines(a).figure).toBe(
+      "Learnt from 5 reviewed takes; on 5 held-out reviewed takes (2 with a gold version, 1 reviewed by several annotators, 2 reviewed by one annotator alone each (2 annotators)) 0.30 edits per cut, F1 0.91.",
+    );
+  });
+
+  it("test_it_gives_no_f1_for_one_annotators_reviews_without_a_cut", () => {
+    // Issue 48, item 3: a model that proposes nothing, scored on an under-cutter's own
+    // reviews, was shown as "F1 1.00".
+    const poisoned = { n_takes: 4, edits_per_cut: 0, f1: 1, gold: 0, shared: 0, single: 4, annotators: 1, true_cuts: 0 };
+    const a = { ...zeroShot, model_version: 1, n_takes: 4, held_out: poisoned };
+    expect(adaptationLines(a).figure).toBe(
+      "Learnt from 4 reviewed takes; on 4 held-out reviewed takes (all reviewed by one annotator alone) 0.00 edits per cut, no F1 (those reviews keep no cut).",
+    );
+  });
+
+  it("test_it_names_the_takes_the_last_training_left_out", () => {
+    const a = { ...zeroShot, training_skipped: "capture 3 ('short.bvh') skipped: too short to learn from (3 frames)\ncapture 4 ('x.csv') skipped: too short to learn from (3 frames)" };
+    expect(adaptationLines(a).notes).toEqual([
+      "Last retraining left out: capture 3 ('short.bvh') skipped: too short to learn from (3 frames); capture 4 ('x.csv') skipped: too short to learn from (3 frames).",
+    ]);
   });
 
   it("test_it_says_why_the_last_training_failed_and_what_is_kept", () => {

@@ -152,9 +152,11 @@ class Refits:
         checked = [(example, checked_cuts(example)) for example in map(as_example, examples)]
         self._found = [kept_study(example, p, studies) for example, _ in checked]
         self._cuts = [cuts for _, cuts in checked]
+        self._given = np.array([_weight(example) for example, _ in checked])
         self._settings = {"tolerance_s": float(tolerance_s),
                           "zero_min_segment_s": p["min_segment_s"], "labels": labels}
-        self.model, self._choice = _learner.fit(self._found, self._cuts, **self._settings)
+        self.model, self._choice = _learner.fit(self._found, self._cuts, given=self._given,
+                                                **self._settings)
 
     def without(self, i: int) -> CutModel | None:
         """The model refitted without example ``i`` (None when it was the only one)."""
@@ -163,8 +165,17 @@ class Refits:
             return None
         weights, precision, calibrate = self._choice
         model, _ = _learner.fit([self._found[j] for j in keep], [self._cuts[j] for j in keep],
-                                choice=(weights[keep], precision, calibrate), **self._settings)
+                                choice=(weights[keep], precision, calibrate),
+                                given=self._given[keep], **self._settings)
         return model
+
+
+def _weight(example: Example) -> float:
+    """An example's given weight, checked: a number in (0, 1]."""
+    w = example.weight
+    if not (isinstance(w, int | float) and not isinstance(w, bool) and 0 < w <= 1):
+        raise ExampleError(f"{example.name}: weight must be a number in (0, 1], got {w!r}")
+    return float(w)
 
 
 def example_study(example: Example, *, studies: Studies | None = None,

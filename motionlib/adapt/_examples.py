@@ -32,6 +32,9 @@ class Example:
     fps, n_frames : the take's frame rate and length; read : returns the take;
     key : identifies the take's content (e.g. its file's checksum), or None to never
     store its study.
+    weight : how much the take may count, in (0, 1]: the learner's own weighting of takes
+        that disagree with the others multiplies it (the service caps one annotator's
+        share of the examples this way).
     """
 
     name: str
@@ -40,6 +43,7 @@ class Example:
     n_frames: int
     read: Callable[[], object]
     key: str | None = None
+    weight: float = 1.0
 
 
 def as_example(item) -> Example:

@@ -92,11 +92,16 @@ def _labelled(labels: Labels, model: CutModel, one: dict,
 
 
 def fit(studies: list[dict], cuts: list[np.ndarray], *, tolerance_s: float,
-        zero_min_segment_s: float, choice: tuple | None = None, labels: Labels | None = None):
+        zero_min_segment_s: float, choice: tuple | None = None, labels: Labels | None = None,
+        given: np.ndarray | None = None):
     """Learn a :class:`CutModel` from example studies and their human cuts (take frames).
 
     ``labels`` says which candidates of a study the scorer learns from and which of them
-    are human cuts (:data:`Labels`; :func:`matched_labels` when None).
+    are human cuts (:data:`Labels`; :func:`matched_labels` when None). ``given`` (one per
+    example, in (0, 1]; all 1 when None) multiplies each example's weight in the scorer's
+    regression and its choice of prior: a cap on what a group of takes may count that the
+    caller knows of (the takes of one annotator). Which takes are outliers, the count
+    calibration and ``down_weighted`` stay the learner's own.
 
     Returns (model, choice). ``choice`` is what the fit chose from all its examples
     together: the examples' weights, the prior's precision and whether the count is
@@ -118,11 +123,12 @@ def fit(studies: list[dict], cuts: list[np.ndarray], *, tolerance_s: float,
         weights = np.asarray(choice[0], dtype=float)
     if len(studies) < CV_TAKES:  # one or two takes do not show how finely a studio cuts
         base = replace(base, min_segment_s=0.0)
+    counted = weights * (np.ones(len(studies)) if given is None else np.asarray(given, dtype=float))
     if choice is None or len(studies) < CV_TAKES:
-        precision, calibrate = _choose(base, studies, cuts, data, weights)
+        precision, calibrate = _choose(base, studies, cuts, data, weights, counted)
     else:
         precision, calibrate = choice[1], choice[2]
-    model = replace(base, weights=tuple(float(v) for v in _map_fit(data, weights, precision)),
+    model = replace(base, weights=tuple(float(v) for v in _map_fit(data, counted, precision)),
                     n_takes=len(studies), n_cuts=int(sum(len(c) for c in cuts)),
                     down_weighted=int(np.sum(weights < 0.5)), precision=precision)
     if calibrate:
@@ -157,12 +163,13 @@ def _calibrated(model: CutModel, studies, cuts) -> float:
     return round((lo + hi) / 2, 4)
 
 
-def _choose(base: CutModel, studies, cuts, data, weights) -> tuple[float, bool]:
+def _choose(base: CutModel, studies, cuts, data, weights, counted) -> tuple[float, bool]:
     """(prior precision, calibrate the count): below CV_TAKES examples FIXED_PRECISION
     and no calibration (keep what is more likely true than not; ``_calibrated``
     otherwise); else the pair whose models, fitted without a fold of example takes, cut
     those takes with the best weighted mean F1 (at the model's tolerance), ties going
-    to the stronger prior and to no calibration."""
+    to the stronger prior and to no calibration. Takes count by ``counted`` (their weights
+    times the caller's); which are trusted for the count is the learner's ``weights``."""
     n = len(data)
     if n < CV_TAKES:
         return FIXED_PRECISION, False
@@ -172,7 +179,7 @@ def _choose(base: CutModel, studies, cuts, data, weights) -> tuple[float, bool]:
         scores = {False: 0.0, True: 0.0}
         for fold in range(folds):
             held = np.arange(n) % folds == fold
-            weights_in = np.where(held, 0.0, weights)
+            weights_in = np.where(held, 0.0, counted)
             fitted = replace(base, weights=tuple(_map_fit(data, weights_in, precision)))
             trusted = [i for i in range(n) if not held[i] and weights[i] >= 0.5]
             calibrated = replace(fitted, threshold=_calibrated(
@@ -180,7 +187,7 @@ def _choose(base: CutModel, studies, cuts, data, weights) -> tuple[float, bool]:
             for calibrate, m in ((False, fitted), (True, calibrated)):
                 for i in np.flatnonzero(held).tolist():
                     found = select(m, studies[i])[0]
-                    scores[calibrate] += weights[i] * metrics.boundary_scores(
+                    scores[calibrate] += counted[i] * metrics.boundary_scores(
                         found, cuts[i], fps=float(studies[i]["fps"]),
                         tolerance_s=base.tolerance_s)["f1"]
         for calibrate in (False, True):

@@ -208,7 +208,13 @@ class ProjectCutModel(Job):
     held_out_takes = models.PositiveIntegerField(null=True, blank=True)
     held_out_edits_per_cut = models.FloatField(null=True, blank=True)
     held_out_f1 = models.FloatField(null=True, blank=True)
+    # What the held-out figure was measured on (``model_gate.basis``): scored takes with a
+    # gold version, reviewed by several annotators, by one annotator alone, and their true
+    # cuts; null for a model trained before it was kept.
+    held_out_basis = models.JSONField(null=True, blank=True)
     refused = models.TextField(blank=True)
+    # The reviewed takes the training left out (unreadable, too short), one line each.
+    skipped = models.TextField(blank=True, default="")
 
     objects = CutModelQuerySet.as_manager()
     task = "retrain"

@@ -1,16 +1,24 @@
 """Learning each project's cutting from its own reviews.
 
 A project's examples are its reviewed takes: the gold version of a capture where one was
-saved, else the consensus of all its submitted reviews (``consensus.consensus_cuts``: one
-example per take, so every take weighs the same and "learnt from N reviewed takes" counts
-takes, and no single annotator decides a take's cuts). After a submit or a gold save,
-``request_training`` queues one training per project (requests made while one waits join
-it); a worker trains with ``motionlib.adapt.fit_cut_model``, scores the new model against
-the current one on reviewed takes each did not learn from (``model_gate``) and stores it
-as the project's next version only if it is not worse; a refused model is stored with the
-reason and no version. Runs of the ``default`` method detect with the newest version; a
-project without one uses the zero-shot detector. A failed training stores its reason and
-leaves the newest version in use.
+saved, else the consensus of all its submitted reviews (``consensus.consensus_cuts``, a
+tie between annotators settled by the project's current model as a half-vote referee:
+one example per take, so every take weighs the same and "learnt from N reviewed takes"
+counts takes). Each example knows its source (gold, shared, or one annotator alone):
+one annotator's own takes weigh together at most what the rest of the project does
+(``annotator_weights``), and an annotator whose takes keep far fewer or far more cuts
+than the zero-shot detector proposes there is not learnt from (``implausible``). A take
+that cannot be read or is too short is left out with a note (``learnable``), never
+failing the training.
+
+After a submit or a gold save, ``request_training`` queues one training per project
+(requests made while one waits join it); a worker trains with
+``motionlib.adapt.fit_cut_model``, scores the new model against the current one on
+reviewed takes each did not learn from, by source (``model_gate``), and stores it as the
+project's next version only if it is accepted; a refused model is stored with the reason
+and no version. Runs of the ``default`` method detect with the newest version; a project
+without one uses the zero-shot detector. A failed training stores its reason and leaves
+the newest version in use. The rules and their reasons: docs/learning.md.
 
 What the fit learnt from each reviewed take (its study) is stored beside the parsed take
 (``takecache.StoredStudies``), so a retraining after one more submit reads and analyses
@@ -88,7 +96,19 @@ CONSENSUS_S = 1.0
 def project_examples(project_id):
     """``[(capture, cuts)]``, by capture id: each reviewed ready capture of the project with
     its gold cuts, else the consensus of the kept cuts of all its submitted reviews
-    (0-based frames)."""
+    (0-based frames). ``project_pool`` says whose each one is."""
+    return project_pool(project_id)[0]
+
+
+def project_pool(project_id, referee=None):
+    """(``project_examples``, sources): the source of each example by capture id —
+    ``model_gate.GOLD`` (a reviewer's gold version), ``model_gate.SHARED`` (the consensus
+    of two or more annotators' reviews) or the id of the one annotator who reviewed it.
+
+    ``referee(capture)``, when given, is the cut frames a voter of no annotator proposes
+    on the take (the project's current model): it settles a tie between annotators
+    (``consensus_cuts``); None when it cannot say.
+    """
     captures = Capture.objects.filter(project_id=project_id, status="ready").select_related(
         "adjudication"
     ).order_by("id")
@@ -99,16 +119,86 @@ def project_examples(project_id):
     )
     submitted = defaultdict(list)
     for review in reviews:
-        submitted[review.capture_id].append([c.frame for c in review.kept_cuts()])
-    examples = []
+        submitted[review.capture_id].append((review.annotator_id, [c.frame for c in review.kept_cuts()]))
+    examples, sources = [], {}
     for capture in captures:
         gold = getattr(capture, "adjudication", None)
         if gold is not None:
             examples.append((capture, sorted(gold.cuts)))
+            sources[capture.pk] = model_gate.GOLD
         elif capture.pk in submitted:
+            annotators = {annotator for annotator, _cuts in submitted[capture.pk]}
+            votes = [cuts for _annotator, cuts in submitted[capture.pk]]
+            tie = referee(capture) if referee is not None and len(votes) > 1 else None
             tolerance = int(round(CONSENSUS_S * capture.fps))
-            examples.append((capture, consensus_cuts(submitted[capture.pk], tolerance)))
-    return examples
+            examples.append((capture, consensus_cuts(votes, tolerance, referee=tie)))
+            sources[capture.pk] = model_gate.SHARED if len(annotators) > 1 else annotators.pop()
+    return examples, sources
+
+
+def annotator_weights(examples, sources):
+    """{capture id: weight} for ``motionlib.adapt.Example.weight``: the takes one annotator
+    alone reviewed weigh together at most as much as all the project's other examples
+    (gold versions, takes several annotators reviewed, other annotators' takes), each
+    ``min(1, others / theirs)``; every other example 1. An annotator who is the whole
+    project (nothing else to weigh against) keeps weight 1: the gate's count check is
+    what stands against them."""
+    lone = defaultdict(list)
+    for capture, _cuts in examples:
+        if sources.get(capture.pk) not in (model_gate.GOLD, model_gate.SHARED, None):
+            lone[sources[capture.pk]].append(capture.pk)
+    weights = {capture.pk: 1.0 for capture, _cuts in examples}
+    for annotator, pks in lone.items():
+        others = len(examples) - len(pks)
+        scale = IMPLAUSIBLE_WEIGHT if annotator in sources.get(model_gate.IMPLAUSIBLE, ()) else 1.0
+        for pk in pks:
+            weights[pk] = scale * (min(1.0, others / len(pks)) if others else 1.0)
+    return weights
+
+
+# What each take of an implausible annotator (``implausible``) counts at most in the fit.
+IMPLAUSIBLE_WEIGHT = 0.1
+
+
+def implausible(examples, sources, zero):
+    """The annotators whose takes, reviewed by them alone, keep far fewer or far more cuts
+    than the zero-shot detector proposes there (pooled over their takes where it proposes
+    any; the gate's ``COUNT_FACTOR``): the signature of one who deletes every candidate or
+    adds cuts everywhere. The zero-shot detector belongs to no annotator, so it can tell
+    which of two annotators who disagree is the odd one. ``zero``: {capture id: zero-shot
+    cuts} for those takes."""
+    kept, proposed = defaultdict(int), defaultdict(int)
+    for capture, cuts in examples:
+        if zero.get(capture.pk):
+            kept[sources[capture.pk]] += len(cuts)
+            proposed[sources[capture.pk]] += zero[capture.pk]
+    return frozenset(a for a in kept if not proposed[a] / model_gate.COUNT_FACTOR <= kept[a]
+                     <= proposed[a] * model_gate.COUNT_FACTOR)
+
+
+def learnable(examples, studies):
+    """(the examples a fit can learn from, a note on each other one): a take that cannot
+    be read or is too short to analyse, or whose cuts lie outside it, is left out and
+    named with the reason, so that one bad take never fails the project's training. Each
+    kept take's study is made here (and stored), which the fit then reads."""
+    from motionlib import adapt
+
+    kept, notes = [], []
+    for capture, cuts in examples:
+        try:
+            n = capture.n_frames or 0
+            outside = [f for f in cuts if not 0 < f < n]
+            if outside:
+                raise Invalid(f"cut {outside[0]} is outside the take ({n} frames)")
+            adapt.example_study(example(capture, cuts), studies=studies)
+        except (CutroomError, MotionlibError, ValueError, FloatingPointError) as exc:
+            # The note names the capture once; the errors name it in their own words.
+            reason = str(exc).removeprefix(f"{example_name(capture)}: ").removeprefix(
+                f"reviewed capture {capture.pk} ({capture.name!r}) ")
+            notes.append(f"capture {capture.pk} ({capture.name!r}) skipped: {reason}")
+            continue
+        kept.append((capture, cuts))
+    return kept, notes
 
 
 def example_segments(capture, cuts):
@@ -169,7 +259,7 @@ def example_take(capture):
     return dataclasses.replace(take, name=example_name(capture), path=None)
 
 
-def example(capture, cuts):
+def example(capture, cuts, weight=1.0):
     """The capture as an example for ``motionlib.adapt.fit_cut_model``: read (``example_take``)
     only if its stored study does not stand in for it; its key is its content."""
     from motionlib import adapt
@@ -177,7 +267,7 @@ def example(capture, cuts):
     return adapt.Example(
         name=example_name(capture), cuts=cuts, fps=capture.fps,
         n_frames=capture.n_frames, read=functools.partial(example_take, capture),
-        key=takecache.example_key(capture),
+        key=takecache.example_key(capture), weight=weight,
     )
 
 
@@ -189,24 +279,41 @@ def train_project_model(job):
 
 def _train(job):
     started = time.perf_counter()
-    examples = project_examples(job.project_id)
-    if not examples:
-        raise Invalid("the project has no submitted review or gold version to learn from")
     stored = takecache.StoredStudies(Capture._meta.get_field("original").storage)
-    # The full fit first, with the stored studies: they stay those of the examples as they
-    # are, which the next training reads (the gate's refits keep theirs in memory).
-    candidate = fit_examples(examples, stored, refits=True)
-    model = candidate.model
+    in_memory = model_gate.FoldStudies(stored)
     # One training at a time per project: no other version appears before this one ends.
     current = ProjectCutModel.objects.newest(job.project_id)
-    in_memory = model_gate.FoldStudies(stored)
+    current_model = _loaded(current.pk, current.version) if current else None
+    examples, sources = project_pool(job.project_id, referee=referee_for(current_model, stored))
+    if not examples:
+        raise Invalid("the project has no submitted review or gold version to learn from")
+    examples, skipped = learnable(examples, stored)
+    if not examples:
+        raise Invalid("no reviewed take can be learnt from: " + "; ".join(skipped))
+    zero = {capture.pk: len(_candidates(capture, None, stored)) for capture, _cuts in examples
+            if sources[capture.pk] not in (model_gate.GOLD, model_gate.SHARED)}
+    odd = implausible(examples, sources, zero)
+    sources = {**sources, model_gate.IMPLAUSIBLE: odd}
+    # An implausible annotator's takes are not learnt from while there is anything else:
+    # the learner's medians and outlier test count takes, and four takes without a cut
+    # would outnumber two honest ones there. The gate still scores the model on them.
+    pool = [e for e in examples if sources[e[0].pk] not in odd] or examples
+    # The full fit first, with the stored studies: they stay those of the examples as they
+    # are, which the next training reads (the gate's refits keep theirs in memory).
+    candidate = fit_examples(pool, stored, refits=True, sources=sources)
+    model = candidate.model
     learnt = set(current.trained_on) if current is not None else set()
     own = [e for e in examples if e[0].pk in learnt]
     # The current model's own examples, refitted only when a take it learnt from is scored.
-    own_refits = functools.cache(lambda: fit_examples(own, in_memory, refits=True))
+    own_refits = functools.cache(lambda: fit_examples(own, in_memory, refits=True, sources=sources))
+    pooled = {capture.pk for capture, _cuts in pool}
+
+    def candidate_without(capture):
+        return candidate.without(_position(pool, capture)) if capture.pk in pooled else model
+
     verdict = model_gate.judge(
-        examples, current, _loaded(current.pk, current.version) if current else None,
-        candidate_without=lambda capture: candidate.without(_position(examples, capture)),
+        examples, current, current_model, sources=sources,
+        candidate_without=candidate_without,
         current_without=lambda capture: own_refits().without(_position(own, capture)),
         detect=lambda capture, cut_model: _candidates(capture, cut_model, in_memory),
     )
@@ -215,25 +322,45 @@ def _train(job):
         job.finish(
             version=None if verdict.refused else (newest["v"] or 0) + 1,
             refused=verdict.refused,
+            skipped="\n".join(skipped),
             model=model.to_json(),
-            labels_model=fit_labels(examples),
+            labels_model=fit_labels(pool),
             n_takes=model.n_takes,
             n_cuts=model.n_cuts,
-            trained_on=[capture.pk for capture, _cuts in examples],
+            trained_on=[capture.pk for capture, _cuts in pool],
             held_out_takes=verdict.figure.takes,
             held_out_edits_per_cut=round(verdict.figure.edits_per_cut, 4),
             held_out_f1=round(verdict.figure.f1, 4),
+            held_out_basis=verdict.basis,
             seconds=round(time.perf_counter() - started, 3),
             finished_at=timezone.now(),
         )
 
 
-def fit_examples(examples, studies, refits=False):
+def referee_for(cut_model, studies=None):
+    """The referee of ``project_pool`` a training uses: ``_referee`` with the project's
+    current model (None: zero-shot)."""
+    return functools.partial(_referee, cut_model=cut_model, studies=studies)
+
+
+def _referee(capture, cut_model, studies):
+    """What the project's current model (zero-shot without one) proposes on ``capture``:
+    the vote that settles a tie between its annotators; None for a take it cannot read
+    (``learnable`` then names it)."""
+    try:
+        return _candidates(capture, cut_model, studies)
+    except (CutroomError, MotionlibError, ValueError, FloatingPointError):
+        return None
+
+
+def fit_examples(examples, studies, refits=False, sources=None):
     """``motionlib.adapt.fit_cut_model`` over ``[(capture, cuts)]``; with ``refits``, the
-    ``motionlib.adapt.Refits`` whose ``model`` that is, to refit without one example."""
+    ``motionlib.adapt.Refits`` whose ``model`` that is, to refit without one example. With
+    ``sources`` (``project_pool``), one annotator's takes are capped (``annotator_weights``)."""
     from motionlib import adapt
 
-    chosen = [example(capture, cuts) for capture, cuts in examples]
+    weights = annotator_weights(examples, sources) if sources is not None else {}
+    chosen = [example(capture, cuts, weights.get(capture.pk, 1.0)) for capture, cuts in examples]
     if refits:
         return adapt.Refits(chosen, studies=studies)
     return adapt.fit_cut_model(chosen, studies=studies)
@@ -353,8 +480,8 @@ def adaptation_summary(run, project_id, viewer):
     """What a review page says about adaptation: the model its candidates came from
     (None: zero-shot) with its own held-out figure, the project's current model, why the
     last training failed, and, for the project's reviewers and admins (``viewer``), why its
-    model was refused: news for those who look after the model, not an error, and nothing
-    an annotator can act on."""
+    model was refused and which reviewed takes it left out: news for those who look after
+    the model, not an error, and nothing an annotator can act on."""
     newest = ProjectCutModel.objects.newest(project_id)
     # Trainings end in the order they were asked for (one at a time per project).
     last = (
@@ -384,14 +511,20 @@ def adaptation_summary(run, project_id, viewer):
         "training": training,
         "training_error": last.error if last is not None and last.status == "failed" else None,
         "training_refused": (last.refused or None) if oversees and last is not None and last.status == "ready" else None,
+        "training_skipped": (last.skipped or None) if oversees and last is not None and last.status == "ready" else None,
     }
 
 
 def held_out(row):
     """A trained model's own figure (``model_gate``): the reviewed takes it was scored on,
-    each by a model fitted without it, with the review edits per true cut and F1 there;
-    None for a model trained before the figure was kept."""
+    each by a model fitted without it, with the review edits per true cut and F1 there,
+    and what those takes' examples came from (``model_gate.basis``; None each for a model
+    trained before it was kept): a figure measured on one annotator's own reviews says
+    how well the model follows that annotator, and F1 on takes whose reviews keep no cut
+    says nothing. None for a model trained before the figure was kept."""
     if row is None or row.held_out_takes is None:
         return None
+    basis = row.held_out_basis or {}
     return {"n_takes": row.held_out_takes, "edits_per_cut": row.held_out_edits_per_cut,
-            "f1": row.held_out_f1}
+            "f1": row.held_out_f1,
+            **{key: basis.get(key) for key in ("gold", "shared", "single", "annotators", "true_cuts")}}

@@ -49,3 +49,28 @@ class ConsensusTestCase(TestCase):
         self.assertEqual(expected, [100, 700, 1390])
         self.assertEqual(consensus_cuts(reviews[::-1], TOL), expected)
         self.assertEqual(consensus_cuts(reviews[1:] + reviews[:1], TOL), expected)
+
+
+class RefereeTestCase(TestCase):
+    """Two annotators who disagree tie; a referee that belongs to neither (the project's
+    current model on the take) settles the tie (issue 48, item 3)."""
+
+    truth = [500, 1500, 2500]
+    over = [200, 500, 1000, 1500, 2000, 2500, 3000]
+
+    def test_an_over_cutter_beside_one_honest_annotator_adds_no_cut_the_referee_did_not_propose(self):
+        self.assertEqual(consensus_cuts([self.truth, self.over], TOL, referee=[510, 1490, 2520]), self.truth)
+
+    def test_an_under_cutter_beside_one_honest_annotator_removes_no_cut_the_referee_proposed(self):
+        self.assertEqual(consensus_cuts([self.truth, []], TOL, referee=[510, 1490, 2520]), self.truth)
+
+    def test_the_referee_never_outvotes_an_annotator(self):
+        # One review: its own cuts, whatever the referee proposes.
+        self.assertEqual(consensus_cuts([self.truth], TOL, referee=[]), self.truth)
+        # Three reviews: a cut one of them made stays out with the referee behind it.
+        self.assertEqual(consensus_cuts([self.truth, self.truth, self.over], TOL, referee=self.over), self.truth)
+        # A cut both annotators made stays in without it.
+        self.assertEqual(consensus_cuts([self.truth, self.truth], TOL, referee=[]), self.truth)
+
+    def test_a_cut_is_placed_among_the_annotators_cuts_never_at_the_referees(self):
+        self.assertEqual(consensus_cuts([[500], []], TOL, referee=[400]), [500])

@@ -97,7 +97,7 @@ class DetectionWithModelTestCase(ReviewedTakesTestCase):
 
 
 class TrainingErrorTestCase(ReviewedTakesTestCase):
-    def test_a_reviewed_take_whose_stored_file_is_gone_fails_the_training_by_name(self):
+    def test_a_reviewed_take_whose_stored_file_is_gone_is_named_when_nothing_else_can_be_learnt(self):
         capture = self.ingested(seed=97)
         self.review_to_the_truth(capture, 97)
         storage = capture.original.storage
@@ -107,8 +107,8 @@ class TrainingErrorTestCase(ReviewedTakesTestCase):
         tasks.retrain(job.pk)
         job.refresh_from_db()
         self.assertEqual(job.status, "failed")
-        self.assertEqual(job.error, f"training: reviewed capture {capture.pk} ('take_97.bvh') "
-                                    f"cannot be read: take_97.bvh: no such file")
+        self.assertEqual(job.error, f"training: no reviewed take can be learnt from: capture {capture.pk} "
+                                    f"('take_97.bvh') skipped: cannot be read: take_97.bvh: no such file")
         # Annotators read this on the review page: no server folder in it.
         self.assertNotIn(capture.original.name, job.error)
 

@@ -85,7 +85,8 @@ class ReviewAdaptationTestCase(BaseTestCase):
         self.assertEqual(
             adapted,
             {"model_version": None, "n_takes": None, "held_out": None, "project_model": None,
-             "training": False, "training_error": None, "training_refused": None},
+             "training": False, "training_error": None, "training_refused": None,
+             "training_skipped": None},
         )
 
     def test_it_names_the_model_and_the_reviewed_takes_it_learnt_from(self):

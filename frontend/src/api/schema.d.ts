@@ -1156,6 +1156,8 @@ export interface components {
             training_error: string | null;
             /** @description Why the model of the last training was refused (the project keeps its model; null for an annotator). */
             training_refused: string | null;
+            /** @description Reviewed takes the last training left out and why, one a line (null for an annotator, or none left out). */
+            training_skipped: string | null;
         };
         Adjudication: {
             capture: components["schemas"]["AdjudicationCapture"];
@@ -1416,6 +1418,7 @@ export interface components {
             status: components["schemas"]["JobStatusEnum"];
             readonly error: string | null;
             refused: string;
+            skipped: string;
             /** Format: int64 */
             n_takes: number;
             /** Format: int64 */
@@ -1426,6 +1429,7 @@ export interface components {
             held_out_edits_per_cut: number | null;
             /** Format: double */
             held_out_f1: number | null;
+            held_out_basis: unknown;
             /** Format: double */
             seconds: number | null;
             /** Format: date-time */
@@ -1550,9 +1554,19 @@ export interface components {
             edits_per_cut: number;
             /**
              * Format: double
-             * @description Boundary F1 there, within 1 s.
+             * @description Boundary F1 there, within 1 s (meaningless when true_cuts is 0).
              */
             f1: number;
+            /** @description Of those, takes with a gold version (null: trained before this was kept). */
+            gold: number | null;
+            /** @description Takes several annotators reviewed. */
+            shared: number | null;
+            /** @description Takes one annotator alone reviewed. */
+            single: number | null;
+            /** @description Annotators behind the single takes. */
+            annotators: number | null;
+            /** @description True cuts of the scored takes. */
+            true_cuts: number | null;
         };
         ImportRequest: {
             /**

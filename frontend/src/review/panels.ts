@@ -140,13 +140,33 @@ export function adaptationLines(a: Adaptation | undefined): { line: string; figu
   if (a.training) notes.push("Retraining on the newest reviews…");
   const kept = project ? `model v${project.version}` : "the zero-shot detector";
   if (a.training_refused) notes.push(`Last retraining ${a.training_refused}. The project keeps ${kept}.`);
+  if (a.training_skipped) notes.push(`Last retraining left out: ${a.training_skipped.split("\n").join("; ")}.`);
   const failure = a.training_error ? `Last retraining failed: ${a.training_error} The project keeps ${kept}.` : "";
   return { line, figure, notes, failure };
 }
 
-/** "on 5 held-out reviewed takes 0.30 edits per cut, F1 0.91" */
+/**
+ * "on 5 held-out reviewed takes (2 with a gold version, 3 reviewed by one annotator alone)
+ * 0.30 edits per cut, F1 0.91": what the figure was measured on, since a figure measured on
+ * one annotator's own reviews says how well the model follows that annotator, and an F1 on
+ * reviews that keep no cut says nothing.
+ */
 function heldOut(h: HeldOut): string {
-  return `on ${h.n_takes} held-out reviewed take${h.n_takes === 1 ? "" : "s"} ${h.edits_per_cut.toFixed(2)} edits per cut, F1 ${h.f1.toFixed(2)}`;
+  const f1 = h.true_cuts === 0 ? "no F1 (those reviews keep no cut)" : `F1 ${h.f1.toFixed(2)}`;
+  return `on ${h.n_takes} held-out reviewed take${h.n_takes === 1 ? "" : "s"}${basis(h)} ${h.edits_per_cut.toFixed(2)} edits per cut, ${f1}`;
+}
+
+/** " (all reviewed by one annotator alone)", " (1 with a gold version, 2 reviewed by several annotators)"… */
+function basis(h: HeldOut): string {
+  if (h.gold === null || h.shared === null || h.single === null || h.annotators === null) return "";
+  const alone = h.annotators === 1 ? "one annotator alone" : `one annotator alone each (${h.annotators} annotators)`;
+  if (h.single === h.n_takes) return ` (all reviewed by ${alone})`;
+  const parts = [
+    h.gold ? `${h.gold} with a gold version` : "",
+    h.shared ? `${h.shared} reviewed by several annotators` : "",
+    h.single ? `${h.single} reviewed by ${alone}` : "",
+  ].filter(Boolean);
+  return ` (${parts.join(", ")})`;
 }
 
 export function renderAdaptation(el: HTMLElement, a: Adaptation | undefined): void {

@@ -59,8 +59,8 @@ class CutModelSerializer(serializers.ModelSerializer):
     class Meta:
         model = ProjectCutModel
         fields = [
-            "id", "version", "status", "error", "refused", "n_takes", "n_cuts", "held_out_takes",
-            "held_out_edits_per_cut", "held_out_f1", "seconds", "created_at", "finished_at",
+            "id", "version", "status", "error", "refused", "skipped", "n_takes", "n_cuts", "held_out_takes",
+            "held_out_edits_per_cut", "held_out_f1", "held_out_basis", "seconds", "created_at", "finished_at",
         ]
 
 
@@ -221,7 +221,13 @@ class HeldOutSerializer(serializers.Serializer):
 
     n_takes = serializers.IntegerField(help_text="Reviewed takes scored.")
     edits_per_cut = serializers.FloatField(help_text="Review edits per true cut there (manual cutting: 1).")
-    f1 = serializers.FloatField(help_text="Boundary F1 there, within 1 s.")
+    f1 = serializers.FloatField(help_text="Boundary F1 there, within 1 s (meaningless when true_cuts is 0).")
+    gold = serializers.IntegerField(allow_null=True, help_text="Of those, takes with a gold version "
+                                    "(null: trained before this was kept).")
+    shared = serializers.IntegerField(allow_null=True, help_text="Takes several annotators reviewed.")
+    single = serializers.IntegerField(allow_null=True, help_text="Takes one annotator alone reviewed.")
+    annotators = serializers.IntegerField(allow_null=True, help_text="Annotators behind the single takes.")
+    true_cuts = serializers.IntegerField(allow_null=True, help_text="True cuts of the scored takes.")
 
 
 class ProjectModelSerializer(serializers.Serializer):
@@ -245,3 +251,6 @@ class AdaptationSerializer(serializers.Serializer):
     training_refused = serializers.CharField(
         allow_null=True, help_text="Why the model of the last training was refused (the project keeps its "
         "model; null for an annotator).")
+    training_skipped = serializers.CharField(
+        allow_null=True, help_text="Reviewed takes the last training left out and why, one a line (null for "
+        "an annotator, or none left out).")
