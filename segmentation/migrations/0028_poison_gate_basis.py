@@ -6,7 +6,7 @@ from django.db import migrations, models
 class Migration(migrations.Migration):
 
     dependencies = [
-        ('segmentation', '0025_labels_model_proposals'),
+        ('segmentation', '0027_comments_attributes'),
     ]
 
     operations = [
