@@ -6,6 +6,7 @@
 - ``reviews``: reviews, cuts, segment labels, the review audit log;
 - ``library``: library segments, gold versions, agreement, label suggestions;
 - ``workers``: the Celery workers' heartbeats;
+- ``videos``: reference videos played in sync with a capture;
 
 Rules about one record live on the models; lookups live on the managers
 (``Capture.objects.visible_to(user)``). Workflows that touch several records are the
@@ -39,6 +40,7 @@ from segmentation.models.projects import (
     ProjectCutModel,
 )
 from segmentation.models.reviews import Cut, Review, ReviewEvent, SegmentLabel
+from segmentation.models.videos import ReferenceVideo
 from segmentation.models.workers import WorkerHeartbeat
 
 __all__ = [
@@ -63,6 +65,7 @@ __all__ = [
     "Membership",
     "Project",
     "ProjectCutModel",
+    "ReferenceVideo",
     "Review",
     "ReviewEvent",
     "SegmentLabel",
