@@ -43,9 +43,12 @@ frontend: $(FRONT_STAMP) install
 	cd frontend && npm run $(if $(filter true,$(CI)),api-types:check,api-types)
 	cd frontend && npm run build
 
-# Browser tests drive Debian's Chromium; nothing downloads a browser of its own.
+# Browser tests drive Debian's Chromium; nothing downloads a browser of its own. Debian's
+# ffmpeg gives the service ffprobe (it reads a reference video's codec, duration and frame
+# rate) and the tests their real videos.
 browser:
 	@command -v chromium >/dev/null || { apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium; }
+	@command -v ffprobe >/dev/null || { apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq ffmpeg; }
 
 lint: install
 	.venv/bin/ruff check .
