@@ -17,6 +17,7 @@ import type { Command } from "../review/keymap";
 import { openPalette } from "../review/palette";
 import { formatTime } from "../review/timescale";
 import { clear, dialog, h, toast } from "../ui/dom";
+import { VideoDock } from "../video/dock";
 import { agreementBox } from "./agreement";
 import { back, cutMarks, forward, labelConflicts, push, start, type Timeline } from "./marks";
 import { Tiers } from "./tiers";
@@ -62,6 +63,7 @@ class AdjudicationPage {
   private readonly abort = new AbortController();
   private readonly player: SkeletonView | null = null;
   private readonly tiers: Tiers;
+  private readonly videos: VideoDock;
   private readonly el: Record<string, HTMLElement> = {};
   private readonly onKey = (e: KeyboardEvent) => {
     const command = pageCommand(e);
@@ -83,6 +85,9 @@ class AdjudicationPage {
     this.source = data.gold?.source_review ?? null;
     this.playback = new PlaybackController(capture.fps!, capture.n_frames!, 0, () => this.refresh());
     clear(root, this.layout());
+    // Reference videos sit at the top of the side column and follow the playback clock.
+    this.videos = new VideoDock(this.el.panel, { captureId: capture.id, fps: capture.fps!, nFrames: capture.n_frames!, playback: this.playback });
+    this.el.panel.prepend(this.videos.root);
     try {
       this.player = new SkeletonView(this.el.viewport, capture.skeleton!);
     } catch (err) {
@@ -111,6 +116,7 @@ class AdjudicationPage {
 
   dispose(): void {
     this.abort.abort();
+    this.videos.dispose();
     this.playback.dispose();
     document.removeEventListener("keydown", this.onKey);
     window.removeEventListener("resize", this.onResize);
@@ -160,14 +166,14 @@ class AdjudicationPage {
           "div",
           { class: "adj-work" },
           h("div", { class: "adj-stage" }, el.viewport, h("div", { class: "hud adj-hud" }, el.hud)),
-          h(
+          (el.panel = h(
             "div",
             { class: "adj-panel" },
             h("div", { class: "adj-actions" }, button("play", "Play", "Play / pause (Space)", () => this.command({ kind: "play" })), button("undo", "Undo", "Undo (Z, Ctrl+Z)", () => this.command({ kind: "undo" })), button("redo", "Redo", "Redo (Shift+Z)", () => this.command({ kind: "redo" })), button("save-gold", "Save gold version", "Save the gold version", () => void this.save(), "btn-primary"), el.status),
             el.editor,
             h("div", { class: "adj-uses" }, ...uses),
             legend,
-          ),
+          )),
         ),
         el.tiers,
       ),
