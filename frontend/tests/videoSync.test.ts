@@ -29,6 +29,10 @@ describe("following the clock", () => {
     expect(plan(clock(), video({ currentTime: 2 }), 0, 30).seekTo).toBeNull();
   });
 
+  it("test_paused_between_frames_it_shows_the_frame_the_page_shows", () => {
+    expect(plan(clock({ position: 241.7 }), video(), 0, 30).seekTo).toBeCloseTo(241 / 120);
+  });
+
   it("test_playing_it_leaves_drift_under_half_a_frame_alone", () => {
     const p = plan(clock({ playing: true, speed: 2 }), video({ currentTime: 2.01, paused: false }), 0, 30);
     expect(p).toEqual({ seekTo: null, play: true, rate: 2, outside: null });
@@ -45,6 +49,11 @@ describe("following the clock", () => {
   it("test_playing_it_seeks_after_a_jump", () => {
     const p = plan(clock({ playing: true }), video({ currentTime: 2 + JUMP_S + 0.01 }), 0, 30);
     expect(p.seekTo).toBeCloseTo(2);
+  });
+
+  it("test_playing_it_seeks_ahead_by_what_a_seek_takes", () => {
+    const p = plan(clock({ playing: true, speed: 2 }), video({ currentTime: 5 }), 0, 30, 0.1);
+    expect(p.seekTo).toBeCloseTo(2.2);
   });
 
   it("test_it_waits_for_a_seek_in_progress", () => {

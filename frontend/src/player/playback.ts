@@ -87,7 +87,9 @@ export class PlaybackController {
     this.state = advance(this.state, (now - this.lastTick) / 1000);
     this.lastTick = now;
     if (this.state.playing) this.raf = requestAnimationFrame(this.tick);
-    this.onFrame(this.frame, this.state.playing);
+    // Listeners first: a video following the clock reads its own time before the page
+    // spends the frame drawing, so both are read at the frame's start.
     this.changed();
+    this.onFrame(this.frame, this.state.playing);
   };
 }

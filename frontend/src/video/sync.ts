@@ -37,12 +37,12 @@ export interface Plan {
 }
 
 /** A drift this large while playing is a jump: seek. */
-export const JUMP_S = 0.25;
+export const JUMP_S = 0.15;
 /** Browsers play between these rates (Chromium: 1/16 to 16). */
 const MIN_RATE = 0.0625;
 const MAX_RATE = 16;
-/** Seconds of drift taken up per second of playing: a half-frame drift at 30 fps is gone in ~0.25 s. */
-const GAIN = 4;
+/** Share of the drift taken up per second of playing: a drift is mostly gone in 1/GAIN s. */
+const GAIN = 8;
 
 /** The video time (s) at a take position (fractional frames). */
 export function videoTime(position: number, fps: number, offset: number): number {
@@ -65,8 +65,9 @@ export function halfFrame(takeFps: number, videoFps: number | null): number {
 }
 
 /** What the video must do to show the clock's moment. */
-export function plan(clock: ClockState, video: VideoState, offset: number, videoFps: number | null): Plan {
-  const target = videoTime(clock.position, clock.fps, offset);
+export function plan(clock: ClockState, video: VideoState, offset: number, videoFps: number | null, seekLead = 0): Plan {
+  // Paused, the page shows the frame the position is in (a pause leaves it fractional).
+  const target = videoTime(clock.playing ? clock.position : Math.floor(clock.position), clock.fps, offset);
   const duration = Number.isFinite(video.duration) ? video.duration : Infinity;
   const outside = target < 0 ? "before" : target > duration ? "after" : null;
   const clamped = Math.min(Math.max(target, 0), duration);
@@ -75,9 +76,10 @@ export function plan(clock: ClockState, video: VideoState, offset: number, video
   if (video.seeking) return { seekTo: null, play, rate: speed, outside };
   const drift = video.currentTime - clamped; // > 0: the video is ahead
   if (!play) return { seekTo: Math.abs(drift) > 1e-3 ? clamped : null, play, rate: speed, outside };
-  if (Math.abs(drift) > JUMP_S * Math.max(1, clock.speed)) return { seekTo: clamped, play, rate: speed, outside };
+  // The take plays on while the video seeks: aim where it will be once the seek is done.
+  if (Math.abs(drift) > JUMP_S * Math.max(1, clock.speed)) return { seekTo: Math.min(clamped + seekLead * clock.speed, duration), play, rate: speed, outside };
   if (Math.abs(drift) <= halfFrame(clock.fps, videoFps)) return { seekTo: null, play, rate: speed, outside };
-  const rate = clamp(clock.speed * (1 - GAIN * drift), Math.max(MIN_RATE, clock.speed / 2), Math.min(MAX_RATE, clock.speed * 1.5));
+  const rate = clamp(clock.speed * (1 - GAIN * drift), Math.max(MIN_RATE, clock.speed / 2), Math.min(MAX_RATE, clock.speed * 2));
   return { seekTo: null, play, rate, outside };
 }
 
@@ -89,7 +91,17 @@ function clamp(value: number, low: number, high: number): number {
 export class VideoSync {
   private stop: () => void = () => {};
   private detached = false;
-  private readonly onVideo = () => this.sync();
+  /** How long a seek while playing takes here (seconds, a moving average), and when the last began. */
+  private seekLead = 0;
+  private seekStarted: number | null = null;
+  private readonly onVideo = (e: Event) => {
+    if (e.type === "seeked" && this.seekStarted !== null) {
+      const took = (performance.now() - this.seekStarted) / 1000;
+      this.seekLead = Math.min(0.5, this.seekLead ? 0.7 * this.seekLead + 0.3 * took : took);
+      this.seekStarted = null;
+    }
+    this.sync();
+  };
 
   constructor(
     private readonly video: HTMLVideoElement,
@@ -128,10 +140,13 @@ export class VideoSync {
   sync(): void {
     const v = this.video;
     if (this.detached || v.readyState < HTMLMediaElement.HAVE_METADATA) return;
-    const p = plan(this.playback.state, v, this.offset, this.videoFps);
+    const p = plan(this.playback.state, v, this.offset, this.videoFps, this.seekLead);
     this.outside(p.outside);
     if (v.playbackRate !== p.rate) v.playbackRate = p.rate;
-    if (p.seekTo !== null) v.currentTime = p.seekTo;
+    if (p.seekTo !== null) {
+      this.seekStarted = p.play ? performance.now() : null;
+      v.currentTime = p.seekTo;
+    }
     if (p.play && v.paused) void v.play().catch(() => {});
     else if (!p.play && !v.paused) v.pause();
   }
