@@ -90,7 +90,7 @@ bench: install bpy
 
 # The README's screenshots, taken by the browser tests.
 screenshots: install frontend browser
-	CUTROOM_SCREENSHOTS=1 $(PY) -m pytest tests/e2e -q -k "restores_the_review or gold_version or glb or fits_a_laptop or overview_and_a_working_window"
+	CUTROOM_SCREENSHOTS=1 $(PY) -m pytest tests/e2e -q -k "restores_the_review or gold_version or glb or fits_a_laptop or overview_and_a_working_window or plays_in_sync_with_the_take"
 
 clean:
 	rm -rf .venv .venv-bpy frontend/node_modules frontend/dist var

@@ -134,7 +134,6 @@ def test_a_reference_video_plays_in_sync_with_the_take(live_server, new_page, st
     page.keyboard.press("Space")
     frames = [now["frame"] for now in assert_playing_in_sync(page, offset, 20)]
     assert frames == sorted(frames) and frames[-1] - frames[0] > 120, frames
-    page.screenshot(path=str(screenshots / "reference-video.png"))
 
     # A seek on the ruler while playing: the video follows to the new place.
     ruler_click(page, 120, n)
@@ -150,6 +149,7 @@ def test_a_reference_video_plays_in_sync_with_the_take(live_server, new_page, st
     page.keyboard.press(",")
     settled(page)
     assert assert_in_sync(page, offset, PAUSED_TOLERANCE_S)["frame"] == paused["frame"] - 10
+    page.screenshot(path=str(screenshots / "reference-video.png"))
 
     # At half speed the video plays at half rate and stays on the take.
     page.get_by_test_id("speed").select_option("0.5")
