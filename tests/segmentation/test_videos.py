@@ -286,3 +286,33 @@ class BackupTests(VideoTestCase):
     def settings_media_parent(self):
         from django.conf import settings
         return Path(settings.MEDIA_ROOT).parent
+
+
+
+def test_a_restored_backup_plays_the_same_video_at_the_same_offset(db, tmp_path, settings):
+    """``manage.py restore`` into an empty installation gives back the video's row, its
+    offset and its file, byte for byte."""
+    from django.contrib.auth import get_user_model
+
+    from segmentation import services
+    from segmentation.services import videos
+    from tests.segmentation.test_backup import fresh_installation, manage
+
+    settings.MEDIA_ROOT = tmp_path / "media"
+    alice = get_user_model().objects.create_user("alice", password="alice-password")
+    project = services.do_create_project(alice, "Studio A")
+    capture, _ = services.do_upload_capture(project, alice, SimpleUploadedFile("c.bvh", b"HIERARCHY"))
+    path = make_video("vp9")
+    video, _ = videos.do_upload_video(capture, alice, SimpleUploadedFile("side.webm", path.read_bytes()))
+    videos.do_set_offset(video, alice, -0.75)
+    backup = tmp_path / "cutroom.tar"
+    call_command("backup", str(backup), stdout=io.StringIO())
+    restored = fresh_installation(tmp_path / "restored")
+    done = manage(restored, "restore", str(backup))
+    assert done.returncode == 0, done.stderr
+    check = manage(restored, "shell", "-v", "0", "-c", (
+        "import hashlib; from segmentation.models import ReferenceVideo as V; v = V.objects.get(); "
+        "print(v.name, v.offset_s, v.capture.name, hashlib.sha256(v.file.read()).hexdigest())"))
+    assert check.returncode == 0, check.stderr
+    digest = hashlib.sha256(path.read_bytes()).hexdigest()
+    assert check.stdout.split() == ["side.webm", "-0.75", "c.bvh", digest]
