@@ -37,6 +37,10 @@ RUN apt-get update && apt-get install -y --no-install-recommends libx11-6 libxre
     && rm -rf /var/lib/apt/lists/* \
     && python -m venv /opt/bpy && /opt/bpy/bin/pip install -r requirements-bpy.txt
 ENV MOTIONLIB_BLENDER_PYTHON=/opt/bpy/bin/python
+# ffprobe reads an uploaded reference video's codec, duration and frame rate (without it
+# only the container is checked).
+RUN apt-get update && apt-get install -y --no-install-recommends ffmpeg \
+    && rm -rf /var/lib/apt/lists/*
 COPY --from=frontend --chown=cutroom:cutroom /app/frontend/dist frontend/dist
 USER cutroom
 EXPOSE 8000

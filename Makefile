@@ -43,9 +43,12 @@ frontend: $(FRONT_STAMP) install
 	cd frontend && npm run $(if $(filter true,$(CI)),api-types:check,api-types)
 	cd frontend && npm run build
 
-# Browser tests drive Debian's Chromium; nothing downloads a browser of its own.
+# Browser tests drive Debian's Chromium; nothing downloads a browser of its own. Debian's
+# ffmpeg gives the service ffprobe (it reads a reference video's codec, duration and frame
+# rate) and the tests their real videos.
 browser:
 	@command -v chromium >/dev/null || { apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium; }
+	@command -v ffprobe >/dev/null || { apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq ffmpeg; }
 
 lint: install
 	.venv/bin/ruff check .
@@ -87,7 +90,7 @@ bench: install bpy
 
 # The README's screenshots, taken by the browser tests.
 screenshots: install frontend browser
-	CUTROOM_SCREENSHOTS=1 $(PY) -m pytest tests/e2e -q -k "restores_the_review or gold_version or glb or fits_a_laptop or overview_and_a_working_window"
+	CUTROOM_SCREENSHOTS=1 $(PY) -m pytest tests/e2e -q -k "restores_the_review or gold_version or glb or fits_a_laptop or overview_and_a_working_window or plays_in_sync_with_the_take"
 
 clean:
 	rm -rf .venv .venv-bpy frontend/node_modules frontend/dist var

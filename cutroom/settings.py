@@ -216,6 +216,11 @@ STORAGES = {
 # frame limits (CUTROOM_MAX_FRAME_VALUES) refuse at ingest what a bigger file would hold
 # (docs/operations.md, "Limits and quotas").
 CUTROOM_MAX_UPLOAD_MB = envint("CUTROOM_MAX_UPLOAD_MB", 1024)
+# Reference videos beside a take (segmentation.files.video): the size of one, and the
+# ffprobe program that reads their codec, duration and frame rate (empty: do not probe;
+# only the container is checked then, from the file's first bytes).
+CUTROOM_MAX_VIDEO_MB = envint("CUTROOM_MAX_VIDEO_MB", 2048)
+CUTROOM_FFPROBE = os.environ.get("CUTROOM_FFPROBE", "ffprobe")
 # The form fields besides the files (Django refuses more with a generic 400). Uploaded files
 # above FILE_UPLOAD_MAX_MEMORY_SIZE are streamed to a temporary file as they arrive, never
 # held in memory; storage then moves that file into place.

@@ -16,6 +16,7 @@ from segmentation.api import (
     segments,
     similar,
     team,
+    videos,
 )
 from segmentation.api.captures import CaptureViewSet
 from segmentation.api.projects import MethodsView, MeView, ProjectViewSet
@@ -57,5 +58,6 @@ urlpatterns = [
     *assignments.urlpatterns,
     *team.urlpatterns,
     *health.urlpatterns,
+    *videos.urlpatterns,
     *router.urls,
 ]

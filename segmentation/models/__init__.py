@@ -8,6 +8,7 @@
 - ``workers``: the Celery workers' heartbeats;
 - ``comments``: threads of comments pinned to a frame, cut or segment of a review;
 - ``attributes``: a project's segment attribute schema and the values segments carry;
+- ``videos``: reference videos played in sync with a capture;
 
 Rules about one record live on the models; lookups live on the managers
 (``Capture.objects.visible_to(user)``). Workflows that touch several records are the
@@ -48,6 +49,7 @@ from segmentation.models.projects import (
     ProjectCutModel,
 )
 from segmentation.models.reviews import Cut, Review, ReviewEvent, SegmentLabel
+from segmentation.models.videos import ReferenceVideo
 from segmentation.models.workers import WorkerHeartbeat
 
 __all__ = [
@@ -75,6 +77,7 @@ __all__ = [
     "Membership",
     "Project",
     "ProjectCutModel",
+    "ReferenceVideo",
     "Review",
     "ReviewEvent",
     "SegmentAttribute",

@@ -15,7 +15,7 @@ from django.utils import timezone
 
 from accounts import locks
 from segmentation.errors import QuotaExceeded, TooManyRequests
-from segmentation.models import Capture, DetectionRun, Project
+from segmentation.models import Capture, DetectionRun, Project, ReferenceVideo
 
 MB = 1024 * 1024
 ACTIVE = ("queued", "processing")
@@ -64,11 +64,13 @@ def check_upload_rate(user, uploads=1, fbx=None):
 
 def check_storage(project, user, size):
     """QuotaExceeded if storing ``size`` more bytes would take ``project`` past
-    CUTROOM_PROJECT_STORAGE_MB or ``user`` past CUTROOM_USER_STORAGE_MB."""
+    CUTROOM_PROJECT_STORAGE_MB or ``user`` past CUTROOM_USER_STORAGE_MB. Captures and
+    their reference videos both count."""
     for owner, used, limit, setting in (
-        (f"project {project.name!r}", _stored(project=project),
+        (f"project {project.name!r}",
+         _stored(Capture, project=project) + _stored(ReferenceVideo, capture__project=project),
          settings.CUTROOM_PROJECT_STORAGE_MB, "CUTROOM_PROJECT_STORAGE_MB"),
-        ("your uploads", _stored(uploaded_by=user),
+        ("your uploads", _stored(Capture, uploaded_by=user) + _stored(ReferenceVideo, uploaded_by=user),
          settings.CUTROOM_USER_STORAGE_MB, "CUTROOM_USER_STORAGE_MB"),
     ):
         if limit and used + size > limit * MB:
@@ -79,8 +81,8 @@ def check_storage(project, user, size):
             )
 
 
-def _stored(**owner):
-    return Capture.objects.filter(**owner).aggregate(total=Sum("stored_bytes"))["total"] or 0
+def _stored(model, **owner):
+    return model.objects.filter(**owner).aggregate(total=Sum("stored_bytes"))["total"] or 0
 
 
 def check_active_runs(project, user=None):

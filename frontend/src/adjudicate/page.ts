@@ -21,6 +21,7 @@ import { formatTimecode, GotoError, parseGoto } from "../review/timecode";
 import { formatTime } from "../review/timescale";
 import { clear, dialog, h, toast } from "../ui/dom";
 import { promptLine } from "../ui/prompt";
+import { VideoDock } from "../video/dock";
 import { agreementBox } from "./agreement";
 import { back, cutMarks, forward, labelConflicts, push, start, unlabelledGold, type Timeline } from "./marks";
 import { Tiers } from "./tiers";
@@ -71,6 +72,7 @@ class AdjudicationPage {
   private readonly abort = new AbortController();
   private readonly player: SkeletonView | null = null;
   private readonly tiers: Tiers;
+  private readonly videos: VideoDock;
   private readonly el: Record<string, HTMLElement> = {};
   private readonly onKey = (e: KeyboardEvent) => {
     const command = pageCommand(e);
@@ -92,6 +94,9 @@ class AdjudicationPage {
     this.source = data.gold?.source_review ?? null;
     this.playback = new PlaybackController(capture.fps!, capture.n_frames!, 0, () => this.refresh());
     clear(root, this.layout());
+    // Reference videos sit at the top of the side column and follow the playback clock.
+    this.videos = new VideoDock(this.el.panel, { captureId: capture.id, fps: capture.fps!, nFrames: capture.n_frames!, playback: this.playback });
+    this.el.panel.prepend(this.videos.root);
     try {
       this.player = new SkeletonView(this.el.viewport, capture.skeleton!);
     } catch (err) {
@@ -120,6 +125,7 @@ class AdjudicationPage {
 
   dispose(): void {
     this.abort.abort();
+    this.videos.dispose();
     this.playback.dispose();
     document.removeEventListener("keydown", this.onKey);
     window.removeEventListener("resize", this.onResize);
@@ -169,7 +175,7 @@ class AdjudicationPage {
           "div",
           { class: "adj-work" },
           h("div", { class: "adj-stage" }, el.viewport, h("div", { class: "hud adj-hud" }, el.hud)),
-          h(
+          (el.panel = h(
             "div",
             { class: "adj-panel" },
             h("div", { class: "adj-actions" }, button("play", "Play", "Play / pause (Space)", () => this.command({ kind: "play" })), button("undo", "Undo", "Undo (Z, Ctrl+Z)", () => this.command({ kind: "undo" })), button("redo", "Redo", "Redo (Shift+Z)", () => this.command({ kind: "redo" })), button("save-gold", "Save gold version", "Save the gold version", () => void this.save(), "btn-primary"), el.status),
@@ -177,7 +183,7 @@ class AdjudicationPage {
             el.editor,
             h("div", { class: "adj-uses" }, ...uses),
             legend,
-          ),
+          )),
         ),
         el.tiers,
       ),

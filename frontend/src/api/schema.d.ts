@@ -619,6 +619,56 @@ export interface paths {
         patch?: never;
         trace?: never;
     };
+    "/api/captures/{id}/videos/": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get: operations["captures_videos_list"];
+        put?: never;
+        post: operations["captures_videos_create"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/captures/{id}/videos/{video_id}/": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get: operations["captures_videos_retrieve"];
+        put?: never;
+        post?: never;
+        delete: operations["captures_videos_destroy"];
+        options?: never;
+        head?: never;
+        /** @description Save the video's offset against the take (seconds). */
+        patch: operations["captures_videos_partial_update"];
+        trace?: never;
+    };
+    "/api/captures/{id}/videos/{video_id}/file/": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** @description The video's bytes; a ``Range`` header gets a 206 with those bytes (seeking). */
+        get: operations["captures_videos_file_retrieve"];
+        put?: never;
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
     "/api/invitations/": {
         parameters: {
             query?: never;
@@ -1921,6 +1971,10 @@ export interface components {
             version?: number;
             label?: string | null;
         };
+        PatchedOffsetRequest: {
+            /** Format: double */
+            offset_s?: number;
+        };
         PatchedProjectRequest: {
             name?: string;
             /** @default  */
@@ -2329,6 +2383,80 @@ export interface components {
         };
         VersionRequest: {
             version: number;
+        };
+        /**
+         * @description One video; ``duration`` (s), ``fps``, ``codec`` and the size are null/empty when
+         *     ffprobe was not installed at upload. The video time at take time ``t`` is
+         *     ``t + offset_s``.
+         */
+        Video: {
+            readonly id: number;
+            readonly name: string;
+            readonly url: string;
+            readonly content_type: string;
+            readonly container: string;
+            readonly codec: string;
+            /** Format: double */
+            readonly duration: number | null;
+            /** Format: double */
+            readonly fps: number | null;
+            readonly width: number | null;
+            readonly height: number | null;
+            readonly stored_bytes: number;
+            readonly checksum: string;
+            /** Format: double */
+            readonly offset_s: number;
+            readonly offset_set_by: components["schemas"]["UserRef"] | null;
+            /** Format: date-time */
+            readonly offset_set_at: string | null;
+            readonly uploaded_by: components["schemas"]["UserRef"] | null;
+            /** Format: date-time */
+            readonly created_at: string;
+        };
+        /** @description A capture's videos, and what the caller may do with them. */
+        VideoList: {
+            /** @description Whether the caller may upload, align and remove videos (reviewers, admins). */
+            may_manage: boolean;
+            /** @description Whether the server reads codec, duration and frame rate (ffprobe installed). */
+            probes: boolean;
+            /** @description The largest video accepted, in MB. */
+            max_mb: number;
+            videos: components["schemas"]["Video"][];
+        };
+        VideoUploadRequest: {
+            /** Format: binary */
+            file: string;
+        };
+        /**
+         * @description One video; ``duration`` (s), ``fps``, ``codec`` and the size are null/empty when
+         *     ffprobe was not installed at upload. The video time at take time ``t`` is
+         *     ``t + offset_s``.
+         */
+        VideoUploaded: {
+            readonly id: number;
+            readonly name: string;
+            readonly url: string;
+            readonly content_type: string;
+            readonly container: string;
+            readonly codec: string;
+            /** Format: double */
+            readonly duration: number | null;
+            /** Format: double */
+            readonly fps: number | null;
+            readonly width: number | null;
+            readonly height: number | null;
+            readonly stored_bytes: number;
+            readonly checksum: string;
+            /** Format: double */
+            readonly offset_s: number;
+            readonly offset_set_by: components["schemas"]["UserRef"] | null;
+            /** Format: date-time */
+            readonly offset_set_at: string | null;
+            readonly uploaded_by: components["schemas"]["UserRef"] | null;
+            /** Format: date-time */
+            readonly created_at: string;
+            /** @description The capture already had this file (same checksum). */
+            readonly duplicate: boolean;
         };
     };
     responses: never;
@@ -3360,6 +3488,159 @@ export interface operations {
                 };
                 content: {
                     "application/json": components["schemas"]["SignalsAnswer"];
+                };
+            };
+        };
+    };
+    captures_videos_list: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path: {
+                id: number;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["VideoList"];
+                };
+            };
+        };
+    };
+    captures_videos_create: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path: {
+                id: number;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "multipart/form-data": components["schemas"]["VideoUploadRequest"];
+            };
+        };
+        responses: {
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["VideoUploaded"];
+                };
+            };
+            201: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["VideoUploaded"];
+                };
+            };
+        };
+    };
+    captures_videos_retrieve: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path: {
+                id: number;
+                video_id: number;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["Video"];
+                };
+            };
+        };
+    };
+    captures_videos_destroy: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path: {
+                id: number;
+                video_id: number;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description No response body */
+            204: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content?: never;
+            };
+        };
+    };
+    captures_videos_partial_update: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path: {
+                id: number;
+                video_id: number;
+            };
+            cookie?: never;
+        };
+        requestBody?: {
+            content: {
+                "application/json": components["schemas"]["PatchedOffsetRequest"];
+            };
+        };
+        responses: {
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["Video"];
+                };
+            };
+        };
+    };
+    captures_videos_file_retrieve: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path: {
+                id: number;
+                video_id: number;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "video/mp4": string;
+                };
+            };
+            206: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "video/mp4": string;
                 };
             };
         };

@@ -12,6 +12,7 @@ import type { Adaptation, Capture, Label, Me, OpenedReview, Project, ReadyCaptur
 import { PlaybackController } from "../player/playback";
 import { clear, h, toast } from "../ui/dom";
 import { icon } from "../ui/icons";
+import { VideoDock } from "../video/dock";
 import { Commands } from "./commands";
 import { openImportDialog } from "./annotationsDialog";
 import { confirmSubmit, openNext, showConflict } from "./dialogs";
@@ -85,6 +86,7 @@ class ReviewPage {
   private readonly commands: Commands;
   private readonly suggestions: Suggestions;
   private readonly notes: Notes;
+  private readonly videos: VideoDock;
   private readonly labels: Label[];
   private readonly el: Elements;
   private readonly onKey = (e: KeyboardEvent) => {
@@ -129,6 +131,8 @@ class ReviewPage {
     this.el = layout.el;
     clear(root, layout.root);
     this.stage = new Stage(this.el, capture, me, frames);
+    // Reference videos float over the stage and follow the playback clock.
+    this.videos = new VideoDock(this.el.viewport.parentElement!, { captureId: capture.id, fps: capture.fps, nFrames: capture.n_frames, playback: this.playback, floating: true });
     this.timeline = this.makeTimeline();
     this.sidebar = new Sidebar(this.el, capture, this.labels, adaptation, {
       label: (name) => this.session.labelAt(this.playback.frame, name),
@@ -170,6 +174,7 @@ class ReviewPage {
 
   dispose(): void {
     this.suggestions.dispose();
+    this.videos.dispose();
     this.playback.dispose();
     this.commands.dispose();
     document.removeEventListener("keydown", this.onKey);
