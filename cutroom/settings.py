@@ -340,7 +340,8 @@ REST_FRAMEWORK = {
     "DEFAULT_AUTHENTICATION_CLASSES": [
         # First, so an anonymous call gets 401 with "WWW-Authenticate: Token", not 403.
         "accounts.authentication.ExpiringTokenAuthentication",
-        "rest_framework.authentication.SessionAuthentication",
+        # Its CSRF check comes before any body is parsed (a text/plain post is a 403).
+        "accounts.authentication.CsrfFirstSessionAuthentication",
     ],
     "DEFAULT_PERMISSION_CLASSES": ["rest_framework.permissions.IsAuthenticated"],
     # Bounded nesting and numbers in every JSON body (see segmentation.api.common.parsers).
