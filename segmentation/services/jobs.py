@@ -117,6 +117,11 @@ def guard(kind, job, work=None):
     except (MotionlibError, CutroomError) as exc:
         job.fail(_bounded(model.input_error.format(error=exc)), permanent=True)
     except Exception:
+        if not model.objects.filter(pk=job.pk).exists():
+            # Deleted while it ran (its stored files with it): nothing failed that matters.
+            log.info("%s of %s %s ended: the row was deleted meanwhile", kind.what,
+                     model._meta.verbose_name, job.pk)
+            return
         reference = internal_error(f"{kind.what} of {model._meta.verbose_name} {job.pk}", log)
         usable_connection()
         job.fail(model.crashed_error.format(what=kind.what, reference=reference))
