@@ -128,6 +128,11 @@ class Job(models.Model):
         """The queued job that cannot start before this one ends, or None."""
         return None
 
+    def next_in_line(self):
+        """The queued job to send once this one ends (it was refused a start while this
+        one ran), or None."""
+        return self.queued_behind()
+
     def finish(self, **fields):
         """Store the result, but only if this job's claim still holds."""
         return self._close("ready", "", False, fields)

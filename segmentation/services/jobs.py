@@ -182,9 +182,9 @@ def usable_connection():
 def send_next(job):
     """Once ``job`` has ended, send the job that waited behind it (its own message may
     have found this one running and been dropped), once the transaction commits."""
-    waiting = job.queued_behind()
+    waiting = job.next_in_line()
     if waiting is not None:
-        transaction.on_commit(lambda: workers.send(waiting.first_job(), waiting.pk))
+        enqueue(waiting.first_job(), waiting.pk)  # on commit, on its kind's queue
 
 
 # ---- failing jobs that did not end by themselves ---------------------------------------
