@@ -102,7 +102,8 @@ def guard(kind, job, work=None):
     or a bug. Then send the job that waited behind this one.
 
     A domain error (motionlib's, naming file, line and value, or the service's own) is the
-    input's fault: its message is stored as it is, as a permanent error; so is the soft
+    input's fault: its message is stored as it is, as a permanent error (unless the error's
+    ``permanent`` is False: Blender killed from outside, which a retry may outlive); so is the soft
     time limit, which the same input would reach again. Anything else is ours: it is
     logged with its traceback and the job stores an internal error with a reference to
     quote.
@@ -115,7 +116,9 @@ def guard(kind, job, work=None):
         usable_connection()
         job.fail(model.stopped_error.format(what=kind.what, settings=settings), permanent=True)
     except (MotionlibError, CutroomError) as exc:
-        job.fail(_bounded(model.input_error.format(error=exc)), permanent=True)
+        # Permanent unless the error says trying again may help (Blender killed from outside).
+        job.fail(_bounded(model.input_error.format(error=exc)),
+                 permanent=getattr(exc, "permanent", True))
     except Exception:
         if not model.objects.filter(pk=job.pk).exists():
             # Deleted while it ran (its stored files with it): nothing failed that matters.

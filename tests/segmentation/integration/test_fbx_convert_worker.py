@@ -114,7 +114,9 @@ def test_it_makes_a_capture_per_animation(fbx_workers, owner, made_fbx):
     assert blender_pids(worker) == blender
 
 
-def test_a_blender_crash_fails_that_capture_and_the_worker_converts_the_next(fbx_workers, owner):
+def test_one_kill_of_blender_does_not_fail_a_good_fbx(fbx_workers, owner):
+    """Issue 48, item 11: one outside kill of the Blender child failed a good FBX for good;
+    the read is tried again in a fresh Blender."""
     start_convert, _ = fbx_workers
     worker = start_convert()
     blenders_ready(worker)
@@ -123,12 +125,12 @@ def test_a_blender_crash_fails_that_capture_and_the_worker_converts_the_next(fbx
              what="conversion to start")
     # Every slot's Blender, the one reading the file among them (the others start afresh
     # on their next file).
-    for pid in blender_pids(worker):
+    killed = blender_pids(worker)
+    for pid in killed:
         os.kill(pid, signal.SIGKILL)
-    crashed = settled(capture_id)
-    assert crashed.status == "failed"
-    assert "13_29_blender.fbx: Blender was killed by signal SIGKILL while reading the FBX" in \
-        crashed.error
+    converted = settled(capture_id)
+    assert converted.status == "ready", converted.error
+    assert not set(blender_pids(worker)) & set(killed)
     assert settled(upload(owner, shared_fbx("flair.fbx"))).status == "ready"
     assert worker.poll() is None
 
