@@ -23,8 +23,6 @@ from segmentation.similar import files
 
 log = logging.getLogger(__name__)
 
-log = logging.getLogger(__name__)
-
 JOBS = (Capture, DetectionRun)
 
 
@@ -37,6 +35,14 @@ def look(concurrency):
     """
     swept = jobs.sweep()
     return swept, stalled(concurrency)
+
+
+def resend_stalled():
+    """Send again the queued jobs that waited CUTROOM_STALL_SECONDS (how many): what looks
+    like a stuck worker is as often a lost message (a broker restarted, a queue purged),
+    which a healthy worker takes at once when it is sent again, and restarting the worker
+    would not bring back."""
+    return jobs.resend_waiting(settings.CUTROOM_STALL_SECONDS)
 
 
 def stalled(concurrency, after=None):

@@ -258,9 +258,14 @@ def _rescue_stale(model):
     return count
 
 
-def _resend_waiting(model):
+def resend_waiting(after):
+    """Send again every queued job that waited more than ``after`` seconds; how many."""
+    return sum(_resend_waiting(model, after) for model in JOB_MODELS)
+
+
+def _resend_waiting(model, after=None):
     count = 0
-    for job in model.objects.waiting_too_long():
+    for job in model.objects.waiting_too_long(after):
         with transaction.atomic():
             model.objects.filter(pk=job.pk, status="queued").update(claimed_at=timezone.now())
             enqueue(job.first_job(), job.pk)
