@@ -1,3 +1,4 @@
+from drf_spectacular.authentication import SessionScheme
 from rest_framework.authentication import SessionAuthentication, TokenAuthentication
 from rest_framework.exceptions import AuthenticationFailed
 from rest_framework.request import is_form_media_type
@@ -41,3 +42,9 @@ class CsrfFirstSessionAuthentication(SessionAuthentication):
         if not is_form_media_type(request.content_type):
             request = request._request
         super().enforce_csrf(request)
+
+
+class CsrfFirstSessionScheme(SessionScheme):
+    """The API schema's cookie sign-in, for ``CsrfFirstSessionAuthentication``."""
+
+    target_class = CsrfFirstSessionAuthentication

@@ -17,9 +17,9 @@ from segmentation.models import Invitation
 
 
 class MyInvitationSerializer(serializers.ModelSerializer):
-    """An invitation as the invitee sees it: which project, what role, from whom; only
-    what the inviter may set, and the project's name as ``shown_name`` cleans it (a name
-    can name a project, not carry a message)."""
+    """An invitation as the invitee sees it: which project, what role, from whom; the
+    project's name on one line, without invisible characters, cut short: it names the
+    project and carries no message."""
 
     project = serializers.SerializerMethodField()
     invited_by = serializers.CharField(source="invited_by.username", default=None)
