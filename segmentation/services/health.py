@@ -17,6 +17,7 @@ from django.utils import timezone
 
 from segmentation import workers
 from segmentation.models import Capture, DetectionRun, LibrarySegment, WorkerHeartbeat
+from segmentation.models.captures import CONVERTING
 from segmentation.models.jobs import claim_cutoff
 from segmentation.services import jobs
 from segmentation.similar import files
@@ -56,14 +57,14 @@ def stalled(concurrency, after=None):
     after = settings.CUTROOM_STALL_SECONDS if after is None else after
     now = timezone.now()
     limit = now - timezone.timedelta(seconds=after)
-    oldest = _earliest(model.objects.filter(status="queued") for model in JOBS)
+    oldest = _earliest(watched(model).filter(status="queued") for model in JOBS)
     if oldest is None or oldest > limit:
         return None
-    taken = _latest(model.objects.exclude(status="queued") for model in JOBS)
+    taken = _latest(watched(model).exclude(status="queued") for model in JOBS)
     if taken is not None and taken > limit:
         return None
     running = sum(
-        model.objects.filter(status="processing", claimed_at__gte=claim_cutoff()).count()
+        watched(model).filter(status="processing", claimed_at__gte=claim_cutoff()).count()
         for model in JOBS
     )
     if running >= concurrency:
@@ -73,6 +74,12 @@ def stalled(concurrency, after=None):
         f"was taken for {after} s (CUTROOM_STALL_SECONDS) while {running} of "
         f"{concurrency} worker processes had one"
     )
+
+
+def watched(model):
+    """The jobs of ``model`` the default queue's workers run: not FBX conversions, which the
+    convert worker runs (and which wait on purpose while their uploader has one running)."""
+    return model.objects.exclude(CONVERTING) if model is Capture else model.objects.all()
 
 
 def _earliest(querysets):
@@ -160,7 +167,7 @@ def _workers():
 def _convert_worker():
     queue = settings.CUTROOM_CONVERT_QUEUE
     alive = _alive(queue)
-    converting = Capture.objects.filter(status="processing", format="fbx", converted="").count()
+    converting = Capture.objects.filter(CONVERTING, status="processing").count()
     found = {"workers": len(alive), "slots": sum(h.processes for h in alive),
              "converting": converting}
     if not alive:
