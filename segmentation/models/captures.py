@@ -132,8 +132,10 @@ class Capture(Job):
 
     def next_in_line(self):
         """The uploader's oldest queued conversion, sent once this conversion ends (it
-        waited for this one: ``CaptureQuerySet.claim``); None for other jobs."""
-        if not self.needs_conversion or self.uploaded_by_id is None:
+        waited for this one: ``CaptureQuerySet.claim``); None for other jobs. Asked of any
+        FBX capture's job (a conversion that succeeded has its ``converted`` file by now);
+        sending one that still cannot start costs nothing: its claim is refused again."""
+        if self.format != "fbx" or self.uploaded_by_id is None:
             return None
         return (Capture.objects.filter(CONVERTING, uploaded_by_id=self.uploaded_by_id,
                                        status="queued")

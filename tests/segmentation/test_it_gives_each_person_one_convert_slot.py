@@ -39,3 +39,10 @@ class OneConvertSlotTestCase(BaseTestCase):
         converted = self.fbx(self.bob, "b.fbx")
         Capture.objects.filter(pk=converted.pk).update(converted="derived/x/take.npz")
         self.assertTrue(Capture.objects.claim(converted.pk, "slot-2"))
+
+    def test_a_conversion_that_succeeded_sends_the_next(self):
+        first, second = self.fbx(self.bob, "a.fbx"), self.fbx(self.bob, "b.fbx")
+        Capture.objects.claim(first.pk, "slot-1")
+        converted = Capture.objects.get(pk=first.pk)
+        converted.converted.name = "derived/x/take.npz"  # as the conversion leaves it
+        self.assertEqual(converted.next_in_line(), second)
