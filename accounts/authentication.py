@@ -1,5 +1,7 @@
-from rest_framework.authentication import TokenAuthentication
+from drf_spectacular.authentication import SessionScheme
+from rest_framework.authentication import SessionAuthentication, TokenAuthentication
 from rest_framework.exceptions import AuthenticationFailed
+from rest_framework.request import is_form_media_type
 
 from accounts.models import ApiToken
 
@@ -24,3 +26,25 @@ class ExpiringTokenAuthentication(TokenAuthentication):
             raise AuthenticationFailed("User inactive or deleted.")
         token.touch()
         return token.user, token
+
+
+class CsrfFirstSessionAuthentication(SessionAuthentication):
+    """DRF's session sign-in, whose CSRF check never parses the body first.
+
+    Django's CSRF check looks for ``csrfmiddlewaretoken`` in ``request.POST``; handed
+    DRF's request, that parses the body with the API's parsers, so a cross-site
+    ``text/plain`` post (which a plain HTML form can send) was answered 415 before the
+    check could refuse it. Django's own request reads ``POST`` only from form bodies and
+    leaves any other body unread, so the check refuses first with its 403.
+    """
+
+    def enforce_csrf(self, request):
+        if not is_form_media_type(request.content_type):
+            request = request._request
+        super().enforce_csrf(request)
+
+
+class CsrfFirstSessionScheme(SessionScheme):
+    """The API schema's cookie sign-in, for ``CsrfFirstSessionAuthentication``."""
+
+    target_class = CsrfFirstSessionAuthentication

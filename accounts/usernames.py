@@ -11,7 +11,8 @@ A new name may also not hold characters that show as nothing or pass for others:
 format characters (zero-width spaces and joiners, direction marks), control and private
 characters, spaces other than the plain one, letters of two scripts that share
 look-alike letters (Latin, Greek, Cyrillic...), as in a Cyrillic "а" in "pаypal", or only
-Cyrillic or Greek letters drawn like Latin ones (a Cyrillic "асе").
+Cyrillic or Greek letters drawn like Latin ones (a Cyrillic "асе"). ``check_shown`` is
+that rule alone; the names people see beside usernames (projects, labels) are held to it.
 """
 
 import hashlib
@@ -36,7 +37,16 @@ LATIN_LOOKALIKES = set(
 REFUSED_CATEGORIES = {"Cc", "Cf", "Co", "Cs", "Cn", "Zl", "Zp"}
 
 
-class UsernameError(ValueError):
+USERNAME_HINT = "use visible letters, digits, spaces and @.+-_"
+NAME_HINT = "use visible letters, digits, punctuation and plain spaces"
+
+
+class ShownNameError(ValueError):
+    """A name shown to others that holds characters that show as nothing or pass for
+    others; the message says which."""
+
+
+class UsernameError(ShownNameError):
     """A username that cannot be given to an account; the message says why."""
 
 
@@ -59,32 +69,51 @@ def clean(name):
     name = unicodedata.normalize("NFKC", typed)
     if not name or len(name) > MAX_LENGTH:
         raise UsernameError(f"must be 1 to {MAX_LENGTH} characters, got {len(name)}")
-    # As typed as well as normalised: NFKC turns some of them into plain spaces or letters.
-    _check_characters(typed)
-    _check_characters(name)
-    scripts = sorted({s for s in map(_script, name) if s in LOOKALIKE_SCRIPTS})
-    if len(scripts) > 1:
-        raise UsernameError(
-            f"mixes letters of the {' and '.join(s.title() for s in scripts)} scripts, "
-            "which look alike; use letters of one of them"
-        )
-    letters = [char for char in name if unicodedata.category(char).startswith("L")]
-    if scripts and scripts != ["LATIN"] and set(letters) <= LATIN_LOOKALIKES:
-        raise UsernameError(
-            f"is written in {scripts[0].title()} letters that all look like Latin ones, so it "
-            "reads as a Latin name it is not; use Latin letters, or others of your script"
-        )
+    try:
+        check_shown(typed, USERNAME_HINT)
+    except ShownNameError as exc:
+        raise UsernameError(str(exc)) from None
     return name
 
 
-def _check_characters(name):
+def check_shown(text, hint=NAME_HINT, words=False):
+    """Refuse ``text``, a name shown to other people, if it holds characters that show as
+    nothing or pass for others (see the module docstring).
+
+    The same rule holds account names and the names others see beside them (projects,
+    labels). With ``words``, letters of two look-alike scripts are refused within a word
+    only: "Студия MoCap" is a fair project name, "pаypal" (a Cyrillic "а") is not.
+    ``ShownNameError`` names the first refused character, its position and code point.
+    """
+    # As typed as well as normalised: NFKC turns some of them into plain spaces or letters.
+    _check_characters(text, hint)
+    name = unicodedata.normalize("NFKC", text)
+    _check_characters(name, hint)
+    for part in name.split() if words else [name]:
+        scripts = sorted({s for s in map(_script, part) if s in LOOKALIKE_SCRIPTS})
+        if len(scripts) > 1:
+            where = f"the word {part!r} " if words else ""
+            raise ShownNameError(
+                f"{where}mixes letters of the {' and '.join(s.title() for s in scripts)} "
+                "scripts, which look alike; use letters of one of them"
+            )
+    scripts = sorted({s for s in map(_script, name) if s in LOOKALIKE_SCRIPTS})
+    letters = [char for char in name if unicodedata.category(char).startswith("L")]
+    if scripts and "LATIN" not in scripts and set(letters) <= LATIN_LOOKALIKES:
+        raise ShownNameError(
+            f"is written in {scripts[0].title()} letters that all look like Latin ones, so it "
+            "reads as a Latin name it is not; use Latin letters, or others of your script"
+        )
+
+
+def _check_characters(name, hint):
     for position, char in enumerate(name, 1):
         category = unicodedata.category(char)
         if category in REFUSED_CATEGORIES or (category == "Zs" and char != " "):
             label = unicodedata.name(char, "unnamed character")
-            raise UsernameError(
+            raise ShownNameError(
                 f"character {position} is U+{ord(char):04X} ({label}), which does not show "
-                "or passes for another; use visible letters, digits, spaces and @.+-_"
+                f"or passes for another; {hint}"
             )
 
 

@@ -55,6 +55,9 @@ BENCHMARKS = {
                              "with one and two workers"),
     "capture-list-load": Benchmark("benchmarks.service.capture_list_load", "the capture "
                                    "list under load on PostgreSQL"),
+    "submit-points": Benchmark("benchmarks.service.submit_points", "a review submit of a "
+                               "1,000-point take: the request now and before, and the job",
+                               ("--frames", "1600")),
     "review-long-take": Benchmark("benchmarks.service.review_long_take", "review requests "
                                   "on a one-hour take"),
     "review-playback": Benchmark("benchmarks.service.review_playback", "the review page's "

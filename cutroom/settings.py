@@ -243,9 +243,12 @@ CUTROOM_HEARTBEAT_STALE = envint("CUTROOM_HEARTBEAT_STALE", 60)
 # The health endpoint calls a similar-clip index stale when a library segment has waited
 # this long to be indexed (searches still find it: they read newer segments from the rows).
 CUTROOM_INDEX_STALE_SECONDS = envint("CUTROOM_INDEX_STALE_SECONDS", 900)
-# A capture of more joint positions (joints or points × frames) than this has the motion
-# descriptors of its library rows computed by a worker after a review submit or gold save,
-# not in the request (which holds the database's write lock on SQLite).
+# After a review submit or gold save, a take of joints of at most this many joint positions
+# (joints × frames) has its library rows built and described in the request; a longer one,
+# and every take of points, by a worker's job (`refresh_library`), so the request (which on
+# SQLite holds the database's write lock) answers at once and the rows appear when the job
+# has run. On the embedded default that job runs on the worker `up` starts beside the web
+# server, like every other job; 0 sends every capture's rows to a worker.
 CUTROOM_DESCRIBE_INLINE = envint("CUTROOM_DESCRIBE_INLINE", 500_000)
 # After this many claims a job that keeps killing its worker is marked failed.
 CUTROOM_MAX_ATTEMPTS = envint("CUTROOM_MAX_ATTEMPTS", 3)
@@ -345,14 +348,15 @@ REST_FRAMEWORK = {
     "DEFAULT_AUTHENTICATION_CLASSES": [
         # First, so an anonymous call gets 401 with "WWW-Authenticate: Token", not 403.
         "accounts.authentication.ExpiringTokenAuthentication",
-        "rest_framework.authentication.SessionAuthentication",
+        # Its CSRF check comes before any body is parsed (a text/plain post is a 403).
+        "accounts.authentication.CsrfFirstSessionAuthentication",
     ],
     "DEFAULT_PERMISSION_CLASSES": ["rest_framework.permissions.IsAuthenticated"],
     # Bounded nesting and numbers in every JSON body (see segmentation.api.common.parsers).
     "DEFAULT_PARSER_CLASSES": [
         "segmentation.api.common.parsers.BoundedJSONParser",
         "rest_framework.parsers.FormParser",
-        "rest_framework.parsers.MultiPartParser",
+        "segmentation.api.common.parsers.UploadParser",
     ],
     "DEFAULT_SCHEMA_CLASS": "drf_spectacular.openapi.AutoSchema",
     "EXCEPTION_HANDLER": "segmentation.api.common.errors.exception_handler",

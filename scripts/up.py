@@ -7,8 +7,9 @@
 
 With no environment set, everything lives under ``var/`` (SQLite, the SQLite broker
 file, uploaded originals, logs). The worker and gunicorn run as child processes with
-their logs in ``var/log/``; a worker that dies is reported (with the end of its log),
-its jobs are requeued and it is restarted; Ctrl-C (or SIGTERM) stops both and waits for
+their logs in ``var/log/``; a worker or web server that dies is reported (with the end of
+its log) and restarted (a dead worker's jobs are requeued; a worker that looks stuck is
+first sent its waiting jobs again, in case their message was lost); Ctrl-C (or SIGTERM) stops both and waits for
 them. Running it again is safe: migrations are applied when missing and demo data is added
 once (``manage.py demo`` leaves an existing demo project as its admins keep it).
 """
@@ -316,9 +317,15 @@ class Watchdog:
     def restarted(self):
         """A (re)started worker gets CUTROOM_STALL_SECONDS to take its first job."""
         self.due = time.monotonic() + self.grace
+        self.resent = False
 
     def check(self):
-        """Why the worker must be restarted, or None (also None until the next check)."""
+        """Why the worker must be restarted, or None (also None until the next check).
+
+        A job waiting while a worker process sits idle is first taken for a lost message:
+        the waiting jobs are sent again and the worker gets CUTROOM_STALL_SECONDS to take
+        them. Only a worker that does not is stuck (a healthy one was restarted again and
+        again for a message no restart brings back)."""
         if time.monotonic() < self.due:
             return None
         self.due = time.monotonic() + self.interval
@@ -327,7 +334,17 @@ class Watchdog:
         from segmentation.services import health
 
         try:
-            return health.look(self.concurrency)[1]
+            stuck = health.look(self.concurrency)[1]
+            if stuck is not None and not self.resent:
+                self.resent, self.due = True, time.monotonic() + self.grace
+                sent = health.resend_stalled()
+                say(f"{stuck}; its message may have been lost: {sent} waiting job(s) sent "
+                    f"again, and the worker is restarted only if it does not take them "
+                    f"within {self.grace} s")
+                return None
+            if stuck is None:
+                self.resent = False
+            return stuck
         except Exception as exc:  # the database busy or gone: look again next time
             say(f"could not check the jobs ({type(exc).__name__}: {exc})")
             return None
@@ -339,18 +356,23 @@ def supervise(worker_child, web_child, watchdog, convert_child=None, bulk_child=
     """Watch the children until a signal arrives; returns the exit code for up.py.
 
     The web server keeps serving whatever happens to the worker; a worker that died or
-    stalled is restarted (rate-limited by Restarts). A bulk lane server that died is
-    restarted at once; meanwhile the web server serves those requests itself."""
-    restarts = Restarts()
+    stalled is restarted (rate-limited by Restarts). A web server that died is restarted
+    (rate-limited too: one that cannot start is not looped on fast); the workers go on
+    meanwhile. A bulk lane server that died is restarted at once; meanwhile the web server
+    serves those requests itself."""
+    restarts, web_restarts = Restarts(), Restarts()
     while True:
         nap(0.5)
         for child in (convert_child, bulk_child):
             if child is not None and child.exited() is not None:
                 restart_at_once(child)
         if web_child.exited() is not None:
-            say(f"the web server stopped unexpectedly (exit code {web_child.exited()}); "
-                f"end of {web_child.log}:\n{web_child.tail()}")
-            return 1
+            pause = web_restarts.pause()
+            if pause:
+                say(f"the web server died {RESTARTS_IN_WINDOW} times within "
+                    f"{RESTART_WINDOW:.0f} s; waiting {pause:.0f} s before restarting it")
+                nap(pause)
+            restart_at_once(web_child)
         code = worker_child.exited()
         if code is not None:
             say(f"the worker died (exit code {code}); end of {worker_child.log}:\n"
@@ -380,7 +402,8 @@ def restart(worker_child, pause):
 
 
 def restart_at_once(child):
-    """Restart a child that died, at once: the convert worker (its conversion in hand is
+    """Restart a child that died, at once: the web server (the service is unreachable
+    until it is back), the convert worker (its conversion in hand is
     requeued by the periodic sweep once its claim is stale: sweeping now would also take
     the other worker's running jobs; Blender crashing or hanging on a file does not get
     here: that costs Blender's process only, and fails that capture) or the bulk lane

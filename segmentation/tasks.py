@@ -204,6 +204,13 @@ def suggest(capture_id, annotator_id):
 
 
 @shared_task(acks_late=True, reject_on_worker_lost=False, base=ContainedTask)
+def refresh_library(capture_id):
+    """Build and describe a capture's library rows after a submit or gold save, off the
+    request (a take of points, or a long one); a second delivery builds them again."""
+    return library.build_library(capture_id)
+
+
+@shared_task(acks_late=True, reject_on_worker_lost=False, base=ContainedTask)
 def describe_library(capture_id):
     """Compute the motion descriptors of a long capture's library rows, off the request
     that made them (idempotent: described rows are left alone)."""

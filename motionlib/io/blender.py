@@ -10,7 +10,10 @@ interpreter if it can import ``bpy``.
 
 A file that crashes Blender, or keeps it busy past the time limit, costs that process only: the
 caller gets a :class:`~motionlib.errors.CaptureError` naming the file and what happened, and the
-next request starts a fresh Blender.
+next request starts a fresh Blender. A Blender that dies during a request (a crash, or a kill
+from outside it: the kernel's out-of-memory killer, an operator) is tried once more in a fresh
+process first (``retry_deaths``), so one outside kill does not fail a good file; a file that
+kills Blender again fails (a hang is not retried: it would hang as long again).
 """
 
 from __future__ import annotations
@@ -40,6 +43,16 @@ class BlenderUnavailable(CaptureError):
     """No interpreter with Blender (``bpy``) was found; the message says how to install one."""
 
 
+class BlenderDied(CaptureError):
+    """Blender ended during a request. ``permanent`` is False when it was killed from outside
+    (SIGKILL: the out-of-memory killer, an operator), which trying again later may outlive."""
+
+    def __init__(self, message, *, path=None, signal_name=None):
+        super().__init__(message, path=path)
+        self.signal_name = signal_name
+        self.permanent = signal_name != "SIGKILL"
+
+
 def blender_python() -> str:
     """Path of an interpreter that can import ``bpy``; BlenderUnavailable if there is none."""
     configured = os.environ.get("MOTIONLIB_BLENDER_PYTHON")
@@ -60,8 +73,9 @@ def blender_python() -> str:
 class Blender:
     """One Blender child process serving requests in order (one at a time)."""
 
-    def __init__(self, python: str | None = None):
+    def __init__(self, python: str | None = None, retry_deaths: int = 1):
         self.python = python
+        self.retry_deaths = retry_deaths
         self.proc = None
         self._reply = None
         self._log = None
@@ -112,11 +126,19 @@ class Blender:
         """
         timeout = DEFAULT_TIMEOUT if timeout is None else timeout
         with self._lock:
-            try:
-                self._ensure_started()
-            except BlenderUnavailable as exc:
-                raise BlenderUnavailable(exc.reason, path=path) from None
-            reply = self._exchange(message, timeout, what, path)
+            for attempt in range(self.retry_deaths + 1):
+                try:
+                    self._ensure_started()
+                    reply = self._exchange(message, timeout, what, path)
+                    break
+                except BlenderUnavailable as exc:
+                    raise BlenderUnavailable(exc.reason, path=path) from None
+                except BlenderDied as exc:  # while starting, or while doing the request
+                    if attempt < self.retry_deaths:
+                        continue
+                    tried = f" (it was tried {attempt + 1} times, each in a fresh Blender)"
+                    raise BlenderDied(exc.reason + (tried if attempt else ""), path=path,
+                                      signal_name=exc.signal_name) from None
         if not reply.get("ok"):
             raise CaptureError(scrub(reply.get("error") or "Blender failed", path), path=path)
         return reply
@@ -143,7 +165,8 @@ class Blender:
                     "MOTIONLIB_BLENDER_TIMEOUT)", path=path)
             chunk = os.read(self._reply.fileno(), 1 << 16)
             if not chunk:
-                raise CaptureError(scrub(self._death(what, logged), path), path=path)
+                told, signal_name = self._death(what, logged)
+                raise BlenderDied(scrub(told, path), path=path, signal_name=signal_name)
             line += chunk
         return json.loads(line)
 
@@ -154,11 +177,11 @@ class Blender:
             self.kill()
             code = self.proc.wait()
         tail = self.log_tail(since=logged)
-        how = (f"was killed by signal {signal.Signals(-code).name}" if code < 0
-               else f"exited with code {code}")
+        signal_name = signal.Signals(-code).name if code < 0 else None
+        how = f"was killed by signal {signal_name}" if signal_name else f"exited with code {code}"
         self.stop()
         return (f"Blender {how} while {what}; the file may be damaged (Blender's last words: "
-                f"{tail or 'none'})")
+                f"{tail or 'none'})"), signal_name
 
     def log_tail(self, lines=3, since=0) -> str:
         """The last ``lines`` lines Blender logged after byte ``since`` of its log."""

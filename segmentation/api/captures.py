@@ -11,13 +11,13 @@ from rest_framework import mixins, viewsets
 from rest_framework.decorators import action
 from rest_framework.exceptions import PermissionDenied
 from rest_framework.pagination import PageNumberPagination
-from rest_framework.parsers import FormParser, MultiPartParser
+from rest_framework.parsers import FormParser
 from rest_framework.response import Response
 
 from segmentation import services
 from segmentation.api.common.heavy import immutable
 from segmentation.api.common.params import body, int_param
-from segmentation.api.common.parsers import BoundedJSONParser
+from segmentation.api.common.parsers import BoundedJSONParser, UploadParser
 from segmentation.api.common.serializers.captures import (
     CaptureListSerializer,
     CaptureSerializer,
@@ -49,7 +49,7 @@ class CaptureViewSet(
 ):
     serializer_class = CaptureSerializer
     pagination_class = CapturePagination
-    parser_classes = [MultiPartParser, FormParser, BoundedJSONParser]
+    parser_classes = [UploadParser, FormParser, BoundedJSONParser]
 
     def get_serializer_class(self):
         return CaptureListSerializer if self.action == "list" else super().get_serializer_class()

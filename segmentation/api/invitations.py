@@ -12,11 +12,14 @@ from rest_framework.views import APIView
 from segmentation import services
 from segmentation.api.common.serializers.base import DetailSerializer, NamedRefSerializer
 from segmentation.api.common.serializers.projects import MemberSerializer
+from segmentation.limits import shown_name
 from segmentation.models import Invitation
 
 
 class MyInvitationSerializer(serializers.ModelSerializer):
-    """An invitation as the invitee sees it: which project, what role, from whom."""
+    """An invitation as the invitee sees it: which project, what role, from whom; the
+    project's name on one line, without invisible characters, cut short: it names the
+    project and carries no message."""
 
     project = serializers.SerializerMethodField()
     invited_by = serializers.CharField(source="invited_by.username", default=None)
@@ -27,7 +30,7 @@ class MyInvitationSerializer(serializers.ModelSerializer):
 
     @extend_schema_field(NamedRefSerializer)
     def get_project(self, invitation):
-        return {"id": invitation.project_id, "name": invitation.project.name}
+        return {"id": invitation.project_id, "name": shown_name(invitation.project.name)}
 
 
 class AcceptedSerializer(MemberSerializer):

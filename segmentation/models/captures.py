@@ -8,14 +8,32 @@ from django.db import models
 from django.utils import timezone
 
 from segmentation.errors import Invalid
-from segmentation.models.jobs import ClaimQuerySet, Job
+from segmentation.models.jobs import ClaimQuerySet, Job, claim_cutoff
 from segmentation.models.projects import Project
 
 
 class CaptureQuerySet(ClaimQuerySet):
+    def claim(self, pk, token):
+        """Claim a capture's job; a conversion (Blender reading an FBX) only while no other
+        conversion of the same uploader holds a live claim. Conversions have few slots, and
+        a file can hang Blender for minutes (MOTIONLIB_BLENDER_TIMEOUT): one person's files
+        take at most one slot, so they never hold back anybody else's. A conversion refused
+        here stays queued; it is sent again when the uploader's conversion ends
+        (``Capture.next_in_line``), or by the sweep."""
+        busy = self.model.objects.filter(
+            CONVERTING, uploaded_by=models.OuterRef("uploaded_by"), status="processing",
+            claimed_at__gte=claim_cutoff(),
+        ).exclude(pk=models.OuterRef("pk"))
+        one_per_person = ~CONVERTING | models.Q(~models.Exists(busy))
+        return super(CaptureQuerySet, self.filter(one_per_person)).claim(pk, token)
+
     def visible_to(self, user):
         """Captures of the projects the user is a member of."""
         return self.filter(project__in=Project.objects.for_user(user))
+
+
+# A capture whose job is a conversion: an FBX Blender has not read yet.
+CONVERTING = models.Q(format="fbx", converted="")
 
 
 def original_path(capture, filename):
@@ -111,6 +129,17 @@ class Capture(Job):
         """The task that starts processing an upload: ``convert`` for an FBX Blender has not
         read yet (the convert queue), else ``ingest``."""
         return "convert" if self.needs_conversion else "ingest"
+
+    def next_in_line(self):
+        """The uploader's oldest queued conversion, sent once this conversion ends (it
+        waited for this one: ``CaptureQuerySet.claim``); None for other jobs. Asked of any
+        FBX capture's job (a conversion that succeeded has its ``converted`` file by now);
+        sending one that still cannot start costs nothing: its claim is refused again."""
+        if self.format != "fbx" or self.uploaded_by_id is None:
+            return None
+        return (Capture.objects.filter(CONVERTING, uploaded_by_id=self.uploaded_by_id,
+                                       status="queued")
+                .exclude(pk=self.pk).order_by("created_at", "pk").first())
 
     def latest_run(self):
         """The newest detection run (uses ``prefetch_related("runs")`` when present)."""

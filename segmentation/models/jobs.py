@@ -55,10 +55,11 @@ class ClaimQuerySet(models.QuerySet):
             claimed_at=timezone.now(), attempts=0,
         ) == 1
 
-    def waiting_too_long(self):
-        """Queued rows nobody claimed within CUTROOM_RESEND_AFTER: their message may be
-        lost (broker down at upload time, queue purged), so they are sent again."""
-        limit = timezone.now() - timezone.timedelta(seconds=settings.CUTROOM_RESEND_AFTER)
+    def waiting_too_long(self, after=None):
+        """Queued rows nobody claimed within ``after`` seconds (CUTROOM_RESEND_AFTER): their
+        message may be lost (broker down at upload time, queue purged), so they are sent again."""
+        after = settings.CUTROOM_RESEND_AFTER if after is None else after
+        limit = timezone.now() - timezone.timedelta(seconds=after)
         last_sent = Q(claimed_at__lt=limit) | Q(claimed_at__isnull=True, created_at__lt=limit)
         return self.filter(last_sent, status="queued")
 
@@ -127,6 +128,11 @@ class Job(models.Model):
     def queued_behind(self):
         """The queued job that cannot start before this one ends, or None."""
         return None
+
+    def next_in_line(self):
+        """The queued job to send once this one ends (it was refused a start while this
+        one ran), or None."""
+        return self.queued_behind()
 
     def finish(self, **fields):
         """Store the result, but only if this job's claim still holds."""

@@ -16,7 +16,7 @@ import motionlib
 from motionlib.errors import shorten
 from motionlib.segmenters import ParamError, get_segmenter, list_segmenters
 from segmentation.errors import CutroomError, NotReady, ReviewStarted, UploadError, UploadTooLarge
-from segmentation.files import storage
+from segmentation.files import cleanup, storage
 from segmentation.files.storage import read_take
 from segmentation.models import Capture, DetectionRun, Project
 from segmentation.services import adaptation, jobs, quotas
@@ -209,6 +209,8 @@ def _ingest(capture):
     with transaction.atomic():
         if capture.finish(**_metadata(take, height), positions=capture.positions.name):
             run = _start_default_run(capture)
+        else:  # deleted meanwhile, or taken over: nothing names the file just written
+            cleanup.forget(capture.positions)
     if run is not None:
         _detect_here(run, take)
 
@@ -286,6 +288,8 @@ def _detect(run, take=None):
     if finished:
         # Reviews opened while this run was computing start from its candidates now.
         do_take_in_candidates(run)
+    else:
+        cleanup.forget(run.signals)
 
 
 def do_redetect(capture, user):

@@ -14,7 +14,7 @@ from django.utils import timezone
 
 from motionlib.io.fbx import read_fbx_all
 from motionlib.io.npz import take_bytes
-from segmentation.files import storage
+from segmentation.files import cleanup, storage
 from segmentation.models import Capture
 from segmentation.services import jobs, quotas
 from segmentation.services.jobs import Kind, enqueue, register
@@ -57,7 +57,9 @@ def _convert(capture):
             for sibling in siblings:
                 add_animation(sibling)
     if not handed_over:
-        # Another worker took this capture over; it converts it itself.
+        # Deleted meanwhile, or another worker took this capture over (it converts it
+        # itself): nothing names the files just written.
+        cleanup.forget(capture.converted)
         for sibling in siblings:
             sibling.converted.delete(save=False)
 

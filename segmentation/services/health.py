@@ -17,11 +17,10 @@ from django.utils import timezone
 
 from segmentation import workers
 from segmentation.models import Capture, DetectionRun, LibrarySegment, WorkerHeartbeat
+from segmentation.models.captures import CONVERTING
 from segmentation.models.jobs import claim_cutoff
 from segmentation.services import jobs
 from segmentation.similar import files
-
-log = logging.getLogger(__name__)
 
 log = logging.getLogger(__name__)
 
@@ -39,6 +38,14 @@ def look(concurrency):
     return swept, stalled(concurrency)
 
 
+def resend_stalled():
+    """Send again the queued jobs that waited CUTROOM_STALL_SECONDS (how many): what looks
+    like a stuck worker is as often a lost message (a broker restarted, a queue purged),
+    which a healthy worker takes at once when it is sent again, and restarting the worker
+    would not bring back."""
+    return jobs.resend_waiting(settings.CUTROOM_STALL_SECONDS)
+
+
 def stalled(concurrency, after=None):
     """Why the workers look stuck, or None while they make progress.
 
@@ -50,14 +57,14 @@ def stalled(concurrency, after=None):
     after = settings.CUTROOM_STALL_SECONDS if after is None else after
     now = timezone.now()
     limit = now - timezone.timedelta(seconds=after)
-    oldest = _earliest(model.objects.filter(status="queued") for model in JOBS)
+    oldest = _earliest(watched(model).filter(status="queued") for model in JOBS)
     if oldest is None or oldest > limit:
         return None
-    taken = _latest(model.objects.exclude(status="queued") for model in JOBS)
+    taken = _latest(watched(model).exclude(status="queued") for model in JOBS)
     if taken is not None and taken > limit:
         return None
     running = sum(
-        model.objects.filter(status="processing", claimed_at__gte=claim_cutoff()).count()
+        watched(model).filter(status="processing", claimed_at__gte=claim_cutoff()).count()
         for model in JOBS
     )
     if running >= concurrency:
@@ -67,6 +74,12 @@ def stalled(concurrency, after=None):
         f"was taken for {after} s (CUTROOM_STALL_SECONDS) while {running} of "
         f"{concurrency} worker processes had one"
     )
+
+
+def watched(model):
+    """The jobs of ``model`` the default queue's workers run: not FBX conversions, which the
+    convert worker runs (and which wait on purpose while their uploader has one running)."""
+    return model.objects.exclude(CONVERTING) if model is Capture else model.objects.all()
 
 
 def _earliest(querysets):
@@ -154,7 +167,7 @@ def _workers():
 def _convert_worker():
     queue = settings.CUTROOM_CONVERT_QUEUE
     alive = _alive(queue)
-    converting = Capture.objects.filter(status="processing", format="fbx", converted="").count()
+    converting = Capture.objects.filter(CONVERTING, status="processing").count()
     found = {"workers": len(alive), "slots": sum(h.processes for h in alive),
              "converting": converting}
     if not alive:

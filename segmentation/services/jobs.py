@@ -102,7 +102,8 @@ def guard(kind, job, work=None):
     or a bug. Then send the job that waited behind this one.
 
     A domain error (motionlib's, naming file, line and value, or the service's own) is the
-    input's fault: its message is stored as it is, as a permanent error; so is the soft
+    input's fault: its message is stored as it is, as a permanent error (unless the error's
+    ``permanent`` is False: Blender killed from outside, which a retry may outlive); so is the soft
     time limit, which the same input would reach again. Anything else is ours: it is
     logged with its traceback and the job stores an internal error with a reference to
     quote.
@@ -115,8 +116,15 @@ def guard(kind, job, work=None):
         usable_connection()
         job.fail(model.stopped_error.format(what=kind.what, settings=settings), permanent=True)
     except (MotionlibError, CutroomError) as exc:
-        job.fail(_bounded(model.input_error.format(error=exc)), permanent=True)
+        # Permanent unless the error says trying again may help (Blender killed from outside).
+        job.fail(_bounded(model.input_error.format(error=exc)),
+                 permanent=getattr(exc, "permanent", True))
     except Exception:
+        if not model.objects.filter(pk=job.pk).exists():
+            # Deleted while it ran (its stored files with it): nothing failed that matters.
+            log.info("%s of %s %s ended: the row was deleted meanwhile", kind.what,
+                     model._meta.verbose_name, job.pk)
+            return
         reference = internal_error(f"{kind.what} of {model._meta.verbose_name} {job.pk}", log)
         usable_connection()
         job.fail(model.crashed_error.format(what=kind.what, reference=reference))
@@ -177,9 +185,9 @@ def usable_connection():
 def send_next(job):
     """Once ``job`` has ended, send the job that waited behind it (its own message may
     have found this one running and been dropped), once the transaction commits."""
-    waiting = job.queued_behind()
+    waiting = job.next_in_line()
     if waiting is not None:
-        transaction.on_commit(lambda: workers.send(waiting.first_job(), waiting.pk))
+        enqueue(waiting.first_job(), waiting.pk)  # on commit, on its kind's queue
 
 
 # ---- failing jobs that did not end by themselves ---------------------------------------
@@ -250,9 +258,14 @@ def _rescue_stale(model):
     return count
 
 
-def _resend_waiting(model):
+def resend_waiting(after):
+    """Send again every queued job that waited more than ``after`` seconds; how many."""
+    return sum(_resend_waiting(model, after) for model in JOB_MODELS)
+
+
+def _resend_waiting(model, after=None):
     count = 0
-    for job in model.objects.waiting_too_long():
+    for job in model.objects.waiting_too_long(after):
         with transaction.atomic():
             model.objects.filter(pk=job.pk, status="queued").update(claimed_at=timezone.now())
             enqueue(job.first_job(), job.pk)

@@ -6,7 +6,7 @@ from django.contrib.auth import get_user_model
 from django.db import IntegrityError, transaction
 
 from segmentation.errors import Invalid
-from segmentation.limits import check_text, text_limit
+from segmentation.limits import check_name, text_limit
 from segmentation.models import Label, Membership, Project
 from segmentation.services.captures import validate_method
 
@@ -16,7 +16,7 @@ COLOR = re.compile(r"^#[0-9a-fA-F]{6}$")
 def do_create_project(user, name, default_method="", default_params=None,
                       annotators_pick_unassigned=True):
     """A new project with ``user`` as its admin; ParamError names a bad default."""
-    check_text("name", name, text_limit(Project, "name"))
+    check_name("name", name, text_limit(Project, "name"))
     params = checked_defaults(default_method, default_params)
     with transaction.atomic():
         project = Project.objects.create(
@@ -34,7 +34,7 @@ def do_update_project(project, **fields):
     the method as stored by a concurrent change, not as this request last saw it.
     """
     if "name" in fields:
-        check_text("name", fields["name"], text_limit(Project, "name"))
+        check_name("name", fields["name"], text_limit(Project, "name"))
     with transaction.atomic():
         current = _locked(project)
         method = fields.get("default_method", current.default_method)
@@ -82,7 +82,7 @@ def do_add_label(project, name, color="#888888", hotkey=None):
     name = name.strip()
     if not name:
         raise Invalid("name: a label needs a name")
-    check_text("name", name, text_limit(Label, "name"))
+    check_name("name", name, text_limit(Label, "name"))
     if not COLOR.match(color or ""):
         raise Invalid(f"color: must look like #rrggbb, got {color!r}")
     if hotkey is not None and (len(hotkey) != 1 or hotkey not in "123456789"):

@@ -14,7 +14,7 @@ from django.db.models import Sum
 from django.utils import timezone
 
 from accounts import locks
-from segmentation.errors import QuotaExceeded, TooManyRequests
+from segmentation.errors import Invalid, QuotaExceeded, TooManyRequests
 from segmentation.models import Capture, DetectionRun, Project, ReferenceVideo
 
 MB = 1024 * 1024
@@ -49,8 +49,18 @@ def check_upload_rate(user, uploads=1, fbx=None):
     made = recent.count()
     if made + uploads <= limit:
         return
-    oldest = recent.order_by("created_at").values_list("created_at", flat=True).first()
-    wait = max(1, int((oldest - since).total_seconds()) + 1) if oldest else 3600
+    if uploads > limit:
+        raise Invalid(
+            f"file: this file holds {uploads} animations, each counted as an upload, and the "
+            f"limit is {limit} uploads per hour (CUTROOM_UPLOADS_PER_HOUR), so it can never "
+            f"pass, however long you wait; split it into files of at most {limit} animations, "
+            "or ask the administrators to raise the limit"
+        )
+    # The wait until enough of the last hour's uploads are an hour old to make room.
+    to_age = made + uploads - limit
+    times = recent.order_by("created_at").values_list("created_at", flat=True)
+    freed = times[to_age - 1] if to_age <= made else None
+    wait = max(1, int((freed - since).total_seconds()) + 1) if freed else 3600
     if uploads == 1:
         what = ""
     else:

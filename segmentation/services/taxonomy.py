@@ -15,7 +15,7 @@ from django.db import IntegrityError, transaction
 
 from motionlib.errors import shorten
 from segmentation.errors import Invalid
-from segmentation.limits import check_text, text_limit
+from segmentation.limits import check_name, text_limit
 from segmentation.models import (
     Adjudication,
     DetectionRun,
@@ -55,7 +55,7 @@ def _apply(project, label, fields):
         name = (fields["name"] or "").strip()
         if not name:
             raise Invalid("name: a label needs a name")
-        check_text("name", name, text_limit(Label, "name"))
+        check_name("name", name, text_limit(Label, "name"))
         if project.labels.filter(name=name).exclude(pk=label.pk).exists():
             raise Invalid(f"name: the project already has a label {name!r}")
         label.name = name

@@ -27,7 +27,7 @@ def blender():
         blender_python()
     except CaptureError as exc:
         pytest.skip(str(exc))
-    b = Blender()
+    b = Blender(retry_deaths=0)  # a kill's message as it is told, not tried again
     yield b
     b.stop()
 

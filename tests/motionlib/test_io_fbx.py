@@ -181,7 +181,7 @@ def test_it_stops_blender_past_the_time_limit_and_reads_the_next_file():
 
 def test_it_survives_blender_dying_mid_file():
     path = shared_fbx("samba_dancing.fbx")
-    own = blender.Blender()
+    own = blender.Blender(retry_deaths=0)  # the death as told (test_blender_retries_a_death)
     own.start()
     doomed = own.pid
     killer = threading.Timer(0.3, lambda: os.kill(doomed, 9))

@@ -128,6 +128,18 @@ class AnimationsCountAsUploadsTestCase(FbxUploadsTestCase):
         self.assertIn("(CUTROOM_UPLOADS_PER_HOUR)", capture.error)
         self.assertEqual(Capture.objects.filter(uploaded_by=self.bob).count(), 2)
 
+    @override_settings(CUTROOM_UPLOADS_PER_HOUR=1)
+    def test_a_file_with_more_animations_than_the_hourly_limit_says_it_can_never_pass(self):
+        """Issue 48, item 12: it was told "try again in 2090 s", which could never help."""
+        capture = self.convert_and_ingest(self.upload_file(self.made / "two_actions.fbx"))
+        self.assertEqual(capture.status, "failed")
+        self.assertIn("this file holds 2 animations, each counted as an upload, and the limit "
+                      "is 1 uploads per hour (CUTROOM_UPLOADS_PER_HOUR), so it can never pass",
+                      capture.error)
+        self.assertIn("split it into files of at most 1 animations", capture.error)
+        self.assertNotIn("try again", capture.error)
+        self.assertTrue(capture.error_permanent)
+
     @override_settings(CUTROOM_UPLOADS_PER_HOUR=2)
     def test_a_file_within_the_limit_gives_all_its_animations_even_converted_again(self):
         capture_id = self.upload_file(self.made / "two_actions.fbx")

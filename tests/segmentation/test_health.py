@@ -55,6 +55,15 @@ class StalledTestCase(BaseTestCase):
         DetectionRun.objects.filter(pk=self.waiting.pk).update(created_at=ago(5))
         self.assertIsNone(health.stalled(concurrency=2))
 
+    def test_an_fbx_waiting_for_the_convert_worker_is_not_the_workers_stall(self):
+        """A conversion waits on the convert worker, or on purpose behind its uploader's
+        running one: the default queue's workers are not stuck for it (issue 48, item 5)."""
+        DetectionRun.objects.filter(pk=self.waiting.pk).update(status="ready", claimed_at=ago(600))
+        Capture.objects.create(project=self.project, uploaded_by=self.bob, name="a.fbx",
+                               format="fbx", checksum="a", original="captures/1/a.fbx",
+                               created_at=ago(300))
+        self.assertIsNone(health.stalled(concurrency=2))
+
     def test_a_dead_claim_does_not_count_as_a_busy_process(self):
         self.running(120)
         self.assertIsNotNone(health.stalled(concurrency=1))

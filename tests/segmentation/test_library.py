@@ -7,15 +7,17 @@ from django.contrib.auth import get_user_model
 from django.db import connection
 from django.test.utils import CaptureQueriesContext
 
-from segmentation import services
+from segmentation import services, tasks
 from segmentation.models import Capture, LibrarySegment
 from segmentation.services import gold
+from segmentation.services.library import built_in_request
 from tests.segmentation.base import BaseTestCase
 
 
-def submit_review(capture, user, cuts, labels):
+def submit_review(capture, user, cuts, labels, worker=True):
     """A review of ``capture`` by ``user`` with exactly ``cuts`` kept and ``labels`` per
-    segment (None leaves a segment unlabelled), submitted."""
+    segment (None leaves a segment unlabelled), submitted; with ``worker``, the library
+    job a take of points or a long take sends is run here, in-process, as a worker would."""
     review = services.get_or_create_review(capture, user)
     for cut in list(review.cuts.all()):
         if cut.frame not in cuts:
@@ -28,6 +30,8 @@ def submit_review(capture, user, cuts, labels):
         if name is not None:
             services.do_label_segment(review, user, index, name, review.version)
     services.do_submit_review(review, user, review.version)
+    if worker and not built_in_request(capture):
+        tasks.refresh_library(capture.pk)
     return review
 
 

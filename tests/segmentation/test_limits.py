@@ -5,7 +5,9 @@ from django.test import override_settings
 from django.utils import timezone
 
 from segmentation import services
+from segmentation.errors import TooManyRequests
 from segmentation.models import Capture, DetectionRun
+from segmentation.services import quotas
 from tests.segmentation.base import BaseTestCase, synthetic_bvh
 
 
@@ -135,3 +137,21 @@ class UploadQuotaTestCase(BaseTestCase):
         content = synthetic_bvh(seed=1, duration=2.0)
         r = self.upload(content)
         self.assertEqual(Capture.objects.get(pk=r.json()["id"]).stored_bytes, len(content))
+
+
+class UploadWaitTestCase(BaseTestCase):
+    """The wait a refusal names is until enough of the hour's uploads age out for this one,
+    not until the oldest does (issue 48, item 12)."""
+
+    @override_settings(CUTROOM_UPLOADS_PER_HOUR=3)
+    def test_it_waits_for_as_many_uploads_to_age_as_the_file_needs(self):
+        now = timezone.now()
+        for minutes_ago in (50, 30, 10):
+            capture = self.ready_capture(name=f"take{minutes_ago}.bvh")
+            Capture.objects.filter(pk=capture.pk).update(
+                uploaded_by=self.bob, created_at=now - timezone.timedelta(minutes=minutes_ago))
+        with self.assertRaises(TooManyRequests) as caught:
+            quotas.check_upload_rate(self.bob, uploads=2)
+        # Two must age out: the one 30 minutes old does so in 30 minutes, not 10.
+        self.assertAlmostEqual(caught.exception.retry_after, 30 * 60, delta=5)
+        self.assertIn("try again in", str(caught.exception))

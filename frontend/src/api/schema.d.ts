@@ -1810,7 +1810,11 @@ export interface components {
          * @enum {string}
          */
         MethodEnum: "cohen_kappa" | "krippendorff_alpha";
-        /** @description An invitation as the invitee sees it: which project, what role, from whom. */
+        /**
+         * @description An invitation as the invitee sees it: which project, what role, from whom; the
+         *     project's name on one line, without invisible characters, cut short: it names the
+         *     project and carries no message.
+         */
         MyInvitation: {
             readonly id: number;
             readonly project: components["schemas"]["NamedRef"];

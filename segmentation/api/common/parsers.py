@@ -10,6 +10,12 @@ can store and compute with, so that no body can turn into a 500:
 - finite numbers only (``1e400`` decodes to infinity, ``NaN`` is not JSON).
 
 The error is an ``Invalid`` (a 400) naming the top-level field at fault and where in it.
+
+Multipart bodies (uploads) go through ``UploadParser``: Django's parser refuses a part
+whose headers pass 1,024 bytes, and a file's name is in its part's headers, so a name of
+255 characters of UTF-8 (up to 1,020 bytes) or a longer one (which Django then cuts to 255
+characters, keeping the extension) was refused with a parser message. The bound on a
+part's headers is ``MAX_PART_HEADER_BYTES`` instead; past it the refusal says why.
 """
 
 import json
@@ -17,13 +23,20 @@ import math
 import re
 
 from django.conf import settings
+from django.http import multipartparser
 from rest_framework.exceptions import ParseError
-from rest_framework.parsers import JSONParser
+from rest_framework.parsers import JSONParser, MultiPartParser
 
 from segmentation.api.common.params import INT_RANGE
 from segmentation.errors import Invalid
 
 MAX_DEPTH = 16
+# The bound on one multipart part's headers (Django's is 1,024 bytes): a file name of
+# several kilobytes still fits, and a header is still bounded.
+MAX_PART_HEADER_BYTES = 16 * 1024
+# Django's parser reads the module's bound at each part; every multipart body this
+# service reads (API uploads, admin forms) is held to this one.
+multipartparser.MAX_TOTAL_HEADER_SIZE = MAX_PART_HEADER_BYTES
 # A string (with its escapes) or a bracket: what the nesting scan must tell apart.
 TOKENS = re.compile(r'"(?:[^"\\]|\\.)*"|[\[\]{}]', re.DOTALL)
 KEY_AFTER = re.compile(r"\s*:")
@@ -48,6 +61,21 @@ class BoundedJSONParser(JSONParser):
             raise ParseError(f"JSON parse error - {exc}") from None
         check_values(data)
         return data
+
+
+class UploadParser(MultiPartParser):
+    """DRF's multipart parser, whose refusal of an overlong part header (a file name of
+    more than ``MAX_PART_HEADER_BYTES``) names the field and the bound."""
+
+    def parse(self, stream, media_type=None, parser_context=None):
+        try:
+            return super().parse(stream, media_type, parser_context)
+        except ParseError as exc:
+            if "header size" not in str(exc.detail):
+                raise
+            raise Invalid(f"file: the file's name is too long; a part's headers (its name with "
+                          f"them) may hold at most {MAX_PART_HEADER_BYTES} bytes; rename the "
+                          "file (names are kept to 255 characters anyway)") from None
 
 
 def _not_a_number(name):
