@@ -125,9 +125,11 @@ def fit_both(items, tolerance_s: float, fit_cuts):
     examples = [labelling.FrameExample(i.example.samples, i.example.descriptors,
                                        i.example.n_frames, i.fps, reviewed(i.cuts, i.frames))
                 for i in items]
-    frames = labelling.fit_frame_model(examples)
+    groups = [i.subject for i in items]  # folds by performer: nested, never the scored one
+    frames = labelling.fit_frame_model(examples, groups=groups, tolerance_s=tolerance_s)
     joint = evidence.fit_label_cuts(cut_model, frames, [i.study for i in items], examples,
-                                    [i.cuts for i in items], tolerance_s=tolerance_s)
+                                    [i.cuts for i in items], tolerance_s=tolerance_s,
+                                    groups=groups)
     return cut_model, joint
 
 
@@ -138,7 +140,7 @@ def score_both(item, cut_model, joint, tolerance_s: float, scored) -> tuple:
     for cuts in (adapt.cuts_in(item.study, cut_model),
                  evidence.select(cut_model, joint, item.study, post)[0]):
         acc = float("nan") if post is None else label_accuracy(
-            item.frames, cuts, labelling.propose(joint.frames, post, cuts))
+            item.frames, cuts, labelling.propose(joint.frames, post, cuts, fps=item.fps))
         rows.append(np.append(scored(item, cuts, tolerance_s), acc))
     return tuple(rows)
 
