@@ -24,10 +24,11 @@ seen through a frame model fitted without its fold (``labelling.out_of_fold``; f
 performer where the caller knows them, ``groups``).
 
 Where a studio cuts exactly where its actions change, the decoded label changes are
-themselves the cuts (``mode`` "decoded"). Which of the three (the cut model's cuts, the
-joint scorer's, the decoded changes) a project gets is chosen on its reviewed takes, each
-seen out of fold: the one with the best mean F1 there, the cut model on a tie. Nothing
-in that choice was set by looking at a benchmark's held-out takes.
+themselves the cuts (``mode`` "decoded"), or say which boundary while the cut model's
+likeliest nearby candidate says where (``mode`` "snapped"). Which of the four (the cut model's cuts, the
+joint scorer's, the decoded changes, the snapped ones) a project gets is chosen on its reviewed takes, each
+seen out of fold: the one with the best mean F1 there, the cut model on a tie. The
+choice reads the reviewed takes only; how the options came to be is in docs/learner.md.
 """
 
 from __future__ import annotations
