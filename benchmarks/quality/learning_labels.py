@@ -118,27 +118,36 @@ def label_accuracy(truth_frames: np.ndarray, cuts, proposals) -> float:
 # ---- fitting and scoring --------------------------------------------------------------------
 
 
-def fit_both(items, tolerance_s: float, fit_cuts):
+def fit_both(items, tolerance_s: float, fit_cuts, *, by_take: bool = False):
     """(cut model, label-aware model) fitted on ``items``: the cut learner as the curve
-    fits it, then the frame model on their reviewed segments and the joint scorer."""
+    fits it, then the frame model on their reviewed segments and the joint scorer. What
+    they choose on their own (sharpness, cut source) is chosen on folds of ``items`` by
+    subject, nested inside the by-subject split; by take (``by_take``) where the outer
+    split is by take too (the single-subject CMU-86 sets)."""
     cut_model = fit_cuts(items, tolerance_s)
     examples = [labelling.FrameExample(i.example.samples, i.example.descriptors,
                                        i.example.n_frames, i.fps, reviewed(i.cuts, i.frames))
                 for i in items]
-    frames = labelling.fit_frame_model(examples)
+    groups = [i.name if by_take else i.subject for i in items]
+    frames = labelling.fit_frame_model(examples, groups=groups, tolerance_s=tolerance_s)
     joint = evidence.fit_label_cuts(cut_model, frames, [i.study for i in items], examples,
-                                    [i.cuts for i in items], tolerance_s=tolerance_s)
+                                    [i.cuts for i in items], tolerance_s=tolerance_s,
+                                    groups=groups)
     return cut_model, joint
 
 
 def score_both(item, cut_model, joint, tolerance_s: float, scored) -> tuple:
-    """([F1, edits, err, label acc] of the current learner, of the label-aware one)."""
+    """([F1, edits, err, label acc] of the current learner, of the label-aware one, and
+    of the decoded label changes taken as the cuts whatever the gate chose (tried, not
+    shipped: the cut model's cuts where there is no frame model))."""
     post = None if joint.frames is None else labelling.posterior(joint.frames, item.example)
     rows = []
-    for cuts in (adapt.cuts_in(item.study, cut_model),
-                 evidence.select(cut_model, joint, item.study, post)[0]):
+    current = adapt.cuts_in(item.study, cut_model)
+    for cuts in (current, evidence.select(cut_model, joint, item.study, post)[0],
+                 current if post is None else
+                 evidence.decoded_cuts(joint.frames, post, item.fps)[0]):
         acc = float("nan") if post is None else label_accuracy(
-            item.frames, cuts, labelling.propose(joint.frames, post, cuts))
+            item.frames, cuts, labelling.propose(joint.frames, post, cuts, fps=item.fps))
         rows.append(np.append(scored(item, cuts, tolerance_s), acc))
     return tuple(rows)
 
@@ -148,7 +157,7 @@ def curve(label, ks, draws, pool_of, fit_cuts, scored) -> dict:
     the mean over the set's takes of the mean over draws (the curve's own draws)."""
     out = {"folds": {}}
     for k in ks:
-        cur, new, sizes = [], [], []
+        cur, new, sizes, dec = [], [], [], []
         for t, item in enumerate(label.items):
             pool = pool_of(label, item)
             kk = min(k, len(pool))
@@ -169,9 +178,11 @@ def curve(label, ks, draws, pool_of, fit_cuts, scored) -> dict:
                 warnings.simplefilter("ignore", RuntimeWarning)
                 cur.append(np.nanmean([r[0] for r in rows], axis=0))
                 new.append(np.nanmean([r[1] for r in rows], axis=0))
+                dec.append(np.nanmean([r[2] for r in rows], axis=0))
         with np.errstate(all="ignore"), warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)
             out[k] = (np.nanmean(cur, axis=0), np.nanmean(new, axis=0), min(sizes), max(sizes))
+            out.setdefault("decoded", {})[k] = np.nanmean(dec, axis=0)
             subjects = [i.subject for i in label.items]
             out["folds"][k] = {s: float(np.mean([n[0] for n, o in zip(new, subjects,
                                                                        strict=True) if o == s]))
@@ -262,7 +273,9 @@ def print_curves(sets, ks, draws, pool_of, fit_cuts, scored, baseline, out) -> d
           "label; '-' where no label model exists); mean over the set's takes of the mean "
           f"over {draws} seeded draws (the curve's). 'current' is the shipped cut learner "
           "(its segments labelled by the same frame model), 'labels' the label-aware "
-          "scorer.", file=out)
+          "learner (the cut source its gate chose on the reviewed takes), 'decoded*' "
+          "(tried, not shipped) the decoded label changes taken as the cuts in every "
+          "draw, whatever the gate chose.", file=out)
     print(f"{'set':<10}{'method':<22}{'F1':>7}{'edits':>7}{'err s':>7}{'label':>7}",
           file=out)
     curves = {}
@@ -277,6 +290,8 @@ def print_curves(sets, ks, draws, pool_of, fit_cuts, scored, baseline, out) -> d
             note = f"k={k}" + (f" (<={hi})" if hi < k else "")
             print(f"{label.name:<10}{note + ' current':<22}" + _cells(cur), file=out)
             print(f"{label.name:<10}{note + ' labels':<22}" + _cells(new), file=out)
+            print(f"{label.name:<10}{note + ' decoded*':<22}" + _cells(got['decoded'][k]),
+                  file=out)
     if len(curves) > 1:
         for k in ks:
             for j, tag in ((0, "current"), (1, "labels")):
@@ -309,7 +324,7 @@ def convention(sets, fit_cuts, scored, out) -> float | None:
         held_k, held_b = kr_items[name], bk_items[name]
         for taught, label in (("Krüger", kr), ("Baak", bk)):
             cut_model, joint = fit_both([i for i in label.items if i.name != name], 1.0,
-                                        fit_cuts)
+                                        fit_cuts, by_take=True)
             post = None if joint.frames is None else labelling.posterior(
                 joint.frames, (held_k if taught == "Krüger" else held_b).example)
             found = evidence.select(cut_model, joint, held_k.study, post)[0]
@@ -337,7 +352,8 @@ def targets(curves: dict, conv: float | None, costs: dict, out) -> None:
         goal = TARGETS.get(name)
         f1, edits, _, acc = got[TARGET_K][1]
         folds = got["folds"][TARGET_K]
-        worse = [k for k in got if k not in ("folds", 0) and got[k][1][0] < got[0][0][0] - 1e-9]
+        worse = [k for k in got if k not in ("folds", "decoded", 0)
+                 and got[k][1][0] < got[0][0][0] - 1e-9]
         cells = [f"F1 {f1:.2f}", f"edits {edits:.2f}", f"label accuracy {acc:.2f}",
                  "F1 per held-out subject " + " ".join(f"{s}:{v:.2f}" for s, v in folds.items())]
         if goal:

@@ -20,7 +20,15 @@ A :class:`LabelCutModel` adds them to the cut model's logit in a logistic scorer
 prior is the cut model itself (weight 1 on its logit, 0 on every evidence): with no frame
 model, or no evidence fitted, it keeps exactly the cut model's cuts, so k = 0 is exactly
 zero-shot. Its evidence weights are fitted on the reviewed takes' candidates, each take
-seen through a posterior that leaves that take out (``posterior(exclude=...)``).
+seen through a frame model fitted without its fold (``labelling.out_of_fold``; folds by
+performer where the caller knows them, ``groups``).
+
+Where a studio cuts exactly where its actions change, the decoded label changes are
+themselves the cuts (``mode`` "decoded"), or say which boundary while the cut model's
+likeliest nearby candidate says where (``mode`` "snapped"). Which of the four (the cut model's cuts, the
+joint scorer's, the decoded changes, the snapped ones) a project gets is chosen on its reviewed takes, each
+seen out of fold: the one with the best mean F1 there, the cut model on a tie. The
+choice reads the reviewed takes only; how the options came to be is in docs/learner.md.
 """
 
 from __future__ import annotations
@@ -33,15 +41,15 @@ from scipy.optimize import minimize
 from scipy.special import expit
 
 from motionlib import metrics
-from motionlib.labelling import FrameModel, decode, posterior
+from motionlib.labelling import FrameModel, decode, out_of_fold
+from motionlib.labelling import _folds as labelling_folds
 
 EVIDENCE = ("mix", "change", "opens", "closes", "same", "length", "decoded",
             "decoded_labelled")
 WINDOW_S = 1.0
 # Strength of the prior that keeps the scorer at the cut model (pseudo-observations).
 PRECISION = 10.0
-# How much better (mean F1 on the reviewed takes) the evidence must cut to be kept.
-GATE_MARGIN = 0.05
+MODES = ("scored", "decoded", "snapped")
 # The count calibration's search range and bisection steps (logits).
 CALIBRATION_RANGE = 8.0
 CALIBRATION_STEPS = 12
@@ -108,6 +116,9 @@ class LabelCutModel:
     frames: FrameModel | None
     weights: np.ndarray
     threshold: float = 0.0
+    # or "decoded": the decoded label changes are the cuts; "snapped": each moved to the
+    # cut model's likeliest candidate near it
+    mode: str = "scored"
 
     @classmethod
     def identity(cls, frames: FrameModel | None = None) -> LabelCutModel:
@@ -143,6 +154,12 @@ def select(cut_model, model: LabelCutModel, study: dict | None, post) -> tuple:
     not, most probable first, none within the cut model's shortest segment of a kept one."""
     if study is None or len(study["features"]) == 0:
         return np.zeros(0, dtype=np.int64), np.zeros(0)
+    if model.mode in ("decoded", "snapped") and model.frames is not None and post is not None:
+        cuts, prob = decoded_cuts(model.frames, post, float(study["fps"]))
+        if model.mode == "snapped":
+            logits, placed_at = candidate_logits(cut_model, study)
+            cuts = snapped(cuts, placed_at, logits, cut_model.min_segment_s * float(study["fps"]))
+        return cuts, prob
     x, frames = design(cut_model, model, study, post)
     logit = x @ model.weights
     order, kept = _ranked(logit, frames, int(round(cut_model.min_segment_s *
@@ -150,6 +167,28 @@ def select(cut_model, model: LabelCutModel, study: dict | None, post) -> tuple:
     chosen = order[kept & (logit[order] > model.threshold)]
     chosen = chosen[np.argsort(frames[chosen], kind="stable")]
     return frames[chosen].astype(np.int64), expit(logit[chosen] - model.threshold)
+
+
+def decoded_cuts(frames: FrameModel, post: np.ndarray, fps: float) -> tuple:
+    """(cuts, probability): where the decoded label changes, each with how much the
+    label mix differs across it."""
+    path = decode(frames, post, fps)
+    cuts = np.flatnonzero(np.diff(path)) + 1
+    if len(cuts) == 0:
+        return cuts.astype(np.int64), np.zeros(0)
+    return cuts.astype(np.int64), evidence(post, cuts, fps, frames)[:, 0]
+
+
+def snapped(cuts: np.ndarray, placed: np.ndarray, logits: np.ndarray, radius: float) -> np.ndarray:
+    """Each decoded change moved to the candidate the cut model finds likeliest within
+    ``radius`` frames of it (the decoded labels say which boundary, the cut model where
+    the studio puts it); left where it is when no candidate is that near."""
+    out = np.asarray(cuts, dtype=np.int64).copy()
+    for j, c in enumerate(out):
+        near = np.flatnonzero(np.abs(placed - c) <= radius)
+        if len(near):
+            out[j] = int(placed[near[np.argmax(logits[near])]])
+    return np.unique(out)
 
 
 def _ranked(logit: np.ndarray, frames: np.ndarray, gap: int) -> tuple[np.ndarray, np.ndarray]:
@@ -170,54 +209,84 @@ def _ranked(logit: np.ndarray, frames: np.ndarray, gap: int) -> tuple[np.ndarray
 
 
 def fit_label_cuts(cut_model, frames: FrameModel | None, studies, examples, cuts,
-                   *, tolerance_s: float) -> LabelCutModel:
+                   *, tolerance_s: float, groups=None) -> LabelCutModel:
     """Fit the evidence weights on reviewed takes: ``studies`` (their candidates),
     ``examples`` (their ``FrameExample``s, in the order the frame model was fitted on)
-    and ``cuts`` (their human cuts). With no frame model, or fewer than two takes (no
-    take can then be seen out of sample), the scorer stays the cut model's."""
-    if frames is None or len(studies) < 2:
-        return LabelCutModel.identity(frames)
-    xs, ys, gaps = [], [], []
+    and ``cuts`` (their human cuts); ``groups`` (a key per take, e.g. its performer) make
+    the folds, each take by itself when not given. With no frame model, or a single fold
+    (no take can then be seen out of sample), the scorer stays the cut model's."""
     model = LabelCutModel.identity(frames)
-    for i, (study, example, c) in enumerate(zip(studies, examples, cuts, strict=True)):
-        if study is None or len(study["features"]) == 0:
+    folds = labelling_folds(examples, groups)
+    if frames is None or len(set(folds)) < 2:
+        return model
+    seen = out_of_fold(examples, folds)
+    xs, ys, takes = [], [], []
+    for study, example, c, got in zip(studies, examples, cuts, seen, strict=True):
+        if study is None or len(study["features"]) == 0 or got is None:
             continue
-        x, placed = design(cut_model, model, study, posterior(frames, example, exclude=i))
+        fold_model, at = got
+        fold_model.sharpness = frames.sharpness
+        post = _per_frame(at, example)
+        x, placed = design(cut_model, LabelCutModel.identity(fold_model), study, post)
         y = np.zeros(len(placed))
         hit, _ = metrics.match(placed, np.asarray(c, dtype=np.int64),
                                tolerance=int(round(tolerance_s * float(study["fps"]))))
         y[hit] = 1.0
         xs.append(x)
         ys.append(y)
-        gaps.append((placed, int(round(cut_model.min_segment_s * float(study["fps"])))))
+        gap = int(round(cut_model.min_segment_s * float(study["fps"])))
+        changes = decoded_cuts(fold_model, post, float(study["fps"]))[0]
+        takes.append(_Seen(placed, gap, np.asarray(c, dtype=np.int64), float(study["fps"]),
+                           changes, snapped(changes, placed, x[:, 0], cut_model.min_segment_s
+                                            * float(study["fps"]))))
     if not xs:
         return model
     weights = _map_fit(np.vstack(xs), np.concatenate(ys))
     ranked = []
-    for x, y, (placed, gap) in zip(xs, ys, gaps, strict=True):
+    for x, y, take in zip(xs, ys, takes, strict=True):
         logit = x @ weights
-        order, kept = _ranked(logit, placed, gap)
+        order, kept = _ranked(logit, take.placed, take.gap)
         ranked.append((logit[order][kept], int(y.sum())))
-    fitted = LabelCutModel(frames, weights, _calibrated(ranked))
-    # The gate: the evidence is kept only where it cuts the reviewed takes, each seen
-    # through a posterior without it, better than the cut model alone.
-    kept_f1 = _mean_f1(fitted, xs, gaps, cuts, studies, tolerance_s)
-    alone_f1 = _mean_f1(model, xs, gaps, cuts, studies, tolerance_s)
-    return fitted if kept_f1 > alone_f1 + GATE_MARGIN else model
+    options = [model, LabelCutModel(frames, weights, _calibrated(ranked)),
+               LabelCutModel(frames, _prior(), 0.0, "decoded"),
+               LabelCutModel(frames, _prior(), 0.0, "snapped")]
+    # The gate: the option that cuts the reviewed takes (each seen out of fold) best.
+    scores = [_mean_f1(option, xs, takes, tolerance_s) for option in options]
+    return options[int(np.argmax(scores))]
 
 
-def _mean_f1(model: LabelCutModel, xs, gaps, cuts, studies, tolerance_s) -> float:
+@dataclass
+class _Seen:
+    """A reviewed take as the gate sees it: its candidates' frames, the shortest segment
+    (frames), its human cuts, fps and the decoded changes of its out-of-fold posterior."""
+
+    placed: np.ndarray
+    gap: int
+    cuts: np.ndarray
+    fps: float
+    decoded: np.ndarray
+    snapped: np.ndarray
+
+
+def _per_frame(at: np.ndarray, example) -> np.ndarray:
+    frames = np.arange(example.n_frames)
+    return at[np.clip(np.searchsorted(example.samples, frames), 0, len(at) - 1)]
+
+
+def _mean_f1(model: LabelCutModel, xs, takes, tolerance_s) -> float:
     """Mean F1 over the reviewed takes of what ``model`` keeps among their candidates."""
     scores = []
-    fitted = [s for s in studies if s is not None and len(s["features"])]
-    for x, (placed, gap), c, study in zip(xs, gaps, cuts, fitted, strict=False):
-        logit = x @ model.weights
-        order, kept = _ranked(logit, placed, gap)
-        chosen = order[kept & (logit[order] > model.threshold)]
-        found = np.sort(placed[chosen])
+    for x, take in zip(xs, takes, strict=True):
+        if model.mode in ("decoded", "snapped"):
+            found = take.decoded if model.mode == "decoded" else take.snapped
+        else:
+            logit = x @ model.weights
+            order, kept = _ranked(logit, take.placed, take.gap)
+            chosen = order[kept & (logit[order] > model.threshold)]
+            found = np.sort(take.placed[chosen])
         scores.append(metrics.boundary_scores(
-            found, metrics.as_windows(np.asarray(c, dtype=np.int64)),
-            fps=float(study["fps"]), tolerance_s=tolerance_s)["f1"])
+            found, metrics.as_windows(take.cuts), fps=take.fps,
+            tolerance_s=tolerance_s)["f1"])
     return float(np.mean(scores)) if scores else 0.0
 
 

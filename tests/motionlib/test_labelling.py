@@ -163,3 +163,80 @@ def test_the_rate_of_the_descriptors_is_the_models():
     samples, x = _frames.descriptors(take)
     assert np.all(np.diff(samples) == int(round(120 / _frames.RATE_HZ)))
     assert len(samples) == len(x)
+
+
+def test_decoding_follows_the_order_the_reviewed_takes_showed():
+    """Issue 47: the stretches' labels are decoded with the label order counted on the
+    reviewed takes, so an ambiguous stretch takes the label the script puts there."""
+    order = [(0, 40, ""), (40, 100, "walk"), (100, 200, "jump")]
+    model = labelling.fit_frame_model([_example(order, seed=s) for s in range(3)])
+    empty, jump, walk = (model.names.index(n) for n in ("", "jump", "walk"))
+    assert model.transitions[walk, jump] == 3 and model.transitions[walk, empty] == 0
+    post = np.zeros((200, 3))
+    post[:40, empty] = post[40:100, walk] = 1.0
+    # after the walk, jump or unlabelled: the frames cannot say (equal likelihood ratios)
+    post[100:, [empty, jump]] = model.prior[[empty, jump]] / model.prior[[empty, jump]].sum()
+    post = 0.98 * post + 0.02 / 3
+    path = labelling.decode(model, post, 10.0)
+    assert_array_equal(path[[20, 70, 150]], [empty, walk, jump])
+    got = labelling.propose(model, post, [40, 100], fps=10.0)
+    assert [label for label, _ in got] == [None, "walk", "jump"]
+
+
+def test_the_metric_finds_the_one_descriptor_that_tells_labels_apart():
+    """Issue 47: the references are compared along the labels' discriminant directions,
+    not along whatever varies most (40 columns of noise, one that tells walk from jump)."""
+    def noisy(seed):
+        rng = np.random.default_rng(seed)
+        x = rng.normal(0, 1, (200, 41))
+        x[100:, 0] += 3.0
+        return FrameExample(np.arange(200), x, 200, 10.0, [(0, 100, "walk"), (100, 200, "jump")])
+    model = labelling.fit_frame_model([noisy(0), noisy(1)])
+    post = labelling.posterior(model, noisy(2))
+    right = np.r_[post[:100].argmax(axis=1) == 2, post[100:].argmax(axis=1) == 1]
+    assert right.mean() > 0.9
+
+
+def test_sharpness_is_chosen_on_the_reviewed_takes_folds():
+    examples = [_example(SEGMENTS, seed=s) for s in range(4)]
+    model = labelling.fit_frame_model(examples, groups=["a", "a", "b", "b"])
+    assert model.sharpness in labelling.SHARPNESS
+    single = labelling.fit_frame_model(examples, groups=["a"] * 4)
+    assert single.sharpness == labelling.SHARPNESS[0]
+
+
+def test_a_stored_model_keeps_its_order_and_sharpness_and_old_ones_still_read():
+    model = labelling.fit_frame_model([_example(SEGMENTS, seed=s) for s in range(2)])
+    model.sharpness = 0.3
+    back = labelling.FrameModel.from_json(model.to_json())
+    assert_array_equal(back.transitions, model.transitions)
+    assert_array_equal(back.starts, model.starts)
+    assert back.sharpness == 0.3
+    import json
+    old = json.loads(model.to_json())
+    for key in ("transitions", "starts", "sharpness"):
+        del old[key]
+    read = labelling.FrameModel.from_json(json.dumps(old))
+    assert read.transitions is None and read.sharpness == 1.0
+    assert len(labelling.decode(read, labelling.posterior(read, _example(SEGMENTS)), 10.0)) == 200
+
+
+def test_merging_two_labels_merges_their_order_counts():
+    model = labelling.fit_frame_model([_example(SEGMENTS, seed=s) for s in range(2)])
+    merged = labelling.relabelled(model, {"walk": "move", "jump": "move"})
+    assert merged.names == ["", "move"]
+    assert_array_equal(merged.transitions, [[0, 2], [0, 0]])
+    assert_array_equal(merged.starts, [2, 0])
+
+
+def test_the_gate_chooses_among_its_options_on_the_reviewed_takes(takes):
+    zero = adapt.CutModel.zero_shot()
+    studies = [s for _, s, _, _ in takes]
+    examples = [e for _, _, e, _ in takes]
+    frames = labelling.fit_frame_model(examples)
+    joint = evidence.fit_label_cuts(zero, frames, studies, examples,
+                                    [c for _, _, _, c in takes], tolerance_s=1.0)
+    assert joint.mode in evidence.MODES
+    post = labelling.posterior(frames, examples[0])
+    found, prob = evidence.select(zero, joint, studies[0], post)
+    assert len(found) == len(prob) and np.all(np.diff(found) > 0)
