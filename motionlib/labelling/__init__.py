@@ -20,12 +20,12 @@ per-frame posterior (``FrameModel.sharpness``) is chosen by :func:`fit_frame_mod
 the reviewed takes themselves, each fold of them seen through a model fitted without it.
 
 Why nearest neighbours for 1-50 reviewed takes (``docs/learner.md``): they have no
-parameter to fit beyond the metric, so one reviewed take already gives a usable posterior
+parameter to fit, so one reviewed take already gives a usable posterior
 and fifty make it finer without a training run; a new label is known as soon as one take
 carries it; a renamed, retired or merged label is a relabelling of the references (and of
 the transition counts), not a retrain; and their cost is a tree query per sample (5 Hz),
-a few seconds for a 60-minute take. The metric (``_frames``: Fisher's discriminant
-directions, shrunk) is one small eigenproblem, stable with a single take.
+a few seconds for a 60-minute take. The metric is unsupervised (``_frames``: PCA of the
+standardised descriptors), so the held-out check that gates the model is not optimistic.
 
 Pure numpy/scipy, no Django.
 """
@@ -242,7 +242,7 @@ def _fit(examples: Sequence[FrameExample]) -> FrameModel | None:
     if len(x) > _frames.MAX_REFERENCES:  # an even stride keeps every take's share
         pick = np.linspace(0, len(x) - 1, _frames.MAX_REFERENCES).astype(np.int64)
         x, y, own = x[pick], y[pick], own[pick]
-    reduction = _frames.Reduction.fit(x, y)
+    reduction = _frames.Reduction.fit(x)
     changes, starts = _counts(examples, names)
     return FrameModel(names, reduction, reduction(x), y, own, _lengths(examples),
                       len(examples), transitions=changes, starts=starts)

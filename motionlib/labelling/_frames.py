@@ -10,12 +10,11 @@ dimensions and sub-sampled to at most ``MAX_REFERENCES``; a take's posterior at 
 is the distance-weighted vote of its ``NEIGHBOURS`` nearest references, smoothed with a
 Dirichlet prior of ``PRIOR`` pseudo-votes spread as the references are.
 
-The reduction is a learnt metric where the references carry two labels or more: the
-discriminant directions of the labels (Fisher's LDA on the standardised descriptors, the
-within-label scatter shrunk by ``SHRINK`` towards its mean variance so that a few takes,
-whose descriptors outnumber their distinct poses, still give a stable inverse), so that
-the neighbours are near in what tells the labels apart rather than in whatever varies
-most (PCA, which the model falls back to with a single label).
+The reduction is unsupervised on purpose: a metric learnt from the labels (Fisher's
+discriminant directions were tried) would make the held-out check that gates the model
+(``segmentation.similar.proposals``) see the held-out take's labels through the metric
+unless it refitted the model per take, and refitted so, on pools of two or three reviewed
+takes it did worse than a constant proposal (``docs/learner.md``).
 """
 
 from __future__ import annotations
@@ -38,9 +37,6 @@ UNLABELLED = ""
 # Neighbours may be up to (1 + APPROXIMATE) times farther than the exact ones: the
 # tree's search then costs a fraction, and a vote of 12 barely changes.
 APPROXIMATE = 0.5
-# Shrinkage of the within-label scatter towards a multiple of the identity (Ledoit-Wolf
-# style; 0.1 is the customary light shrinkage, not fitted on any figure).
-SHRINK = 0.1
 
 
 def descriptors(take) -> tuple[np.ndarray, np.ndarray]:
@@ -80,39 +76,17 @@ class Reduction:
         self.mean, self.scale, self.basis = mean, scale, basis
 
     @classmethod
-    def fit(cls, x: np.ndarray, y: np.ndarray | None = None) -> Reduction:
-        """Standardise ``x`` (n, d); then the discriminant directions of labels ``y``
-        (n,) when it has two labels or more, else the ``DIMS`` principal directions."""
+    def fit(cls, x: np.ndarray) -> Reduction:
+        """Standardise ``x`` (n, d); then its ``DIMS`` principal directions."""
         mean = x.mean(axis=0)
         scale = x.std(axis=0)
         scale[scale < 1e-9] = 1.0
         z = (x - mean) / scale
-        if y is not None and len(np.unique(y)) > 1:
-            return cls(mean, scale, _discriminant(z, y))
         _, vectors = np.linalg.eigh(np.cov(z, rowvar=False).reshape(z.shape[1], -1))
         return cls(mean, scale, vectors[:, ::-1][:, :DIMS])
 
     def __call__(self, x: np.ndarray) -> np.ndarray:
         return ((x - self.mean) / self.scale) @ self.basis
-
-
-def _discriminant(z: np.ndarray, y: np.ndarray) -> np.ndarray:
-    """(d, m) Fisher's discriminant directions of standardised ``z`` and labels ``y``,
-    m = min(labels - 1, DIMS), the within-label scatter shrunk by ``SHRINK``."""
-    classes, y = np.unique(y, return_inverse=True)
-    counts = np.bincount(y).astype(float)
-    means = np.zeros((len(classes), z.shape[1]))
-    np.add.at(means, y, z)
-    means /= counts[:, None]
-    r = z - means[y]
-    within = r.T @ r / len(z)
-    within = (1 - SHRINK) * within + SHRINK * np.eye(len(within)) * np.trace(within) / len(within)
-    centred = (means - z.mean(axis=0)) * np.sqrt(counts / len(z))[:, None]
-    between = centred.T @ centred
-    from scipy.linalg import eigh
-
-    _, vectors = eigh(between, within)
-    return vectors[:, ::-1][:, :max(1, min(len(classes) - 1, DIMS))]
 
 
 def vote(tree: cKDTree, labels: np.ndarray, owners: np.ndarray, prior: np.ndarray,

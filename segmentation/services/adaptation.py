@@ -430,7 +430,7 @@ def proposals(row, take, cuts):
         frames = labelling.relabelled(frames, gone)
     post = labelling.posterior(frames, take)
     return [{"label": int(name) if name else None, "probability": p}
-            for name, p in labelling.propose(frames, post, cuts)]
+            for name, p in labelling.propose(frames, post, cuts, fps=float(take.fps))]
 
 
 def _loaded_labels(pk):
