@@ -57,6 +57,14 @@ def load_npy(fieldfile):
             return np.load(io.BytesIO(handle.read()), allow_pickle=False)
 
 
+def float32_blocks(array, start, stop, frames):
+    """The rows ``start .. stop - 1`` of ``array`` (a stored, maybe memory-mapped array) as
+    little-endian float32 bytes, ``frames`` rows at a time: an answer streams an hour of
+    positions without holding more than one block in memory."""
+    for first in range(start, stop, frames):
+        yield np.ascontiguousarray(array[first:min(first + frames, stop)], "<f4").tobytes()
+
+
 def load_npz(fieldfile):
     """name -> array of a stored ``.npz``."""
     with fieldfile.storage.open(fieldfile.name, "rb") as handle:
