@@ -57,6 +57,10 @@ BENCHMARKS = {
                                    "list under load on PostgreSQL"),
     "review-long-take": Benchmark("benchmarks.service.review_long_take", "review requests "
                                   "on a one-hour take"),
+    "review-poses": Benchmark("benchmarks.service.review_long_take", "the hour-long take "
+                              "opened in Chromium: first pose and every pose, JSON chunks "
+                              "against the streamed float32 poses",
+                              ("--browser", "--browser-repeats", "3")),
     "review-playback": Benchmark("benchmarks.service.review_playback", "the review page's "
                                  "redraw interval and scrub latency on 38-s, 10- and "
                                  "60-minute takes, the old front end against the new"),
