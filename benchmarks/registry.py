@@ -72,6 +72,9 @@ BENCHMARKS = {
     # library: the segment library's list and similar-clip search
     "library-list": Benchmark("benchmarks.library.listing", "the library list on a million "
                               "segments, SQLite", ("--busy", "3")),
+    "library-list-100k": Benchmark("benchmarks.library.listing", "the library list on "
+                                   "100,000 segments, SQLite",
+                                   ("--segments", "100000", "--busy", "3")),
     "library-list-postgres": Benchmark("benchmarks.library.listing", "the library list on "
                                        "100,000 segments, PostgreSQL",
                                        ("--postgres", "--segments", "100000", "--busy", "3")),
