@@ -72,3 +72,20 @@ def test_it_uses_at_most_what_is_configured(monkeypatch):
     assert 1 <= threads.threads() <= threads.MAX_THREADS
     assert threads.bounds(5, 2) == [(0, 2), (2, 5)]
     assert threads.bounds(1, 2) == [(0, 1)]
+
+
+def test_the_body_frame_and_low_pass_are_the_same_to_the_bit(monkeypatch):
+    from motionlib import features
+
+    rng = np.random.default_rng(50)
+    positions = rng.normal(size=(3001, 7, 3))
+    joints = {"root": 0, "left_hip": 1, "right_hip": 2}
+    one_thread(monkeypatch)
+    body = features.body_frame_positions(positions, joints, [3, 4, 6])
+    smooth = features.lowpass(positions.reshape(3001, -1), fps=120, cutoff_hz=3)
+    monkeypatch.setenv("MOTIONLIB_THREADS", "2")
+    monkeypatch.setattr(features, "PARALLEL_FRAMES", 1)
+    np.testing.assert_array_equal(features.body_frame_positions(positions, joints, [3, 4, 6]), body)
+    np.testing.assert_array_equal(features.lowpass(positions.reshape(3001, -1), fps=120, cutoff_hz=3), smooth)
+    np.testing.assert_array_equal(features.lowpass(positions, fps=120, cutoff_hz=3),
+                                  smooth.reshape(positions.shape))
