@@ -52,7 +52,8 @@ BENCHMARKS = {
     "hour-detect": Benchmark("benchmarks.service.hour_detect", "detection of the hour-long "
                              "take with and without stored positions"),
     "bulk-import": Benchmark("benchmarks.service.bulk_import", "manage.py import_captures "
-                             "with one and two workers"),
+                             "of 12 five-minute takes with one and two workers",
+                             ("--takes", "12", "--checks", "header")),
     "capture-list-load": Benchmark("benchmarks.service.capture_list_load", "the capture "
                                    "list under load on PostgreSQL"),
     "review-long-take": Benchmark("benchmarks.service.review_long_take", "review requests "
