@@ -81,7 +81,7 @@ pytest: install
 # figure quoted has one source, and a change shows as a diff), headed by date, commit and load.
 # `python -m benchmarks` lists every benchmark; these are the ones cheap enough to rerun.
 BENCHES := speed-io quality learning-curve speed-adapt points-read points-similar fbx-read \
-	upload-to-candidates capture-list-load poisoning annotation-import
+	upload-to-candidates hour-take bulk-import capture-list-load poisoning annotation-import
 
 bench: install bpy
 	@command -v wrk >/dev/null || { apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq wrk; } \

@@ -52,7 +52,8 @@ BENCHMARKS = {
     "hour-detect": Benchmark("benchmarks.service.hour_detect", "detection of the hour-long "
                              "take with and without stored positions"),
     "bulk-import": Benchmark("benchmarks.service.bulk_import", "manage.py import_captures "
-                             "with one and two workers"),
+                             "of 12 five-minute takes with one and two workers",
+                             ("--takes", "12", "--checks", "header")),
     "capture-list-load": Benchmark("benchmarks.service.capture_list_load", "the capture "
                                    "list under load on PostgreSQL"),
     "submit-points": Benchmark("benchmarks.service.submit_points", "a review submit of a "
@@ -60,6 +61,10 @@ BENCHMARKS = {
                                ("--frames", "1600")),
     "review-long-take": Benchmark("benchmarks.service.review_long_take", "review requests "
                                   "on a one-hour take"),
+    "review-poses": Benchmark("benchmarks.service.review_long_take", "the hour-long take "
+                              "opened in Chromium: first pose and every pose, JSON chunks "
+                              "against the streamed float32 poses",
+                              ("--browser", "--browser-repeats", "3")),
     "review-playback": Benchmark("benchmarks.service.review_playback", "the review page's "
                                  "redraw interval and scrub latency on 38-s, 10- and "
                                  "60-minute takes, the old front end against the new"),
@@ -78,6 +83,9 @@ BENCHMARKS = {
     "library-attribute-filter": Benchmark("benchmarks.library.attribute_filter", "the "
                                           "library list filtered by a segment attribute, "
                                           "200,000 segments, SQLite"),
+    "library-list-100k": Benchmark("benchmarks.library.listing", "the library list on "
+                                   "100,000 segments, SQLite",
+                                   ("--segments", "100000", "--busy", "3")),
     "library-list-postgres": Benchmark("benchmarks.library.listing", "the library list on "
                                        "100,000 segments, PostgreSQL",
                                        ("--postgres", "--segments", "100000", "--busy", "3")),

@@ -11,6 +11,8 @@ from __future__ import annotations
 import numpy as np
 from scipy import signal as sps
 
+from motionlib import threads
+
 # The 8 limb bones of the 2011 bone-angle paper: (upper joint, lower joint).
 LIMB_BONES = (
     ("left_shoulder", "left_elbow"),
@@ -92,6 +94,21 @@ def body_frame_positions(
     -------
     (n_frames, n_joints or len(which), 3) positions, same unit as the input.
     """
+    n_chosen = positions.shape[1] if which is None else len(which)
+    out = np.empty((positions.shape[0], n_chosen, 3))
+    # Frames are independent: a long take's halves are turned at once (motionlib.threads).
+    parts = threads.threads() if len(positions) >= PARALLEL_FRAMES else 1
+    threads.run_all([lambda a=a, b=b: _body_frame(positions[a:b], joints, which, out[a:b])
+                     for a, b in threads.bounds(len(positions), parts)])
+    return out
+
+
+# Frames from which the body frame is worth splitting over threads.
+PARALLEL_FRAMES = 50_000
+
+
+def _body_frame(positions, joints, which, out):
+    """``body_frame_positions`` of ``positions`` written into ``out``."""
     # np.take copies the chosen joints several times faster than fancy indexing does.
     chosen = positions if which is None else np.take(positions, which, axis=1)
     root = positions[:, joints["root"]]
@@ -100,12 +117,10 @@ def body_frame_positions(
     c, s = c[:, None], s[:, None]
     x = chosen[..., 0] - root[:, 0:1]
     z = chosen[..., 2] - root[:, 2:3]
-    out = np.empty(chosen.shape)
     np.subtract(chosen[..., 1], root[:, 1:2], out=out[..., 1])
     # Rotate about Y by +angle so the hip axis lies on +X for every frame.
     out[..., 0] = c * x + s * z
     out[..., 2] = -s * x + c * z
-    return out
 
 
 def heading_cos_sin(dx: np.ndarray, dz: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -134,8 +149,15 @@ def lowpass(y: np.ndarray, *, fps: float, cutoff_hz: float, order: int = 2) -> n
     if cutoff_hz >= fps / 2:
         return y.copy()
     sos = sps.butter(order, cutoff_hz, fs=fps, output="sos")
-    padlen = min(3 * (2 * len(sos) + 1), y.shape[0] - 1)
-    return sps.sosfiltfilt(sos, y, axis=0, padlen=max(padlen, 0))
+    padlen = max(min(3 * (2 * len(sos) + 1), y.shape[0] - 1), 0)
+    columns = y.reshape(len(y), -1)
+    if len(y) < PARALLEL_FRAMES or columns.shape[1] < 2 or threads.threads() < 2:
+        return sps.sosfiltfilt(sos, y, axis=0, padlen=padlen)
+    # Columns are filtered independently: a long take's are split over threads.
+    parts = threads.run_all([
+        lambda a=a, b=b: sps.sosfiltfilt(sos, columns[:, a:b], axis=0, padlen=padlen)
+        for a, b in threads.bounds(columns.shape[1], threads.threads())])
+    return np.concatenate(parts, axis=1).reshape(y.shape)
 
 
 def local_extrema(y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from motionlib import _kinematics
+from motionlib import _kinematics, threads
 from motionlib.errors import InputError
 
 _AXIS = {"X": 0, "Y": 1, "Z": 2}
@@ -147,9 +147,18 @@ def forward_kinematics(take, channels: np.ndarray | None = None) -> np.ndarray:
         return np.array(take.positions, dtype=np.float64)
     channels = _channels(skeleton, take.channels if channels is None else channels)
     out = np.empty((channels.shape[0], skeleton.n_joints, 3))
-    _kinematics.positions(channels, channels.shape[0], skeleton.n_channels, *_layout(skeleton),
-                          out)
+    layout = _layout(skeleton)
+    # Frames are independent: a long take's halves are walked at once (``motionlib.threads``).
+    parts = threads.threads() if channels.shape[0] >= PARALLEL_FRAMES else 1
+    threads.run_all([
+        lambda a=a, b=b: _kinematics.positions(channels[a:b], b - a, skeleton.n_channels,
+                                               *layout, out[a:b])
+        for a, b in threads.bounds(channels.shape[0], parts)])
     return out
+
+
+# Frames from which forward kinematics is worth splitting over threads (~50 ms of work).
+PARALLEL_FRAMES = 50_000
 
 
 def body_frame_rows(take, chosen: list[int], *, root: int, left_hip: int, right_hip: int,

@@ -30,7 +30,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from benchmarks.harness import REPO
+from benchmarks.harness import PACKAGE, REPO
 from benchmarks.harness.service import (
     drop_database,
     scratch_database,
@@ -42,7 +42,8 @@ from benchmarks.harness.service import (
 # The workers run as `make up` runs them: one core per pool process, no BLAS threads.
 SINGLE_THREADED = up_script().SINGLE_THREADED
 
-OUT = REPO / "benchmarks" / "out"
+# This checkout's cache, also when the product under test is another revision's.
+OUT = PACKAGE / "out"
 
 
 def take_files(n, minutes, fps=120.0, seed=1000):

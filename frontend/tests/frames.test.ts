@@ -1,6 +1,6 @@
-import { describe, expect, it } from "vitest";
+import { afterEach, describe, expect, it, vi } from "vitest";
 import type { FramesResponse } from "../src/api/types";
-import { decodeFloat32, FrameStore, planChunks } from "../src/review/frames";
+import { decodeFloat32, FrameStore, loadFrames, planChunks, planPoses, posesAsJson } from "../src/review/frames";
 
 function base64(bytes: Uint8Array): string {
   return btoa(String.fromCharCode(...bytes));
@@ -82,5 +82,112 @@ describe("floorLevel", () => {
     // Point 0 is a gap (NaN) in every frame; point 1 is seen at height -2.
     store.put(chunk(0, 8, 2, (_f, k) => (k < 3 ? Number.NaN : k % 3 === 1 ? -2 : 50)));
     expect(store.floorLevel()).toBe(-2);
+  });
+});
+
+describe("planPoses", () => {
+  it("test_it_asks_for_a_small_head_at_the_playhead_then_after_it_then_before_it", () => {
+    expect(planPoses(432000, 12345, 600)).toEqual([{ start: 12345, stop: 12945 }, { start: 12945, stop: 432000 }, { start: 0, stop: 12345 }]);
+    expect(planPoses(432000, 0, 600)).toEqual([{ start: 0, stop: 600 }, { start: 600, stop: 432000 }]);
+  });
+
+  it("test_it_keeps_the_head_inside_the_take", () => {
+    expect(planPoses(1000, 990, 600)).toEqual([{ start: 400, stop: 1000 }, { start: 0, stop: 400 }]);
+    expect(planPoses(400, 0, 600)).toEqual([{ start: 0, stop: 400 }]);
+  });
+});
+
+describe("FrameStore.receive", () => {
+  it("test_it_counts_a_frame_only_when_all_its_bytes_are_in_even_split_inside_a_value", () => {
+    const store = new FrameStore(6, 1);
+    const bytes = new Uint8Array(new Float32Array([...Array(9).keys()].map((i) => i + 0.5)).buffer); // frames 2, 3, 4
+    store.receive(2, 0, bytes.subarray(0, 13)); // frame 2 and one byte of frame 3
+    expect(store.loadedFrames).toBe(1);
+    expect(store.has(2) && !store.has(3)).toBe(true);
+    store.receive(2, 13, bytes.subarray(13, 30));
+    expect([store.has(3), store.has(4)]).toEqual([true, false]);
+    store.receive(2, 30, bytes.subarray(30));
+    expect(store.loadedFrames).toBe(3);
+    expect([...store.pose(4)]).toEqual([6.5, 7.5, 8.5]);
+  });
+
+  it("test_it_refuses_bytes_past_the_last_frame", () => {
+    const store = new FrameStore(2, 1);
+    expect(() => store.receive(1, 0, new Uint8Array(24))).toThrow(/run past frame 2/);
+  });
+});
+
+/** A fetch that answers /poses/ from `take` ((n_frames, n_joints * 3) values), in pieces of `piece` bytes. */
+function posesServer(take: Float32Array, nJoints: number, piece = 7) {
+  const asked: string[] = [];
+  const fetcher = async (url: string) => {
+    asked.push(url);
+    const q = new URL(url, "http://x").searchParams;
+    const start = Number(q.get("start"));
+    const stop = Number(q.get("stop"));
+    const bytes = new Uint8Array(take.slice(start * nJoints * 3, stop * nJoints * 3).buffer);
+    const body = new ReadableStream<Uint8Array>({
+      start(controller) {
+        for (let i = 0; i < bytes.length; i += piece) controller.enqueue(bytes.slice(i, i + piece));
+        controller.close();
+      },
+    });
+    return new Response(body, { status: 200, headers: { "X-Poses-Joints": String(nJoints) } });
+  };
+  return { asked, fetcher };
+}
+
+describe("loadFrames", () => {
+  const realFetch = globalThis.fetch;
+  afterEach(() => {
+    globalThis.fetch = realFetch;
+  });
+
+  it("test_it_fills_every_pose_from_the_head_and_two_streamed_answers", async () => {
+    const take = new Float32Array(900 * 2 * 3).map((_, i) => i);
+    const server = posesServer(take, 2);
+    globalThis.fetch = server.fetcher as typeof fetch;
+    const store = new FrameStore(900, 2);
+    let release = () => {};
+    const gate = new Promise<void>((resolve) => (release = resolve));
+    let chunks = 0;
+    const done = loadFrames(7, store, 100, () => chunks++, undefined, gate);
+    await vi.waitFor(() => expect(chunks).toBe(1));
+    // The head alone until the page lets the rest come.
+    expect(server.asked).toEqual(["/api/captures/7/poses/?start=100&stop=700"]);
+    expect(store.loadedFrames).toBe(600);
+    release();
+    await done;
+    expect(server.asked.slice(1)).toEqual(["/api/captures/7/poses/?start=700&stop=900", "/api/captures/7/poses/?start=0&stop=100"]);
+    expect(store.loadedFrames).toBe(900);
+    expect(store.error).toBeNull();
+    expect(store.positions).toEqual(take);
+  });
+
+  it("test_it_shows_the_servers_own_words_when_it_refuses", async () => {
+    globalThis.fetch = (async () =>
+      new Response(JSON.stringify({ detail: "capture 7 is processing; it has no poses yet" }), { status: 400 })) as typeof fetch;
+    const store = new FrameStore(10, 1);
+    await loadFrames(7, store, 0, () => {});
+    expect(store.error).toBe("capture 7 is processing; it has no poses yet");
+  });
+
+  it("test_it_names_an_answer_of_the_wrong_skeleton", async () => {
+    globalThis.fetch = posesServer(new Float32Array(10 * 3 * 3), 3).fetcher as typeof fetch;
+    const store = new FrameStore(10, 2);
+    await loadFrames(7, store, 0, () => {});
+    expect(store.error).toBe("Poses 0–10: expected 2 joints, got 3.");
+  });
+
+  it("test_it_names_an_answer_cut_short", async () => {
+    globalThis.fetch = (async () => new Response(new Uint8Array(12 * 4), { status: 200, headers: { "X-Poses-Joints": "1" } })) as typeof fetch;
+    const store = new FrameStore(10, 1);
+    await loadFrames(7, store, 0, () => {});
+    expect(store.error).toBe("Poses 0–10: expected 120 bytes, got 48.");
+  });
+
+  it("test_it_keeps_the_json_chunks_for_poses_json", () => {
+    expect(posesAsJson("?poses=json")).toBe(true);
+    expect(posesAsJson("")).toBe(false);
   });
 });

@@ -38,11 +38,15 @@ static int slow_number(const char *p, const char *end, double *value) {
         return -1;
     memcpy(buf, p, (size_t)n);
     buf[n] = '\0';
+    /* Called with or without the GIL (read_rows lets it go): take it for Python's call. */
+    PyGILState_STATE gil = PyGILState_Ensure();
     double v = PyOS_string_to_double(buf, &stop, NULL);
-    if (v == -1.0 && PyErr_Occurred()) {
+    int failed = v == -1.0 && PyErr_Occurred();
+    if (failed)
         PyErr_Clear();
+    PyGILState_Release(gil);
+    if (failed)
         return -1;
-    }
     if (stop != buf + n || !isfinite(v))
         return -1;
     *value = v;
@@ -174,26 +178,30 @@ static const char *scan_number(const char *p, const char *end, double *value) {
 }
 
 PyDoc_STRVAR(read_rows_doc,
-"read_rows(data, offset, out, row_length) -> int\n\n"
-"Read the lines of ``data[offset:]`` into ``out`` (a writable float64 buffer), each\n"
+"read_rows(data, offset, out, row_length[, stop]) -> int\n\n"
+"Read the lines of ``data[offset:stop]`` into ``out`` (a writable float64 buffer), each\n"
 "non-blank line holding exactly ``row_length`` numbers. Returns the number of rows read,\n"
 "or -1 when a line has another count, a token is not a finite decimal, or there are more\n"
-"rows than ``out`` holds.");
+"rows than ``out`` holds. Other threads run meanwhile (the GIL is let go).");
 
 static PyObject *read_rows(PyObject *self, PyObject *args) {
     (void)self;
     Py_buffer data, out;
-    Py_ssize_t offset, row_length, rows = 0;
-    if (!PyArg_ParseTuple(args, "y*nw*n", &data, &offset, &out, &row_length))
+    Py_ssize_t offset, row_length, rows = 0, stop = -1;
+    if (!PyArg_ParseTuple(args, "y*nw*n|n", &data, &offset, &out, &row_length, &stop))
         return NULL;
     Py_ssize_t result = -1;
-    if (offset < 0 || offset > data.len || row_length <= 0 || out.len % sizeof(double)) {
-        PyErr_SetString(PyExc_ValueError, "read_rows: bad offset, row length or buffer");
+    if (stop < 0)
+        stop = data.len;
+    if (offset < 0 || offset > stop || stop > data.len || row_length <= 0 ||
+        out.len % sizeof(double)) {
+        PyErr_SetString(PyExc_ValueError, "read_rows: bad offset, stop, row length or buffer");
         goto done;
     }
-    const char *p = (const char *)data.buf + offset, *end = (const char *)data.buf + data.len;
+    const char *p = (const char *)data.buf + offset, *end = (const char *)data.buf + stop;
     double *dst = (double *)out.buf;
     Py_ssize_t capacity = (Py_ssize_t)(out.len / sizeof(double)) / row_length;
+    Py_BEGIN_ALLOW_THREADS
     while (p < end) {
         Py_ssize_t count = 0;
         for (;;) {
@@ -202,20 +210,22 @@ static PyObject *read_rows(PyObject *self, PyObject *args) {
             if (p == end || *p == '\n')
                 break;
             if (count == row_length || rows == capacity)
-                goto done;
+                goto bad;
             p = scan_number(p, end, dst + rows * row_length + count);
             if (!p || (p < end && *p != '\n' && !is_blank((unsigned char)*p)))
-                goto done;
+                goto bad;
             count++;
         }
         if (count) {
             if (count != row_length)
-                goto done;
+                goto bad;
             rows++;
         }
         p++;  /* past the '\n' (or the end) */
     }
     result = rows;
+bad:
+    Py_END_ALLOW_THREADS
 done:
     PyBuffer_Release(&data);
     PyBuffer_Release(&out);

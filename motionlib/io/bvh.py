@@ -24,6 +24,7 @@ from motionlib.take import DEFAULT_LIMITS, Limits, Take, check_size, frame_range
 
 _CHANNEL_BY_LOWER = {c.lower(): c for c in CHANNEL_NAMES}
 _MOTION = re.compile(rb"^[ \t]*MOTION\b", re.MULTILINE | re.IGNORECASE)
+_NOT_BLANK = re.compile(rb"[^ \t\n\r\x0b\x0c]")  # what bytes.strip() keeps
 
 
 _TOKEN = re.compile(r"\n|[{}]|[^\s{}]+")
@@ -356,7 +357,7 @@ def _head(data: bytes, file_bytes: int, path, limits: Limits):
     """The HIERARCHY and the motion header at the start of ``data``, checked against
     ``limits`` for a file of ``file_bytes``: (skeleton, n_frames, frame_time, body byte,
     body line)."""
-    if not data.strip():
+    if _NOT_BLANK.search(data) is None:  # not data.strip(): that copies a whole hour of text
         raise CaptureError("empty file", path=path, line=1)
     m = _MOTION.search(data)
     header = data[:m.start()] if m else data

@@ -6,18 +6,22 @@ import math
 import numpy as np
 from django.conf import settings
 from django.db.models import Exists, OuterRef, Prefetch
+from django.http import HttpResponseNotModified, StreamingHttpResponse
+from drf_spectacular.types import OpenApiTypes
 from drf_spectacular.utils import OpenApiParameter, PolymorphicProxySerializer, extend_schema
 from rest_framework import mixins, viewsets
 from rest_framework.decorators import action
 from rest_framework.exceptions import PermissionDenied
 from rest_framework.pagination import PageNumberPagination
 from rest_framework.parsers import FormParser
+from rest_framework.renderers import JSONRenderer
 from rest_framework.response import Response
 
 from segmentation import services
 from segmentation.api.common.heavy import immutable
 from segmentation.api.common.params import body, int_param
 from segmentation.api.common.parsers import BoundedJSONParser, UploadParser
+from segmentation.api.common.renderers import BinaryRenderer
 from segmentation.api.common.serializers.captures import (
     CaptureListSerializer,
     CaptureSerializer,
@@ -145,6 +149,36 @@ class CaptureViewSet(
             "dtype": "float32", "data": base64.b64encode(block.tobytes()).decode("ascii"),
         }).data)
 
+    @extend_schema(
+        parameters=[OpenApiParameter("start", int), OpenApiParameter("stop", int)],
+        responses={(200, "application/octet-stream"): OpenApiTypes.BINARY},
+    )
+    # JSON first: an error answers JSON to a client that accepts both.
+    @action(detail=True, renderer_classes=[JSONRenderer, BinaryRenderer])
+    def poses(self, request, pk=None):
+        """Joint positions of frames start .. stop - 1 as one binary answer: little-endian
+        float32, shape (stop - start, n_joints, 3), frame after frame, streamed from the
+        stored array as it is read (no frame cap, nothing encoded). The range is in the
+        ``X-Poses-Start`` and ``X-Poses-Stop`` headers, the joints in ``X-Poses-Joints``."""
+        capture = self.get_object()
+        if capture.status != "ready":
+            raise NotReady(f"capture {capture.pk} is {capture.status}; it has no poses yet")
+        n = capture.n_frames
+        start = int_param(request, "start", 0, 0, n - 1)
+        stop = int_param(request, "stop", n, start + 1, n)
+        etag = f'"poses-{POSES_FORMAT}-{capture.pk}-{capture.positions.name}-{start}-{stop}"'
+        if request.headers.get("If-None-Match") == etag:
+            return HttpResponseNotModified(headers={"ETag": etag, "Cache-Control": "private, no-cache"})
+        positions = storage.load_npy(capture.positions)
+        frame_bytes = 4 * 3 * positions.shape[1]
+        return StreamingHttpResponse(
+            storage.float32_blocks(positions, start, stop, max(1, POSES_BLOCK_BYTES // frame_bytes)),
+            content_type="application/octet-stream",
+            headers={"Content-Length": str((stop - start) * frame_bytes), "ETag": etag,
+                     "Cache-Control": "private, no-cache", "X-Poses-Start": str(start),
+                     "X-Poses-Stop": str(stop), "X-Poses-Joints": str(positions.shape[1])},
+        )
+
     @extend_schema(request=None, responses={202: CaptureSerializer})
     @action(detail=True, methods=["post"])
     def retry(self, request, pk=None):
@@ -207,3 +241,8 @@ def _sampled_float32(name, values, max_points):
 
 
 SIGNAL_ENCODINGS = {"json": _sampled, "float32": _sampled_float32}
+
+# The poses answer's layout, named in its ETag: a browser never keeps one across a change.
+POSES_FORMAT = "f4le1"
+# Bytes of positions copied out of the stored array at a time while a poses answer streams.
+POSES_BLOCK_BYTES = 1 << 20

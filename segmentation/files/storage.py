@@ -9,7 +9,7 @@ import tempfile
 
 import numpy as np
 from django.conf import settings
-from django.core.files.base import ContentFile
+from django.core.files.base import ContentFile, File
 
 import motionlib
 from motionlib.io.npz import load_take
@@ -36,10 +36,34 @@ def local_path(fieldfile):
 
 
 def save_npy(fieldfile, name, array):
-    """Store ``array`` as a ``.npy`` file in ``fieldfile`` (the model is not saved)."""
-    buffer = io.BytesIO()
-    np.save(buffer, array, allow_pickle=False)
-    fieldfile.save(name, ContentFile(buffer.getvalue()), save=False)
+    """Store ``array`` as a ``.npy`` file in ``fieldfile`` (the model is not saved).
+
+    Written once, to a scratch file beside the media root, which a filesystem storage then
+    moves into place (an hour of positions, 160 MB, is neither held in a buffer nor copied
+    again); another storage reads the scratch file.
+    """
+    folder = settings.MEDIA_ROOT if os.path.isdir(settings.MEDIA_ROOT) else None
+    handle, path = tempfile.mkstemp(dir=folder, prefix=".npy-", suffix=".upload")
+    try:
+        with os.fdopen(handle, "w+b") as scratch:
+            np.save(scratch, array, allow_pickle=False)
+            scratch.seek(0)
+            fieldfile.save(name, _Scratch(scratch, path), save=False)
+    finally:
+        if os.path.exists(path):
+            os.remove(path)
+
+
+class _Scratch(File):
+    """A written scratch file that storage may move instead of copying (Django's
+    ``FileSystemStorage`` moves whatever has a ``temporary_file_path``)."""
+
+    def __init__(self, scratch, path):
+        super().__init__(scratch, name=os.path.basename(path))
+        self.path = path
+
+    def temporary_file_path(self):
+        return self.path
 
 
 def save_npz(fieldfile, name, arrays):
@@ -55,6 +79,14 @@ def load_npy(fieldfile):
     except NotImplementedError:
         with fieldfile.storage.open(fieldfile.name, "rb") as handle:
             return np.load(io.BytesIO(handle.read()), allow_pickle=False)
+
+
+def float32_blocks(array, start, stop, frames):
+    """The rows ``start .. stop - 1`` of ``array`` (a stored, maybe memory-mapped array) as
+    little-endian float32 bytes, ``frames`` rows at a time: an answer streams an hour of
+    positions without holding more than one block in memory."""
+    for first in range(start, stop, frames):
+        yield np.ascontiguousarray(array[first:min(first + frames, stop)], "<f4").tobytes()
 
 
 def load_npz(fieldfile):

@@ -48,6 +48,8 @@ def long_capture(studio):
 @pytest.mark.slow
 def test_it_opens_a_ten_minute_take_in_under_two_seconds_and_plays_it(live_server, new_page, long_capture):
     page = new_page("ann")
+    poses_seen = []
+    page.on("request", lambda request: "/poses/" in request.url and poses_seen.append(request.url))
     page.goto(f"{live_server.url}/captures/{long_capture.pk}/")
     viewport = page.get_by_test_id("viewport")
     expect(viewport).to_have_attribute("data-first-pose-ms", re.compile(r"^\d+$"))
@@ -55,10 +57,14 @@ def test_it_opens_a_ten_minute_take_in_under_two_seconds_and_plays_it(live_serve
     print(f"\n72,000-frame take: first pose after {opened_ms} ms")
     assert opened_ms < 2000
 
-    # The rest streams in behind it, chunk by chunk.
+    # The rest streams in behind it: one small answer for the first pose, then one streamed
+    # answer for all the rest (the playhead is at the start), binary, not JSON chunks.
     loading = page.get_by_test_id("frames-loading")
     expect(loading).to_have_attribute("data-done", re.compile(r"^\d+$"), timeout=30_000)
     print(f"all {N_FRAMES} frames loaded after {loading.get_attribute('data-done')} ms")
+    assert [url.split("/api/")[1] for url in poses_seen] == [
+        f"captures/{long_capture.pk}/poses/?start=0&stop=600",
+        f"captures/{long_capture.pk}/poses/?start=600&stop={N_FRAMES}"]
     # Then the feature signal is fetched again at full resolution (first paint used ~4,000 points).
     expect(page.get_by_test_id("timeline")).to_have_attribute("data-signal-step", "1")
 
@@ -95,7 +101,7 @@ def test_it_opens_a_ten_minute_take_in_under_two_seconds_and_plays_it(live_serve
 
 
 def _held_frames(page):
-    """Hold every frames request but the first pose's until ``release()``: the page's pose
+    """Hold every poses request but the first pose's until ``release()``: the page's pose
     download stays in flight for as long as a check needs. Returns (held routes, requests
     seen in order, release)."""
     held, seen, state = [], [], {"holding": True}
@@ -112,7 +118,7 @@ def _held_frames(page):
         while held:
             held.pop(0).continue_()
 
-    page.route("**/api/captures/*/frames/*", frames)
+    page.route("**/api/captures/*/poses/*", frames)
     return held, seen, release
 
 
@@ -132,7 +138,7 @@ def test_it_draws_every_lane_at_full_resolution_while_the_poses_still_load(live_
     expect(page.get_by_test_id("frames-loading")).to_have_attribute("data-done", re.compile(r"^\d+$"), timeout=30_000)
     # In request order: the first pose, the full signals, then the rest of the poses.
     full = [i for i, url in enumerate(seen) if f"max_points={N_FRAMES}" in url]
-    frames = [i for i, url in enumerate(seen) if "/frames/" in url]
+    frames = [i for i, url in enumerate(seen) if "/poses/" in url]
     assert len(full) == 1 and frames[0] < full[0] < frames[-1]
     assert page.errors == []
 
@@ -147,7 +153,7 @@ def test_the_previous_order_asks_for_the_full_signals_after_every_pose(live_serv
 
     release()
     expect(page.get_by_test_id("timeline")).to_have_attribute("data-signal-step", "1", timeout=30_000)
-    last_frames = max(i for i, url in enumerate(seen) if "/frames/" in url)
+    last_frames = max(i for i, url in enumerate(seen) if "/poses/" in url)
     assert seen.index(next(url for url in seen if f"max_points={N_FRAMES}" in url)) > last_frames
     assert page.errors == []
 
@@ -160,14 +166,25 @@ def test_the_rest_of_the_poses_wait_until_the_lanes_are_drawn(live_server, new_p
     page.goto(f"{live_server.url}/captures/{long_capture.pk}/")
     expect(page.get_by_test_id("viewport")).to_have_attribute("data-first-pose-ms", re.compile(r"^\d+$"))
     assert held
-    # Both chunks asked for at once have landed (5,000 of 72,000 frames); a request for the
-    # next would be sent as each landed, were the poses not held back. No more were sent.
-    expect(page.locator(".hud-loading-bar")).to_have_attribute("style", re.compile(r"width: 6\.9%"))
+    # The first pose's answer has landed (600 of 72,000 frames); the answer with the rest
+    # would be asked for as it landed, were the poses not held back. It was not.
+    expect(page.locator(".hud-loading-bar")).to_have_attribute("style", re.compile(r"width: 0\.8%"))
     page.wait_for_timeout(500)  # time for a request the page sent to reach this process
     assert page.get_by_test_id("frames-loading").get_attribute("data-done") is None
-    assert len([url for url in seen if "/frames/" in url]) == 2
+    assert len([url for url in seen if "/poses/" in url]) == 1
 
     held.pop().continue_()
     expect(page.get_by_test_id("timeline")).to_have_attribute("data-lanes-ms", re.compile(r"^\d+$"))
     expect(page.get_by_test_id("frames-loading")).to_have_attribute("data-done", re.compile(r"^\d+$"), timeout=30_000)
+    assert page.errors == []
+
+
+def test_the_previous_loader_asks_for_json_chunks_with_poses_json(live_server, new_page, long_capture):
+    page = new_page("ann")
+    seen = []
+    page.on("request", lambda request: seen.append(request.url))
+    page.goto(f"{live_server.url}/captures/{long_capture.pk}/?poses=json")
+    expect(page.get_by_test_id("frames-loading")).to_have_attribute("data-done", re.compile(r"^\d+$"), timeout=30_000)
+    assert not any("/poses/" in url for url in seen)
+    assert len([url for url in seen if "/frames/" in url]) == -(-N_FRAMES // 5000) + 1  # the first chunk in two
     assert page.errors == []

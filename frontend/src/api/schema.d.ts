@@ -250,6 +250,28 @@ export interface paths {
         patch?: never;
         trace?: never;
     };
+    "/api/captures/{id}/poses/": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /**
+         * @description Joint positions of frames start .. stop - 1 as one binary answer: little-endian
+         *     float32, shape (stop - start, n_joints, 3), frame after frame, streamed from the
+         *     stored array as it is read (no frame cap, nothing encoded). The range is in the
+         *     ``X-Poses-Start`` and ``X-Poses-Stop`` headers, the joints in ``X-Poses-Joints``.
+         */
+        get: operations["captures_poses_retrieve"];
+        put?: never;
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
     "/api/captures/{id}/redetect/": {
         parameters: {
             query?: never;
@@ -2892,6 +2914,32 @@ export interface operations {
                 };
                 content: {
                     "application/json": components["schemas"]["Frames"];
+                };
+            };
+        };
+    };
+    captures_poses_retrieve: {
+        parameters: {
+            query?: {
+                format?: "bin" | "json";
+                start?: number;
+                stop?: number;
+            };
+            header?: never;
+            path: {
+                /** @description A unique integer value identifying this capture. */
+                id: number;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/octet-stream": string;
                 };
             };
         };

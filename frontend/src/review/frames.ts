@@ -1,8 +1,11 @@
-// Joint positions for playback, fetched in chunks (the API serves at most 5,000 frames
-// per request, fewer for many joints, continuing from its "stop") into one Float32Array so a 72,000-frame take never builds JS objects
-// per frame. The chunk under the playhead comes first; the rest stream in after it.
+// Joint positions for playback, into one Float32Array so an hour-long take never builds JS
+// objects per frame. The poses come as raw little-endian float32 from /poses/: a small first
+// answer at the playhead (a pose on screen at once), then the rest as two streamed answers
+// (after the playhead, before it) whose bytes land in the array as they arrive. The JSON
+// /frames/ path (base64 chunks of at most 5,000 frames) stays for `?poses=json`, so a
+// benchmark can time both in the same run.
 
-import { get } from "../api/client";
+import { ApiError, errorText, get, isLoggedOut, retryDelay, toLogin } from "../api/client";
 import type { FramesResponse } from "../api/types";
 
 export const CHUNK = 5000;
@@ -89,6 +92,27 @@ export class FrameStore {
     return Number.isFinite(low) ? low : null;
   }
 
+  /**
+   * Bytes `offset ..` of a /poses/ answer for frames [start, ...) (little-endian float32,
+   * frame after frame): copied in place; each frame whose bytes are all in counts as
+   * loaded. A chunk may end inside a value; the next one carries on from there.
+   */
+  receive(start: number, offset: number, chunk: Uint8Array): void {
+    const frameBytes = this.nJoints * 12;
+    const at = start * frameBytes + offset;
+    if (at + chunk.length > this.positions.byteLength) {
+      throw new Error(`Poses from frame ${start}: ${offset + chunk.length} bytes run past frame ${this.nFrames}.`);
+    }
+    new Uint8Array(this.positions.buffer, this.positions.byteOffset).set(chunk, at);
+    if (frameBytes === 0) return;
+    const done = Math.floor((offset + chunk.length) / frameBytes);
+    for (let f = start + Math.floor(offset / frameBytes); f < start + done; f++) {
+      if (!LITTLE_ENDIAN) swapFrame(this.positions, f * this.nJoints * 3, this.nJoints * 3);
+      if (!this.loaded[f]) this.loadedFrames++;
+      this.loaded[f] = 1;
+    }
+  }
+
   put(response: FramesResponse): void {
     const values = decodeFloat32(response.data);
     const count = response.n_frames;
@@ -108,13 +132,119 @@ export class FrameStore {
   }
 }
 
+function swapFrame(values: Float32Array, first: number, count: number): void {
+  const view = new DataView(values.buffer, values.byteOffset);
+  for (let i = first; i < first + count; i++) view.setFloat32(i * 4, view.getFloat32(i * 4, true), false);
+}
+
 /**
- * Fill `store` chunk by chunk, two requests in flight (the server is small), calling
+ * The /poses/ ranges [start, stop) in the order they are asked for: `head` frames at
+ * `firstFrame` alone (a small first answer puts a pose on screen sooner), then the rest of
+ * the take after them, then the part before them.
+ */
+export function planPoses(nFrames: number, firstFrame = 0, head = HEAD): { start: number; stop: number }[] {
+  const from = Math.min(Math.max(firstFrame, 0), Math.max(nFrames - head, 0));
+  const headStop = Math.min(from + head, nFrames);
+  return [
+    { start: from, stop: headStop },
+    { start: headStop, stop: nFrames },
+    { start: 0, stop: from },
+  ].filter((r) => r.stop > r.start);
+}
+
+/** At most this often (ms) a streamed answer tells the page that more poses have landed. */
+export const PROGRESS_MS = 100;
+
+/** Whether the page was asked for the previous JSON frame chunks (`?poses=json`). */
+export function posesAsJson(search = typeof location === "undefined" ? "" : location.search): boolean {
+  return new URLSearchParams(search).get("poses") === "json";
+}
+
+/** GET a /poses/ range, asking again after a busy server's Retry-After as `api` does. */
+async function fetchPoses(url: string, signal?: AbortSignal): Promise<Response> {
+  const init: RequestInit = { headers: { Accept: "application/octet-stream, application/json" }, credentials: "same-origin", signal };
+  let response = await fetch(url, init);
+  for (let attempt = 0; ; attempt++) {
+    const wait = retryDelay("GET", response.status, response.headers.get("Retry-After"), attempt);
+    if (wait === null) break;
+    await new Promise((resolve) => setTimeout(resolve, wait));
+    response = await fetch(url, init);
+  }
+  if (!response.ok) {
+    const text = await response.text();
+    let body: unknown = text;
+    try {
+      body = JSON.parse(text);
+    } catch {
+      // Not JSON: the text is the message.
+    }
+    if (isLoggedOut(response.status, body) && typeof window !== "undefined") toLogin();
+    throw new ApiError(response.status, errorText(response.status, body), body);
+  }
+  return response;
+}
+
+/** Stream one /poses/ range into `store`, calling `progress` as frames land. */
+async function streamPoses(captureId: number, range: { start: number; stop: number }, store: FrameStore, progress: () => void, signal?: AbortSignal): Promise<void> {
+  const response = await fetchPoses(`/api/captures/${captureId}/poses/?start=${range.start}&stop=${range.stop}`, signal);
+  const joints = Number(response.headers.get("X-Poses-Joints"));
+  if (joints !== store.nJoints) throw new Error(`Poses ${range.start}–${range.stop}: expected ${store.nJoints} joints, got ${response.headers.get("X-Poses-Joints")}.`);
+  const expected = (range.stop - range.start) * store.nJoints * 12;
+  let offset = 0;
+  const take = (chunk: Uint8Array) => {
+    store.receive(range.start, offset, chunk);
+    offset += chunk.length;
+    progress();
+  };
+  if (response.body && typeof response.body.getReader === "function") {
+    const reader = response.body.getReader();
+    for (let part = await reader.read(); !part.done; part = await reader.read()) take(part.value);
+  } else {
+    take(new Uint8Array(await response.arrayBuffer()));
+  }
+  if (offset !== expected) throw new Error(`Poses ${range.start}–${range.stop}: expected ${expected} bytes, got ${offset}.`);
+}
+
+/**
+ * Fill `store` from /poses/: the head at `firstFrame` first (then `onChunk`), then, once
+ * `gate` lets them (the page holds the rest back while it fetches what it draws next), the
+ * rest of the take as two streamed answers at once, calling `onChunk` at most every
+ * PROGRESS_MS while they stream and once when all is in. A failure ends loading with its
+ * text in `store.error`.
+ */
+export async function loadFrames(captureId: number, store: FrameStore, firstFrame: number, onChunk: () => void, signal?: AbortSignal, gate: Promise<void> = Promise.resolve()): Promise<void> {
+  if (posesAsJson()) return loadFramesJson(captureId, store, firstFrame, onChunk, signal, gate);
+  const [head, ...rest] = planPoses(store.nFrames, firstFrame, HEAD);
+  let told = 0;
+  const progress = () => {
+    const now = Date.now();
+    if (now - told < PROGRESS_MS) return;
+    told = now;
+    onChunk();
+  };
+  try {
+    if (!head) return;
+    await streamPoses(captureId, head, store, () => {}, signal);
+    if (signal?.aborted) return;
+    onChunk();
+    await gate;
+    if (signal?.aborted) return;
+    await Promise.all(rest.map((range) => streamPoses(captureId, range, store, progress, signal)));
+    if (!signal?.aborted) onChunk();
+  } catch (err) {
+    if (signal?.aborted) return;
+    store.error = err instanceof Error ? err.message : String(err);
+    onChunk();
+  }
+}
+
+/**
+ * The previous loader (`?poses=json`): fill `store` chunk by chunk, two requests in flight (the server is small), calling
  * `onChunk` after each so the player and progress bar can update. After each chunk a
  * request waits for `gate`: the page holds the rest of the poses back while it fetches
  * what it draws next, so that request does not queue behind pose chunks.
  */
-export async function loadFrames(captureId: number, store: FrameStore, firstFrame: number, onChunk: () => void, signal?: AbortSignal, gate: Promise<void> = Promise.resolve()): Promise<void> {
+export async function loadFramesJson(captureId: number, store: FrameStore, firstFrame: number, onChunk: () => void, signal?: AbortSignal, gate: Promise<void> = Promise.resolve()): Promise<void> {
   const queue = planChunks(store.nFrames, firstFrame, CHUNK, HEAD);
   const worker = async () => {
     for (let range = queue.shift(); range && !signal?.aborted; range = queue.shift()) {
