@@ -4,7 +4,8 @@
 A review or gold version gives every segment, unlabelled ones too (CSV rows and ELAN
 annotations with an empty label, so that importing the file again gives back the same
 cuts); Label Studio regions need a label, so it gets the labelled ones. Library segments
-are labelled by definition.
+are labelled by definition. The CSV carries each segment's attribute values too, one
+``attribute:<name>`` column per attribute (as the library's manifest.csv does).
 """
 
 import io
@@ -14,6 +15,7 @@ from pathlib import PurePath
 
 import motionlib.io.annotations as fmt
 from segmentation.files.exports import ZIP_ENTRY_TIME, slug
+from segmentation.models import GoldAttributeValue, LibraryAttributeValue, SegmentAttributeValue
 
 FORMATS = {"csv": ("text/csv", "csv"), "eaf": ("application/xml", "eaf"),
            "labelstudio": ("application/json", "json")}
@@ -23,15 +25,28 @@ MAX_SEGMENTS = 100_000
 
 
 def review_track(review):
-    """The review's segments as a track named by its annotator."""
+    """The review's segments as a track named by its annotator, with their attributes."""
     capture = review.capture
-    spans = [fmt.Span(start, stop, label) for _, start, stop, label in review.segments()]
+    frames = dict(review.kept_frames())
+    values = {}
+    for row in (SegmentAttributeValue.objects.filter(review=review).select_related("attribute")
+                .order_by("attribute__position", "attribute_id")):
+        start = 0 if row.cut_id is None else frames.get(row.cut_id)
+        if start is not None:
+            values.setdefault(start, []).append((row.attribute.name, row.attribute.shown(row.value)))
+    spans = [fmt.Span(start, stop, label, attributes=tuple(values.get(start, ())))
+             for _, start, stop, label in review.segments()]
     return fmt.Track(capture.name, review.annotator.username, capture.fps, capture.n_frames, spans)
 
 
 def gold_track(gold):
     capture = gold.capture
-    spans = [fmt.Span(start, stop, label) for start, stop, label in gold.segments()]
+    values = {}
+    for row in (GoldAttributeValue.objects.filter(capture=capture).select_related("attribute")
+                .order_by("attribute__position", "attribute_id")):
+        values.setdefault(row.start, []).append((row.attribute.name, row.attribute.shown(row.value)))
+    spans = [fmt.Span(start, stop, label, attributes=tuple(values.get(start, ())))
+             for start, stop, label in gold.segments()]
     return fmt.Track(capture.name, GOLD, capture.fps, capture.n_frames, spans)
 
 
@@ -44,8 +59,14 @@ def library_tracks(segments):
     for (_, who), group in itertools.groupby(segments, key=lambda s: (s.capture_id, source(s))):
         group = list(group)
         capture = group[0].capture
+        values = {}
+        for row in (LibraryAttributeValue.objects.filter(segment__in=[s.pk for s in group])
+                    .select_related("attribute").order_by("attribute__position", "attribute_id")):
+            values.setdefault(row.segment_id, []).append(
+                (row.attribute.name, row.attribute.shown(row.value)))
         yield fmt.Track(capture.name, who, capture.fps, capture.n_frames,
-                        [fmt.Span(s.start, s.stop, s.label.name) for s in group])
+                        [fmt.Span(s.start, s.stop, s.label.name,
+                                  attributes=tuple(values.get(s.pk, ()))) for s in group])
 
 
 def take_stem(name):

@@ -2,6 +2,7 @@
 files re-import to the same segments, pympi-ling reads the ELAN ones, and each role
 exports only what it sees."""
 
+import csv
 import io
 import json
 import tempfile
@@ -70,6 +71,30 @@ class CaptureExportTest(LibraryTestCase):
         assert gold.status_code == 200 and b'TIER_ID="gold"' in gold.content
         self.login(self.charlie)
         assert self.export("csv").status_code == 404
+
+    def test_the_csv_carries_each_segments_attribute_values_and_imports_back(self):
+        """Issue 49, item 5: attributes travel in the CSV, one ``attribute:<name>`` column each
+        (a yes/no as true/false; empty where a segment has none); the ELAN and Label Studio
+        files keep only cuts and labels."""
+        from segmentation.models import SegmentAttributeValue
+        from segmentation.services import attributes
+
+        quality = attributes.do_add_attribute(self.project, "quality", "choice", ["good", "unusable"])
+        cleanup = attributes.do_add_attribute(self.project, "=needs cleanup", "boolean")
+        cut_200 = self.bob_review.cuts.get(frame=200)
+        SegmentAttributeValue.objects.create(review=self.bob_review, cut=None, attribute=quality, value="good")
+        SegmentAttributeValue.objects.create(review=self.bob_review, cut=cut_200, attribute=quality,
+                                             value="unusable")
+        SegmentAttributeValue.objects.create(review=self.bob_review, cut=cut_200, attribute=cleanup,
+                                             value="true")
+        self.login(self.bob)
+        text = self.export("csv").content.decode()
+        rows = list(csv.DictReader(io.StringIO(text)))
+        assert [(r["start_frame"], r["attribute:quality"], r["attribute:=needs cleanup"]) for r in rows] == [
+            ("0", "good", ""), ("100", "", ""), ("200", "unusable", "true")]
+        records = read_annotations(text.encode(), "c.csv", "csv", fps=120.0)
+        assert [(r.start, r.stop, r.label) for r in records] == [
+            (0, 100, "walk"), (100, 200, None), (200, 400, "punch")]
 
     def test_bad_export_requests_are_named(self):
         self.login(self.bob)

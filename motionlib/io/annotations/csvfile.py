@@ -132,14 +132,28 @@ def _record(row, layout, columns, fps, line):
 
 
 def write_annotations_csv(tracks: list[Track]) -> str:
-    """One row per span of every track, in the layout :func:`read_annotations_csv` reads."""
+    """One row per span of every track, in the layout :func:`read_annotations_csv` reads,
+    then one ``attribute:<name>`` column per segment attribute any span carries (a yes/no
+    as true/false; empty where a span has none). Reading ignores those columns."""
+    tracks = list(tracks)  # read twice: the attribute names, then the rows
+    names = list(dict.fromkeys(n for t in tracks for s in t.spans for n, _ in s.attributes))
     out = io.StringIO()
     writer = csv.writer(out, lineterminator="\n")
-    writer.writerow(COLUMNS)
+    writer.writerow(COLUMNS + [spreadsheet_safe(f"attribute:{n}") for n in names])
     for t in tracks:
         for s in t.spans:
+            values = dict(s.attributes)
             writer.writerow([spreadsheet_safe(t.take), spreadsheet_safe(t.source),
                              spreadsheet_safe(s.label or ""), s.start, s.stop,
                              seconds(s.start, t.fps), seconds(s.stop, t.fps),
-                             timecode(s.start, t.fps), timecode(s.stop, t.fps)])
+                             timecode(s.start, t.fps), timecode(s.stop, t.fps)]
+                            + [_attribute_cell(values.get(n)) for n in names])
     return out.getvalue()
+
+
+def _attribute_cell(value) -> str:
+    if value is None:
+        return ""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    return spreadsheet_safe(str(value))

@@ -41,6 +41,9 @@ class Span:
     stop: int
     label: str | None
     where: str = ""
+    #: ``(name, value)`` of the segment's attributes, in the project's order, for writing
+    #: (the CSV writer gives each name an ``attribute:<name>`` column; reading ignores them).
+    attributes: tuple[tuple[str, object], ...] = ()
 
 
 @dataclass(frozen=True)
