@@ -151,7 +151,7 @@ def _array(value, shape) -> np.ndarray | None:
         return None
     out = np.asarray(value, dtype=float)
     if out.shape != shape:
-        raise ValueError(f"counts of shape {out.shape}, expected {shape}")
+        raise InputError(f"counts of shape {out.shape}, expected {shape}")
     return out
 
 

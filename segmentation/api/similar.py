@@ -13,6 +13,7 @@ from segmentation.api.common.serializers.library import SegmentSerializer
 from segmentation.db.statements import Statement
 from segmentation.models import Capture, LibrarySegment
 from segmentation.models.library import STAFF, own
+from segmentation.services.attributes import shown_library_values
 from segmentation.similar import search
 from segmentation.similar.pools import Scope
 
@@ -56,13 +57,19 @@ class SimilarView(APIView):
                                  descriptor=descriptor, descriptor_shape=shape)
         segment.capture = Capture(pk=capture_id, skeleton=skeleton)
         # The role then decides which clips it may be compared with.
-        results = []
+        results, shown = [], []
         for s, d in search.similar(segment, Scope(user.pk, role), k=k):
             if isinstance(s, search.Shown):
                 results.append({**s.data, "distance": round(d, 4)})
+                shown.append(results[-1])
             else:
                 s.distance = round(d, 4)
                 results.append(SimilarSegmentSerializer(s).data)
+        # Rows shown from the index's columns get their attribute values in one query, as
+        # the serializer gives them to the others.
+        values = shown_library_values([row["id"] for row in shown]) if shown else {}
+        for row in shown:
+            row["attributes"] = values[row["id"]]
         return Response({"segment": pk, "results": results})
 
 

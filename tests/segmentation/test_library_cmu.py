@@ -121,7 +121,7 @@ class ExportTest(CmuLibraryTestCase):
             "file": "13_29_Squat_3805-4593.bvh", "format": "bvh", "segment": None, "capture": "13_29.bvh",
             "capture_id": self.capture.pk, "start": 3805, "stop": 4593, "frames": 788,
             "unit": "the capture's own (BVH numbers as in the original)", "label": "Squat",
-            "gold": False, "annotator": "bob", "agreement": None}
+            "gold": False, "annotator": "bob", "agreement": None, "attributes": {}}
         rows = list(csv.DictReader(io.StringIO(archive.read("manifest.csv").decode())))
         assert rows[0]["label"] == "Squat" and rows[0]["annotator"] == "bob"
         exported = self.read_back(archive.read("13_29_Squat_3805-4593.bvh"))
