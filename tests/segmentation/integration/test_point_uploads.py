@@ -6,7 +6,7 @@ from pathlib import Path
 import pytest
 
 from segmentation import services
-from segmentation.models import Capture
+from segmentation.models import Capture, LibrarySegment
 from tests.motionlib.points_data import HDM05, points_file
 from tests.segmentation.integration.conftest import wait_for
 from tests.segmentation.integration.test_pipeline import (
@@ -53,4 +53,7 @@ def test_a_worker_suggests_labels_for_a_take_of_points_of_no_known_set(running_w
     wait_for(lambda: settled(first) and settled(second), timeout=120, what="ingest and detection")
     bob_client = client_for(bob)
     label_all_and_submit(bob_client, first, "reach")
+    # A point take's library rows are built by a worker after the submit.
+    wait_for(lambda: LibrarySegment.objects.filter(capture_id=first).exists(), timeout=120,
+             what="the submitted review's library rows")
     assert suggested_labels(bob_client, second) == {"reach"}
