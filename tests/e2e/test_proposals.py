@@ -10,14 +10,12 @@ import re
 from django.core.files.uploadedfile import SimpleUploadedFile
 from playwright.sync_api import expect
 
-from motionlib import synth
-from segmentation import services, tasks
+from segmentation import tasks
 from segmentation.models import ProjectCutModel
 from tests.e2e.conftest import synthetic_bvh
 from tests.e2e.test_review_page import ReviewScreen
 from tests.segmentation.base import ingested
-
-SECONDS = 30.0
+from tests.segmentation.truth_reviews import SECONDS, review_to_the_truth
 
 
 def ingest(studio, seed):
@@ -25,28 +23,12 @@ def ingest(studio, seed):
     return ingested(studio["project"], studio["alice"], upload)
 
 
-def review_to_the_truth(studio, capture, user, seed):
-    """``user`` cuts at the take's true boundaries, labels every segment with its true
-    action and submits (the set-up: earlier takes of the project)."""
-    _take, segments = synth.generate(seed=seed, fps=120.0, duration=SECONDS)
-    for _, _, action in segments:
-        if not studio["project"].labels.filter(name=action).exists():
-            services.do_add_label(studio["project"], action)
-    review = services.get_or_create_review(capture, user)
-    for cut in list(review.cuts.all()):
-        services.do_change_cut(review, user, cut, review.version, fate="deleted")
-    for start, _stop, _label in segments[1:]:
-        services.do_insert_cut(review, user, start, review.version)
-    for index, (_, _, action) in enumerate(segments):
-        services.do_label_segment(review, user, index, action, review.version)
-    services.do_submit_review(review, user, review.version)
-
 
 def trained_take(studio):
     """bob reviews two takes; the project trains (the worker's job, run here); a third
     take is detected with the model and its run carries proposals."""
     for seed in (92, 93):
-        review_to_the_truth(studio, ingest(studio, seed), studio["bob"], seed)
+        review_to_the_truth(studio["project"], ingest(studio, seed), studio["bob"], seed)
     job = ProjectCutModel.objects.get(project=studio["project"], status="queued")
     tasks.retrain(job.pk)
     assert ProjectCutModel.objects.get(pk=job.pk).labels_model

@@ -9,6 +9,7 @@ from segmentation.models import LabelSuggestion
 from segmentation.services.gold import do_save_gold
 from segmentation.similar import proposals
 from tests.segmentation.test_adaptation_detect import SECONDS, ReviewedTakesTestCase
+from tests.segmentation.truth_reviews import review_to_the_truth
 
 TRUE = set(synth.ACTIONS)
 
@@ -25,22 +26,9 @@ class ProposalsBase(ReviewedTakesTestCase):
         services.do_set_member(cls.project, "dora", "annotator")
 
     def review(self, capture, user, seed, name=lambda action: action):
-        """``user`` cuts ``capture`` at its true boundaries, labels each segment
-        ``name(true action)`` and submits (the submit's jobs run here)."""
-        _take, segments = synth.generate(seed=seed, fps=120.0, duration=SECONDS)
-        for _, _, action in segments:
-            if not self.project.labels.filter(name=name(action)).exists():
-                services.do_add_label(self.project, name(action))
-        review = services.get_or_create_review(capture, user)
-        for cut in list(review.cuts.all()):
-            services.do_change_cut(review, user, cut, review.version, fate="deleted")
-        for start, _stop, _label in segments[1:]:
-            services.do_insert_cut(review, user, start, review.version)
-        for index, (_, _, action) in enumerate(segments):
-            services.do_label_segment(review, user, index, name(action), review.version)
+        """``review_to_the_truth``, the submit's jobs run here."""
         with self.captureOnCommitCallbacks(execute=True):
-            services.do_submit_review(review, user, review.version)
-        return segments
+            return review_to_the_truth(self.project, capture, user, seed, name)
 
     def bobs(self, action):
         return f"bob {action}"

@@ -12,10 +12,9 @@ from segmentation.models import Capture
 from tests.segmentation.base import synthetic_bvh
 from tests.segmentation.integration.conftest import wait_for
 from tests.segmentation.integration.test_pipeline import settled, upload
+from tests.segmentation.truth_reviews import SECONDS, review_to_the_truth
 
 pytestmark = pytest.mark.integration
-
-SECONDS = 30.0
 
 
 def client_for(user):
@@ -23,20 +22,6 @@ def client_for(user):
     client.force_authenticate(user)
     return client
 
-
-def review_to_the_truth(project, capture, user, seed):
-    _take, segments = synth.generate(seed=seed, fps=120.0, duration=SECONDS)
-    for _, _, action in segments:
-        if not project.labels.filter(name=action).exists():
-            services.do_add_label(project, action)
-    review = services.get_or_create_review(capture, user)
-    for cut in list(review.cuts.all()):
-        services.do_change_cut(review, user, cut, review.version, fate="deleted")
-    for start, _stop, _label in segments[1:]:
-        services.do_insert_cut(review, user, start, review.version)
-    for index, (_, _, action) in enumerate(segments):
-        services.do_label_segment(review, user, index, action, review.version)
-    services.do_submit_review(review, user, review.version)
 
 
 def offered(client, capture):
