@@ -106,3 +106,29 @@ export function toLogin(): void {
 export const get = <T>(url: string) => api<T>("GET", url);
 export const post = <T>(url: string, body?: unknown) => api<T>("POST", url, body ?? {});
 export const patch = <T>(url: string, body: unknown) => api<T>("PATCH", url, body);
+
+/** POST a multipart form with upload progress (0..1), which fetch cannot report; resolves
+ * with the parsed answer, fails with the server's message, or with `interrupted` when the
+ * connection breaks. */
+export function postWithProgress<T>(url: string, form: FormData, onProgress: (share: number) => void, interrupted: string): Promise<T> {
+  return new Promise((resolve, reject) => {
+    const xhr = new XMLHttpRequest();
+    xhr.open("POST", url);
+    const token = readCookie(document.cookie, "csrftoken");
+    if (token) xhr.setRequestHeader("X-CSRFToken", token);
+    xhr.setRequestHeader("Accept", "application/json");
+    xhr.upload.onprogress = (e) => e.lengthComputable && onProgress(e.loaded / e.total);
+    xhr.onload = () => {
+      let body: unknown = xhr.responseText;
+      try {
+        body = JSON.parse(xhr.responseText);
+      } catch {
+        // keep the text
+      }
+      if (xhr.status >= 200 && xhr.status < 300) resolve(body as T);
+      else reject(new Error(errorText(xhr.status, body)));
+    };
+    xhr.onerror = () => reject(new Error(interrupted));
+    xhr.send(form);
+  });
+}

@@ -1,6 +1,6 @@
 // Uploads with progress. fetch() cannot report upload progress, so this uses XHR.
 
-import { errorText, readCookie } from "../api/client";
+import { postWithProgress } from "../api/client";
 import type { Uploaded } from "../api/types";
 
 export interface UploadItem {
@@ -41,28 +41,9 @@ export function pairFiles(files: File[]): { items: UploadItem[]; problems: strin
 }
 
 export function upload(item: UploadItem, project: number, onProgress: (share: number) => void): Promise<Uploaded> {
-  return new Promise((resolve, reject) => {
-    const form = new FormData();
-    form.append("file", item.file);
-    if (item.asf) form.append("asf", item.asf);
-    form.append("project", String(project));
-    const xhr = new XMLHttpRequest();
-    xhr.open("POST", "/api/captures/");
-    const token = readCookie(document.cookie, "csrftoken");
-    if (token) xhr.setRequestHeader("X-CSRFToken", token);
-    xhr.setRequestHeader("Accept", "application/json");
-    xhr.upload.onprogress = (e) => e.lengthComputable && onProgress(e.loaded / e.total);
-    xhr.onload = () => {
-      let body: unknown = xhr.responseText;
-      try {
-        body = JSON.parse(xhr.responseText);
-      } catch {
-        // keep the text
-      }
-      if (xhr.status >= 200 && xhr.status < 300) resolve(body as Uploaded);
-      else reject(new Error(errorText(xhr.status, body)));
-    };
-    xhr.onerror = () => reject(new Error("The upload was interrupted (network error)."));
-    xhr.send(form);
-  });
+  const form = new FormData();
+  form.append("file", item.file);
+  if (item.asf) form.append("asf", item.asf);
+  form.append("project", String(project));
+  return postWithProgress("/api/captures/", form, onProgress, "The upload was interrupted (network error).");
 }

@@ -1,6 +1,6 @@
 // The reference-video API of a capture (docs/api.md, "Reference videos").
 
-import { api, errorText, get, patch, readCookie } from "../api/client";
+import { api, get, patch, postWithProgress } from "../api/client";
 import type { components } from "../api/schema";
 
 export type Video = components["schemas"]["Video"];
@@ -17,28 +17,9 @@ export const removeVideo = (captureId: number, videoId: number) => api<null>("DE
 
 /** Upload one file with progress (0..1); the promise fails with the server's message. */
 export function uploadVideo(captureId: number, file: File, onProgress: (share: number) => void): Promise<Video & { duplicate: boolean }> {
-  return new Promise((resolve, reject) => {
-    const form = new FormData();
-    form.append("file", file);
-    const xhr = new XMLHttpRequest();
-    xhr.open("POST", base(captureId));
-    const token = readCookie(document.cookie, "csrftoken");
-    if (token) xhr.setRequestHeader("X-CSRFToken", token);
-    xhr.setRequestHeader("Accept", "application/json");
-    xhr.upload.onprogress = (e) => e.lengthComputable && onProgress(e.loaded / e.total);
-    xhr.onload = () => {
-      let body: unknown = xhr.responseText;
-      try {
-        body = JSON.parse(xhr.responseText);
-      } catch {
-        // keep the text
-      }
-      if (xhr.status >= 200 && xhr.status < 300) resolve(body as Video & { duplicate: boolean });
-      else reject(new Error(errorText(xhr.status, body)));
-    };
-    xhr.onerror = () => reject(new Error(`${file.name}: the upload was interrupted (network error).`));
-    xhr.send(form);
-  });
+  const form = new FormData();
+  form.append("file", file);
+  return postWithProgress(base(captureId), form, onProgress, `${file.name}: the upload was interrupted (network error).`);
 }
 
 /** A refusal made before sending: a file larger than the server takes. */
